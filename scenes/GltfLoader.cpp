@@ -1,0 +1,895 @@
+// GltfLoader: loadGltf() turns a glTF 2.0 file into a Scene, through tinygltf. A file that starts
+// with the GLB magic is read as binary glTF, any other as JSON text (a .glb without it is an
+// error).
+//
+// What is read: the node hierarchy of the default scene (else scene 0, else every root node)
+// with matrix or TRS transforms; every TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive
+// becomes one Mesh (one per primitive, stored once however many nodes use it, one Instance per
+// node that uses it); POSITION, NORMAL, TANGENT, TEXCOORD_0 and indices; the first perspective
+// camera met in the walk; KHR_lights_punctual lights; pbrMetallicRoughness materials mapped onto
+// Blinn-Phong (see materialFor).
+// What is not: animations, skins and morph targets (the bind pose is drawn), sparse accessors
+// (an error), texture coordinate sets other than 0, samplers (Texture always wraps), and the
+// metallic-roughness, occlusion and emissive textures, for which Material has no slot (their
+// factors apply). Points and lines are skipped with a warning.
+//
+// Conventions: glTF's own, which are Scene's (right-handed, metres, +Y up, cameras look down
+// -Z, counter-clockwise front faces); matrices are column-major like glm.
+// Robustness: tinygltf parses the JSON and reads buffers and images but does not check that
+// accessors fit their buffers, that indices fit the vertices, or that the node graph is a tree;
+// this file checks all of it before reading, so a malformed file gives one SceneError naming the
+// file, never a crash or a hang. An image that cannot be read is not an error: it gives one
+// warning naming it (Scene::warnings and stderr) and materials fall back to their factors.
+// Thread safety: each call owns its tinygltf instance; calls may run concurrently.
+#include "scenes/SceneLoader.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <set>
+#include <system_error>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <tiny_gltf.h>
+
+namespace scenes {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+static_assert(std::endian::native == std::endian::little,
+              "glTF buffers are little-endian and are read with memcpy");
+
+// Deeper node hierarchies are treated as malformed: real files nest a few dozen levels (deep
+// skeletons a few hundred), and the bound keeps the recursive walk's stack small (~200 B/level).
+constexpr int kMaxNodeDepth = 1024;
+// glTF's infinite far plane (zfar absent) becomes at least this multiple of znear: depth is
+// stored with finite precision downstream, and 1e4 keeps a 24-bit standard-Z buffer usable.
+constexpr float kInfiniteFarOverNear = 1e4f;
+// Blinn-Phong exponent limits: 1 is the broadest lobe that is still a lobe; beyond 2048 the
+// highlight is narrower than a texel of any texture we load.
+constexpr float kMinSpecularPower = 1.0f;
+constexpr float kMaxSpecularPower = 2048.0f;
+// roughness^4 below this is a perfect mirror for our purposes; it also avoids dividing by zero.
+constexpr float kMinRoughness4 = 1e-4f;
+// Markers in GltfConverter::mMeshOf for primitives not (yet) turned into a Mesh.
+constexpr int kNotConverted = -1;
+constexpr int kSkipped = -2;
+
+[[noreturn]] void fail(const fs::path& path, const std::string& what) {
+    throw SceneError(path.string() + ": " + what);
+}
+
+std::string str(size_t value) {
+    return std::to_string(value);
+}
+
+// tinygltf's messages end lines with '\n'; a SceneError is one line.
+std::string oneLine(const std::string& text) {
+    std::string line;
+    for (char c : text) {
+        if (c != '\n')
+            line += c;
+        else if (!line.empty() && line.back() != ' ')
+            line += "; ";
+    }
+    while (!line.empty() && (line.back() == ' ' || line.back() == ';'))
+        line.pop_back();
+    return line;
+}
+
+std::vector<unsigned char> readFile(const fs::path& path) {
+    std::error_code error;
+    if (!fs::exists(path, error))
+        fail(path, "file not found");
+    if (!fs::is_regular_file(path, error))
+        fail(path, "not a regular file");
+    const uintmax_t size = fs::file_size(path, error);
+    if (error)
+        fail(path, "cannot read the size: " + error.message());
+    // tinygltf takes the size as unsigned int.
+    if (size > std::numeric_limits<unsigned int>::max())
+        fail(path, "larger than 4 GiB");
+    std::vector<unsigned char> bytes(size);
+    std::ifstream in(path, std::ios::binary);
+    if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
+        fail(path, "cannot be read");
+    return bytes;
+}
+
+bool isGlb(const std::vector<unsigned char>& bytes) {
+    return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+}
+
+// tinygltf 2.7 checks the BIN chunk's length without counting its 8-byte header, so a truncated
+// GLB can make it read past the end of the file; the layout is checked here first.
+void checkGlbLayout(const fs::path& path, const std::vector<unsigned char>& bytes) {
+    auto word = [&](size_t offset) {
+        uint32_t value;
+        std::memcpy(&value, bytes.data() + offset, 4);
+        return value;
+    };
+    constexpr uint32_t kJsonChunk = 0x4E4F534A; // "JSON"
+    if (bytes.size() < 20)
+        fail(path, "GLB file shorter than its 20-byte header");
+    if (word(4) != 2)
+        fail(path, "GLB version " + str(word(4)) + " (expected 2)");
+    if (word(8) != bytes.size())
+        fail(path, "GLB header gives a length of " + str(word(8)) + " bytes, the file has " +
+                       str(bytes.size()));
+    if (word(16) != kJsonChunk)
+        fail(path, "the first GLB chunk is not JSON");
+    const uint64_t jsonEnd = 20 + uint64_t(word(12));
+    if (jsonEnd > bytes.size())
+        fail(path, "the GLB JSON chunk runs past the end of the file");
+    if (jsonEnd == bytes.size())
+        return; // no BIN chunk
+    if (jsonEnd + 8 > bytes.size())
+        fail(path, "truncated GLB chunk header after the JSON chunk");
+    if (jsonEnd + 8 + word(size_t(jsonEnd)) > bytes.size())
+        fail(path, "the GLB BIN chunk runs past the end of the file");
+}
+
+// tinygltf calls this for every image it could read from a file or data URI. Decoding failures
+// are recorded instead of failing the whole load: an undecodable texture is only a warning.
+bool decodeImage(tinygltf::Image* image, int imageIndex, std::string*, std::string*, int width,
+                 int height, const unsigned char* bytes, int size, void* undecodable) {
+    // Images stored in bufferViews reach here before anything checked that the bufferView lies
+    // inside its buffer; GltfConverter::readImages decodes them once it has.
+    if (image->bufferView >= 0)
+        return true;
+    std::string error;
+    if (!tinygltf::LoadImageData(image, imageIndex, &error, nullptr, width, height, bytes, size,
+                                 nullptr))
+        static_cast<std::set<int>*>(undecodable)->insert(imageIndex);
+    return true;
+}
+
+// tinygltf looks for external files beside the model and then in the working directory; the
+// latter would silently pick up an unrelated file of the same name, so it is refused. Paths
+// searched in the working directory are the ones tinygltf builds as "./" + uri.
+bool fileExistsBesideModel(const std::string& path, void*) {
+    return path.rfind("./", 0) != 0 && tinygltf::FileExists(path, nullptr);
+}
+
+tinygltf::Model parseModel(const fs::path& path, std::set<int>& undecodableImages) {
+    std::vector<unsigned char> bytes = readFile(path);
+    tinygltf::TinyGLTF parser;
+    parser.SetImageLoader(decodeImage, &undecodableImages);
+    parser.SetFsCallbacks({fileExistsBesideModel, tinygltf::ExpandFilePath, tinygltf::ReadWholeFile,
+                           tinygltf::WriteWholeFile, nullptr});
+    // tinygltf wants an absolute base directory; its warnings are all about images, which
+    // GltfConverter::readImages reports in its own words, so they are not kept.
+    const std::string baseDir = fs::absolute(path).parent_path().string();
+    tinygltf::Model model;
+    std::string error, ignoredWarnings;
+    bool loaded;
+    if (isGlb(bytes)) {
+        checkGlbLayout(path, bytes);
+        loaded = parser.LoadBinaryFromMemory(&model, &error, &ignoredWarnings, bytes.data(),
+                                             unsigned(bytes.size()), baseDir);
+    } else {
+        if (path.extension() == ".glb")
+            fail(path, "not a GLB file (it does not start with 'glTF')");
+        loaded = parser.LoadASCIIFromString(&model, &error, &ignoredWarnings,
+                                            reinterpret_cast<const char*>(bytes.data()),
+                                            unsigned(bytes.size()), baseDir);
+    }
+    if (!loaded)
+        fail(path, error.empty() ? "tinygltf cannot parse the file" : oneLine(error));
+    return model;
+}
+
+const char* modeName(int mode) {
+    switch (mode) {
+    case TINYGLTF_MODE_POINTS:
+        return "POINTS";
+    case TINYGLTF_MODE_LINE:
+        return "LINES";
+    case TINYGLTF_MODE_LINE_LOOP:
+        return "LINE_LOOP";
+    case TINYGLTF_MODE_LINE_STRIP:
+        return "LINE_STRIP";
+    default:
+        return "unknown";
+    }
+}
+
+// Cross products have length twice the triangle's area, so summing them weights by area.
+std::vector<glm::vec3> areaWeightedNormals(const Mesh& mesh) {
+    std::vector<glm::vec3> normals(mesh.positions.size(), glm::vec3(0.0f));
+    for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+        const uint32_t a = mesh.indices[i], b = mesh.indices[i + 1], c = mesh.indices[i + 2];
+        const glm::vec3 faceNormal = glm::cross(mesh.positions[b] - mesh.positions[a],
+                                                mesh.positions[c] - mesh.positions[a]);
+        normals[a] += faceNormal;
+        normals[b] += faceNormal;
+        normals[c] += faceNormal;
+    }
+    for (glm::vec3& normal : normals) {
+        // A vertex only on zero-area triangles (or on none) is never drawn: any unit vector does.
+        const float length = glm::length(normal);
+        normal = length > 0.0f ? normal / length : glm::vec3(0.0f, 0.0f, 1.0f);
+    }
+    return normals;
+}
+
+// The glTF specification's rules for strips and fans keep every triangle counter-clockwise.
+std::vector<uint32_t> triangleList(int mode, std::vector<uint32_t> v) {
+    if (mode == TINYGLTF_MODE_TRIANGLES)
+        return v;
+    std::vector<uint32_t> list;
+    for (size_t i = 0; i + 2 < v.size(); ++i) {
+        if (mode == TINYGLTF_MODE_TRIANGLE_STRIP)
+            list.insert(list.end(), {v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]});
+        else
+            list.insert(list.end(), {v[i + 1], v[i + 2], v[0]});
+    }
+    return list;
+}
+
+// Where an accessor's elements lie, once checked to be inside their bufferView and buffer.
+struct AccessorData {
+    const unsigned char* first = nullptr;
+    size_t strideBytes = 0;
+    size_t count = 0;
+};
+
+class GltfConverter {
+public:
+    GltfConverter(fs::path path, tinygltf::Model model, std::set<int> undecodableImages)
+        : mPath(std::move(path)), mModel(std::move(model)),
+          mUndecodableImages(std::move(undecodableImages)) {}
+
+    Scene convert();
+
+private:
+    [[noreturn]] void fail(const std::string& what) const { scenes::fail(mPath, what); }
+    void warn(const std::string& what);
+
+    void checkExtensions() const;
+    void readImages();
+    std::vector<int> parentOfEachNode() const;
+    std::vector<int> rootNodes(const std::vector<int>& parentOf) const;
+    void visitNode(int nodeIndex, const glm::mat4& worldFromParent, int depth);
+    glm::mat4 parentFromNode(int nodeIndex) const;
+    void considerCamera(int cameraIndex, const glm::mat4& worldFromCamera);
+    void addCamera();
+    void addLights();
+
+    int meshFor(int meshIndex, size_t primitiveIndex);
+    Mesh convertPrimitive(int meshIndex, size_t primitiveIndex);
+    uint32_t materialFor(int materialIndex);
+    int textureFor(int textureIndex, bool srgb);
+
+    const tinygltf::Accessor& accessorAt(int accessorIndex, const std::string& what) const;
+    AccessorData accessorData(const tinygltf::Accessor& accessor, const std::string& where) const;
+    template <int N>
+    std::vector<glm::vec<N, float>> readVectors(int accessorIndex, const std::string& what,
+                                                bool allowNormalizedIntegers = false) const;
+    std::vector<uint32_t> readIndices(int accessorIndex, const std::string& what,
+                                      size_t vertexCount) const;
+
+    fs::path mPath;
+    tinygltf::Model mModel;
+    std::set<int> mUndecodableImages;
+    Scene mScene;
+    std::set<std::string> mWarned;
+    std::vector<bool> mOnPath;             // per node: on the path from the root being walked
+    std::vector<std::vector<int>> mMeshOf; // [mesh][primitive] -> Scene::meshes index or marker
+    std::vector<int> mMaterialOf;          // per glTF material -> Scene::materials, -1 = not yet
+    int mDefaultMaterial = -1;             // Scene::materials index of the default, -1 = none
+    std::map<std::pair<int, bool>, int> mTextureOf; // (image, srgb) -> Scene::textures index
+    std::optional<std::pair<int, glm::mat4>> mPlacedCamera; // (camera, worldFromCamera)
+    std::vector<std::pair<int, glm::mat4>> mPlacedLights;   // (KHR light, worldFromLight)
+};
+
+void GltfConverter::warn(const std::string& what) {
+    const std::string warning = mPath.string() + ": " + what;
+    if (!mWarned.insert(warning).second)
+        return;
+    std::cerr << "warning: " << warning << '\n';
+    mScene.warnings.push_back(warning);
+}
+
+Scene GltfConverter::convert() {
+    mScene.name = mPath.stem().string();
+    checkExtensions();
+    readImages();
+    mOnPath.assign(mModel.nodes.size(), false);
+    mMeshOf.resize(mModel.meshes.size());
+    for (size_t m = 0; m < mModel.meshes.size(); ++m)
+        mMeshOf[m].assign(mModel.meshes[m].primitives.size(), kNotConverted);
+    mMaterialOf.assign(mModel.materials.size(), -1);
+
+    for (int root : rootNodes(parentOfEachNode()))
+        visitNode(root, glm::mat4(1.0f), 0);
+    if (mScene.triangleCount() == 0)
+        fail("the scene has no triangles to draw");
+
+    addLights();
+    if (mPlacedCamera)
+        addCamera();
+    else
+        mScene.cameras.push_back(cameraFramingBounds(mScene.boundsWorld()));
+    try {
+        validate(mScene);
+    } catch (const SceneError& error) {
+        fail(error.what());
+    }
+    return std::move(mScene);
+}
+
+// A required extension we do not implement would be silently misdrawn (e.g. compressed
+// geometry that has no plain accessors), so it is an error.
+void GltfConverter::checkExtensions() const {
+    for (const std::string& extension : mModel.extensionsRequired)
+        if (extension != "KHR_lights_punctual")
+            fail("requires the unsupported extension " + extension);
+}
+
+// Images tinygltf could not read (missing file, undecodable data) get one warning each, whether
+// or not a material slot we map uses them: the user should know the file is incomplete.
+void GltfConverter::readImages() {
+    for (size_t i = 0; i < mModel.images.size(); ++i) {
+        tinygltf::Image& image = mModel.images[i];
+        const std::string label = !image.uri.empty() ? image.uri : image.name;
+        const std::string name = "image " + str(i) + (label.empty() ? "" : " '" + label + "'");
+        std::string problem;
+        if (image.bufferView >= 0) {
+            if (size_t(image.bufferView) >= mModel.bufferViews.size())
+                fail(name + ": bufferView " + std::to_string(image.bufferView) + " out of range");
+            const tinygltf::BufferView& view = mModel.bufferViews[size_t(image.bufferView)];
+            if (view.buffer < 0 || size_t(view.buffer) >= mModel.buffers.size())
+                fail(name + ": buffer " + std::to_string(view.buffer) + " out of range");
+            const std::vector<unsigned char>& data = mModel.buffers[size_t(view.buffer)].data;
+            if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset ||
+                view.byteLength > size_t(std::numeric_limits<int>::max()))
+                fail(name + ": bufferView " + std::to_string(image.bufferView) +
+                     " runs past the end of its buffer");
+            std::string error;
+            if (view.byteLength == 0 || !tinygltf::LoadImageData(&image, int(i), &error, nullptr, 0,
+                                                                 0, data.data() + view.byteOffset,
+                                                                 int(view.byteLength), nullptr))
+                problem = "could not be decoded";
+        } else if (mUndecodableImages.count(int(i))) {
+            problem = "could not be decoded";
+        } else if (image.image.empty()) {
+            std::error_code error;
+            problem = fs::exists(mPath.parent_path() / image.uri, error) ? "could not be read"
+                                                                         : "file not found";
+        }
+        const bool layoutKnown = image.width > 0 && image.height > 0 && image.component >= 1 &&
+                                 image.component <= 4 && (image.bits == 8 || image.bits == 16);
+        if (problem.empty() &&
+            (!layoutKnown || image.image.size() != size_t(image.width) * size_t(image.height) *
+                                                       size_t(image.component) *
+                                                       size_t(image.bits / 8)))
+            problem = "has an unsupported pixel layout";
+        if (!problem.empty()) {
+            image.image.clear();
+            warn(name + " " + problem + "; materials using it fall back to their factors");
+        }
+    }
+}
+
+// Every node has at most one parent (glTF nodes form strict trees). Checking it up front also
+// bounds the walk: a node shared by two parents at every level would be visited 2^depth times.
+std::vector<int> GltfConverter::parentOfEachNode() const {
+    std::vector<int> parentOf(mModel.nodes.size(), -1);
+    for (size_t n = 0; n < mModel.nodes.size(); ++n) {
+        for (int child : mModel.nodes[n].children) {
+            if (child < 0 || size_t(child) >= mModel.nodes.size())
+                fail("node " + str(n) + ": child " + std::to_string(child) + " out of range");
+            if (parentOf[size_t(child)] >= 0)
+                fail("node " + str(size_t(child)) + " is a child of more than one node (nodes " +
+                     str(size_t(parentOf[size_t(child)])) + " and " + str(n) + ")");
+            parentOf[size_t(child)] = int(n);
+        }
+    }
+    return parentOf;
+}
+
+std::vector<int> GltfConverter::rootNodes(const std::vector<int>& parentOf) const {
+    int sceneIndex = mModel.defaultScene;
+    if (sceneIndex < 0 && !mModel.scenes.empty())
+        sceneIndex = 0;
+    if (sceneIndex >= int(mModel.scenes.size()))
+        fail("default scene " + std::to_string(sceneIndex) + " out of range");
+    if (sceneIndex >= 0)
+        return mModel.scenes[size_t(sceneIndex)].nodes;
+    std::vector<int> roots;
+    for (size_t n = 0; n < parentOf.size(); ++n)
+        if (parentOf[n] < 0)
+            roots.push_back(int(n));
+    return roots;
+}
+
+void GltfConverter::visitNode(int nodeIndex, const glm::mat4& worldFromParent, int depth) {
+    if (nodeIndex < 0 || size_t(nodeIndex) >= mModel.nodes.size())
+        fail("scene node " + std::to_string(nodeIndex) + " out of range");
+    if (mOnPath[size_t(nodeIndex)])
+        fail("node " + std::to_string(nodeIndex) + " is its own ancestor (cyclic node graph)");
+    if (depth > kMaxNodeDepth)
+        fail("node hierarchy deeper than " + std::to_string(kMaxNodeDepth) + " levels");
+    mOnPath[size_t(nodeIndex)] = true;
+
+    const tinygltf::Node& node = mModel.nodes[size_t(nodeIndex)];
+    const glm::mat4 worldFromNode = worldFromParent * parentFromNode(nodeIndex);
+    if (node.mesh >= int(mModel.meshes.size()))
+        fail("node " + std::to_string(nodeIndex) + ": mesh " + std::to_string(node.mesh) +
+             " out of range");
+    if (node.mesh >= 0) {
+        for (size_t p = 0; p < mModel.meshes[size_t(node.mesh)].primitives.size(); ++p) {
+            const int mesh = meshFor(node.mesh, p);
+            if (mesh >= 0)
+                mScene.instances.push_back({uint32_t(mesh), worldFromNode});
+        }
+    }
+    if (node.camera >= int(mModel.cameras.size()))
+        fail("node " + std::to_string(nodeIndex) + ": camera " + std::to_string(node.camera) +
+             " out of range");
+    if (node.camera >= 0)
+        considerCamera(node.camera, worldFromNode);
+
+    const auto lightExtension = node.extensions.find("KHR_lights_punctual");
+    if (lightExtension != node.extensions.end()) {
+        const tinygltf::Value& value = lightExtension->second;
+        if (!value.IsObject() || !value.Get("light").IsInt())
+            fail("node " + std::to_string(nodeIndex) + ": KHR_lights_punctual needs a light index");
+        mPlacedLights.emplace_back(value.Get("light").Get<int>(), worldFromNode);
+    }
+
+    for (int child : node.children)
+        visitNode(child, worldFromNode, depth + 1);
+    mOnPath[size_t(nodeIndex)] = false;
+}
+
+glm::mat4 GltfConverter::parentFromNode(int nodeIndex) const {
+    const tinygltf::Node& node = mModel.nodes[size_t(nodeIndex)];
+    const std::string where = "node " + std::to_string(nodeIndex);
+    auto finite = [](const std::vector<double>& values) {
+        return std::all_of(values.begin(), values.end(), [](double x) { return std::isfinite(x); });
+    };
+    if (!finite(node.matrix) || !finite(node.translation) || !finite(node.rotation) ||
+        !finite(node.scale))
+        fail(where + ": transform is not finite");
+    if (!node.matrix.empty()) {
+        if (node.matrix.size() != 16)
+            fail(where + ": matrix needs 16 numbers");
+        glm::dmat4 matrix;
+        std::copy(node.matrix.begin(), node.matrix.end(), glm::value_ptr(matrix));
+        return glm::mat4(matrix);
+    }
+    glm::mat4 transform(1.0f);
+    if (!node.translation.empty()) {
+        if (node.translation.size() != 3)
+            fail(where + ": translation needs 3 numbers");
+        transform = glm::translate(
+            transform, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
+    }
+    if (!node.rotation.empty()) {
+        if (node.rotation.size() != 4)
+            fail(where + ": rotation needs 4 numbers");
+        // glTF stores quaternions as (x, y, z, w); glm's constructor takes w first. Exporters
+        // write them to a few digits, so they are renormalised rather than required to be unit.
+        const glm::quat rotation(float(node.rotation[3]), float(node.rotation[0]),
+                                 float(node.rotation[1]), float(node.rotation[2]));
+        if (!(glm::length(rotation) > 0.0f))
+            fail(where + ": rotation is a zero quaternion");
+        transform *= glm::mat4_cast(glm::normalize(rotation));
+    }
+    if (!node.scale.empty()) {
+        if (node.scale.size() != 3)
+            fail(where + ": scale needs 3 numbers");
+        transform = glm::scale(transform, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+    }
+    return transform;
+}
+
+// The first perspective camera met in the walk is the one used. It is placed after the walk,
+// when the bounds that an infinite far plane must reach are known.
+void GltfConverter::considerCamera(int cameraIndex, const glm::mat4& worldFromCamera) {
+    const tinygltf::Camera& source = mModel.cameras[size_t(cameraIndex)];
+    if (source.type != "perspective")
+        warn("camera " + std::to_string(cameraIndex) + " is " + source.type +
+             "; only perspective cameras are used");
+    else if (!mPlacedCamera)
+        mPlacedCamera.emplace(cameraIndex, worldFromCamera);
+}
+
+void GltfConverter::addCamera() {
+    const auto& [cameraIndex, worldFromCamera] = *mPlacedCamera;
+    const tinygltf::Camera& source = mModel.cameras[size_t(cameraIndex)];
+    const tinygltf::PerspectiveCamera& lens = source.perspective;
+    Camera camera;
+    camera.name = source.name.empty() ? "camera " + std::to_string(cameraIndex) : source.name;
+    const glm::mat3 linear(worldFromCamera);
+    camera.positionWorld = glm::vec3(worldFromCamera[3]);
+    camera.forwardWorld = glm::normalize(linear * glm::vec3(0.0f, 0.0f, -1.0f));
+    camera.upWorld = glm::normalize(linear * glm::vec3(0.0f, 1.0f, 0.0f));
+    camera.verticalFovRadians = float(lens.yfov);
+    camera.nearMetres = float(lens.znear);
+    // zfar absent (0) means infinite; see kInfiniteFarOverNear. The far plane also reaches past
+    // the farthest point of the model so that nothing of it is clipped.
+    float farMetres = float(lens.zfar);
+    if (!(farMetres > 0.0f)) {
+        const Aabb bounds = mScene.boundsWorld();
+        const glm::vec3 farthestCorner = glm::max(glm::abs(bounds.min - camera.positionWorld),
+                                                  glm::abs(bounds.max - camera.positionWorld));
+        farMetres =
+            std::max(kInfiniteFarOverNear * camera.nearMetres, 2.0f * glm::length(farthestCorner));
+    }
+    camera.farMetres = farMetres;
+    mScene.cameras.push_back(camera);
+}
+
+// KHR_lights_punctual lights, placed once the geometry is known: a light without a range is
+// unbounded in glTF, but ours need finite support, so it reaches just past the farthest corner
+// of the model's bounds (the windowed falloff makes it slightly dimmer there than glTF's).
+// Intensities are taken as they are (candela or lux in glTF, unitless here).
+void GltfConverter::addLights() {
+    const Aabb bounds = mScene.boundsWorld();
+    for (const auto& [lightIndex, worldFromLight] : mPlacedLights) {
+        if (lightIndex < 0 || size_t(lightIndex) >= mModel.lights.size())
+            fail("KHR_lights_punctual light " + std::to_string(lightIndex) + " out of range");
+        const tinygltf::Light& source = mModel.lights[size_t(lightIndex)];
+        const std::string where = "KHR_lights_punctual light " + std::to_string(lightIndex);
+        Light light;
+        if (source.type == "point")
+            light.type = LightType::Point;
+        else if (source.type == "spot")
+            light.type = LightType::Spot;
+        else if (source.type == "directional")
+            light.type = LightType::Directional;
+        else
+            fail(where + ": unknown type '" + source.type + "'");
+        if (!source.color.empty()) {
+            if (source.color.size() != 3)
+                fail(where + ": color needs 3 numbers");
+            light.color = glm::vec3(source.color[0], source.color[1], source.color[2]);
+        }
+        light.intensity = float(source.intensity);
+        light.positionWorld = glm::vec3(worldFromLight[3]);
+        light.directionWorld =
+            glm::normalize(glm::mat3(worldFromLight) * glm::vec3(0.0f, 0.0f, -1.0f));
+        const glm::vec3 farthestCorner = glm::max(glm::abs(bounds.min - light.positionWorld),
+                                                  glm::abs(bounds.max - light.positionWorld));
+        light.rangeMetres =
+            source.range > 0.0 ? float(source.range) : 1.01f * glm::length(farthestCorner);
+        light.spotInnerCos = float(std::cos(source.spot.innerConeAngle));
+        light.spotOuterCos = float(std::cos(source.spot.outerConeAngle));
+        mScene.lights.push_back(light);
+    }
+}
+
+int GltfConverter::meshFor(int meshIndex, size_t primitiveIndex) {
+    int& converted = mMeshOf[size_t(meshIndex)][primitiveIndex];
+    if (converted != kNotConverted)
+        return converted;
+    const int mode = mModel.meshes[size_t(meshIndex)].primitives[primitiveIndex].mode;
+    if (mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+        mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+        Mesh mesh = convertPrimitive(meshIndex, primitiveIndex);
+        converted = int(mScene.meshes.size());
+        mScene.meshes.push_back(std::move(mesh));
+    } else {
+        warn("mesh " + std::to_string(meshIndex) + " primitive " + str(primitiveIndex) + ": mode " +
+             modeName(mode) + " skipped (only triangles are drawn)");
+        converted = kSkipped;
+    }
+    return converted;
+}
+
+Mesh GltfConverter::convertPrimitive(int meshIndex, size_t primitiveIndex) {
+    const tinygltf::Mesh& source = mModel.meshes[size_t(meshIndex)];
+    const tinygltf::Primitive& primitive = source.primitives[primitiveIndex];
+    const std::string where =
+        "mesh " + std::to_string(meshIndex) + " primitive " + str(primitiveIndex);
+    auto attribute = [&](const char* name) {
+        const auto found = primitive.attributes.find(name);
+        return found == primitive.attributes.end() ? -1 : found->second;
+    };
+
+    Mesh mesh;
+    mesh.name = source.name.empty() ? "mesh " + std::to_string(meshIndex) : source.name;
+    if (source.primitives.size() > 1)
+        mesh.name += " #" + str(primitiveIndex);
+    if (attribute("POSITION") < 0)
+        fail(where + ": no POSITION attribute");
+    mesh.positions = readVectors<3>(attribute("POSITION"), where + " POSITION");
+    const size_t vertexCount = mesh.positions.size();
+    if (vertexCount > std::numeric_limits<uint32_t>::max())
+        fail(where + ": more than 2^32 vertices");
+    auto readAttribute = [&](auto& into, const char* name, auto reader) {
+        if (attribute(name) < 0)
+            return;
+        into = reader(attribute(name), where + " " + name);
+        if (into.size() != vertexCount)
+            fail(where + ": " + str(into.size()) + " " + name + " values for " + str(vertexCount) +
+                 " positions");
+    };
+    readAttribute(mesh.normals, "NORMAL",
+                  [&](int a, const std::string& w) { return readVectors<3>(a, w); });
+    readAttribute(mesh.tangents, "TANGENT",
+                  [&](int a, const std::string& w) { return readVectors<4>(a, w); });
+    readAttribute(mesh.uvs, "TEXCOORD_0",
+                  [&](int a, const std::string& w) { return readVectors<2>(a, w, true); });
+
+    std::vector<uint32_t> vertices;
+    if (primitive.indices >= 0) {
+        vertices = readIndices(primitive.indices, where + " indices", vertexCount);
+    } else {
+        vertices.resize(vertexCount);
+        std::iota(vertices.begin(), vertices.end(), 0u);
+    }
+    if (primitive.mode == TINYGLTF_MODE_TRIANGLES && vertices.size() % 3 != 0)
+        fail(where + ": " + str(vertices.size()) + " vertices do not make whole triangles");
+    mesh.indices = triangleList(primitive.mode, std::move(vertices));
+
+    if (mesh.normals.empty()) {
+        mesh.normals = areaWeightedNormals(mesh);
+    } else {
+        // Zero-length normals occur in exported files; the geometry tells what they should be.
+        std::vector<glm::vec3> computed;
+        for (size_t v = 0; v < vertexCount; ++v) {
+            const float length = glm::length(mesh.normals[v]);
+            if (length > 0.0f) {
+                mesh.normals[v] /= length;
+                continue;
+            }
+            if (computed.empty())
+                computed = areaWeightedNormals(mesh);
+            mesh.normals[v] = computed[v];
+        }
+    }
+    mesh.material = materialFor(primitive.material);
+    return mesh;
+}
+
+// glTF metallic-roughness onto Blinn-Phong: metals reflect their whole colour at normal
+// incidence and dielectrics about 4%, so ks = mix(0.04, 1, metallic) (a scalar approximation of
+// the coloured F0); the exponent matching a GGX lobe of the same roughness is 2 / roughness^4 - 2.
+uint32_t GltfConverter::materialFor(int materialIndex) {
+    if (materialIndex < 0) {
+        // A primitive without a material gets Material's defaults, a plain white dielectric,
+        // rather than glTF's default (fully metallic, fully rough) which Blinn-Phong draws badly.
+        if (mDefaultMaterial < 0) {
+            mDefaultMaterial = int(mScene.materials.size());
+            mScene.materials.push_back(Material{.name = "default"});
+        }
+        return uint32_t(mDefaultMaterial);
+    }
+    if (size_t(materialIndex) >= mModel.materials.size())
+        fail("material " + std::to_string(materialIndex) + " out of range");
+    if (mMaterialOf[size_t(materialIndex)] >= 0)
+        return uint32_t(mMaterialOf[size_t(materialIndex)]);
+
+    const tinygltf::Material& source = mModel.materials[size_t(materialIndex)];
+    const tinygltf::PbrMetallicRoughness& pbr = source.pbrMetallicRoughness;
+    const std::string where = "material " + std::to_string(materialIndex);
+    Material material;
+    material.name = source.name.empty() ? where : source.name;
+    if (pbr.baseColorFactor.size() != 4)
+        fail(where + ": baseColorFactor needs 4 numbers");
+    material.baseColorFactor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
+                                         pbr.baseColorFactor[2], pbr.baseColorFactor[3]);
+    if (!(pbr.metallicFactor >= 0.0 && pbr.metallicFactor <= 1.0))
+        fail(where + ": metallicFactor outside [0, 1]");
+    if (!(pbr.roughnessFactor >= 0.0 && pbr.roughnessFactor <= 1.0))
+        fail(where + ": roughnessFactor outside [0, 1]");
+    material.metallic = float(pbr.metallicFactor);
+    material.roughness = float(pbr.roughnessFactor);
+    material.specularIntensity = glm::mix(0.04f, 1.0f, material.metallic);
+    const float roughness2 = material.roughness * material.roughness;
+    const float roughness4 = std::max(roughness2 * roughness2, kMinRoughness4);
+    material.specularPower =
+        std::clamp(2.0f / roughness4 - 2.0f, kMinSpecularPower, kMaxSpecularPower);
+    material.baseColorTexture = textureFor(pbr.baseColorTexture.index, true);
+    material.normalTexture = textureFor(source.normalTexture.index, false);
+
+    mMaterialOf[size_t(materialIndex)] = int(mScene.materials.size());
+    mScene.materials.push_back(material);
+    return uint32_t(mMaterialOf[size_t(materialIndex)]);
+}
+
+// Scene::textures index for a glTF texture, -1 (fall back to the factor) when its image could
+// not be read. Colour and data uses of one image are separate Textures, as srgb differs.
+int GltfConverter::textureFor(int textureIndex, bool srgb) {
+    if (textureIndex < 0)
+        return -1;
+    if (size_t(textureIndex) >= mModel.textures.size())
+        fail("texture " + std::to_string(textureIndex) + " out of range");
+    const int imageIndex = mModel.textures[size_t(textureIndex)].source;
+    if (imageIndex < 0) {
+        warn("texture " + std::to_string(textureIndex) +
+             " has no image source we can read; materials using it fall back to their factors");
+        return -1;
+    }
+    if (size_t(imageIndex) >= mModel.images.size())
+        fail("texture " + std::to_string(textureIndex) + ": image " + std::to_string(imageIndex) +
+             " out of range");
+    const tinygltf::Image& image = mModel.images[size_t(imageIndex)];
+    if (image.image.empty())
+        return -1; // readImages warned
+    const auto cached = mTextureOf.find({imageIndex, srgb});
+    if (cached != mTextureOf.end())
+        return cached->second;
+
+    Texture texture;
+    texture.name = image.uri.empty() ? "image " + std::to_string(imageIndex) : image.uri;
+    texture.width = image.width;
+    texture.height = image.height;
+    texture.srgb = srgb;
+    const size_t pixelCount = size_t(image.width) * size_t(image.height);
+    const size_t components = size_t(image.component);
+    texture.rgba8.resize(pixelCount * 4);
+    // 16-bit channels keep their high byte (stb returns native-endian, here little-endian).
+    const size_t bytesPerChannel = size_t(image.bits / 8);
+    auto channel = [&](size_t pixel, size_t c) {
+        return image.image[(pixel * components + c) * bytesPerChannel + bytesPerChannel - 1];
+    };
+    for (size_t p = 0; p < pixelCount; ++p) {
+        uint8_t* out = &texture.rgba8[p * 4];
+        // 1 component is grey, 2 grey + alpha, 3 RGB, 4 RGBA.
+        const bool grey = components <= 2;
+        out[0] = channel(p, 0);
+        out[1] = grey ? out[0] : channel(p, 1);
+        out[2] = grey ? out[0] : channel(p, 2);
+        out[3] = components == 2 ? channel(p, 1) : components == 4 ? channel(p, 3) : 255;
+    }
+    const int index = int(mScene.textures.size());
+    mScene.textures.push_back(std::move(texture));
+    mTextureOf[{imageIndex, srgb}] = index;
+    return index;
+}
+
+const tinygltf::Accessor& GltfConverter::accessorAt(int accessorIndex,
+                                                    const std::string& what) const {
+    if (accessorIndex < 0 || size_t(accessorIndex) >= mModel.accessors.size())
+        fail(what + ": accessor " + std::to_string(accessorIndex) + " out of range");
+    return mModel.accessors[size_t(accessorIndex)];
+}
+
+AccessorData GltfConverter::accessorData(const tinygltf::Accessor& accessor,
+                                         const std::string& where) const {
+    if (accessor.sparse.isSparse)
+        fail(where + ": sparse accessors are not supported");
+    if (accessor.bufferView < 0)
+        fail(where + ": no bufferView (zero-filled accessors are not supported)");
+    if (size_t(accessor.bufferView) >= mModel.bufferViews.size())
+        fail(where + ": bufferView " + std::to_string(accessor.bufferView) + " out of range");
+    const tinygltf::BufferView& view = mModel.bufferViews[size_t(accessor.bufferView)];
+    if (view.buffer < 0 || size_t(view.buffer) >= mModel.buffers.size())
+        fail(where + ": buffer " + std::to_string(view.buffer) + " out of range");
+    const std::vector<unsigned char>& buffer = mModel.buffers[size_t(view.buffer)].data;
+    if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
+        fail(where + ": bufferView " + std::to_string(accessor.bufferView) + " (" +
+             str(view.byteLength) + " bytes from byte " + str(view.byteOffset) +
+             ") runs past the end of buffer " + std::to_string(view.buffer) + " (" +
+             str(buffer.size()) + " bytes)");
+
+    const int componentBytes = tinygltf::GetComponentSizeInBytes(uint32_t(accessor.componentType));
+    const int components = tinygltf::GetNumComponentsInType(uint32_t(accessor.type));
+    if (componentBytes <= 0 || components <= 0)
+        fail(where + ": invalid componentType or type");
+    const size_t elementBytes = size_t(componentBytes) * size_t(components);
+    const size_t strideBytes = view.byteStride == 0 ? elementBytes : view.byteStride;
+    if (strideBytes < elementBytes)
+        fail(where + ": byteStride " + str(strideBytes) + " is smaller than an element (" +
+             str(elementBytes) + " bytes)");
+    if (accessor.count == 0)
+        fail(where + ": count is 0");
+    // Written with a division so that no product can overflow, whatever the file claims.
+    const size_t available =
+        accessor.byteOffset <= view.byteLength ? view.byteLength - accessor.byteOffset : 0;
+    if (elementBytes > available || (accessor.count - 1) > (available - elementBytes) / strideBytes)
+        fail(where + ": " + str(accessor.count) + " elements of " + str(elementBytes) +
+             " bytes every " + str(strideBytes) + " bytes from byte " + str(accessor.byteOffset) +
+             " run past the end of bufferView " + std::to_string(accessor.bufferView) + " (" +
+             str(view.byteLength) + " bytes)");
+    return {buffer.data() + view.byteOffset + accessor.byteOffset, strideBytes, accessor.count};
+}
+
+// Float vectors of N components; with allowNormalizedIntegers also normalized unsigned bytes and
+// shorts (as glTF allows for texture coordinates). Every value must be finite.
+template <int N>
+std::vector<glm::vec<N, float>> GltfConverter::readVectors(int accessorIndex,
+                                                           const std::string& what,
+                                                           bool allowNormalizedIntegers) const {
+    const tinygltf::Accessor& accessor = accessorAt(accessorIndex, what);
+    const std::string where = what + " (accessor " + std::to_string(accessorIndex) + ")";
+    constexpr int kType = N == 2   ? TINYGLTF_TYPE_VEC2
+                          : N == 3 ? TINYGLTF_TYPE_VEC3
+                                   : TINYGLTF_TYPE_VEC4;
+    const int componentType = accessor.componentType;
+    const bool normalizedInteger = allowNormalizedIntegers && accessor.normalized &&
+                                   (componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                    componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+    if (accessor.type != kType ||
+        (componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && !normalizedInteger))
+        fail(where + ": expected VEC" + std::to_string(N) + " of FLOAT" +
+             (allowNormalizedIntegers ? " or normalized UNSIGNED_BYTE/UNSIGNED_SHORT" : ""));
+
+    const AccessorData data = accessorData(accessor, where);
+    std::vector<glm::vec<N, float>> values(data.count);
+    for (size_t i = 0; i < data.count; ++i) {
+        const unsigned char* element = data.first + i * data.strideBytes;
+        for (int c = 0; c < N; ++c) {
+            float value;
+            if (componentType == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+                std::memcpy(&value, element + 4 * c, 4);
+            } else if (componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
+                value = float(element[c]) / 255.0f;
+            } else {
+                uint16_t integer;
+                std::memcpy(&integer, element + 2 * c, 2);
+                value = float(integer) / 65535.0f;
+            }
+            if (!std::isfinite(value))
+                fail(where + ": element " + str(i) + " is NaN or infinite");
+            values[i][c] = value;
+        }
+    }
+    return values;
+}
+
+std::vector<uint32_t> GltfConverter::readIndices(int accessorIndex, const std::string& what,
+                                                 size_t vertexCount) const {
+    const tinygltf::Accessor& accessor = accessorAt(accessorIndex, what);
+    const std::string where = what + " (accessor " + std::to_string(accessorIndex) + ")";
+    const int componentType = accessor.componentType;
+    if (accessor.type != TINYGLTF_TYPE_SCALAR ||
+        (componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+         componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+         componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+        fail(where + ": expected SCALAR of UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT");
+
+    const AccessorData data = accessorData(accessor, where);
+    std::vector<uint32_t> indices(data.count);
+    for (size_t i = 0; i < data.count; ++i) {
+        const unsigned char* element = data.first + i * data.strideBytes;
+        uint32_t index = 0;
+        if (componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
+            index = element[0];
+        } else if (componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
+            uint16_t value;
+            std::memcpy(&value, element, 2);
+            index = value;
+        } else {
+            std::memcpy(&index, element, 4);
+        }
+        if (index >= vertexCount)
+            fail(where + ": index " + std::to_string(index) + " (element " + str(i) +
+                 ") out of range of " + str(vertexCount) + " vertices");
+        indices[i] = index;
+    }
+    return indices;
+}
+
+} // namespace
+
+Scene loadGltf(const fs::path& path) {
+    try {
+        std::set<int> undecodableImages;
+        tinygltf::Model model = parseModel(path, undecodableImages);
+        return GltfConverter(path, std::move(model), std::move(undecodableImages)).convert();
+    } catch (const SceneError&) {
+        throw;
+    } catch (const std::exception& error) {
+        // tinygltf and its JSON parser may throw (bad_alloc, out_of_range on odd input).
+        fail(path, error.what());
+    }
+}
+
+} // namespace scenes
