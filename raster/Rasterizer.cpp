@@ -1,0 +1,276 @@
+// Triangle set-up and binning for the Rasterizer (see Rasterizer.h for the conventions).
+#include "raster/Rasterizer.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace raster {
+
+namespace {
+
+// A polygon vertex during clipping: clip position plus its weights of the original vertices.
+struct ClipVertex {
+    glm::vec4 clip;
+    glm::vec3 barycentric;
+};
+
+// Clip planes as signed distances (inside >= 0): z >= 0, w - z >= 0, and the guard band.
+constexpr int kClipPlaneCount = 6;
+
+float planeDistance(int plane, const glm::vec4& c, float guardX, float guardY) {
+    switch (plane) {
+    case 0: return c.z;
+    case 1: return c.w - c.z;
+    case 2: return guardX * c.w - c.x;
+    case 3: return guardX * c.w + c.x;
+    case 4: return guardY * c.w - c.y;
+    default: return guardY * c.w + c.y;
+    }
+}
+
+// Sutherland-Hodgman against one plane. A triangle clipped by 6 planes has at most 9 vertices.
+constexpr int kMaxPolygon = 3 + kClipPlaneCount;
+
+int clipPolygon(const ClipVertex* in, int count, ClipVertex* out, int plane, float guardX,
+                float guardY) {
+    int outCount = 0;
+    for (int i = 0; i < count; ++i) {
+        const ClipVertex& a = in[i];
+        const ClipVertex& b = in[(i + 1) % count];
+        const float da = planeDistance(plane, a.clip, guardX, guardY);
+        const float db = planeDistance(plane, b.clip, guardX, guardY);
+        if (da >= 0.0f) out[outCount++] = a;
+        if ((da >= 0.0f) != (db >= 0.0f)) {
+            // Always interpolate from the inside vertex so that an edge shared by two
+            // triangles is cut at exactly the same point whichever triangle clips it.
+            const bool aInside = da >= 0.0f;
+            const ClipVertex& from = aInside ? a : b;
+            const ClipVertex& to = aInside ? b : a;
+            const float dFrom = aInside ? da : db, dTo = aInside ? db : da;
+            const float t = dFrom / (dFrom - dTo);
+            out[outCount++] = {from.clip + (to.clip - from.clip) * t,
+                               from.barycentric + (to.barycentric - from.barycentric) * t};
+        }
+    }
+    return outCount;
+}
+
+// Attribute planes from the unsnapped screen positions (see AttributePlanes). With the edge
+// function E_ab(p) = (bx-ax)(py-ay) - (by-ay)(px-ax): l1 = E_20 / area, l2 = E_01 / area.
+// A triangle that is degenerate before snapping but not after falls back to the snapped
+// positions, which are then the only consistent description of it.
+void setUpAttributePlanes(SetupTriangle& s, double x[3], double y[3], const double depth[3]) {
+    double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    const double snappedArea = (double(s.x[1] - s.x[0]) * (s.y[2] - s.y[0]) -
+                                double(s.y[1] - s.y[0]) * (s.x[2] - s.x[0])) /
+                               (double(kSubpixelScale) * kSubpixelScale);
+    if (!(area > 1e-6 * snappedArea)) {
+        for (int i = 0; i < 3; ++i) {
+            x[i] = double(s.x[i]) / kSubpixelScale;
+            y[i] = double(s.y[i]) / kSubpixelScale;
+        }
+        area = snappedArea;
+    }
+    auto plane = [&](int a, int b, double out[3]) {
+        // E_ab at pixel (px, py), sampled at its centre (px + 0.5, py + 0.5), over the area.
+        const double dx = x[b] - x[a], dy = y[b] - y[a];
+        out[1] = -dy / area;
+        out[2] = dx / area;
+        out[0] = (dx * (0.5 - y[a]) - dy * (0.5 - x[a])) / area;
+    };
+    plane(2, 0, s.planes.l1);
+    plane(0, 1, s.planes.l2);
+    for (int k = 0; k < 3; ++k)
+        s.planes.z[k] = (k == 0 ? depth[0] : 0.0) + s.planes.l1[k] * (depth[1] - depth[0]) +
+                        s.planes.l2[k] * (depth[2] - depth[0]);
+}
+
+}  // namespace
+
+Rasterizer::Rasterizer(int width, int height) : mWidth(width), mHeight(height) {
+    if (width <= 0 || height <= 0 || width > kMaxViewportSize || height > kMaxViewportSize)
+        throw std::invalid_argument("Rasterizer: viewport " + std::to_string(width) + "x" +
+                                    std::to_string(height) + " outside 1.." +
+                                    std::to_string(kMaxViewportSize));
+    mTilesX = (width + kTileSize - 1) / kTileSize;
+    mTilesY = (height + kTileSize - 1) / kTileSize;
+}
+
+void Rasterizer::setUpAndBin(const TriangleList& triangles, CullMode cullMode) {
+    const uint32_t triangleCount = triangles.triangleCount();
+    const uint32_t batchCount = (triangleCount + kTrianglesPerBatch - 1) / kTrianglesPerBatch;
+    mBatches.resize(batchCount);
+    tbb::parallel_for(uint32_t(0), batchCount, [&](uint32_t b) {
+        const uint32_t first = b * kTrianglesPerBatch;
+        const uint32_t last = std::min(first + kTrianglesPerBatch, triangleCount);
+        setUpBatch(triangles, first, last, cullMode, mBatches[b]);
+    });
+    mStats = RasterStats{};
+    for (const Batch& batch : mBatches) {
+        mStats.trianglesIn += batch.stats.trianglesIn;
+        mStats.trianglesCulled += batch.stats.trianglesCulled;
+        mStats.trianglesClipped += batch.stats.trianglesClipped;
+        mStats.trianglesSetUp += batch.stats.trianglesSetUp;
+    }
+}
+
+void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last,
+                            CullMode cullMode, Batch& batch) const {
+    batch.triangles.clear();
+    batch.triangles.reserve(last - first);  // address space only; pages are touched on use
+    batch.pairTile.clear();
+    batch.pairTriangle.clear();
+    batch.stats = RasterStats{};
+    batch.stats.trianglesIn = last - first;
+
+    const float guardX = kGuardBandPixels / (0.5f * float(mWidth));
+    const float guardY = kGuardBandPixels / (0.5f * float(mHeight));
+    static const glm::vec3 kCorner[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+    for (uint32_t t = first; t < last; ++t) {
+        glm::vec4 clip[3];
+        for (int i = 0; i < 3; ++i) {
+            const uint32_t index = triangles.indices[size_t(t) * 3 + i];
+            clip[i] = triangles.clipPositions[index];
+        }
+        // Trivial reject against the view frustum (x, y within +-w, 0 <= z <= w): no pixel
+        // centre of the viewport can be covered when all three vertices are outside one plane.
+        auto outcode = [](const glm::vec4& c) {
+            return (c.x > c.w) | (c.x < -c.w) << 1 | (c.y > c.w) << 2 | (c.y < -c.w) << 3 |
+                   (c.z < 0.0f) << 4 | (c.z > c.w) << 5;
+        };
+        // Non-finite input has no meaningful coverage; reject it rather than draw garbage.
+        auto finite = [](const glm::vec4& c) {
+            return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w);
+        };
+        if (!finite(clip[0]) || !finite(clip[1]) || !finite(clip[2])) {
+            ++batch.stats.trianglesCulled;
+            continue;
+        }
+        const int code0 = outcode(clip[0]), code1 = outcode(clip[1]), code2 = outcode(clip[2]);
+        if (code0 & code1 & code2) {
+            ++batch.stats.trianglesCulled;
+            continue;
+        }
+        // The clip volume contains the frustum: only a vertex outside the frustum can need
+        // clipping, so the common case (all inside) skips the plane tests.
+        bool needsClip = false;
+        if (code0 | code1 | code2)
+            for (int plane = 0; plane < kClipPlaneCount && !needsClip; ++plane)
+                for (int i = 0; i < 3; ++i)
+                    if (planeDistance(plane, clip[i], guardX, guardY) < 0.0f) needsClip = true;
+
+        if (!needsClip) {
+            emitTriangle(clip, kCorner, t, cullMode, batch);
+            continue;
+        }
+        ++batch.stats.trianglesClipped;
+        ClipVertex polygon[2][kMaxPolygon];
+        int count = 3;
+        for (int i = 0; i < 3; ++i) polygon[0][i] = {clip[i], kCorner[i]};
+        int current = 0;
+        for (int plane = 0; plane < kClipPlaneCount && count >= 3; ++plane) {
+            count = clipPolygon(polygon[current], count, polygon[1 - current], plane, guardX, guardY);
+            current = 1 - current;
+        }
+        // Fan-triangulate the convex result; every piece keeps the original triangle's id.
+        for (int i = 1; i + 1 < count; ++i) {
+            const ClipVertex& a = polygon[current][0];
+            const ClipVertex& b = polygon[current][i];
+            const ClipVertex& c = polygon[current][i + 1];
+            const glm::vec4 pieceClip[3] = {a.clip, b.clip, c.clip};
+            const glm::vec3 pieceBarycentric[3] = {a.barycentric, b.barycentric, c.barycentric};
+            emitTriangle(pieceClip, pieceBarycentric, t, cullMode, batch);
+        }
+    }
+    // Counting sort of the (tile, triangle) pairs; stable, so each bin keeps submission order.
+    const size_t tileCount = size_t(mTilesX) * mTilesY;
+    batch.binOffsets.assign(tileCount + 1, 0);
+    for (uint32_t tile : batch.pairTile) ++batch.binOffsets[tile + 1];
+    for (size_t tile = 0; tile < tileCount; ++tile) batch.binOffsets[tile + 1] += batch.binOffsets[tile];
+    batch.binItems.resize(batch.pairTile.size());
+    std::vector<uint32_t>& cursor = batch.pairTile;  // reused in place: each pair reads its tile first
+    for (size_t pair = 0; pair < cursor.size(); ++pair) {
+        const uint32_t tile = cursor[pair];
+        batch.binItems[batch.binOffsets[tile]++] = batch.pairTriangle[pair];
+    }
+    // The loop advanced every offset to its bin's end; shift back to starts.
+    for (size_t tile = tileCount; tile > 0; --tile) batch.binOffsets[tile] = batch.binOffsets[tile - 1];
+    batch.binOffsets[0] = 0;
+}
+
+void Rasterizer::emitTriangle(const glm::vec4 clip[3], const glm::vec3 barycentric[3],
+                              uint32_t triangle, CullMode cullMode, Batch& batch) const {
+    SetupTriangle s;
+    double screenXs[3], screenYs[3], depth[3];
+    const float halfWidth = 0.5f * float(mWidth), halfHeight = 0.5f * float(mHeight);
+    for (int i = 0; i < 3; ++i) {
+        // After clipping, w = 0 is only possible at the clip-space origin (the eye of a
+        // zero-near projection): such a piece is seen edge-on and covers nothing.
+        if (!(clip[i].w > 0.0f)) {
+            ++batch.stats.trianglesCulled;
+            return;
+        }
+        const float invW = 1.0f / clip[i].w;
+        const float screenX = (clip[i].x * invW + 1.0f) * halfWidth;
+        const float screenY = (1.0f - clip[i].y * invW) * halfHeight;
+        s.x[i] = int32_t(std::lrint(screenX * float(kSubpixelScale)));
+        s.y[i] = int32_t(std::lrint(screenY * float(kSubpixelScale)));
+        screenXs[i] = (double(clip[i].x) / clip[i].w + 1.0) * (0.5 * mWidth);
+        screenYs[i] = (1.0 - double(clip[i].y) / clip[i].w) * (0.5 * mHeight);
+        depth[i] = double(clip[i].z) / clip[i].w;
+        s.invW[i] = invW;
+        s.barycentricOfOriginal[i] = barycentric[i];
+    }
+    // Signed doubled area in fixed point; with y down, counter-clockwise in NDC is negative.
+    const int64_t area = int64_t(s.x[1] - s.x[0]) * (s.y[2] - s.y[0]) -
+                         int64_t(s.y[1] - s.y[0]) * (s.x[2] - s.x[0]);
+    if (area == 0) {
+        ++batch.stats.trianglesCulled;  // degenerate after snapping: covers nothing
+        return;
+    }
+    s.frontFacing = area < 0;
+    if ((cullMode == CullMode::Back && !s.frontFacing) ||
+        (cullMode == CullMode::Front && s.frontFacing)) {
+        ++batch.stats.trianglesCulled;
+        return;
+    }
+    if (area < 0) {  // traversal wants positive area: swap vertices 1 and 2
+        std::swap(s.x[1], s.x[2]);
+        std::swap(s.y[1], s.y[2]);
+        std::swap(screenXs[1], screenXs[2]);
+        std::swap(screenYs[1], screenYs[2]);
+        std::swap(depth[1], depth[2]);
+        std::swap(s.invW[1], s.invW[2]);
+        std::swap(s.barycentricOfOriginal[1], s.barycentricOfOriginal[2]);
+    }
+    // Pixel bounds: pixel p is sampled at p + 0.5, so the first candidate column is
+    // ceil(minX - 0.5) and the last floor(maxX - 0.5), in fixed point.
+    const int32_t minXf = std::min({s.x[0], s.x[1], s.x[2]});
+    const int32_t maxXf = std::max({s.x[0], s.x[1], s.x[2]});
+    const int32_t minYf = std::min({s.y[0], s.y[1], s.y[2]});
+    const int32_t maxYf = std::max({s.y[0], s.y[1], s.y[2]});
+    constexpr int32_t kHalf = kSubpixelScale / 2;
+    auto ceilDiv = [](int32_t a) { return -((-a) >> kSubpixelBits); };  // ceil(a / 256)
+    s.minX = std::max(0, ceilDiv(minXf - kHalf));
+    s.minY = std::max(0, ceilDiv(minYf - kHalf));
+    s.maxX = std::min(mWidth - 1, (maxXf - kHalf) >> kSubpixelBits);
+    s.maxY = std::min(mHeight - 1, (maxYf - kHalf) >> kSubpixelBits);
+    if (s.minX > s.maxX || s.minY > s.maxY) {
+        ++batch.stats.trianglesCulled;  // between sample points or off screen
+        return;
+    }
+    setUpAttributePlanes(s, screenXs, screenYs, depth);
+    s.triangle = triangle;
+    const uint32_t index = uint32_t(batch.triangles.size());
+    batch.triangles.push_back(s);
+    ++batch.stats.trianglesSetUp;
+    for (int ty = s.minY / kTileSize; ty <= s.maxY / kTileSize; ++ty)
+        for (int tx = s.minX / kTileSize; tx <= s.maxX / kTileSize; ++tx)
+            batch.pairTile.push_back(uint32_t(ty * mTilesX + tx)), batch.pairTriangle.push_back(index);
+}
+
+}  // namespace raster

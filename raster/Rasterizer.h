@@ -1,0 +1,303 @@
+// Rasterizer: one generic, sort-middle triangle rasterizer, templated on the fragment function.
+//
+// Conventions (the contract every pass relies on):
+// - Input is clip space (x, y, z, w) after the projection, OpenGL/glTF axes: x right, y up, and
+//   depth in [0, w] (D3D/Vulkan "zero to one" clip volume: 0 <= z <= w). Whether z = 0 is the
+//   near plane (standard) or the far plane (reversed Z) does not matter here: both planes are
+//   clipped homogeneously, so w > 0 for every vertex that reaches set-up (a piece touching the
+//   clip-space origin, w = 0, is edge-on and dropped). Triangles with a non-finite coordinate are
+//   rejected.
+// - Screen space: x right, y DOWN, pixel (px, py) covers [px, px+1) x [py, py+1) and is sampled at
+//   its centre. Vertices are snapped to fixed point with 8 sub-pixel bits (kSubpixelBits).
+// - Front faces are counter-clockwise in normalised device coordinates (glTF convention).
+// - Fill rule: top-left. A pixel centre exactly on an edge belongs to the triangle only if the
+//   edge is a top edge (horizontal, interior below) or a left edge; shared edges and vertices of a
+//   watertight mesh are therefore covered exactly once.
+// - Clipping: against z >= 0 and z <= w (near and far, whichever is which) and a guard band of
+//   +-kGuardBandPixels around the screen centre; everything else is handled by the scissor of the
+//   tile traversal. Triangles entirely outside one frustum plane are rejected before clipping.
+// - Edge functions are evaluated in int64: snapped coordinates stay below 2^23 in magnitude
+//   (guard band), differences below 2^24, products below 2^48.
+//
+// Threading and determinism: triangles are set up in fixed-size batches (kTrianglesPerBatch,
+// independent of the thread count) in parallel with TBB, each batch binning its triangles into
+// its own per-tile lists. Tiles are then rasterized in parallel; inside a tile, batches and
+// triangles are visited in submission order. A pixel is only ever touched by the thread that owns
+// its tile, so the result is bitwise identical for any thread count. Use tbb::task_arena to set
+// the thread count.
+//
+// The fragment function is called as fn(const Fragment&) for every covered sample that passes
+// the (early) depth test; it may be called concurrently for different tiles and must only write
+// data belonging to its own pixel. A Rasterizer object keeps scratch memory between draws: one
+// draw at a time per object.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <tbb/parallel_for.h>
+
+namespace raster {
+
+inline constexpr int kSubpixelBits = 8;
+inline constexpr int32_t kSubpixelScale = 1 << kSubpixelBits;
+// Half-extent of the guard band in pixels around the screen centre; keeps snapped coordinates
+// below 2^23 (see the overflow bound above) for any viewport up to kMaxViewportSize.
+inline constexpr float kGuardBandPixels = 16384.0f;
+inline constexpr int kMaxViewportSize = 16384;
+// Screen tiles: 64x64 pixels balances binning cost against load balance on few cores.
+inline constexpr int kTileSize = 64;
+// Input triangles per set-up batch: fixed so that binning order never depends on the threads.
+inline constexpr uint32_t kTrianglesPerBatch = 2048;
+
+enum class CullMode { None, Back, Front };
+enum class DepthTest { Always, Less, LessEqual, Greater, GreaterEqual };
+
+struct RasterState {
+    CullMode cullMode = CullMode::Back;
+    DepthTest depthTest = DepthTest::Less;
+    bool depthWrite = true;
+};
+
+// Triangles as indexed clip-space vertices; triangle t uses indices[3t .. 3t+2].
+struct TriangleList {
+    std::span<const glm::vec4> clipPositions;
+    std::span<const uint32_t> indices;
+    uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
+};
+
+struct Fragment {
+    int x = 0;
+    int y = 0;
+    float depth = 0.0f;  // z / w, interpolated linearly in screen space, in [0, 1]
+    // Perspective-correct weights of the ORIGINAL triangle's three vertices (also after
+    // clipping), so varyings are interpolated with interpolate(a, b, c, fragment.barycentric).
+    glm::vec3 barycentric{0.0f};
+    uint32_t triangle = 0;  // index into the TriangleList
+    bool frontFacing = true;
+};
+
+template <class T>
+inline T interpolate(const T& a, const T& b, const T& c, const glm::vec3& weights) {
+    return a * weights.x + b * weights.y + c * weights.z;
+}
+
+struct RasterStats {
+    uint64_t trianglesIn = 0;
+    uint64_t trianglesCulled = 0;   // back/front-face or degenerate
+    uint64_t trianglesClipped = 0;  // needed polygon clipping
+    uint64_t trianglesSetUp = 0;    // after clipping (a clipped triangle can become several)
+    uint64_t samplesCovered = 0;
+    uint64_t samplesPassed = 0;  // passed the depth test
+};
+
+// Screen-space barycentrics l1, l2 and depth as affine functions of the pixel index:
+// value(px, py) = c[0] + c[1] * px + c[2] * py (pixel centres folded into c[0]). They are set up
+// in double from the UNSNAPPED vertex positions: snapping may shift a triangle by up to 1/512
+// pixel, which on a grazing surface moves the reconstructed position by ~1e-4 relative (measured
+// on a tilted plane); coverage uses the snapped edges, attributes do not inherit their error.
+struct AttributePlanes {
+    double l1[3];
+    double l2[3];
+    double z[3];
+};
+
+// A triangle after clipping, snapping and orientation fix-up; positive area in the
+// edge-function convention used by the traversal.
+struct SetupTriangle {
+    AttributePlanes planes;
+    int32_t x[3], y[3];  // fixed point, kSubpixelBits fraction bits
+    float invW[3];
+    glm::vec3 barycentricOfOriginal[3];  // vertex i as weights of the original triangle's vertices
+    uint32_t triangle;
+    bool frontFacing;
+    int minX, minY, maxX, maxY;  // inclusive pixel bounds, already clamped to the viewport
+};
+
+class Rasterizer {
+public:
+    Rasterizer(int width, int height);
+
+    int width() const { return mWidth; }
+    int height() const { return mHeight; }
+
+    // Rasterizes every triangle; depth (width*height floats, row 0 = top) may be null for no
+    // depth test. Cost: set-up O(triangles), traversal O(covered bounding-box pixels).
+    template <class FragmentFn>
+    void draw(const TriangleList& triangles, const RasterState& state, float* depth,
+              FragmentFn&& fragmentFn);
+
+    const RasterStats& lastStats() const { return mStats; }
+    int tileCountX() const { return mTilesX; }
+    int tileCountY() const { return mTilesY; }
+
+private:
+    // Cache-line aligned: neighbouring batches are set up by different threads, and their
+    // vector ends and counters would otherwise share lines (false sharing measured as a 2-thread
+    // slowdown).
+    struct alignas(64) Batch {
+        std::vector<SetupTriangle> triangles;
+        // Bins as one compressed table: the triangles (indices into `triangles`, in submission
+        // order) of tile t are binItems[binOffsets[t] .. binOffsets[t+1]). Built by a counting
+        // sort of (tile, triangle) pairs, so steady-state frames allocate nothing.
+        std::vector<uint32_t> pairTile;
+        std::vector<uint32_t> pairTriangle;
+        std::vector<uint32_t> binOffsets;
+        std::vector<uint32_t> binItems;
+        RasterStats stats;
+    };
+
+    // Clip, cull, snap and bin all triangles into mBatches (parallel, deterministic).
+    void setUpAndBin(const TriangleList& triangles, CullMode cullMode);
+    void setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last, CullMode cullMode,
+                    Batch& batch) const;
+    void emitTriangle(const glm::vec4 clip[3], const glm::vec3 barycentric[3], uint32_t triangle,
+                      CullMode cullMode, Batch& batch) const;
+
+    template <class FragmentFn>
+    void rasterizeTile(int tileIndex, const RasterState& state, float* depth,
+                       FragmentFn& fragmentFn, RasterStats& tileStats) const;
+
+    int mWidth;
+    int mHeight;
+    int mTilesX;
+    int mTilesY;
+    std::vector<Batch> mBatches;
+    struct alignas(64) TileStats {
+        RasterStats stats;
+    };
+    std::vector<TileStats> mTileStats;
+    RasterStats mStats;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Template implementation: the per-tile traversal is inlined with the fragment function.
+
+namespace detail {
+inline bool depthPasses(DepthTest test, float fragmentDepth, float storedDepth) {
+    switch (test) {
+    case DepthTest::Always: return true;
+    case DepthTest::Less: return fragmentDepth < storedDepth;
+    case DepthTest::LessEqual: return fragmentDepth <= storedDepth;
+    case DepthTest::Greater: return fragmentDepth > storedDepth;
+    case DepthTest::GreaterEqual: return fragmentDepth >= storedDepth;
+    }
+    return false;
+}
+
+// Top-left rule as a bias: with our orientation (positive area, y down), an edge a->b is a
+// left edge when dy < 0 and a top edge when dy == 0 and dx > 0. Samples exactly on any other
+// edge are excluded by requiring edge >= 1 there.
+inline int64_t fillBias(int32_t ax, int32_t ay, int32_t bx, int32_t by) {
+    int32_t dx = bx - ax, dy = by - ay;
+    bool topLeft = dy < 0 || (dy == 0 && dx > 0);
+    return topLeft ? 0 : -1;
+}
+}  // namespace detail
+
+template <class FragmentFn>
+void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, float* depth,
+                      FragmentFn&& fragmentFn) {
+    setUpAndBin(triangles, state.cullMode);
+    const int tileCount = mTilesX * mTilesY;
+    mTileStats.assign(size_t(tileCount), TileStats{});
+    tbb::parallel_for(0, tileCount, [&](int tile) {
+        rasterizeTile(tile, state, depth, fragmentFn, mTileStats[size_t(tile)].stats);
+    });
+    // Sum in a fixed order so the statistics are as deterministic as the pixels.
+    for (const TileStats& tile : mTileStats) {
+        mStats.samplesCovered += tile.stats.samplesCovered;
+        mStats.samplesPassed += tile.stats.samplesPassed;
+    }
+}
+
+template <class FragmentFn>
+void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* depth,
+                               FragmentFn& fragmentFn, RasterStats& tileStats) const {
+    const int tileMinX = (tileIndex % mTilesX) * kTileSize;
+    const int tileMinY = (tileIndex / mTilesX) * kTileSize;
+    const int tileMaxX = std::min(tileMinX + kTileSize, mWidth) - 1;
+    const int tileMaxY = std::min(tileMinY + kTileSize, mHeight) - 1;
+    constexpr int64_t kHalf = kSubpixelScale / 2;
+
+    // Counted in registers, stored once: a memory increment per sample costs measurably.
+    uint64_t samplesCovered = 0, samplesPassed = 0;
+    for (const Batch& batch : mBatches) {
+        const uint32_t binEnd = batch.binOffsets[size_t(tileIndex) + 1];
+        for (uint32_t item = batch.binOffsets[size_t(tileIndex)]; item < binEnd; ++item) {
+            const SetupTriangle& t = batch.triangles[batch.binItems[item]];
+            const int minX = std::max(t.minX, tileMinX), maxX = std::min(t.maxX, tileMaxX);
+            const int minY = std::max(t.minY, tileMinY), maxY = std::min(t.maxY, tileMaxY);
+            if (minX > maxX || minY > maxY) continue;
+
+            // Edge i is opposite vertex i: e0 = v1->v2, e1 = v2->v0, e2 = v0->v1.
+            const int32_t* x = t.x;
+            const int32_t* y = t.y;
+            const int64_t stepX0 = -int64_t(y[2] - y[1]) * kSubpixelScale;
+            const int64_t stepX1 = -int64_t(y[0] - y[2]) * kSubpixelScale;
+            const int64_t stepX2 = -int64_t(y[1] - y[0]) * kSubpixelScale;
+            const int64_t stepY0 = int64_t(x[2] - x[1]) * kSubpixelScale;
+            const int64_t stepY1 = int64_t(x[0] - x[2]) * kSubpixelScale;
+            const int64_t stepY2 = int64_t(x[1] - x[0]) * kSubpixelScale;
+            const int64_t bias0 = detail::fillBias(x[1], y[1], x[2], y[2]);
+            const int64_t bias1 = detail::fillBias(x[2], y[2], x[0], y[0]);
+            const int64_t bias2 = detail::fillBias(x[0], y[0], x[1], y[1]);
+            auto edge = [](int32_t ax, int32_t ay, int32_t bx, int32_t by, int64_t px, int64_t py) {
+                return int64_t(bx - ax) * (py - ay) - int64_t(by - ay) * (px - ax);
+            };
+            const int64_t px0 = int64_t(minX) * kSubpixelScale + kHalf;
+            const int64_t py0 = int64_t(minY) * kSubpixelScale + kHalf;
+            int64_t row0 = edge(x[1], y[1], x[2], y[2], px0, py0);
+            int64_t row1 = edge(x[2], y[2], x[0], y[0], px0, py0);
+            int64_t row2 = edge(x[0], y[0], x[1], y[1], px0, py0);
+
+            for (int py = minY; py <= maxY; ++py) {
+                int64_t w0 = row0, w1 = row1, w2 = row2;
+                float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;
+                for (int px = minX; px <= maxX; ++px) {
+                    if (((w0 + bias0) | (w1 + bias1) | (w2 + bias2)) >= 0) {
+                        ++samplesCovered;
+                        const AttributePlanes& p = t.planes;
+                        const double l1 = p.l1[0] + p.l1[1] * px + p.l1[2] * py;
+                        const double l2 = p.l2[0] + p.l2[1] * px + p.l2[2] * py;
+                        const float l0 = float(1.0 - l1 - l2);
+                        const float z = float(std::clamp(p.z[0] + p.z[1] * px + p.z[2] * py, 0.0, 1.0));
+                        bool pass = !depthRow || detail::depthPasses(state.depthTest, z, depthRow[px]);
+                        if (pass) {
+                            ++samplesPassed;
+                            if (depthRow && state.depthWrite) depthRow[px] = z;
+                            const float q0 = l0 * t.invW[0], q1 = float(l1) * t.invW[1],
+                                        q2 = float(l2) * t.invW[2];
+                            const float invSum = 1.0f / (q0 + q1 + q2);
+                            glm::vec3 b(q0 * invSum, q1 * invSum, q2 * invSum);
+                            Fragment fragment;
+                            fragment.x = px;
+                            fragment.y = py;
+                            fragment.depth = z;
+                            // Map back to the original vertices (set-up may have clipped
+                            // the triangle or swapped two vertices to fix the orientation).
+                            fragment.barycentric = t.barycentricOfOriginal[0] * b.x +
+                                                   t.barycentricOfOriginal[1] * b.y +
+                                                   t.barycentricOfOriginal[2] * b.z;
+                            fragment.triangle = t.triangle;
+                            fragment.frontFacing = t.frontFacing;
+                            fragmentFn(fragment);
+                        }
+                    }
+                    w0 += stepX0;
+                    w1 += stepX1;
+                    w2 += stepX2;
+                }
+                row0 += stepY0;
+                row1 += stepY1;
+                row2 += stepY2;
+            }
+        }
+    }
+    tileStats.samplesCovered = samplesCovered;
+    tileStats.samplesPassed = samplesPassed;
+}
+
+}  // namespace raster
