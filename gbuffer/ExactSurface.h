@@ -1,0 +1,37 @@
+// ExactSurface: the unquantised surface behind every pixel, for the double-precision reference.
+// The rasterizer records which triangle covers each pixel; position and normal are then
+// recomputed in double by intersecting the pixel centre's view ray with that triangle's
+// unrounded world-space vertices, so no float rounding of depth, interpolation or G-buffer
+// encoding reaches the reference. Material values (albedo, specular) come straight from the
+// material and texture lookup, never through a G-buffer encoding.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gbuffer/FrameView.h"
+#include "gbuffer/SceneGeometry.h"
+
+namespace gbuffer {
+
+struct ExactSurface {
+    static constexpr uint32_t kNoTriangle = UINT32_MAX;
+
+    int width = 0;
+    int height = 0;
+    std::vector<uint32_t> triangle;  // covering triangle per pixel, kNoTriangle for background
+    std::vector<uint8_t> backFacing;  // 1 where the visible side is the back face (normal flipped)
+    std::vector<glm::vec3> albedo;
+    std::vector<glm::vec2> specular;  // intensity, power
+    std::vector<glm::dvec3> positionView;
+    std::vector<glm::dvec3> normalView;
+
+    void resize(int w, int h);
+    bool covered(size_t pixel) const { return triangle[pixel] != kNoTriangle; }
+    // Fills positionView and normalView from `triangle` (parallel over rows, deterministic).
+    void computeGeometry(const SceneGeometry& geometry, const FrameView& view);
+};
+
+}  // namespace gbuffer

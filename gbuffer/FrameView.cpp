@@ -1,0 +1,36 @@
+#include "gbuffer/FrameView.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace gbuffer {
+
+FrameView FrameView::fromCamera(const scenes::Camera& camera, int width, int height,
+                                DepthConvention convention) {
+    FrameView view;
+    view.depthConvention = convention;
+    view.width = width;
+    view.height = height;
+    view.nearMetres = camera.nearMetres;
+    view.farMetres = camera.farMetres;
+    const double aspect = double(width) / double(height);
+    // Built in double, then rounded: the float matrices and the exact ones describe one camera.
+    const glm::dvec3 eye(camera.positionWorld), forward(camera.forwardWorld), up(camera.upWorld);
+    view.viewFromWorldExact = glm::lookAtRH(eye, eye + forward, up);
+    glm::dmat4 clipFromViewExact = glm::perspectiveRH_ZO(
+        double(camera.verticalFovRadians), aspect, double(camera.nearMetres), double(camera.farMetres));
+    if (convention == DepthConvention::Reversed) {
+        // z' = w - z maps [0, w] onto [w, 0]: near -> 1, far -> 0.
+        glm::dmat4 reverse(1.0);
+        reverse[2][2] = -1.0;
+        reverse[3][2] = 1.0;
+        clipFromViewExact = reverse * clipFromViewExact;
+    }
+    view.viewFromClipExact = glm::inverse(clipFromViewExact);
+    view.viewFromWorld = glm::mat4(view.viewFromWorldExact);
+    view.clipFromView = glm::mat4(clipFromViewExact);
+    view.viewFromClip = glm::mat4(view.viewFromClipExact);
+    view.viewFromWorldNormal = glm::mat3(view.viewFromWorld);
+    return view;
+}
+
+}  // namespace gbuffer

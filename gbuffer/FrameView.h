@@ -1,0 +1,45 @@
+// FrameView: the camera of one frame as matrices, for a given viewport. Depth is "zero to one"
+// (0 <= z <= w in clip space). With standard Z, 0 is the near plane and 1 the far plane; with
+// reversed Z (the default), 1 is the near plane and 0 the far plane, which spreads float32
+// precision evenly over distance (standard float depth loses ~1e-4 relative position accuracy
+// at tens of metres; reversed Z keeps it near float epsilon). View space is right-handed, camera
+// looking down -Z. Double-precision copies serve the reference.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "scenes/Scene.h"
+
+namespace gbuffer {
+
+enum class DepthConvention { Standard, Reversed };
+
+struct FrameView {
+    int width = 0;
+    int height = 0;
+    float nearMetres = 0.1f;
+    float farMetres = 100.0f;
+    DepthConvention depthConvention = DepthConvention::Reversed;
+    glm::mat4 viewFromWorld{1.0f};
+    glm::mat4 clipFromView{1.0f};
+    glm::mat4 viewFromClip{1.0f};   // inverse projection, for position reconstruction
+    glm::mat3 viewFromWorldNormal{1.0f};  // rotation part, for directions and normals
+    glm::dmat4 viewFromWorldExact{1.0};
+    glm::dmat4 viewFromClipExact{1.0};
+
+    static FrameView fromCamera(const scenes::Camera& camera, int width, int height,
+                                DepthConvention convention = DepthConvention::Reversed);
+
+    bool reversedZ() const { return depthConvention == DepthConvention::Reversed; }
+    // Depth of "nothing here": the far plane's value.
+    float clearDepth() const { return reversedZ() ? 0.0f : 1.0f; }
+
+    glm::mat4 clipFromWorld() const { return clipFromView * viewFromWorld; }
+    // Normalised device coordinates of pixel (x, y)'s centre; y up, as in clip space.
+    glm::vec2 ndcOfPixel(int x, int y) const {
+        return {(float(x) + 0.5f) / float(width) * 2.0f - 1.0f,
+                1.0f - (float(y) + 0.5f) / float(height) * 2.0f};
+    }
+};
+
+}  // namespace gbuffer

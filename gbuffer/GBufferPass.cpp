@@ -1,0 +1,114 @@
+#include "gbuffer/GBufferPass.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace gbuffer {
+
+namespace {
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geometry)
+    : mScene(scene), mGeometry(geometry) {
+    if (geometry.triangleCount() >= kBackFaceBit)
+        throw std::length_error(scene.name + ": too many triangles for the visibility buffer");
+}
+
+void GBufferPass::transformVertices(const FrameView& view) {
+    const size_t count = mGeometry.positionWorld.size();
+    mClipPositions.resize(count);
+    mNormalView.resize(count);
+    const glm::mat4 clipFromWorld = view.clipFromWorld();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 4096), [&](const auto& range) {
+        for (size_t v = range.begin(); v != range.end(); ++v) {
+            mClipPositions[v] = clipFromWorld * glm::vec4(mGeometry.positionWorld[v], 1.0f);
+            mNormalView[v] = view.viewFromWorldNormal * mGeometry.normalWorld[v];
+        }
+    });
+}
+
+void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
+    const int width = target.width();
+    const std::vector<uint32_t>& indices = mGeometry.indices;
+    const std::vector<scenes::Material>& materials = mScene.materials;
+    const std::vector<scenes::Texture>& textures = mScene.textures;
+    tbb::parallel_for(0, target.height(), [&](int y) {
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = size_t(y) * width + x;
+            const uint32_t visible = mVisibleTriangle[pixel];
+            if (visible == kNoTriangle) {
+                target.writeBackground(pixel);
+                continue;
+            }
+            const uint32_t t = visible & ~kBackFaceBit;
+            const bool backFace = (visible & kBackFaceBit) != 0;
+            const glm::vec3 weights(1.0f - mBarycentric[pixel].x - mBarycentric[pixel].y,
+                                    mBarycentric[pixel].x, mBarycentric[pixel].y);
+            const uint32_t i0 = indices[3 * t], i1 = indices[3 * t + 1], i2 = indices[3 * t + 2];
+            glm::vec3 normal = raster::interpolate(mNormalView[i0], mNormalView[i1], mNormalView[i2], weights);
+            const float length2 = glm::dot(normal, normal);
+            normal = length2 > 0.0f ? normal * (1.0f / std::sqrt(length2)) : glm::vec3(0.0f, 0.0f, 1.0f);
+            if (backFace) normal = -normal;  // two-sided draws light the visible side
+            const scenes::Material& material = materials[mGeometry.triangleMaterial[t]];
+            glm::vec3 albedo(material.baseColorFactor);
+            if (material.baseColorTexture >= 0) {
+                const glm::vec2 uv = raster::interpolate(mGeometry.uv[i0], mGeometry.uv[i1], mGeometry.uv[i2], weights);
+                albedo *= glm::vec3(textures[size_t(material.baseColorTexture)].sample(uv));
+            }
+            target.writeSurface(pixel, normal, albedo, material.specularIntensity, material.specularPower);
+            if (exact) {
+                exact->triangle[pixel] = t;
+                exact->backFacing[pixel] = backFace ? 1 : 0;
+                exact->albedo[pixel] = albedo;
+                exact->specular[pixel] = {material.specularIntensity, material.specularPower};
+            }
+        }
+    });
+}
+
+GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& target,
+                                       ExactSurface* exact) {
+    GBufferPassTimings timings;
+    const FrameView& view = target.view();
+    auto start = std::chrono::steady_clock::now();
+    transformVertices(view);
+    timings.transformMs = millisecondsSince(start);
+
+    start = std::chrono::steady_clock::now();
+    target.clearDepth();
+    mVisibleTriangle.assign(target.pixelCount(), kNoTriangle);
+    mBarycentric.resize(target.pixelCount());
+    const int width = view.width;
+    auto recordVisible = [&](const raster::Fragment& fragment) {
+        const size_t pixel = size_t(fragment.y) * width + fragment.x;
+        mVisibleTriangle[pixel] = fragment.triangle | (fragment.frontFacing ? 0u : kBackFaceBit);
+        mBarycentric[pixel] = {fragment.barycentric.y, fragment.barycentric.z};
+    };
+    raster::RasterState state;
+    state.cullMode = raster::CullMode::Back;
+    state.depthTest = view.reversedZ() ? raster::DepthTest::Greater : raster::DepthTest::Less;
+    rasterizer.draw(raster::TriangleList{mClipPositions, mGeometry.indices}, state,
+                    target.depthPlane(), recordVisible);
+    timings.rasterMs = millisecondsSince(start);
+
+    start = std::chrono::steady_clock::now();
+    if (exact) exact->resize(view.width, view.height);
+    resolve(target, exact);
+    timings.resolveMs = millisecondsSince(start);
+
+    if (exact) {
+        start = std::chrono::steady_clock::now();
+        exact->computeGeometry(mGeometry, view);
+        timings.exactMs = millisecondsSince(start);
+    }
+    return timings;
+}
+
+}  // namespace gbuffer

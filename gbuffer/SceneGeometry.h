@@ -1,0 +1,29 @@
+// SceneGeometry: a Scene's instances flattened into one world-space triangle list, built once per
+// scene and shared by every pass of every frame (G-buffer, forward shading, the reference).
+// Vertex i of triangle t is vertices[indices[3t + i]]; triangle t has material triangleMaterial[t].
+// Instance transforms are applied here, in double, and rounded once.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scenes/Scene.h"
+
+namespace gbuffer {
+
+struct SceneGeometry {
+    std::vector<glm::vec3> positionWorld;
+    std::vector<glm::dvec3> positionWorldExact;  // unrounded instance transform, for the reference
+    std::vector<glm::vec3> normalWorld;          // unit
+    std::vector<glm::vec2> uv;                   // (0,0) where the mesh has none
+    std::vector<uint32_t> indices;
+    std::vector<uint32_t> triangleMaterial;
+    std::vector<uint32_t> triangleInstance;
+
+    uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
+    static SceneGeometry build(const scenes::Scene& scene);
+};
+
+}  // namespace gbuffer
