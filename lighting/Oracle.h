@@ -1,0 +1,15 @@
+// Oracle: how many lights contribute at each pixel, counted by brute force over every light
+// from the G-buffer. Culling stages are checked against it: at every pixel a stage must evaluate
+// at least this many lights.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "lighting/ShadingStage.h"
+
+namespace lighting {
+
+std::vector<uint32_t> countContributingLights(const Frame& frame);
+
+}  // namespace lighting
