@@ -1,0 +1,77 @@
+// Result images of one render, written through OpenImageIO and AtomicFile (a failed write never
+// leaves a partial file under the final name):
+//   - a multi-layer float32 OpenEXR with the beauty, G-buffer and light-count planes and the run's
+//     metadata in the header;
+//   - a tone-mapped 8-bit sRGB PNG preview of the beauty;
+//   - a false-colour PNG heatmap of per-pixel light counts with a legend strip below the data.
+//
+// Conventions: every plane is width * height values in row-major order, rows top to bottom (row 0
+// is the top of the image, as in OpenImageIO and EXR), no padding between rows. Colour planes are
+// linear (scene-referred) radiance.
+//
+// Errors: a wrong argument (empty or duplicate channel name, null plane, non-positive size) throws
+// std::invalid_argument; a failure to write (folder missing or read-only, disk full, codec error,
+// legend font missing) throws std::runtime_error naming the final path and the reason.
+//
+// Thread safety: the functions share no state and may run concurrently for different paths.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace experiments {
+
+// One float plane of a multi-layer EXR. data is borrowed: it must hold width * height values and
+// stay alive during the write call.
+struct ImagePlane {
+    std::string channelName; // e.g. "R", "N.X", "albedo.R", "lights.evaluated"
+    const float* data;
+};
+
+// Writes one OpenEXR file with one float32 channel per plane (never half: stored values are
+// bit-exact copies of the input), ZIP compression, and every metadata pair as a string attribute
+// in the header (e.g. {"testbed:stage", "tiled"}). Dots in channel names make EXR layers
+// ("N.X" is channel X of layer N), which viewers and `oiiotool --info -v` show.
+//
+// Channel order: EXR stores the channel list sorted by name, so the order of planes is not kept
+// in the file. OpenImageIO reads channels back as the unlayered ones first in R,G,B,A,Z order,
+// then each layer in name order (R,G,B,Z,N.X,N.Y,N.Z,albedo.R,...); look channels up by name.
+// Cost: one pass over the planes, interleaving 16 rows at a time (the ZIP block height), so the
+// extra memory is 16 rows of pixels, not a copy of the image.
+void writeMultiLayerExr(const std::filesystem::path& path, int width, int height,
+                        const std::vector<ImagePlane>& planes,
+                        const std::vector<std::pair<std::string, std::string>>& metadata);
+
+// Writes an 8-bit sRGB PNG of width x height: each linear channel is multiplied by exposure (a
+// linear factor, not stops; must be finite and > 0), tone-mapped with Narkowicz's ACES filmic fit
+// and encoded with the sRGB OETF. NaN and negative values show as 0 (black), +Inf as 1 (white),
+// so a broken pixel never corrupts its neighbours or the file.
+void writePreviewPng(const std::filesystem::path& path, int width, int height, const float* r,
+                     const float* g, const float* b, float exposure = 1.0f);
+
+// Layout of the heatmap PNG: the data occupies the top-left width x height pixels unchanged in
+// position; a legend strip of kHeatmapLegendHeight rows is appended below it. The PNG is at least
+// kHeatmapMinWidth wide so that the legend's labels fit for small images; columns right of the
+// data are filled with the legend's grey, which no count maps to.
+inline constexpr int kHeatmapLegendHeight = 52; // pixels: margin, colour bar, ticks, labels
+inline constexpr int kHeatmapMinWidth = 320;    // pixels: fits ~10 labels of up to 4 digits
+
+// Writes a false-colour heatmap of per-pixel light counts (width * height values) as an 8-bit
+// PNG: 0 is black, 1..scaleMax follow the Turbo colormap linearly from dark blue to dark red, and
+// counts above scaleMax are white (saturated). The legend shows the colour of every count from 0
+// to scaleMax on a bar with labelled ticks (0, round intermediate values, scaleMax) and a white
+// swatch labelled ">scaleMax". scaleMax == 0 means heatmapAutoScale() of the image. Use the same
+// explicit scaleMax for images that are to be compared side by side.
+// Labels are drawn with OpenImageIO's render_text and the DejaVu Sans font from Debian's
+// fonts-dejavu-core package; without it this throws std::runtime_error saying so.
+void writeHeatmapPng(const std::filesystem::path& path, int width, int height,
+                     const uint32_t* counts, uint32_t scaleMax);
+
+// The largest of the n counts, at least 1 (so an all-zero image still has a valid scale).
+uint32_t heatmapAutoScale(const uint32_t* counts, size_t n);
+
+} // namespace experiments

@@ -1,0 +1,32 @@
+// RenderCommand: `testbed render`: runs a RenderJob and writes its results into --out:
+//   render.exr   multi-layer OpenEXR (beauty R,G,B; N.X,N.Y,N.Z; Z; albedo.R,G,B;
+//                lights.evaluated; lights.oracle), options and timings in the header
+//   preview.png  tone-mapped beauty
+//   heatmap.png  lights evaluated per pixel, false colour with a legend
+//   stats.json   configuration, machine, commit, timings, light counts, error metrics
+// Every file is written under a temporary name and renamed, so a failed run leaves no partial
+// output. The output folder is checked for writability before any work.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "experiments/RenderJob.h"
+
+namespace experiments {
+
+struct RenderCommandOptions {
+    RenderOptions render;
+    std::filesystem::path out = "out";
+    uint32_t heatmapMax = 0;  // 0 = the image's own maximum
+};
+
+nlohmann::json statsJson(const RenderRun& run);
+
+// Validates, renders, writes; returns the process exit code (0 on success). Errors are
+// reported on stderr as one line starting with "testbed: error:".
+int runRenderCommand(const RenderCommandOptions& options);
+
+}  // namespace experiments

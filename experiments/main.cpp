@@ -1,0 +1,71 @@
+// testbed: the command-line front end. Subcommands:
+//   render  one scene, one stage -> render.exr, preview.png, heatmap.png, stats.json
+//   list    scenes, stages (and later encodings) known to this build
+// Every option's default is stated by --help; unknown options are errors.
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "experiments/RenderCommand.h"
+#include "lighting/StageRegistry.h"
+#include "scenes/ProceduralScenes.h"
+
+namespace {
+
+void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& options,
+                      std::vector<std::string>& sceneOptionTexts) {
+    experiments::RenderOptions& r = options.render;
+    render.add_option("--scene", r.scene, "built-in scene name or .gltf/.glb/.json file")->capture_default_str();
+    render.add_option("--scene-option", sceneOptionTexts,
+                      "scene-specific key=value (repeatable), e.g. behind=1000 for wall")
+        ->allow_extra_args(false);
+    render.add_option("--stage", r.stage, "shading stage, NAME or NAME:key=value,...")->capture_default_str();
+    render.add_option("--lights", r.lights, "generated point lights")->capture_default_str();
+    render.add_option("--seed", r.seed, "seed of the light generator")->capture_default_str();
+    render.add_option("--width", r.width, "image width in pixels")->capture_default_str();
+    render.add_option("--height", r.height, "image height in pixels")->capture_default_str();
+    render.add_option("--threads", r.threads, "worker threads, 0 = all hardware threads")->capture_default_str();
+    render.add_option("--out", options.out, "output folder")->capture_default_str();
+    render.add_option("--heatmap-max", options.heatmapMax,
+                      "light count at the top of the heatmap scale, 0 = the image's maximum")
+        ->capture_default_str();
+    render.add_flag("--compare-reference", r.compareReference,
+                    "also render the double-precision reference and record the error");
+}
+
+int listEverything() {
+    std::cout << "scenes (default " << scenes::kDefaultSceneName << "):\n";
+    for (const std::string& name : scenes::proceduralSceneNames()) std::cout << "  " << name << "\n";
+    std::cout << "  <file>.gltf | <file>.glb | <file>.json\n";
+    std::cout << "stages:\n";
+    for (const lighting::StageInfo& info : lighting::stageInfos())
+        std::cout << "  " << info.name << "  - " << info.description << "\n";
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"testbed: CPU rasterizer research testbed for deferred shading"};
+    app.require_subcommand(1);
+    experiments::RenderCommandOptions renderOptions;
+    std::vector<std::string> sceneOptionTexts;
+    CLI::App* render = app.add_subcommand("render", "render one scene with one shading stage");
+    addRenderOptions(*render, renderOptions, sceneOptionTexts);
+    CLI::App* list = app.add_subcommand("list", "list scenes and stages");
+    CLI11_PARSE(app, argc, argv);
+    if (render->parsed()) {
+        for (const std::string& text : sceneOptionTexts) {
+            const size_t equals = text.find('=');
+            if (equals == std::string::npos || equals == 0) {
+                std::cerr << "testbed: error: --scene-option '" << text << "' is not key=value\n";
+                return 1;
+            }
+            renderOptions.render.sceneOptions[text.substr(0, equals)] = text.substr(equals + 1);
+        }
+        return experiments::runRenderCommand(renderOptions);
+    }
+    if (list->parsed()) return listEverything();
+    return 1;
+}

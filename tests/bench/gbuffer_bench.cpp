@@ -1,0 +1,93 @@
+// G-buffer pass and shading cost on `atrium` at 1280x720, at 1 and 2 threads.
+// Reports ms per frame (manual time), triangles/s, and for shading ns per light-sample.
+// Compare ratios measured in one run (2 threads vs 1); absolute figures depend on the machine.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <memory>
+
+#include <tbb/task_arena.h>
+
+#include "gbuffer/GBufferPass.h"
+#include "gbuffer/SceneGeometry.h"
+#include "lighting/LightList.h"
+#include "lighting/StageRegistry.h"
+#include "scenes/ProceduralScenes.h"
+
+namespace {
+
+constexpr int kWidth = 1280;
+constexpr int kHeight = 720;
+
+struct AtriumFixture {
+    scenes::Scene scene;
+    gbuffer::SceneGeometry geometry;
+    gbuffer::FrameView view;
+
+    explicit AtriumFixture(int lightCount) {
+        scenes::SceneRequest request;
+        request.lightCount = lightCount;
+        request.seed = 1;
+        scene = scenes::buildProceduralScene("atrium", request);
+        geometry = gbuffer::SceneGeometry::build(scene);
+        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
+    }
+};
+
+const AtriumFixture& atrium() {
+    static const AtriumFixture fixture(256);
+    return fixture;
+}
+
+void gbufferPass(benchmark::State& state) {
+    const AtriumFixture& f = atrium();
+    tbb::task_arena arena(int(state.range(0)));
+    gbuffer::GBuffer target(gbuffer::GBufferLayout::reference(), f.view);
+    raster::Rasterizer rasterizer(kWidth, kHeight);
+    gbuffer::GBufferPass pass(f.scene, f.geometry);
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        arena.execute([&] { pass.render(rasterizer, target); });
+        state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    state.counters["triangles"] = double(f.geometry.triangleCount());
+    state.counters["triangles/s"] = benchmark::Counter(double(f.geometry.triangleCount()),
+                                                       benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["fragments"] = double(rasterizer.lastStats().samplesCovered);
+}
+BENCHMARK(gbufferPass)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void bruteShading(benchmark::State& state) {
+    const AtriumFixture& f = atrium();
+    tbb::task_arena arena(int(state.range(0)));
+    gbuffer::GBuffer target(gbuffer::GBufferLayout::reference(), f.view);
+    raster::Rasterizer rasterizer(kWidth, kHeight);
+    gbuffer::GBufferPass pass(f.scene, f.geometry);
+    arena.execute([&] { pass.render(rasterizer, target); });
+    const lighting::LightList lights = lighting::LightList::build(f.scene.lights, f.view);
+    lighting::Frame frame;
+    frame.scene = &f.scene;
+    frame.geometry = &f.geometry;
+    frame.view = &f.view;
+    frame.gbuffer = &target;
+    frame.lights = &lights;
+    auto stage = lighting::makeStage("brute");
+    lighting::StageResult result;
+    uint64_t samples = 0;
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        arena.execute([&] { stage->shade(frame, result); });
+        state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        samples = 0;
+        for (uint32_t n : result.lightsEvaluated) samples += n;
+    }
+    state.counters["light_samples"] = double(samples);
+    // ns per light-sample = time per iteration / samples.
+    state.counters["ns/light-sample"] = benchmark::Counter(
+        double(samples) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(bruteShading)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(2);
+
+}  // namespace
+
+BENCHMARK_MAIN();

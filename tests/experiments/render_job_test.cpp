@@ -1,0 +1,175 @@
+// End-to-end renders in process: determinism across thread counts, brute against the
+// double-precision reference, the oracle, and refusal of bad input before any work.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+#include <OpenImageIO/imageio.h>
+
+#include "experiments/RenderCommand.h"
+#include "experiments/RenderJob.h"
+
+namespace {
+
+using experiments::RenderOptions;
+using experiments::RenderRun;
+using experiments::runRender;
+
+RenderOptions smallAtrium(int threads) {
+    RenderOptions options;
+    options.scene = "atrium";
+    options.stage = "brute";
+    options.lights = 64;
+    options.seed = 7;
+    options.width = 320;
+    options.height = 180;
+    options.threads = threads;
+    return options;
+}
+
+template <class T>
+bool bitwiseEqual(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+TEST(RenderJob, BitwiseIdenticalForAnyThreadCount) {
+    const RenderRun one = runRender(smallAtrium(1));
+    for (int threads : {2, 7}) {
+        const RenderRun many = runRender(smallAtrium(threads));
+        EXPECT_TRUE(bitwiseEqual(one.gbuffer->depth(), many.gbuffer->depth())) << threads;
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_TRUE(bitwiseEqual(one.gbuffer->normalPlane(c), many.gbuffer->normalPlane(c))) << threads;
+            EXPECT_TRUE(bitwiseEqual(one.gbuffer->albedoPlane(c), many.gbuffer->albedoPlane(c))) << threads;
+            EXPECT_TRUE(bitwiseEqual(one.result.radiance[c], many.result.radiance[c])) << threads;
+        }
+        EXPECT_TRUE(bitwiseEqual(one.result.lightsEvaluated, many.result.lightsEvaluated));
+        EXPECT_TRUE(bitwiseEqual(one.oracle, many.oracle));
+        EXPECT_EQ(one.rasterStats.samplesPassed, many.rasterStats.samplesPassed);
+    }
+}
+
+TEST(RenderJob, BruteMatchesReferenceOnAtrium) {
+    RenderOptions options = smallAtrium(0);
+    options.compareReference = true;
+    const RenderRun run = runRender(options);
+    ASSERT_TRUE(run.error.has_value());
+    EXPECT_LT(run.error->relativeRmse, 1e-4) << "rmse " << run.error->rmse;
+    EXPECT_GT(run.error->relativeRmse, 0.0) << "float and double should differ a little";
+    // The scene is lit: not a black image compared with a black image.
+    double sum = 0.0;
+    for (float v : run.reference.radiance[1]) sum += v;
+    EXPECT_GT(sum / run.reference.radiance[1].size(), 1e-3);
+}
+
+TEST(RenderJob, BruteEvaluatesEveryLightAndCountsTheOracle) {
+    const RenderRun run = runRender(smallAtrium(0));
+    const uint32_t lightCount = uint32_t(run.scene.lights.size());
+    uint64_t covered = 0, oracle = 0;
+    for (size_t pixel = 0; pixel < run.oracle.size(); ++pixel) {
+        const bool isCovered = run.gbuffer->covered(pixel);
+        covered += isCovered;
+        EXPECT_EQ(run.result.lightsEvaluated[pixel], isCovered ? lightCount : 0u);
+        EXPECT_LE(run.oracle[pixel], run.result.lightsEvaluated[pixel]);
+        oracle += run.oracle[pixel];
+    }
+    EXPECT_GT(covered, run.oracle.size() / 2);
+    EXPECT_GT(oracle, covered);             // more than the ambient light somewhere
+    EXPECT_LT(oracle, covered * lightCount);  // the falloff has finite support
+}
+
+struct BadCase {
+    const char* name;
+    RenderOptions options;
+};
+// Keeps gtest from printing the options' bytes into every test name.
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
+
+class BadInput : public ::testing::TestWithParam<BadCase> {};
+
+RenderOptions with(void (*change)(RenderOptions&)) {
+    RenderOptions options = smallAtrium(1);
+    change(options);
+    return options;
+}
+
+TEST_P(BadInput, IsRefusedBeforeAnyWork) {
+    const std::filesystem::path out =
+        std::filesystem::path(::testing::TempDir()) / ("bad_input_" + std::string(GetParam().name));
+    std::filesystem::remove_all(out);
+    experiments::RenderCommandOptions options;
+    options.render = GetParam().options;
+    options.out = out;
+    testing::internal::CaptureStderr();
+    const int code = experiments::runRenderCommand(options);
+    const std::string message = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(code, 1);
+    EXPECT_NE(message.find("testbed: error:"), std::string::npos) << message;
+    EXPECT_FALSE(std::filesystem::exists(out / "render.exr"));
+    EXPECT_FALSE(std::filesystem::exists(out / "stats.json"));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cli, BadInput,
+    ::testing::Values(
+        BadCase{"unknown_scene", with([](RenderOptions& o) { o.scene = "nosuchscene"; })},
+        BadCase{"missing_file", with([](RenderOptions& o) { o.scene = "/nonexistent/x.gltf"; })},
+        BadCase{"unknown_stage", with([](RenderOptions& o) { o.stage = "nosuchstage"; })},
+        BadCase{"stage_option", with([](RenderOptions& o) { o.stage = "brute:tile=3"; })},
+        BadCase{"zero_width", with([](RenderOptions& o) { o.width = 0; })},
+        BadCase{"negative_height", with([](RenderOptions& o) { o.height = -5; })},
+        BadCase{"absurd_size", with([](RenderOptions& o) { o.width = o.height = 100000; })},
+        BadCase{"negative_lights", with([](RenderOptions& o) { o.lights = -1; })},
+        BadCase{"scene_option", with([](RenderOptions& o) { o.sceneOptions["nosuch"] = "1"; })}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(RenderCommand, UnwritableOutputFolderIsRefused) {
+    const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "a_regular_file";
+    std::ofstream(file) << "x";
+    experiments::RenderCommandOptions options;
+    options.render = smallAtrium(1);
+    options.out = file / "sub";
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(experiments::runRenderCommand(options), 1);
+    const std::string message = testing::internal::GetCapturedStderr();
+    EXPECT_NE(message.find("a_regular_file"), std::string::npos) << message;
+}
+
+TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
+    const std::filesystem::path out = std::filesystem::path(::testing::TempDir()) / "render_ok";
+    std::filesystem::remove_all(out);
+    experiments::RenderCommandOptions options;
+    options.render = smallAtrium(2);
+    options.render.compareReference = true;
+    options.out = out;
+    testing::internal::CaptureStdout();
+    ASSERT_EQ(experiments::runRenderCommand(options), 0);
+    testing::internal::GetCapturedStdout();
+    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "stats.json"})
+        EXPECT_TRUE(std::filesystem::is_regular_file(out / file)) << file;
+
+    auto input = OIIO::ImageInput::open((out / "render.exr").string());
+    ASSERT_TRUE(input);
+    const std::vector<std::string> expected = {"R", "G", "B", "N.X", "N.Y", "N.Z", "Z", "albedo.R",
+                                               "albedo.G", "albedo.B", "lights.evaluated", "lights.oracle"};
+    for (const std::string& name : expected) {
+        const auto& names = input->spec().channelnames;
+        EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+    }
+    EXPECT_EQ(input->spec().width, 320);
+
+    std::ifstream statsFile(out / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(statsFile);
+    for (const char* key : {"scene", "stage", "width", "height", "threads", "triangles", "lights",
+                            "timings_ms", "light_evaluations", "oracle_light_evaluations", "error"})
+        EXPECT_TRUE(stats.contains(key)) << key;
+    for (const char* pass : {"gbuffer", "shading", "total"})
+        EXPECT_TRUE(stats["timings_ms"].contains(pass)) << pass;
+    for (const char* metric : {"rmse", "max_abs", "psnr"})
+        EXPECT_TRUE(stats["error"].contains(metric)) << metric;
+    EXPECT_GE(stats["triangles"].get<uint64_t>(), 250000u);
+}
+
+}  // namespace
