@@ -13,6 +13,19 @@ namespace {
 double millisecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
+// Perspective-correct barycentrics of the pixel centre at `ndc` in the triangle with clip-space
+// vertices c0, c1, c2. The point sum(b_i c_i) projects onto ndc when
+// sum b_i (x_i - ndc.x w_i) = 0 and sum b_i (y_i - ndc.y w_i) = 0, so b is the cross product of
+// those two rows, normalised to sum 1. Homogeneous: valid for triangles crossing the near plane.
+glm::vec3 perspectiveBarycentrics(const glm::vec4& c0, const glm::vec4& c1, const glm::vec4& c2,
+                                  glm::vec2 ndc) {
+    const glm::vec3 rowX(c0.x - ndc.x * c0.w, c1.x - ndc.x * c1.w, c2.x - ndc.x * c2.w);
+    const glm::vec3 rowY(c0.y - ndc.y * c0.w, c1.y - ndc.y * c1.w, c2.y - ndc.y * c2.w);
+    const glm::vec3 b = glm::cross(rowX, rowY);
+    const float sum = b.x + b.y + b.z;
+    return sum != 0.0f ? b * (1.0f / sum) : glm::vec3(1.0f / 3.0f);
+}
+
 }  // namespace
 
 GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geometry)
@@ -36,6 +49,7 @@ void GBufferPass::transformVertices(const FrameView& view) {
 
 void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
     const int width = target.width();
+    const FrameView& view = target.view();
     const std::vector<uint32_t>& indices = mGeometry.indices;
     const std::vector<scenes::Material>& materials = mScene.materials;
     const std::vector<scenes::Texture>& textures = mScene.textures;
@@ -49,9 +63,9 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
             }
             const uint32_t t = visible & ~kBackFaceBit;
             const bool backFace = (visible & kBackFaceBit) != 0;
-            const glm::vec3 weights(1.0f - mBarycentric[pixel].x - mBarycentric[pixel].y,
-                                    mBarycentric[pixel].x, mBarycentric[pixel].y);
             const uint32_t i0 = indices[3 * t], i1 = indices[3 * t + 1], i2 = indices[3 * t + 2];
+            const glm::vec3 weights = perspectiveBarycentrics(
+                mClipPositions[i0], mClipPositions[i1], mClipPositions[i2], view.ndcOfPixel(x, y));
             glm::vec3 normal = raster::interpolate(mNormalView[i0], mNormalView[i1], mNormalView[i2], weights);
             const float length2 = glm::dot(normal, normal);
             normal = length2 > 0.0f ? normal * (1.0f / std::sqrt(length2)) : glm::vec3(0.0f, 0.0f, 1.0f);
@@ -84,12 +98,13 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     start = std::chrono::steady_clock::now();
     target.clearDepth();
     mVisibleTriangle.assign(target.pixelCount(), kNoTriangle);
-    mBarycentric.resize(target.pixelCount());
     const int width = view.width;
+    // Only the triangle is recorded: its barycentrics are computed once per pixel in resolve()
+    // rather than for every sample that passes the depth test (the compiler drops the unused
+    // interpolation from the inlined traversal).
     auto recordVisible = [&](const raster::Fragment& fragment) {
         const size_t pixel = size_t(fragment.y) * width + fragment.x;
         mVisibleTriangle[pixel] = fragment.triangle | (fragment.frontFacing ? 0u : kBackFaceBit);
-        mBarycentric[pixel] = {fragment.barycentric.y, fragment.barycentric.z};
     };
     raster::RasterState state;
     state.cullMode = raster::CullMode::Back;

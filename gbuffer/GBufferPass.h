@@ -42,7 +42,7 @@ private:
     void resolve(GBuffer& target, ExactSurface* exact) const;
 
     // Visibility buffer: the visible triangle per pixel (kNoTriangle for background, the top bit
-    // set when the back face is visible) and its perspective-correct barycentrics b1, b2.
+    // set when the back face is visible).
     static constexpr uint32_t kNoTriangle = UINT32_MAX;
     static constexpr uint32_t kBackFaceBit = 1u << 31;
 
@@ -51,7 +51,6 @@ private:
     std::vector<glm::vec4> mClipPositions;
     std::vector<glm::vec3> mNormalView;
     std::vector<uint32_t> mVisibleTriangle;
-    std::vector<glm::vec2> mBarycentric;
 };
 
 }  // namespace gbuffer

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <tbb/blocked_range.h>
+
 namespace raster {
 
 namespace {
@@ -74,6 +76,7 @@ void setUpAttributePlanes(SetupTriangle& s, double x[3], double y[3], const doub
         }
         area = snappedArea;
     }
+    double l1[3], l2[3];
     auto plane = [&](int a, int b, double out[3]) {
         // E_ab at pixel (px, py), sampled at its centre (px + 0.5, py + 0.5), over the area.
         const double dx = x[b] - x[a], dy = y[b] - y[a];
@@ -81,14 +84,31 @@ void setUpAttributePlanes(SetupTriangle& s, double x[3], double y[3], const doub
         out[2] = dx / area;
         out[0] = (dx * (0.5 - y[a]) - dy * (0.5 - x[a])) / area;
     };
-    plane(2, 0, s.planes.l1);
-    plane(0, 1, s.planes.l2);
+    plane(2, 0, l1);
+    plane(0, 1, l2);
     for (int k = 0; k < 3; ++k)
-        s.planes.z[k] = (k == 0 ? depth[0] : 0.0) + s.planes.l1[k] * (depth[1] - depth[0]) +
-                        s.planes.l2[k] * (depth[2] - depth[0]);
+        s.planes.z[k] = (k == 0 ? depth[0] : 0.0) + l1[k] * (depth[1] - depth[0]) + l2[k] * (depth[2] - depth[0]);
+    // Barycentrics relative to the bounding-box corner, rounded to float.
+    s.planes.l1[0] = float(l1[0] + l1[1] * s.minX + l1[2] * s.minY);
+    s.planes.l2[0] = float(l2[0] + l2[1] * s.minX + l2[2] * s.minY);
+    for (int k = 1; k < 3; ++k) {
+        s.planes.l1[k] = float(l1[k]);
+        s.planes.l2[k] = float(l2[k]);
+    }
 }
 
 }  // namespace
+
+Rasterizer::ProjectedVertex Rasterizer::project(const glm::vec4& clip) const {
+    // After clipping, w = 0 is only possible at the clip-space origin (the eye of a zero-near
+    // projection): a piece touching it is seen edge-on and covers nothing (invW = 0 marks it).
+    if (!(clip.w > 0.0f)) return {0, 0, 0.0f};
+    const float invW = 1.0f / clip.w;
+    const float screenX = (clip.x * invW + 1.0f) * (0.5f * float(mWidth));
+    const float screenY = (1.0f - clip.y * invW) * (0.5f * float(mHeight));
+    return {int32_t(std::lrint(screenX * float(kSubpixelScale))),
+            int32_t(std::lrint(screenY * float(kSubpixelScale))), invW};
+}
 
 Rasterizer::Rasterizer(int width, int height) : mWidth(width), mHeight(height) {
     if (width <= 0 || height <= 0 || width > kMaxViewportSize || height > kMaxViewportSize)
@@ -102,6 +122,18 @@ Rasterizer::Rasterizer(int width, int height) : mWidth(width), mHeight(height) {
 void Rasterizer::setUpAndBin(const TriangleList& triangles, CullMode cullMode) {
     const uint32_t triangleCount = triangles.triangleCount();
     const uint32_t batchCount = (triangleCount + kTrianglesPerBatch - 1) / kTrianglesPerBatch;
+    // Project and snap every vertex once: a vertex is shared by about six triangles. Vertices
+    // outside the guard band are projected too (finite, unused: their triangles are clipped).
+    const size_t vertexCount = triangles.clipPositions.size();
+    mProjected.resize(vertexCount);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexCount, 8192), [&](const auto& range) {
+        for (size_t v = range.begin(); v != range.end(); ++v) {
+            const glm::vec4& c = triangles.clipPositions[v];
+            const bool insideGuardBand = std::abs(c.x) <= kGuardBandPixels / (0.5f * float(mWidth)) * c.w &&
+                                         std::abs(c.y) <= kGuardBandPixels / (0.5f * float(mHeight)) * c.w;
+            mProjected[v] = insideGuardBand ? project(c) : ProjectedVertex{0, 0, 0.0f};
+        }
+    });
     mBatches.resize(batchCount);
     tbb::parallel_for(uint32_t(0), batchCount, [&](uint32_t b) {
         const uint32_t first = b * kTrianglesPerBatch;
@@ -121,6 +153,7 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
                             CullMode cullMode, Batch& batch) const {
     batch.triangles.clear();
     batch.triangles.reserve(last - first);  // address space only; pages are touched on use
+    batch.clippedWeights.clear();
     batch.pairTile.clear();
     batch.pairTriangle.clear();
     batch.stats = RasterStats{};
@@ -128,13 +161,13 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
 
     const float guardX = kGuardBandPixels / (0.5f * float(mWidth));
     const float guardY = kGuardBandPixels / (0.5f * float(mHeight));
-    static const glm::vec3 kCorner[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
     for (uint32_t t = first; t < last; ++t) {
         glm::vec4 clip[3];
+        uint32_t index[3];
         for (int i = 0; i < 3; ++i) {
-            const uint32_t index = triangles.indices[size_t(t) * 3 + i];
-            clip[i] = triangles.clipPositions[index];
+            index[i] = triangles.indices[size_t(t) * 3 + i];
+            clip[i] = triangles.clipPositions[index[i]];
         }
         // Trivial reject against the view frustum (x, y within +-w, 0 <= z <= w): no pixel
         // centre of the viewport can be covered when all three vertices are outside one plane.
@@ -164,13 +197,15 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
                     if (planeDistance(plane, clip[i], guardX, guardY) < 0.0f) needsClip = true;
 
         if (!needsClip) {
-            emitTriangle(clip, kCorner, t, cullMode, batch);
+            const ProjectedVertex projected[3] = {mProjected[index[0]], mProjected[index[1]],
+                                                  mProjected[index[2]]};
+            emitTriangle(clip, projected, nullptr, t, cullMode, batch);
             continue;
         }
         ++batch.stats.trianglesClipped;
         ClipVertex polygon[2][kMaxPolygon];
         int count = 3;
-        for (int i = 0; i < 3; ++i) polygon[0][i] = {clip[i], kCorner[i]};
+        for (int i = 0; i < 3; ++i) polygon[0][i] = {clip[i], glm::vec3(i == 0, i == 1, i == 2)};
         int current = 0;
         for (int plane = 0; plane < kClipPlaneCount && count >= 3; ++plane) {
             count = clipPolygon(polygon[current], count, polygon[1 - current], plane, guardX, guardY);
@@ -183,7 +218,8 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
             const ClipVertex& c = polygon[current][i + 1];
             const glm::vec4 pieceClip[3] = {a.clip, b.clip, c.clip};
             const glm::vec3 pieceBarycentric[3] = {a.barycentric, b.barycentric, c.barycentric};
-            emitTriangle(pieceClip, pieceBarycentric, t, cullMode, batch);
+            const ProjectedVertex projected[3] = {project(a.clip), project(b.clip), project(c.clip)};
+            emitTriangle(pieceClip, projected, pieceBarycentric, t, cullMode, batch);
         }
     }
     // Counting sort of the (tile, triangle) pairs; stable, so each bin keeps submission order.
@@ -192,9 +228,8 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
     for (uint32_t tile : batch.pairTile) ++batch.binOffsets[tile + 1];
     for (size_t tile = 0; tile < tileCount; ++tile) batch.binOffsets[tile + 1] += batch.binOffsets[tile];
     batch.binItems.resize(batch.pairTile.size());
-    std::vector<uint32_t>& cursor = batch.pairTile;  // reused in place: each pair reads its tile first
-    for (size_t pair = 0; pair < cursor.size(); ++pair) {
-        const uint32_t tile = cursor[pair];
+    for (size_t pair = 0; pair < batch.pairTile.size(); ++pair) {
+        const uint32_t tile = batch.pairTile[pair];
         batch.binItems[batch.binOffsets[tile]++] = batch.pairTriangle[pair];
     }
     // The loop advanced every offset to its bin's end; shift back to starts.
@@ -202,28 +237,18 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
     batch.binOffsets[0] = 0;
 }
 
-void Rasterizer::emitTriangle(const glm::vec4 clip[3], const glm::vec3 barycentric[3],
-                              uint32_t triangle, CullMode cullMode, Batch& batch) const {
+void Rasterizer::emitTriangle(const glm::vec4 clip[3], const ProjectedVertex projected[3],
+                              const glm::vec3 barycentric[3], uint32_t triangle, CullMode cullMode,
+                              Batch& batch) const {
     SetupTriangle s;
-    double screenXs[3], screenYs[3], depth[3];
-    const float halfWidth = 0.5f * float(mWidth), halfHeight = 0.5f * float(mHeight);
     for (int i = 0; i < 3; ++i) {
-        // After clipping, w = 0 is only possible at the clip-space origin (the eye of a
-        // zero-near projection): such a piece is seen edge-on and covers nothing.
-        if (!(clip[i].w > 0.0f)) {
+        if (projected[i].invW == 0.0f) {
             ++batch.stats.trianglesCulled;
             return;
         }
-        const float invW = 1.0f / clip[i].w;
-        const float screenX = (clip[i].x * invW + 1.0f) * halfWidth;
-        const float screenY = (1.0f - clip[i].y * invW) * halfHeight;
-        s.x[i] = int32_t(std::lrint(screenX * float(kSubpixelScale)));
-        s.y[i] = int32_t(std::lrint(screenY * float(kSubpixelScale)));
-        screenXs[i] = (double(clip[i].x) / clip[i].w + 1.0) * (0.5 * mWidth);
-        screenYs[i] = (1.0 - double(clip[i].y) / clip[i].w) * (0.5 * mHeight);
-        depth[i] = double(clip[i].z) / clip[i].w;
-        s.invW[i] = invW;
-        s.barycentricOfOriginal[i] = barycentric[i];
+        s.x[i] = projected[i].x;
+        s.y[i] = projected[i].y;
+        s.invW[i] = projected[i].invW;
     }
     // Signed doubled area in fixed point; with y down, counter-clockwise in NDC is negative.
     const int64_t area = int64_t(s.x[1] - s.x[0]) * (s.y[2] - s.y[0]) -
@@ -238,15 +263,14 @@ void Rasterizer::emitTriangle(const glm::vec4 clip[3], const glm::vec3 barycentr
         ++batch.stats.trianglesCulled;
         return;
     }
+    int order[3] = {0, 1, 2};  // which input vertex each set-up vertex is
     if (area < 0) {  // traversal wants positive area: swap vertices 1 and 2
         std::swap(s.x[1], s.x[2]);
         std::swap(s.y[1], s.y[2]);
-        std::swap(screenXs[1], screenXs[2]);
-        std::swap(screenYs[1], screenYs[2]);
-        std::swap(depth[1], depth[2]);
         std::swap(s.invW[1], s.invW[2]);
-        std::swap(s.barycentricOfOriginal[1], s.barycentricOfOriginal[2]);
+        std::swap(order[1], order[2]);
     }
+    s.swapped = order[1] == 2;
     // Pixel bounds: pixel p is sampled at p + 0.5, so the first candidate column is
     // ceil(minX - 0.5) and the last floor(maxX - 0.5), in fixed point.
     const int32_t minXf = std::min({s.x[0], s.x[1], s.x[2]});
@@ -255,13 +279,31 @@ void Rasterizer::emitTriangle(const glm::vec4 clip[3], const glm::vec3 barycentr
     const int32_t maxYf = std::max({s.y[0], s.y[1], s.y[2]});
     constexpr int32_t kHalf = kSubpixelScale / 2;
     auto ceilDiv = [](int32_t a) { return -((-a) >> kSubpixelBits); };  // ceil(a / 256)
-    s.minX = std::max(0, ceilDiv(minXf - kHalf));
-    s.minY = std::max(0, ceilDiv(minYf - kHalf));
-    s.maxX = std::min(mWidth - 1, (maxXf - kHalf) >> kSubpixelBits);
-    s.maxY = std::min(mHeight - 1, (maxYf - kHalf) >> kSubpixelBits);
-    if (s.minX > s.maxX || s.minY > s.maxY) {
+    const int minX = std::max(0, ceilDiv(minXf - kHalf));
+    const int minY = std::max(0, ceilDiv(minYf - kHalf));
+    const int maxX = std::min(mWidth - 1, (maxXf - kHalf) >> kSubpixelBits);
+    const int maxY = std::min(mHeight - 1, (maxYf - kHalf) >> kSubpixelBits);
+    if (minX > maxX || minY > maxY) {
         ++batch.stats.trianglesCulled;  // between sample points or off screen
         return;
+    }
+    s.minX = int16_t(minX);
+    s.minY = int16_t(minY);
+    s.maxX = int16_t(maxX);
+    s.maxY = int16_t(maxY);
+    s.clippedWeights = SetupTriangle::kNotClipped;
+    if (barycentric) {
+        s.clippedWeights = uint32_t(batch.clippedWeights.size());
+        batch.clippedWeights.push_back({barycentric[order[0]], barycentric[order[1]], barycentric[order[2]]});
+    }
+    // Unsnapped positions in double, only for triangles that survived culling (most culled
+    // triangles are back faces, and these divisions showed in profiles).
+    double screenXs[3], screenYs[3], depth[3];
+    for (int i = 0; i < 3; ++i) {
+        const glm::vec4& c = clip[order[i]];
+        screenXs[i] = (double(c.x) / c.w + 1.0) * (0.5 * mWidth);
+        screenYs[i] = (1.0 - double(c.y) / c.w) * (0.5 * mHeight);
+        depth[i] = double(c.z) / c.w;
     }
     setUpAttributePlanes(s, screenXs, screenYs, depth);
     s.triangle = triangle;

@@ -32,6 +32,7 @@
 // draw at a time per object.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -93,28 +94,37 @@ struct RasterStats {
     uint64_t samplesPassed = 0;  // passed the depth test
 };
 
-// Screen-space barycentrics l1, l2 and depth as affine functions of the pixel index:
-// value(px, py) = c[0] + c[1] * px + c[2] * py (pixel centres folded into c[0]). They are set up
-// in double from the UNSNAPPED vertex positions: snapping may shift a triangle by up to 1/512
-// pixel, which on a grazing surface moves the reconstructed position by ~1e-4 relative (measured
-// on a tilted plane); coverage uses the snapped edges, attributes do not inherit their error.
+// Depth and screen-space barycentrics l1, l2 as affine functions of the pixel index. They are
+// set up in double from the UNSNAPPED vertex positions: snapping may shift a triangle by up to
+// 1/512 pixel, which on a grazing surface moves the reconstructed position by ~1e-4 relative
+// (measured on a tilted plane); coverage uses the snapped edges, attributes do not inherit their
+// error. Depth stays double: z(px, py) = z[0] + z[1] px + z[2] py (pixel centres folded in).
+// The barycentrics are float, relative to the triangle's bounding-box corner to keep their
+// magnitudes small: l(px, py) = l[0] + l[1] (px - minX) + l[2] (py - minY).
 struct AttributePlanes {
-    double l1[3];
-    double l2[3];
     double z[3];
+    float l1[3];
+    float l2[3];
 };
 
 // A triangle after clipping, snapping and orientation fix-up; positive area in the
-// edge-function convention used by the traversal.
+// edge-function convention used by the traversal. Kept small (it streams through memory
+// between set-up and traversal): clipped pieces keep their weights in a side table.
 struct SetupTriangle {
+    static constexpr uint32_t kNotClipped = UINT32_MAX;
+
     AttributePlanes planes;
     int32_t x[3], y[3];  // fixed point, kSubpixelBits fraction bits
     float invW[3];
-    glm::vec3 barycentricOfOriginal[3];  // vertex i as weights of the original triangle's vertices
     uint32_t triangle;
+    // Index into Batch::clippedWeights (vertex i as weights of the original triangle's
+    // vertices), or kNotClipped: vertex i is original vertex i (1 and 2 swapped if `swapped`).
+    uint32_t clippedWeights;
+    int16_t minX, minY, maxX, maxY;  // inclusive pixel bounds, clamped to the viewport
     bool frontFacing;
-    int minX, minY, maxX, maxY;  // inclusive pixel bounds, already clamped to the viewport
+    bool swapped;
 };
+static_assert(kMaxViewportSize <= INT16_MAX, "pixel bounds are stored as int16_t");
 
 class Rasterizer {
 public:
@@ -139,6 +149,7 @@ private:
     // slowdown).
     struct alignas(64) Batch {
         std::vector<SetupTriangle> triangles;
+        std::vector<std::array<glm::vec3, 3>> clippedWeights;
         // Bins as one compressed table: the triangles (indices into `triangles`, in submission
         // order) of tile t are binItems[binOffsets[t] .. binOffsets[t+1]). Built by a counting
         // sort of (tile, triangle) pairs, so steady-state frames allocate nothing.
@@ -153,8 +164,16 @@ private:
     void setUpAndBin(const TriangleList& triangles, CullMode cullMode);
     void setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last, CullMode cullMode,
                     Batch& batch) const;
-    void emitTriangle(const glm::vec4 clip[3], const glm::vec3 barycentric[3], uint32_t triangle,
-                      CullMode cullMode, Batch& batch) const;
+    // A vertex snapped to fixed point; invW == 0 marks one that must not be set up (w <= 0).
+    struct ProjectedVertex {
+        int32_t x, y;
+        float invW;
+    };
+    ProjectedVertex project(const glm::vec4& clip) const;
+    // `barycentric` (weights of the original vertices) is null for an unclipped triangle.
+    void emitTriangle(const glm::vec4 clip[3], const ProjectedVertex projected[3],
+                      const glm::vec3 barycentric[3], uint32_t triangle, CullMode cullMode,
+                      Batch& batch) const;
 
     template <class FragmentFn>
     void rasterizeTile(int tileIndex, const RasterState& state, float* depth,
@@ -164,6 +183,7 @@ private:
     int mHeight;
     int mTilesX;
     int mTilesY;
+    std::vector<ProjectedVertex> mProjected;  // per input vertex, for unclipped triangles
     std::vector<Batch> mBatches;
     struct alignas(64) TileStats {
         RasterStats stats;
@@ -228,8 +248,8 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
         const uint32_t binEnd = batch.binOffsets[size_t(tileIndex) + 1];
         for (uint32_t item = batch.binOffsets[size_t(tileIndex)]; item < binEnd; ++item) {
             const SetupTriangle& t = batch.triangles[batch.binItems[item]];
-            const int minX = std::max(t.minX, tileMinX), maxX = std::min(t.maxX, tileMaxX);
-            const int minY = std::max(t.minY, tileMinY), maxY = std::min(t.maxY, tileMaxY);
+            const int minX = std::max(int(t.minX), tileMinX), maxX = std::min(int(t.maxX), tileMaxX);
+            const int minY = std::max(int(t.minY), tileMinY), maxY = std::min(int(t.maxY), tileMaxY);
             if (minX > maxX || minY > maxY) continue;
 
             // Edge i is opposite vertex i: e0 = v1->v2, e1 = v2->v0, e2 = v0->v1.
@@ -260,27 +280,30 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                     if (((w0 + bias0) | (w1 + bias1) | (w2 + bias2)) >= 0) {
                         ++samplesCovered;
                         const AttributePlanes& p = t.planes;
-                        const double l1 = p.l1[0] + p.l1[1] * px + p.l1[2] * py;
-                        const double l2 = p.l2[0] + p.l2[1] * px + p.l2[2] * py;
-                        const float l0 = float(1.0 - l1 - l2);
                         const float z = float(std::clamp(p.z[0] + p.z[1] * px + p.z[2] * py, 0.0, 1.0));
                         bool pass = !depthRow || detail::depthPasses(state.depthTest, z, depthRow[px]);
                         if (pass) {
                             ++samplesPassed;
                             if (depthRow && state.depthWrite) depthRow[px] = z;
-                            const float q0 = l0 * t.invW[0], q1 = float(l1) * t.invW[1],
-                                        q2 = float(l2) * t.invW[2];
+                            const float dx = float(px - t.minX), dy = float(py - t.minY);
+                            const float l1 = p.l1[0] + p.l1[1] * dx + p.l1[2] * dy;
+                            const float l2 = p.l2[0] + p.l2[1] * dx + p.l2[2] * dy;
+                            const float q0 = (1.0f - l1 - l2) * t.invW[0], q1 = l1 * t.invW[1],
+                                        q2 = l2 * t.invW[2];
                             const float invSum = 1.0f / (q0 + q1 + q2);
-                            glm::vec3 b(q0 * invSum, q1 * invSum, q2 * invSum);
+                            const glm::vec3 b(q0 * invSum, q1 * invSum, q2 * invSum);
                             Fragment fragment;
                             fragment.x = px;
                             fragment.y = py;
                             fragment.depth = z;
                             // Map back to the original vertices (set-up may have clipped
                             // the triangle or swapped two vertices to fix the orientation).
-                            fragment.barycentric = t.barycentricOfOriginal[0] * b.x +
-                                                   t.barycentricOfOriginal[1] * b.y +
-                                                   t.barycentricOfOriginal[2] * b.z;
+                            if (t.clippedWeights == SetupTriangle::kNotClipped) {
+                                fragment.barycentric = t.swapped ? glm::vec3(b.x, b.z, b.y) : b;
+                            } else {
+                                const auto& w = batch.clippedWeights[t.clippedWeights];
+                                fragment.barycentric = w[0] * b.x + w[1] * b.y + w[2] * b.z;
+                            }
                             fragment.triangle = t.triangle;
                             fragment.frontFacing = t.frontFacing;
                             fragmentFn(fragment);
