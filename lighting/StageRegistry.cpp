@@ -15,8 +15,9 @@ struct StageEntry {
 
 const std::vector<StageEntry>& registry() {
     static const std::vector<StageEntry> entries = {
-        {{"reference", "every light at every pixel, double precision, exact surface"}, makeReferenceStage},
-        {{"brute", "every light at every pixel, float, from the G-buffer"}, makeBruteStage},
+        {{"reference", "every light at every pixel, double precision, exact surface", StageKind::Reference},
+         makeReferenceStage},
+        {{"brute", "every light at every pixel, float, from the G-buffer", StageKind::Exact}, makeBruteStage},
     };
     return entries;
 }
@@ -56,6 +57,44 @@ void rejectUnknownOptions(const StageSpec& spec, std::initializer_list<const cha
             throw StageError("stage '" + spec.name + "': unknown option '" + key + "' (valid: " +
                              (valid.empty() ? "none" : valid) + ")");
     }
+}
+
+int intOption(const StageSpec& spec, const char* key, int defaultValue, int minValue, int maxValue) {
+    const auto found = spec.options.find(key);
+    if (found == spec.options.end()) return defaultValue;
+    size_t used = 0;
+    int value = 0;
+    try {
+        value = std::stoi(found->second, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != found->second.size() || found->second.empty() || value < minValue || value > maxValue)
+        throw StageError("stage '" + spec.name + "': option " + key + "=" + found->second +
+                         " is not an integer in " + std::to_string(minValue) + ".." +
+                         std::to_string(maxValue));
+    return value;
+}
+
+bool boolOption(const StageSpec& spec, const char* key, bool defaultValue) {
+    const auto found = spec.options.find(key);
+    if (found == spec.options.end()) return defaultValue;
+    if (found->second == "1" || found->second == "on" || found->second == "true") return true;
+    if (found->second == "0" || found->second == "off" || found->second == "false") return false;
+    throw StageError("stage '" + spec.name + "': option " + key + "=" + found->second +
+                     " is not a boolean (1/0, on/off, true/false)");
+}
+
+std::string choiceOption(const StageSpec& spec, const char* key, const std::vector<std::string>& choices) {
+    const auto found = spec.options.find(key);
+    if (found == spec.options.end()) return choices.front();
+    std::string valid;
+    for (const std::string& choice : choices) {
+        if (choice == found->second) return choice;
+        valid += (valid.empty() ? "" : ", ") + choice;
+    }
+    throw StageError("stage '" + spec.name + "': option " + key + "=" + found->second +
+                     " is not one of " + valid);
 }
 
 std::vector<StageInfo> stageInfos() {

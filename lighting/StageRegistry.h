@@ -22,9 +22,18 @@ struct StageSpec {
     static StageSpec parse(const std::string& spec);  // throws StageError on malformed text
 };
 
+// What a stage promises about its image, which decides how tests check it:
+//   Reference  the double-precision truth
+//   Exact      the same image as `brute` up to float summation order, and at every pixel at
+//              least as many lights evaluated as contribute (culling never drops a light)
+//   Approximate an approximation by design (e.g. lower-resolution lighting); its error against
+//              the reference is measured and bounded, not required to vanish
+enum class StageKind { Reference, Exact, Approximate };
+
 struct StageInfo {
     std::string name;
     std::string description;
+    StageKind kind = StageKind::Exact;
 };
 
 std::vector<StageInfo> stageInfos();

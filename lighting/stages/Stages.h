@@ -4,6 +4,8 @@
 
 #include <initializer_list>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "lighting/StageRegistry.h"
 
@@ -11,6 +13,12 @@ namespace lighting {
 
 // Throws StageError naming the stage and the first option key not in `known`.
 void rejectUnknownOptions(const StageSpec& spec, std::initializer_list<const char*> known);
+
+// Typed option readers: the default when absent, a StageError naming the stage, key and the
+// accepted values when malformed. The first choice is the default.
+int intOption(const StageSpec& spec, const char* key, int defaultValue, int minValue, int maxValue);
+bool boolOption(const StageSpec& spec, const char* key, bool defaultValue);
+std::string choiceOption(const StageSpec& spec, const char* key, const std::vector<std::string>& choices);
 
 std::unique_ptr<ShadingStage> makeBruteStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeReferenceStage(const StageSpec& spec);

@@ -90,4 +90,4 @@ BENCHMARK(bruteShading)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMilli
 
 }  // namespace
 
-BENCHMARK_MAIN();
+

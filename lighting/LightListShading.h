@@ -1,0 +1,34 @@
+// shadeWithLightList: the shading loop every culling stage ends in. At one pixel, evaluate the
+// given lights (indices into the frame's light list, ascending) with the one BRDF, accumulate
+// radiance and count evaluations. Keeping the indices ascending makes the sum bitwise equal to
+// `brute`'s whenever the skipped lights contribute exactly zero (x + 0 == x in IEEE arithmetic),
+// which is what exact culling guarantees.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "lighting/Brdf.h"
+#include "lighting/EveryLight.h"
+#include "lighting/ShadingStage.h"
+
+namespace lighting {
+
+// Shades pixel (x, y) of the G-buffer with `lightIndices`; writes result.radiance and
+// result.lightsEvaluated at that pixel. Background pixels get zero and no evaluations.
+inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
+                               const std::vector<LightInView<float>>& lights,
+                               std::span<const uint32_t> lightIndices, StageResult& result) {
+    const size_t pixel = size_t(y) * gb.width() + x;
+    ShadingPoint<float> point;
+    if (!gbufferSurfaceAt(gb, x, y, point)) return;
+    const glm::vec3 toViewer = glm::normalize(-point.positionView);
+    glm::vec3 sum(0.0f);
+    for (uint32_t index : lightIndices) sum += evaluateLight(point, toViewer, lights[index]);
+    result.radiance[0][pixel] = sum.x;
+    result.radiance[1][pixel] = sum.y;
+    result.radiance[2][pixel] = sum.z;
+    result.lightsEvaluated[pixel] = uint32_t(lightIndices.size());
+}
+
+}  // namespace lighting

@@ -1,0 +1,134 @@
+// Every stage registered as Exact, on atrium, wall (with lights behind it) and spheres: the same
+// image as `brute` (max abs difference <= 1e-5 of the image's peak) and, at every pixel, at
+// least as many lights evaluated as contribute (the oracle). New stages are covered as soon as
+// they are registered; nothing here names them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include <tbb/task_arena.h>
+
+#include "gbuffer/GBufferPass.h"
+#include "lighting/Oracle.h"
+#include "lighting/StageRegistry.h"
+#include "scenes/ProceduralScenes.h"
+
+namespace {
+
+struct SceneCase {
+    const char* name;
+    const char* scene;
+    int lights;
+    std::map<std::string, std::string> options;
+};
+
+// Small images keep the suite fast; light counts are high enough that culling matters.
+constexpr int kWidth = 256;
+constexpr int kHeight = 144;
+
+const SceneCase kScenes[] = {
+    {"atrium", "atrium", 300, {}},
+    {"wall_behind", "wall", 400, {{"behind", "200"}}},
+    {"spheres", "spheres", 200, {}},
+};
+
+struct PreparedFrame {
+    scenes::Scene scene;
+    gbuffer::SceneGeometry geometry;
+    gbuffer::FrameView view;
+    std::unique_ptr<gbuffer::GBuffer> gbuffer;
+    lighting::LightList lights;
+    lighting::Frame frame;
+    std::vector<uint32_t> oracle;
+    lighting::StageResult brute;
+};
+
+const PreparedFrame& prepared(const SceneCase& c) {
+    static std::map<std::string, std::unique_ptr<PreparedFrame>> cache;
+    auto& slot = cache[c.name];
+    if (slot) return *slot;
+    slot = std::make_unique<PreparedFrame>();
+    PreparedFrame& f = *slot;
+    scenes::SceneRequest request;
+    request.lightCount = c.lights;
+    request.seed = 3;
+    request.options = c.options;
+    f.scene = scenes::buildProceduralScene(c.scene, request);
+    f.geometry = gbuffer::SceneGeometry::build(f.scene);
+    f.view = gbuffer::FrameView::fromCamera(f.scene.cameras[0], kWidth, kHeight);
+    f.gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), f.view);
+    raster::Rasterizer rasterizer(kWidth, kHeight);
+    gbuffer::GBufferPass(f.scene, f.geometry).render(rasterizer, *f.gbuffer);
+    f.lights = lighting::LightList::build(f.scene.lights, f.view);
+    f.frame.scene = &f.scene;
+    f.frame.geometry = &f.geometry;
+    f.frame.view = &f.view;
+    f.frame.gbuffer = f.gbuffer.get();
+    f.frame.lights = &f.lights;
+    f.oracle = lighting::countContributingLights(f.frame);
+    lighting::makeStage("brute")->shade(f.frame, f.brute);
+    return f;
+}
+
+std::vector<std::string> exactStageNames() {
+    std::vector<std::string> names;
+    for (const lighting::StageInfo& info : lighting::stageInfos())
+        if (info.kind == lighting::StageKind::Exact) names.push_back(info.name);
+    return names;
+}
+
+class ExactStage : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+
+TEST_P(ExactStage, MatchesBruteAndNeverDropsALight) {
+    const auto& [stageName, sceneIndex] = GetParam();
+    const SceneCase& c = kScenes[sceneIndex];
+    const PreparedFrame& f = prepared(c);
+    lighting::StageResult result;
+    lighting::makeStage(stageName)->shade(f.frame, result);
+    ASSERT_EQ(result.width, kWidth);
+    ASSERT_EQ(result.height, kHeight);
+
+    float peak = 0.0f;
+    for (int ch = 0; ch < 3; ++ch)
+        for (float v : f.brute.radiance[ch]) peak = std::max(peak, v);
+    ASSERT_GT(peak, 0.0f);
+    uint64_t evaluated = 0, oracle = 0;
+    int imageFailures = 0, droppedLights = 0;
+    for (size_t pixel = 0; pixel < f.oracle.size(); ++pixel) {
+        evaluated += result.lightsEvaluated[pixel];
+        oracle += f.oracle[pixel];
+        for (int ch = 0; ch < 3; ++ch) {
+            const float difference = std::abs(result.radiance[ch][pixel] - f.brute.radiance[ch][pixel]);
+            if (!(difference <= 1e-5f * peak) && imageFailures++ < 5)
+                ADD_FAILURE() << stageName << " on " << c.name << ": pixel (" << pixel % kWidth << ", "
+                              << pixel / kWidth << ") channel " << ch << " differs from brute by "
+                              << difference << " (peak " << peak << ")";
+        }
+        if (result.lightsEvaluated[pixel] < f.oracle[pixel] && droppedLights++ < 5)
+            ADD_FAILURE() << stageName << " on " << c.name << ": pixel (" << pixel % kWidth << ", "
+                          << pixel / kWidth << ") evaluated " << result.lightsEvaluated[pixel]
+                          << " lights but " << f.oracle[pixel] << " contribute";
+    }
+    EXPECT_EQ(imageFailures, 0);
+    EXPECT_EQ(droppedLights, 0);
+    RecordProperty("culling_efficiency", std::to_string(double(oracle) / std::max<uint64_t>(evaluated, 1)));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllExactStages, ExactStage,
+    ::testing::Combine(::testing::ValuesIn(exactStageNames()), ::testing::Range(0, int(std::size(kScenes)))),
+    [](const auto& info) {
+        std::string name = std::get<0>(info.param) + "_" + kScenes[std::get<1>(info.param)].name;
+        std::replace(name.begin(), name.end(), '-', '_');
+        return name;
+    });
+
+TEST(StageRegistry, EveryStageRejectsUnknownOptions) {
+    for (const lighting::StageInfo& info : lighting::stageInfos())
+        EXPECT_THROW(lighting::makeStage(info.name + ":no_such_option=1"), lighting::StageError) << info.name;
+    EXPECT_THROW(lighting::makeStage("no-such-stage"), lighting::StageError);
+}
+
+}  // namespace
