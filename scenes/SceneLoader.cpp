@@ -78,7 +78,24 @@ Scene loadScene(const std::string& nameOrPath, const SceneRequest& request) {
             throw SceneError(nameOrPath + ": light count must be >= 0, got " +
                              std::to_string(request.lightCount));
         Scene scene = loadGltf(path);
-        if (request.lightCount > 0 && scene.lights.empty()) {
+        const bool fileHasLights = !scene.lights.empty();
+        if (!fileHasLights) {
+            // A model file brings no lighting of its own: a weak ambient and a key light from
+            // above the camera make it visible even without generated lights, as for the
+            // built-in scenes (which add one ambient and one directional light too).
+            Light ambient;
+            ambient.type = LightType::Ambient;
+            ambient.color = glm::vec3(1.0f);
+            ambient.intensity = 0.05f;
+            Light key;
+            key.type = LightType::Directional;
+            const Camera& camera = scene.cameras.front();
+            key.directionWorld = glm::normalize(camera.forwardWorld - 0.8f * camera.upWorld);
+            key.color = glm::vec3(1.0f, 0.97f, 0.92f);
+            key.intensity = 2.0f;
+            scene.lights = {ambient, key};
+        }
+        if (request.lightCount > 0 && !fileHasLights) {
             try {
                 scatterPointLights(scene, defaultScatterFor(scene), request.lightCount,
                                    request.seed);

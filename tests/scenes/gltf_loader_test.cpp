@@ -767,10 +767,14 @@ TEST(LoadScene, GltfWithoutLightsGetsGeneratedLights) {
     request.lightCount = 16;
     request.seed = 7;
     const Scene scene = scenes::loadScene(sharedModel("Suzanne/Suzanne.gltf").string(), request);
-    EXPECT_EQ(scene.lights.size(), 16u);
+    // The 16 generated point lights plus the default ambient and key light of a light-less model.
+    ASSERT_EQ(scene.lights.size(), 18u);
+    EXPECT_EQ(scene.lights[0].type, scenes::LightType::Ambient);
+    EXPECT_EQ(scene.lights[1].type, scenes::LightType::Directional);
+    for (size_t i = 2; i < scene.lights.size(); ++i) EXPECT_EQ(scene.lights[i].type, scenes::LightType::Point);
     EXPECT_EQ(scene.triangleCount(), 3936u);
     const Scene again = scenes::loadScene(sharedModel("Suzanne/Suzanne.gltf").string(), request);
-    ASSERT_EQ(again.lights.size(), 16u);
+    ASSERT_EQ(again.lights.size(), 18u);
     expectNear(again.lights[5].positionWorld, scene.lights[5].positionWorld, 0.0f);
 }
 
