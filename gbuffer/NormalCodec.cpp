@@ -1,0 +1,447 @@
+// NormalCodec implementation. Every codec first turns its input into a unit double vector
+// (unitOrFallback) and does its maths in double, so the only float rounding is the final cast of
+// the decoded direction; the quantisation error then dominates even at 16 bits per component.
+// Singular points of each map (poles, -Z, folds) are handled with atan2/tan forms and explicit
+// clamps instead of the shader formulas of the papers, which divide by zero there.
+#include "gbuffer/NormalCodec.h"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace gbuffer {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+// The thesis' stereographic scale: maps |a| <= 1.7777 (z >= -0.519) into the stored square, trading
+// precision for back-facing normals that perspective still shows.
+constexpr double kStereographicScale = 1.7777;
+// Best-fit normals store RGB8 SNORM: integer vectors in [-127, 127]^3.
+constexpr int kBestFitComponentMax = 127;
+
+struct CodecInfo {
+    NormalCodecKind kind;
+    const char* name;
+    std::vector<int> bits;
+};
+
+const std::vector<CodecInfo>& codecTable() {
+    static const std::vector<CodecInfo> table = {
+        {NormalCodecKind::Float32, "float32", {96}},
+        {NormalCodecKind::Xyz, "xyz", {24, 30, 48}},
+        {NormalCodecKind::XyReconstructZ, "xy-z", {16, 20, 24, 32}},
+        {NormalCodecKind::Spherical, "spherical", {16, 20, 24, 32}},
+        {NormalCodecKind::Spheremap, "spheremap", {16, 20, 24, 32}},
+        {NormalCodecKind::Stereographic, "stereographic", {16, 20, 24, 32}},
+        {NormalCodecKind::StereographicScaled, "stereographic-scaled", {16, 20, 24, 32}},
+        {NormalCodecKind::BestFit, "best-fit", {24}},
+        {NormalCodecKind::Octahedral, "octahedral", {16, 20, 24, 32}},
+        {NormalCodecKind::OctahedralPrecise, "octahedral-precise", {16, 20, 24, 32}},
+    };
+    return table;
+}
+
+const CodecInfo& codecInfo(NormalCodecKind kind) {
+    for (const CodecInfo& info : codecTable())
+        if (info.kind == kind)
+            return info;
+    throw std::invalid_argument("unknown NormalCodecKind value");
+}
+
+// Bits per stored component; validates the spec (cheap switch, no allocation on the hot path).
+int componentBits(const NormalCodecSpec& spec) {
+    const int b = spec.bits;
+    switch (spec.kind) {
+    case NormalCodecKind::Float32:
+        if (b == 96)
+            return 32;
+        break;
+    case NormalCodecKind::Xyz:
+        if (b == 24 || b == 30 || b == 48)
+            return b / 3;
+        break;
+    case NormalCodecKind::BestFit:
+        if (b == 24)
+            return 8;
+        break;
+    default:
+        if (b == 16 || b == 20 || b == 24 || b == 32)
+            return b / 2;
+        break;
+    }
+    throw std::invalid_argument("normal codec " + std::string(normalCodecName(spec.kind)) +
+                                " does not support " + std::to_string(b) + " bits");
+}
+
+std::uint64_t fieldMask(int b) {
+    return (std::uint64_t{1} << b) - 1;
+}
+std::uint64_t field(std::uint64_t code, int index, int b) {
+    return (code >> (index * b)) & fieldMask(b);
+}
+std::int64_t snormMax(int b) {
+    return (std::int64_t{1} << (b - 1)) - 1;
+}
+
+std::uint64_t quantizeSnorm(double v, int b) {
+    const std::int64_t n = snormMax(b);
+    v = std::isnan(v) ? 0.0 : std::clamp(v, -1.0, 1.0);
+    return static_cast<std::uint64_t>(std::llround(v * static_cast<double>(n)) + n);
+}
+double dequantizeSnorm(std::uint64_t stored, int b) {
+    const std::int64_t n = snormMax(b);
+    // The one code above 2n (2^b - 1) is never written; saturate it like D3D SNORM does.
+    const std::int64_t q = std::min<std::int64_t>(static_cast<std::int64_t>(stored), 2 * n) - n;
+    return static_cast<double>(q) / static_cast<double>(n);
+}
+std::uint64_t pack2(std::uint64_t a, std::uint64_t c, int b) {
+    return a | (c << b);
+}
+
+glm::dvec3 unitOrFallback(glm::vec3 v) {
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        return glm::dvec3(kFallbackNormalView);
+    const glm::dvec3 d(v);
+    // Squares of float values (<= 1.2e77, >= 2e-90 when nonzero) cannot overflow or vanish in
+    // double, so subnormal and huge inputs normalise exactly enough.
+    const double length = std::sqrt(glm::dot(d, d));
+    if (!(length > 0.0))
+        return glm::dvec3(kFallbackNormalView);
+    return d / length;
+}
+
+glm::vec3 toUnitFloat(glm::dvec3 d) {
+    const double length = std::sqrt(glm::dot(d, d));
+    if (!(length > 0.0) || !std::isfinite(length))
+        return kFallbackNormalView;
+    return glm::vec3(d / length);
+}
+
+double signNotZero(double v) {
+    return v >= 0.0 ? 1.0 : -1.0;
+}
+
+// Azimuthal direction of xy, with +X for the poles (any direction is right there).
+glm::dvec2 azimuthDirection(const glm::dvec3& d, double& radius) {
+    radius = std::hypot(d.x, d.y);
+    return radius > 0.0 ? glm::dvec2(d.x, d.y) / radius : glm::dvec2(1.0, 0.0);
+}
+
+// --- octahedral -------------------------------------------------------------------------------
+
+glm::dvec2 octahedralFromUnit(const glm::dvec3& d) {
+    const double l1 = std::abs(d.x) + std::abs(d.y) + std::abs(d.z);
+    glm::dvec2 p(d.x / l1, d.y / l1);
+    if (d.z < 0.0) // fold the lower hemisphere onto the corners of the square
+        p = glm::dvec2((1.0 - std::abs(p.y)) * signNotZero(p.x),
+                       (1.0 - std::abs(p.x)) * signNotZero(p.y));
+    return p;
+}
+
+glm::vec3 octahedralDecode(std::uint64_t code, int b) {
+    const double px = dequantizeSnorm(field(code, 0, b), b);
+    const double py = dequantizeSnorm(field(code, 1, b), b);
+    glm::dvec3 n(px, py, 1.0 - std::abs(px) - std::abs(py));
+    if (n.z < 0.0)
+        n = glm::dvec3((1.0 - std::abs(py)) * signNotZero(px),
+                       (1.0 - std::abs(px)) * signNotZero(py), n.z);
+    return toUnitFloat(n);
+}
+
+std::uint64_t octahedralEncode(const glm::dvec3& d, int b) {
+    const glm::dvec2 p = octahedralFromUnit(d);
+    return pack2(quantizeSnorm(p.x, b), quantizeSnorm(p.y, b), b);
+}
+
+// Tries floor/ceil in both axes and keeps the code whose decoded float direction has the smallest
+// normalAngleRadians to `reference` (compared in double). Plain rounding is one of the four and
+// wins ties, so this is never worse than `octahedral` under that metric.
+std::uint64_t octahedralPreciseEncode(const glm::dvec3& d, glm::vec3 reference, int b) {
+    const glm::dvec2 p = octahedralFromUnit(d);
+    const double n = static_cast<double>(snormMax(b));
+    std::uint64_t best = pack2(quantizeSnorm(p.x, b), quantizeSnorm(p.y, b), b);
+    double bestError = normalAngleRadians(reference, octahedralDecode(best, b));
+    const double xs[2] = {std::floor(p.x * n), std::ceil(p.x * n)};
+    const double ys[2] = {std::floor(p.y * n), std::ceil(p.y * n)};
+    for (double x : xs) {
+        for (double y : ys) {
+            const std::uint64_t candidate =
+                pack2(quantizeSnorm(x / n, b), quantizeSnorm(y / n, b), b);
+            if (candidate == best)
+                continue; // plain rounding, already measured
+            const double error = normalAngleRadians(reference, octahedralDecode(candidate, b));
+            if (error < bestError) {
+                bestError = error;
+                best = candidate;
+            }
+        }
+    }
+    return best;
+}
+
+// --- best-fit ---------------------------------------------------------------------------------
+
+// Kaplanyan's best-fit normals: among integer vectors k in [-127,127]^3, store the one pointing
+// closest to d. Choice: a direct per-input search rather than Kaplanyan/Hillaire's 2D lookup table
+// of the best length. The candidates are the same (for each major-axis length m = 1..127, the
+// minor components rounded along the ray d * m / |d_major|), plus the naive round(127 d); the
+// table picks one length per table cell, the search picks it per direction, so it is never
+// worse than the table and needs no start-up work or memory. Cost: 128 dot products per encode.
+std::uint64_t bestFitEncode(const glm::dvec3& d) {
+    int major = 0;
+    for (int i = 1; i < 3; ++i)
+        if (std::abs(d[i]) > std::abs(d[major]))
+            major = i;
+    const glm::dvec3 ray = d / std::abs(d[major]); // major component is exactly +-1
+    // Candidates are ranked by cos^2 = (k.d)^2 / (k.k), compared by cross-multiplication (no
+    // division or sqrt in the loop); nearbyint is one SSE4.1 instruction, and the tie rule of the
+    // rounding does not matter for a candidate.
+    glm::dvec3 best(std::nearbyint(d.x * kBestFitComponentMax),
+                    std::nearbyint(d.y * kBestFitComponentMax),
+                    std::nearbyint(d.z * kBestFitComponentMax));
+    double bestDot = glm::dot(best, d);
+    double bestLength2 = glm::dot(best, best);
+    if (!(bestDot > 0.0)) { // cannot happen for a unit d; keeps the comparison well defined
+        bestDot = 0.0;
+        bestLength2 = 1.0;
+    }
+    for (int m = 1; m <= kBestFitComponentMax; ++m) {
+        const glm::dvec3 k(std::nearbyint(ray.x * m), std::nearbyint(ray.y * m),
+                           std::nearbyint(ray.z * m));
+        const double kd = glm::dot(k, d); // > 0: the major term m|d_major| dominates
+        const double kk = glm::dot(k, k);
+        if (kd * kd * bestLength2 > bestDot * bestDot * kk) {
+            bestDot = kd;
+            bestLength2 = kk;
+            best = k;
+        }
+    }
+    std::uint64_t code = 0;
+    for (int i = 0; i < 3; ++i)
+        code |= static_cast<std::uint64_t>(best[i] + kBestFitComponentMax) << (8 * i);
+    return code;
+}
+
+// --- spherical, spheremap, stereographic ------------------------------------------------------
+
+std::uint64_t sphericalEncode(const glm::dvec3& d, int b) {
+    // Polar angle theta in [0, pi] as UNORM over 2^b - 1 steps (both poles exact); azimuth phi
+    // periodic over 2^b steps, so no code is wasted on a duplicate seam.
+    const double theta = std::atan2(std::hypot(d.x, d.y), d.z); // accurate near the poles
+    const double phi = std::atan2(d.y, d.x);
+    const double thetaSteps = static_cast<double>(fieldMask(b));
+    const std::int64_t phiSteps = std::int64_t{1} << b;
+    const auto qTheta = static_cast<std::uint64_t>(std::llround(theta / kPi * thetaSteps));
+    std::int64_t qPhi = std::llround(phi / (2.0 * kPi) * static_cast<double>(phiSteps));
+    qPhi = ((qPhi % phiSteps) + phiSteps) % phiSteps;
+    return pack2(static_cast<std::uint64_t>(qPhi), std::min(qTheta, fieldMask(b)), b);
+}
+
+glm::vec3 sphericalDecode(std::uint64_t code, int b) {
+    const double phi = static_cast<double>(field(code, 0, b)) * 2.0 * kPi /
+                       static_cast<double>(std::uint64_t{1} << b);
+    const double theta =
+        static_cast<double>(field(code, 1, b)) * kPi / static_cast<double>(fieldMask(b));
+    return toUnitFloat(glm::dvec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                  std::cos(theta)));
+}
+
+std::uint64_t spheremapEncode(const glm::dvec3& d, int b) {
+    // Pranckevicius' enc = xy / sqrt(8z + 8) + 0.5 is, as SNORM s = 2 enc - 1, the point
+    // sin(theta / 2) * azimuth in the unit disc. This form is finite at z = -1 (any rim point).
+    double radius = 0.0;
+    const glm::dvec2 dir = azimuthDirection(d, radius);
+    const glm::dvec2 s = dir * std::sin(0.5 * std::atan2(radius, d.z));
+    return pack2(quantizeSnorm(s.x, b), quantizeSnorm(s.y, b), b);
+}
+
+glm::vec3 spheremapDecode(std::uint64_t code, int b) {
+    glm::dvec2 s(dequantizeSnorm(field(code, 0, b), b), dequantizeSnorm(field(code, 1, b), b));
+    double s2 = glm::dot(s, s);
+    if (s2 > 1.0) { // square corners outside the disc: pull back to the rim (-Z), no NaN
+        s /= std::sqrt(s2);
+        s2 = 1.0;
+    }
+    const glm::dvec2 xy = 2.0 * s * std::sqrt(std::max(0.0, 1.0 - s2));
+    return toUnitFloat(glm::dvec3(xy, 1.0 - 2.0 * s2));
+}
+
+std::uint64_t stereographicEncode(const glm::dvec3& d, double scale, int b) {
+    // a = xy / (1 + z) = tan(theta / 2) * azimuth; the tan form stays finite at -Z (~1.6e16).
+    double radius = 0.0;
+    const glm::dvec2 dir = azimuthDirection(d, radius);
+    glm::dvec2 s = dir * (std::tan(0.5 * std::atan2(radius, d.z)) / scale);
+    // Outside the stored square: shrink radially, which keeps the azimuth (per-axis clamping
+    // would not).
+    const double extent = std::max(std::abs(s.x), std::abs(s.y));
+    if (extent > 1.0)
+        s /= extent;
+    return pack2(quantizeSnorm(s.x, b), quantizeSnorm(s.y, b), b);
+}
+
+glm::vec3 stereographicDecode(std::uint64_t code, double scale, int b) {
+    const glm::dvec2 a = scale * glm::dvec2(dequantizeSnorm(field(code, 0, b), b),
+                                            dequantizeSnorm(field(code, 1, b), b));
+    const double a2 = glm::dot(a, a);
+    return toUnitFloat(glm::dvec3(2.0 * a, 1.0 - a2) / (1.0 + a2));
+}
+
+} // namespace
+
+const char* normalCodecName(NormalCodecKind kind) {
+    return codecInfo(kind).name;
+}
+
+std::vector<std::string> normalCodecNames() {
+    std::vector<std::string> names;
+    for (const CodecInfo& info : codecTable())
+        names.emplace_back(info.name);
+    return names;
+}
+
+std::vector<int> supportedBits(NormalCodecKind kind) {
+    return codecInfo(kind).bits;
+}
+
+std::vector<NormalCodecSpec> allNormalCodecSpecs() {
+    std::vector<NormalCodecSpec> specs;
+    for (const CodecInfo& info : codecTable())
+        for (int bits : info.bits)
+            specs.push_back({info.kind, bits});
+    return specs;
+}
+
+std::string NormalCodecSpec::text() const {
+    return std::string(normalCodecName(kind)) + ":" + std::to_string(bits);
+}
+
+NormalCodecSpec NormalCodecSpec::parse(const std::string& text) {
+    auto fail = [&](const std::string& why) -> NormalCodecSpec {
+        std::string message = "normal codec '" + text + "': " + why +
+                              "; expected NAME:BITS (BITS = total bits) with one of:";
+        for (const CodecInfo& info : codecTable()) {
+            message += std::string(" ") + info.name + ":";
+            for (std::size_t i = 0; i < info.bits.size(); ++i)
+                message += (i ? "|" : "") + std::to_string(info.bits[i]);
+        }
+        throw std::invalid_argument(message);
+    };
+    const std::size_t colon = text.rfind(':');
+    if (colon == std::string::npos)
+        return fail("missing ':BITS'");
+    const std::string name = text.substr(0, colon);
+    const std::string bitsText = text.substr(colon + 1);
+    for (const CodecInfo& info : codecTable()) {
+        if (name != info.name)
+            continue;
+        int bits = 0;
+        const char* end = bitsText.data() + bitsText.size();
+        const auto [ptr, ec] = std::from_chars(bitsText.data(), end, bits);
+        if (bitsText.empty() || ec != std::errc() || ptr != end)
+            return fail("BITS '" + bitsText + "' is not an integer");
+        if (std::find(info.bits.begin(), info.bits.end(), bits) == info.bits.end())
+            return fail(std::string(info.name) + " does not support " + bitsText + " bits");
+        return {info.kind, bits};
+    }
+    return fail("unknown name '" + name + "'");
+}
+
+double normalAngleRadians(glm::vec3 a, glm::vec3 b) {
+    const glm::dvec3 da(a), db(b);
+    return std::atan2(glm::length(glm::cross(da, db)), glm::dot(da, db));
+}
+
+NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView) {
+    const int b = componentBits(spec);
+    const glm::dvec3 d = unitOrFallback(unitNormalView);
+    NormalCode code;
+    switch (spec.kind) {
+    case NormalCodecKind::Float32: {
+        const glm::vec3 f(d);
+        code.low = std::bit_cast<std::uint32_t>(f.x) |
+                   (std::uint64_t{std::bit_cast<std::uint32_t>(f.y)} << 32);
+        code.high = std::bit_cast<std::uint32_t>(f.z);
+        break;
+    }
+    case NormalCodecKind::Xyz:
+        code.low = quantizeSnorm(d.x, b) | (quantizeSnorm(d.y, b) << b) |
+                   (quantizeSnorm(d.z, b) << (2 * b));
+        break;
+    case NormalCodecKind::XyReconstructZ:
+        code.low = pack2(quantizeSnorm(d.x, b), quantizeSnorm(d.y, b), b);
+        break;
+    case NormalCodecKind::Spherical:
+        code.low = sphericalEncode(d, b);
+        break;
+    case NormalCodecKind::Spheremap:
+        code.low = spheremapEncode(d, b);
+        break;
+    case NormalCodecKind::Stereographic:
+        code.low = stereographicEncode(d, 1.0, b);
+        break;
+    case NormalCodecKind::StereographicScaled:
+        code.low = stereographicEncode(d, kStereographicScale, b);
+        break;
+    case NormalCodecKind::BestFit:
+        code.low = bestFitEncode(d);
+        break;
+    case NormalCodecKind::Octahedral:
+        code.low = octahedralEncode(d, b);
+        break;
+    case NormalCodecKind::OctahedralPrecise: {
+        // The reference is the caller's vector when it is a direction at all (the metric ignores
+        // length), so "never worse than octahedral" holds exactly against what callers measure.
+        const bool usable = std::isfinite(unitNormalView.x) && std::isfinite(unitNormalView.y) &&
+                            std::isfinite(unitNormalView.z) && unitNormalView != glm::vec3(0.0f);
+        code.low = octahedralPreciseEncode(d, usable ? unitNormalView : glm::vec3(d), b);
+        break;
+    }
+    }
+    return code;
+}
+
+glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code) {
+    const int b = componentBits(spec);
+    switch (spec.kind) {
+    case NormalCodecKind::Float32: {
+        const glm::vec3 f(std::bit_cast<float>(static_cast<std::uint32_t>(code.low)),
+                          std::bit_cast<float>(static_cast<std::uint32_t>(code.low >> 32)),
+                          std::bit_cast<float>(code.high));
+        return toUnitFloat(unitOrFallback(f));
+    }
+    case NormalCodecKind::Xyz:
+        return toUnitFloat(glm::dvec3(dequantizeSnorm(field(code.low, 0, b), b),
+                                      dequantizeSnorm(field(code.low, 1, b), b),
+                                      dequantizeSnorm(field(code.low, 2, b), b)));
+    case NormalCodecKind::XyReconstructZ: {
+        const double x = dequantizeSnorm(field(code.low, 0, b), b);
+        const double y = dequantizeSnorm(field(code.low, 1, b), b);
+        // Outside the unit disc the code is not a unit vector's; z = 0 is the nearest sphere point.
+        return toUnitFloat(glm::dvec3(x, y, std::sqrt(std::max(0.0, 1.0 - x * x - y * y))));
+    }
+    case NormalCodecKind::Spherical:
+        return sphericalDecode(code.low, b);
+    case NormalCodecKind::Spheremap:
+        return spheremapDecode(code.low, b);
+    case NormalCodecKind::Stereographic:
+        return stereographicDecode(code.low, 1.0, b);
+    case NormalCodecKind::StereographicScaled:
+        return stereographicDecode(code.low, kStereographicScale, b);
+    case NormalCodecKind::BestFit:
+        // (127,127,127) is the zero vector (never written): toUnitFloat falls back to +Z.
+        return toUnitFloat(
+            glm::dvec3(static_cast<double>(field(code.low, 0, 8)) - kBestFitComponentMax,
+                       static_cast<double>(field(code.low, 1, 8)) - kBestFitComponentMax,
+                       static_cast<double>(field(code.low, 2, 8)) - kBestFitComponentMax));
+    case NormalCodecKind::Octahedral:
+    case NormalCodecKind::OctahedralPrecise:
+        return octahedralDecode(code.low, b);
+    }
+    return kFallbackNormalView;
+}
+
+} // namespace gbuffer

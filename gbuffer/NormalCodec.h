@@ -1,0 +1,89 @@
+// NormalCodec: the G-buffer normal encodings of the literature as pure functions, so that
+// experiments can compare them by their angular error at equal storage (bits per pixel).
+//
+// Conventions:
+// - Input and output are view-space unit normals (right-handed, camera looking down -Z, so a
+//   front-facing surface has normalView.z > 0). Nothing here depends on the view except `xy-z`,
+//   which assumes z >= 0 and is kept to measure what that assumption costs.
+// - A codec is named "NAME:BITS" where BITS is the TOTAL number of bits of the code (pbrt-style
+//   registry: parse() ends in an error listing every valid name and bit count).
+// - Signed components are quantised as SNORM (D3D / Cigolle et al. 2014): b bits hold
+//   q in [-(2^(b-1)-1), 2^(b-1)-1], value q / (2^(b-1)-1), stored offset by 2^(b-1)-1. Unlike the
+//   thesis' "v*0.5+0.5" UNORM this represents 0 and +-1 exactly (so +Z, the axes and the
+//   octahedral folds are exact); the code 2^b-1 is never written and decodes as +1.
+// - Component i of a code lives in bits [i*b, (i+1)*b) of NormalCode::low (x first).
+// - Robustness contract: encode accepts ANY input. A non-finite input (NaN or Inf component) or a
+//   zero vector encodes kFallbackNormalView (+Z). Non-unit lengths (huge, subnormal, 1+-1e-3) are
+//   normalised in double first. decode accepts ANY code (also codes no encoder writes) and returns
+//   a finite unit vector (to float rounding, |n| = 1 +- 1e-6), never NaN/Inf.
+// - All functions are pure, allocation-free (except the name/registry helpers and parse) and
+//   thread-safe. Encode/decode cost tens of nanoseconds; `best-fit` encode searches 128
+//   candidates (several times a plain encode, sub-microsecond) and `octahedral-precise` decodes
+//   up to 4 candidates.
+// - Not implemented: `pixel-view` (the thesis' per-pixel view frame). It needs the pixel's view
+//   ray, which this per-normal API does not take; it would be a separate entry point.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace gbuffer {
+
+enum class NormalCodecKind {
+    Float32,             // "float32": xyz float32, the reference (96 bits)
+    Xyz,                 // "xyz": three SNORM components, the naive baseline
+    XyReconstructZ,      // "xy-z": X, Y stored, Z = +sqrt(1-x^2-y^2) (wrong for z < 0)
+    Spherical,           // "spherical": azimuth and polar angle
+    Spheremap,           // "spheremap": Lambert azimuthal equal-area (Pranckevicius method #4)
+    Stereographic,       // "stereographic": projection from -Z, plane square [-1,1]^2
+    StereographicScaled, // "stereographic-scaled": the same with the thesis' scale 1.7777
+    BestFit,             // "best-fit": Kaplanyan 2010 best-fit normals in RGB8
+    Octahedral,          // "octahedral": Meyer / Cigolle octahedral map, plain rounding
+    OctahedralPrecise,   // "octahedral-precise": the best of the 4 floor/ceil neighbours
+};
+
+// The code of one normal. Up to 64 bits live in `low`; only float32 (96 bits) uses `high`
+// (its z component), which is why this is not a bare uint64_t.
+struct NormalCode {
+    std::uint64_t low = 0;
+    std::uint32_t high = 0;
+    friend bool operator==(const NormalCode&, const NormalCode&) = default;
+};
+
+// What invalid inputs (NaN/Inf, zero vector) encode to and what invalid float32 codes decode to:
+// facing the camera, the least surprising direction for shading.
+inline constexpr glm::vec3 kFallbackNormalView{0.0f, 0.0f, 1.0f};
+
+struct NormalCodecSpec {
+    NormalCodecKind kind = NormalCodecKind::Octahedral;
+    int bits = 24; // total bits of the code
+
+    std::string text() const; // "NAME:BITS", parse(text()) == *this
+    // Parses "NAME:BITS"; throws std::invalid_argument naming the input and listing every valid
+    // NAME with its BITS. Called once per configuration, not per pixel.
+    static NormalCodecSpec parse(const std::string& text);
+    friend bool operator==(const NormalCodecSpec&, const NormalCodecSpec&) = default;
+};
+
+const char* normalCodecName(NormalCodecKind kind);
+std::vector<std::string> normalCodecNames(); // registry order, the CLI names
+// Total bit counts a codec supports: 2-component codecs 16, 20, 24, 32 (8/10/12/16 per
+// component); xyz 24, 30, 48; best-fit 24; float32 96.
+std::vector<int> supportedBits(NormalCodecKind kind);
+std::vector<NormalCodecSpec> allNormalCodecSpecs(); // every name x every supported bits
+
+// Encodes a view-space normal; see the robustness contract above. Throws std::invalid_argument
+// only for a spec with unsupported bits (a programming error: parse() never makes one).
+NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView);
+// Decodes to a unit vector; bits of `code` above spec.bits are ignored.
+glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code);
+
+// Angle between two directions in radians, computed in double as atan2(|a x b|, a . b), which
+// stays accurate for tiny angles (acos of a dot product loses ~1e-4 rad near 0). Lengths do not
+// matter. This is the metric `octahedral-precise` minimises, so tests must use it as well.
+double normalAngleRadians(glm::vec3 a, glm::vec3 b);
+
+} // namespace gbuffer
