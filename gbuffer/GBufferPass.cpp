@@ -28,6 +28,37 @@ glm::vec3 perspectiveBarycentrics(const glm::vec4& c0, const glm::vec4& c1, cons
 
 }  // namespace
 
+Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& scene,
+                          std::span<const glm::vec4> clipPositions,
+                          std::span<const glm::vec3> normalsView, uint32_t triangle, bool backFace,
+                          glm::vec2 ndc) {
+    const uint32_t* corners = geometry.indices.data() + 3 * size_t(triangle);
+    const uint32_t i0 = corners[0], i1 = corners[1], i2 = corners[2];
+    const glm::vec3 weights =
+        perspectiveBarycentrics(clipPositions[i0], clipPositions[i1], clipPositions[i2], ndc);
+    Surface surface;
+    glm::vec3 normal = raster::interpolate(normalsView[i0], normalsView[i1], normalsView[i2], weights);
+    const float length2 = glm::dot(normal, normal);
+    normal = length2 > 0.0f ? normal * (1.0f / std::sqrt(length2)) : glm::vec3(0.0f, 0.0f, 1.0f);
+    surface.normalView = backFace ? -normal : normal;  // two-sided draws light the visible side
+    const scenes::Material& material = scene.materials[geometry.triangleMaterial[triangle]];
+    glm::vec3 albedo(material.baseColorFactor);
+    if (material.baseColorTexture >= 0) {
+        const glm::vec2 uv = raster::interpolate(geometry.uv[i0], geometry.uv[i1], geometry.uv[i2], weights);
+        albedo *= glm::vec3(scene.textures[size_t(material.baseColorTexture)].sample(uv));
+    }
+    surface.albedo = albedo;
+    surface.specularIntensity = material.specularIntensity;
+    surface.specularPower = material.specularPower;
+    return surface;
+}
+
+glm::vec3 positionViewOfPixel(const FrameView& view, int x, int y, float depth) {
+    const glm::vec2 ndc = view.ndcOfPixel(x, y);
+    const glm::vec4 p = view.viewFromClip * glm::vec4(ndc, depth, 1.0f);
+    return glm::vec3(p) / p.w;
+}
+
 GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geometry)
     : mScene(scene), mGeometry(geometry) {
     if (geometry.triangleCount() >= kBackFaceBit)
@@ -50,9 +81,6 @@ void GBufferPass::transformVertices(const FrameView& view) {
 void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
     const int width = target.width();
     const FrameView& view = target.view();
-    const std::vector<uint32_t>& indices = mGeometry.indices;
-    const std::vector<scenes::Material>& materials = mScene.materials;
-    const std::vector<scenes::Texture>& textures = mScene.textures;
     tbb::parallel_for(0, target.height(), [&](int y) {
         for (int x = 0; x < width; ++x) {
             const size_t pixel = size_t(y) * width + x;
@@ -63,25 +91,15 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
             }
             const uint32_t t = visible & ~kBackFaceBit;
             const bool backFace = (visible & kBackFaceBit) != 0;
-            const uint32_t i0 = indices[3 * t], i1 = indices[3 * t + 1], i2 = indices[3 * t + 2];
-            const glm::vec3 weights = perspectiveBarycentrics(
-                mClipPositions[i0], mClipPositions[i1], mClipPositions[i2], view.ndcOfPixel(x, y));
-            glm::vec3 normal = raster::interpolate(mNormalView[i0], mNormalView[i1], mNormalView[i2], weights);
-            const float length2 = glm::dot(normal, normal);
-            normal = length2 > 0.0f ? normal * (1.0f / std::sqrt(length2)) : glm::vec3(0.0f, 0.0f, 1.0f);
-            if (backFace) normal = -normal;  // two-sided draws light the visible side
-            const scenes::Material& material = materials[mGeometry.triangleMaterial[t]];
-            glm::vec3 albedo(material.baseColorFactor);
-            if (material.baseColorTexture >= 0) {
-                const glm::vec2 uv = raster::interpolate(mGeometry.uv[i0], mGeometry.uv[i1], mGeometry.uv[i2], weights);
-                albedo *= glm::vec3(textures[size_t(material.baseColorTexture)].sample(uv));
-            }
-            target.writeSurface(pixel, normal, albedo, material.specularIntensity, material.specularPower);
+            const Surface surface = surfaceOfTriangle(mGeometry, mScene, mClipPositions, mNormalView, t,
+                                                      backFace, view.ndcOfPixel(x, y));
+            target.writeSurface(pixel, surface.normalView, surface.albedo, surface.specularIntensity,
+                                surface.specularPower);
             if (exact) {
                 exact->triangle[pixel] = t;
                 exact->backFacing[pixel] = backFace ? 1 : 0;
-                exact->albedo[pixel] = albedo;
-                exact->specular[pixel] = {material.specularIntensity, material.specularPower};
+                exact->albedo[pixel] = surface.albedo;
+                exact->specular[pixel] = {surface.specularIntensity, surface.specularPower};
             }
         }
     });
