@@ -17,6 +17,11 @@
 
 #include "gbuffer/NormalCodec.h"
 
+namespace gbuffer {
+// Test names and messages show "octahedral:24", not the spec's bytes.
+void PrintTo(const NormalCodecSpec& spec, std::ostream* os) { *os << spec.text(); }
+}  // namespace gbuffer
+
 namespace {
 
 using gbuffer::NormalCode;
