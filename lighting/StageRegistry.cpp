@@ -18,6 +18,24 @@ const std::vector<StageEntry>& registry() {
         {{"reference", "every light at every pixel, double precision, exact surface", StageKind::Reference},
          makeReferenceStage},
         {{"brute", "every light at every pixel, float, from the G-buffer", StageKind::Exact}, makeBruteStage},
+        {{"deferred", "traditional deferred: one light volume per light, shaded and added per fragment "
+                      "(volume=sphere|rect, stencil=0, vfc=1)", StageKind::Exact},
+         makeDeferredStage},
+        {{"light-indexed", "light-indexed deferred: volumes write per-pixel light lists (max=16), "
+                           "overflow shades every light", StageKind::Exact},
+         makeLightIndexedStage},
+        {{"clustered", "implicit clusters: grid of screen tiles x depth slices (default 24x12x32, exp), "
+                       "lights assigned per cluster AABB", StageKind::Exact},
+         makeClusteredStage},
+        {{"tiled", "tiled deferred: per-tile depth-bounded frusta (tile=16, vfc=1, mask=0)", StageKind::Exact},
+         makeTiledStage},
+        {{"tiled-backface", "tiled deferred plus per-tile normal-cone back-face culling of lights",
+          StageKind::Exact},
+         makeTiledBackfaceStage},
+        {{"forward", "single-pass forward, per-object light lists (prepass=0|1)", StageKind::Exact},
+         makeForwardStage},
+        {{"forward-multipass", "one additive pass per light over its illumination set", StageKind::Exact},
+         makeForwardMultipassStage},
     };
     return entries;
 }

@@ -22,5 +22,12 @@ std::string choiceOption(const StageSpec& spec, const char* key, const std::vect
 
 std::unique_ptr<ShadingStage> makeBruteStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeReferenceStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeDeferredStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeLightIndexedStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeClusteredStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeTiledStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeTiledBackfaceStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeForwardStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeForwardMultipassStage(const StageSpec& spec);
 
 }  // namespace lighting

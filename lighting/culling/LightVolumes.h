@@ -1,0 +1,196 @@
+// LightVolumes: light-volume rasterization over a G-buffer, shared by the `deferred` and
+// `light-indexed` stages (Ishmukhametov 2013, 1.3, 2.3 and 3.5; Trebilco's light-indexed
+// deferred lighting).
+//
+// For each light drawn (bounded lights by their conservative sphere from boundingSpheresView),
+// draw() calls fn(light, x, y, pixel) for every covered G-buffer pixel whose surface MAY lie
+// inside the sphere, at most once per light and pixel. It never misses a pixel whose surface
+// lies inside the sphere:
+// - Sphere volumes rasterize a proxy polyhedron (an icosahedron subdivided once, 80 faces) whose
+//   faces CIRCUMSCRIBE the sphere, grown further by kProxyMarginPixels of screen space (so
+//   fixed-point snapping of the silhouette cannot lose a pixel). Only BACK faces are drawn (front
+//   faces culled): a surface inside the volume is in front of (or on) the volume's back face, so
+//   the test "surface not behind the back face" keeps it. Near-plane clipping only removes back
+//   faces in front of the near plane, where no surface lies, so a camera inside the volume or a
+//   volume crossing the near plane loses nothing. Far-plane clipping WOULD lose pixels, so a
+//   proxy reaching beyond the far plane falls back to the screen rectangle.
+// - stencil=1 adds the two-sided test: the FRONT faces mark pixels whose surface is not in
+//   front of the front face; the back faces then only accept marked pixels. When
+//   the proxy crosses the near plane its front faces are clipped, so the front test is skipped.
+// - Rect volumes cover the sphere's conservative screen rectangle (full screen when the sphere
+//   crosses the near plane), with no back-face test.
+// Every volume is followed by the depth-bounds test: the surface's view depth within
+// [centre - radius, centre + radius].
+//
+// Batching: all lights of a frame are drawn in ONE rasterizer draw, light after light in ascending
+// index order. Inside a screen tile the rasterizer visits triangles in submission order, and a
+// pixel belongs to one tile, so every pixel meets its lights in ascending order (what exactness
+// needs) while all tiles work in parallel and the set-up cost is paid once. Rectangles (volume=rect,
+// far-plane fallback) and unbounded lights (directional, ambient: full screen) are drawn as
+// screen-aligned quads in the same stream, at their place in the light order. With stencil=1
+// each sphere is submitted twice with no face culling: the first copy's front faces mark pixels,
+// the second copy's back faces test; light i's copies precede light i+1's in every tile.
+//
+// Depth comparisons are done in the fragment function against the G-buffer's depth plane with a
+// tolerance (kDepthTolerance) that only ever keeps more pixels: float rounding of the proxy's
+// clip coordinates moves its depth by ~1 ulp, more than the proxy's metric margin in standard Z.
+//
+// Conventions: view space right-handed, camera looking down -Z; depth in the G-buffer's
+// convention (reversed Z by default: near = 1). Threading: one draw at a time per object; inside
+// a draw fn is called concurrently for different tiles but for any pixel by one task only.
+// Deterministic: the pixels visited do not depend on the thread count.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gbuffer/GBuffer.h"
+#include "lighting/LightBounds.h"
+#include "raster/Rasterizer.h"
+
+namespace lighting {
+
+// A unit proxy: triangles wound counter-clockwise seen from outside; every face plane is at
+// distance >= 1 from the origin (the unit sphere is inside), vertices at circumradius.
+struct ProxyMesh {
+    std::vector<glm::vec3> positions;
+    std::vector<uint32_t> indices;
+    float circumradius = 1.0f;  // largest vertex distance from the origin
+};
+// The icosahedron subdivided once (42 vertices, 80 faces), scaled so its inradius is 1.
+const ProxyMesh& unitProxySphere();
+
+enum class VolumeShape { Sphere, Rect };
+
+// Screen growth of the proxy in pixels: covers fixed-point snapping (1/512 px) and the float
+// rounding of vertex transforms by a wide margin; costs a thin ring of extra fragments.
+inline constexpr float kProxyMarginPixels = 0.25f;
+// Relative depth tolerance (of the depth value in reversed Z, of 1 in standard Z).
+inline constexpr float kDepthTolerance = 1e-5f;
+
+struct LightVolumeStats {
+    uint64_t lightsDrawn = 0;    // bounded lights that reached a volume draw
+    uint64_t rectFallbacks = 0;  // sphere volumes replaced by the rectangle (far plane)
+    uint64_t fragments = 0;      // samples covered by the volume draw (before any depth test)
+};
+
+class LightVolumeRasterizer {
+public:
+    LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape, bool stencil);
+
+    // True when the sphere may touch the view frustum (conservative; six planes).
+    bool inViewFrustum(const LightSphere& sphere) const;
+
+    // Draws the volumes of `lightIndices` (ascending; unbounded lights included) in one pass and
+    // calls fn(light, x, y, pixel) as described in the file comment. Cost: set-up of 80 (160 with
+    // stencil) triangles per sphere, then O(covered bounding-box pixels) in parallel over tiles.
+    template <class Fn>
+    void draw(const std::vector<LightSphere>& spheres, const std::vector<uint32_t>& lightIndices, Fn&& fn);
+
+    const LightVolumeStats& stats() const { return mStats; }
+
+    // Inclusive pixel rectangle that contains the projection of the sphere (full screen when it
+    // crosses the near plane); empty (minX > maxX) when it cannot be seen.
+    struct PixelRect {
+        int minX, minY, maxX, maxY;
+    };
+    PixelRect screenRect(const LightSphere& sphere) const;
+    // The G-buffer depth values a surface inside the sphere can have: its view-depth range
+    // (clamped to the near and far planes) mapped to depth, widened by kDepthTolerance.
+    struct DepthRange {
+        float lo, hi;
+    };
+    DepthRange depthBounds(const LightSphere& sphere) const;
+
+private:
+    // One drawn light: what the fragment function needs, looked up by triangle.
+    struct Slot {
+        uint32_t light;
+        DepthRange depth;
+        bool backFaceTest;   // a sphere proxy (else a screen quad: no depth test)
+        bool frontFaceTest;  // stencil: the surface must not be in front of the front face
+    };
+    // Triangles of a stencil front-marking copy carry this bit in mTriangleSlot.
+    static constexpr uint32_t kFrontCopy = 0x80000000u;
+
+    // The surface is not behind the fragment (it may be in front of the volume's back face),
+    // with the tolerance in the conservative direction.
+    bool surfaceNotBehind(float fragmentDepth, float surfaceDepth) const {
+        const float tolerance = kDepthTolerance * (mReversedZ ? surfaceDepth : 1.0f);
+        return mReversedZ ? fragmentDepth <= surfaceDepth + tolerance
+                          : fragmentDepth >= surfaceDepth - tolerance;
+    }
+    bool surfaceNotInFront(float fragmentDepth, float surfaceDepth) const {
+        const float tolerance = kDepthTolerance * (mReversedZ ? surfaceDepth : 1.0f);
+        return mReversedZ ? fragmentDepth >= surfaceDepth - tolerance
+                          : fragmentDepth <= surfaceDepth + tolerance;
+    }
+    // Fills mClip, mIndices, mTriangleSlot and mSlots for the lights to draw.
+    void buildGeometry(const std::vector<LightSphere>& spheres, const std::vector<uint32_t>& lightIndices);
+    void addProxy(const LightSphere& sphere, uint32_t slot);
+    void addQuad(const PixelRect& rect, uint32_t slot);
+
+    const gbuffer::GBuffer& mGBuffer;
+    const float* mDepth;
+    VolumeShape mShape;
+    bool mStencil;
+    bool mReversedZ;
+    float mClearDepth;
+    float mNearMetres, mFarMetres;
+    float mProjX, mProjY;                  // clipFromView[0][0], [1][1]
+    float mPixelsPerTanX, mPixelsPerTanY;  // focal lengths in pixels
+    glm::dmat4 mClipFromViewExact;
+    glm::mat4 mClipFromView;
+    raster::Rasterizer mRasterizer;
+    std::vector<glm::vec4> mClip;
+    std::vector<uint32_t> mIndices;
+    std::vector<uint32_t> mTriangleSlot;  // per triangle: index into mSlots (| kFrontCopy)
+    std::vector<Slot> mSlots;
+    std::vector<uint32_t> mVisitedStamp;  // light index + 1 of the last light that visited a pixel
+    std::vector<uint32_t> mFrontStamp;    // stencil: light index + 1 passing the front-face test
+    LightVolumeStats mStats;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+template <class Fn>
+void LightVolumeRasterizer::draw(const std::vector<LightSphere>& spheres,
+                                 const std::vector<uint32_t>& lightIndices, Fn&& fn) {
+    buildGeometry(spheres, lightIndices);
+    const int width = mGBuffer.width();
+    const float clearDepth = mClearDepth;
+    const raster::TriangleList triangles{mClip, mIndices};
+    raster::RasterState state;
+    state.depthWrite = false;
+    // Without stencil only back faces are drawn; quads are wound clockwise (back-facing).
+    state.cullMode = mStencil ? raster::CullMode::None : raster::CullMode::Front;
+    const bool stencil = mStencil;
+    mRasterizer.draw(triangles, state, nullptr, [&](const raster::Fragment& f) {
+        const uint32_t code = mTriangleSlot[f.triangle];
+        const Slot& slot = mSlots[code & ~kFrontCopy];
+        const size_t pixel = size_t(f.y) * width + f.x;
+        // Background and the depth-bounds test, on depth values (no division per pixel).
+        const float depth = mDepth[pixel];
+        if (depth == clearDepth || depth < slot.depth.lo || depth > slot.depth.hi) return;
+        const uint32_t stamp = slot.light + 1;
+        if (code & kFrontCopy) {
+            if (f.frontFacing && surfaceNotInFront(f.depth, depth)) mFrontStamp[pixel] = stamp;
+            return;
+        }
+        if (slot.backFaceTest) {
+            if (stencil && f.frontFacing) return;
+            if (!surfaceNotBehind(f.depth, depth)) return;
+            if (slot.frontFaceTest && mFrontStamp[pixel] != stamp) return;
+        }
+        // A watertight convex proxy covers a pixel with one back face; the stamp guards the
+        // sum against a double visit all the same (one light must be added once).
+        if (mVisitedStamp[pixel] == stamp) return;
+        mVisitedStamp[pixel] = stamp;
+        fn(slot.light, f.x, f.y, pixel);
+    });
+    mStats.fragments += mRasterizer.lastStats().samplesCovered;
+}
+
+}  // namespace lighting

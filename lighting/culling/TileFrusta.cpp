@@ -1,0 +1,197 @@
+#include "lighting/culling/TileFrusta.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace lighting {
+
+TileGrid TileGrid::make(int widthPixels, int heightPixels, int tileSizePixels) {
+    TileGrid grid;
+    grid.widthPixels = widthPixels;
+    grid.heightPixels = heightPixels;
+    grid.tileSizePixels = tileSizePixels;
+    grid.tileCountX = (widthPixels + tileSizePixels - 1) / tileSizePixels;
+    grid.tileCountY = (heightPixels + tileSizePixels - 1) / tileSizePixels;
+    return grid;
+}
+
+std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& gb,
+                                                        const TileGrid& grid,
+                                                        const TileBoundsOptions& options) {
+    std::vector<TileSurfaceBounds> bounds(size_t(grid.tileCount()));
+    const size_t maxSamples = size_t(grid.tileSizePixels) * grid.tileSizePixels;
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, grid.tileCount()), [&](const tbb::blocked_range<int>& range) {
+            // Per-task scratch: the second passes (mask, cone half-angle) need the bounds first.
+            std::vector<float> depths;
+            std::vector<glm::vec3> normals;
+            depths.reserve(maxSamples);
+            normals.reserve(maxSamples);
+            for (int tile = range.begin(); tile != range.end(); ++tile) {
+                const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
+                TileSurfaceBounds& b = bounds[size_t(tile)];
+                depths.clear();
+                normals.clear();
+                float minDepth = INFINITY, maxDepth = -INFINITY;
+                glm::vec3 normalSum(0.0f);
+                for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
+                    for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
+                        if (!gb.covered(size_t(y) * gb.width() + x))
+                            continue;
+                        const gbuffer::Surface s = gb.decode(x, y);
+                        const float depth = -s.positionView.z;
+                        minDepth = std::min(minDepth, depth);
+                        maxDepth = std::max(maxDepth, depth);
+                        if (options.depthMask)
+                            depths.push_back(depth);
+                        if (options.normalCone) {
+                            const float length = glm::length(s.normalView);
+                            // A zero normal has no facing: the BRDF's sign test then never passes,
+                            // but keep the tile's cone open rather than reason about it.
+                            const glm::vec3 n =
+                                length > 0.0f ? s.normalView / length : glm::vec3(0.0f);
+                            normals.push_back(n);
+                            normalSum += n;
+                        }
+                    }
+                if (!(minDepth <= maxDepth))
+                    continue; // no covered pixel
+                b.covered = true;
+                b.minDepthMetres = minDepth;
+                b.maxDepthMetres = maxDepth;
+                if (options.depthMask) {
+                    const float perMetre = depthBinsPerMetre(minDepth, maxDepth);
+                    uint32_t mask = 0;
+                    for (float d : depths)
+                        mask |= 1u << depthBin(d, minDepth, perMetre);
+                    b.depthMask = mask;
+                }
+                if (options.normalCone) {
+                    const float sumLength = glm::length(normalSum);
+                    // Normals cancelling out (sum ~ 0) leave no meaningful axis: the cone stays
+                    // open.
+                    if (!(sumLength > 1e-3f * float(normals.size())))
+                        continue;
+                    const glm::vec3 axis = normalSum / sumLength;
+                    float minDot = 1.0f;
+                    for (const glm::vec3& n : normals)
+                        minDot = std::min(minDot, glm::dot(axis, n));
+                    b.normalAxisView = axis;
+                    b.normalHalfAngle = std::acos(std::clamp(minDot, -1.0f, 1.0f));
+                    if (std::find(normals.begin(), normals.end(), glm::vec3(0.0f)) != normals.end())
+                        b.normalHalfAngle = 3.14159265f;
+                }
+            }
+        });
+    return bounds;
+}
+
+TileEdgePlanes TileEdgePlanes::make(const gbuffer::FrameView& view, const TileGrid& grid) {
+    TileEdgePlanes edges;
+    const int nx = grid.tileCountX + 1, ny = grid.tileCountY + 1;
+    auto rayAt = [&](int px, int py) {
+        const float ndcX = float(px) / float(grid.widthPixels) * 2.0f - 1.0f;
+        const float ndcY = 1.0f - float(py) / float(grid.heightPixels) * 2.0f;
+        const glm::vec4 p = view.viewFromClip * glm::vec4(ndcX, ndcY, 0.5f, 1.0f);
+        const glm::vec3 pView = glm::vec3(p) / p.w;
+        return pView / -pView.z;
+    };
+    edges.cornerRays.resize(size_t(nx) * ny);
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i)
+            edges.cornerRays[size_t(j) * nx + i] =
+                rayAt(std::min(i * grid.tileSizePixels, grid.widthPixels),
+                      std::min(j * grid.tileSizePixels, grid.heightPixels));
+    // Each edge plane from the two image-border rays of its line; all rays of one pixel-edge
+    // line lie in one plane through the eye (no skew in a pinhole projection).
+    for (int i = 0; i < nx; ++i) {
+        const int px = std::min(i * grid.tileSizePixels, grid.widthPixels);
+        glm::vec3 n = glm::normalize(glm::cross(rayAt(px, 0), rayAt(px, grid.heightPixels)));
+        if (n.x < 0.0f)
+            n = -n;
+        edges.columnNormals.push_back(n);
+    }
+    for (int j = 0; j < ny; ++j) {
+        const int py = std::min(j * grid.tileSizePixels, grid.heightPixels);
+        glm::vec3 n = glm::normalize(glm::cross(rayAt(0, py), rayAt(grid.widthPixels, py)));
+        if (n.y > 0.0f)
+            n = -n; // increasing pixel y = decreasing view y
+        edges.rowNormals.push_back(n);
+    }
+    return edges;
+}
+
+TileBox tileBox(const TileEdgePlanes& edges, const TileGrid& grid, int tx, int ty,
+                float minDepthMetres, float maxDepthMetres) {
+    TileBox box;
+    const glm::vec3 rays[4] = {edges.cornerRay(grid, tx, ty), edges.cornerRay(grid, tx + 1, ty),
+                               edges.cornerRay(grid, tx, ty + 1),
+                               edges.cornerRay(grid, tx + 1, ty + 1)};
+    box.boxMin = glm::vec3(INFINITY);
+    box.boxMax = glm::vec3(-INFINITY);
+    glm::vec3 sum(0.0f);
+    for (int k = 0; k < 8; ++k) {
+        const glm::vec3 corner = rays[k & 3] * (k < 4 ? minDepthMetres : maxDepthMetres);
+        box.corners[k] = corner;
+        box.boxMin = glm::min(box.boxMin, corner);
+        box.boxMax = glm::max(box.boxMax, corner);
+        sum += corner;
+    }
+    box.centre = sum * 0.125f;
+    return box;
+}
+
+std::vector<uint32_t> lightsInViewFrustum(const gbuffer::FrameView& view, const TileGrid& grid,
+                                          const TileEdgePlanes& edges,
+                                          const std::vector<LightSphere>& spheres) {
+    // Decoded depths may stray from [near, far] by float rounding; widen by far more than that.
+    const float nearDepth = view.nearMetres * 0.999f, farDepth = view.farMetres * 1.001f;
+    std::vector<uint32_t> kept;
+    kept.reserve(spheres.size());
+    for (uint32_t i = 0; i < spheres.size(); ++i) {
+        const LightSphere& s = spheres[i];
+        const float depth = -s.centreView.z;
+        if (s.unbounded || (depth + s.radius >= nearDepth && depth - s.radius <= farDepth &&
+                            sphereInColumnSlab(edges, 0, grid.tileCountX, s.centreView, s.radius) &&
+                            sphereInRowSlab(edges, 0, grid.tileCountY, s.centreView, s.radius)))
+            kept.push_back(i);
+    }
+    return kept;
+}
+
+bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
+                        const glm::vec3& lightCentreView) {
+    constexpr float kHalfPi = 1.57079632679f;
+    if (bounds.normalHalfAngle + kBackfaceSlackRadians >= kHalfPi)
+        return false;
+    // Centre in or next to the box: some sample may surround it; delta is undefined or >= pi/2.
+    const glm::vec3 pad = 1e-4f * (box.boxMax - box.boxMin) + glm::vec3(1e-5f);
+    if (distanceSquaredToBox(lightCentreView, box.boxMin - pad, box.boxMax + pad) == 0.0f)
+        return false;
+    const glm::vec3 toCentre = box.centre - lightCentreView;
+    const float centreDistance = glm::length(toCentre);
+    if (!(centreDistance > 0.0f))
+        return false;
+    const glm::vec3 lightAxis = toCentre / centreDistance;
+    float minCos = 1.0f;
+    for (const glm::vec3& corner : box.corners) {
+        const glm::vec3 toCorner = corner - lightCentreView;
+        const float length = glm::length(toCorner);
+        if (!(length > 0.0f))
+            return false;
+        minCos = std::min(minCos, glm::dot(lightAxis, toCorner) / length);
+    }
+    if (!(minCos > 0.0f))
+        return false; // delta >= pi/2: the light cone is not convex
+    const float delta = std::acos(std::min(minCos, 1.0f));
+    // Angle between the normal axis and the direction light travels; the thesis' omega (to the
+    // light) is pi minus this, and omega > pi/2 + alpha + delta is the same condition.
+    const float axisAngle =
+        std::acos(std::clamp(glm::dot(bounds.normalAxisView, lightAxis), -1.0f, 1.0f));
+    return axisAngle + bounds.normalHalfAngle + delta + kBackfaceSlackRadians <= kHalfPi;
+}
+
+} // namespace lighting

@@ -1,0 +1,148 @@
+// TileFrusta: the screen-tile machinery of tiled light culling (tiled deferred, tiled forward):
+// a grid of square screen tiles, per-tile surface bounds read from the G-buffer (view depth
+// range, Harada's 2.5D depth mask, a normal cone), the tile's depth-bounded frustum in view
+// space, and the conservative tests of a light's bounding sphere against them.
+//
+// Conventions: view space right-handed, camera at the origin looking down -Z; "depth" is the
+// positive view distance -z in metres. Pixel (x, y) covers [x, x+1) x [y, y+1) in pixel units
+// with y down; its sample is the pixel centre, as in FrameView::ndcOfPixel. Tile side planes
+// pass through pixel EDGES, so every sample of a tile lies half a pixel inside them: float
+// rounding of reconstructed positions (~1e-7 relative) never puts a sample outside its frustum.
+// Depth bounds are the min/max of the decoded positions themselves (bitwise the ones shading
+// uses), so samples lie inside them exactly.
+//
+// Every test here is conservative: it may keep a light that touches no sample, never the
+// reverse. Spheres must be the widened ones of LightBounds.h. Thread safety: all functions are
+// pure or write only their own outputs; computeTileSurfaceBounds runs in parallel over tiles.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gbuffer/FrameView.h"
+#include "gbuffer/GBuffer.h"
+#include "lighting/LightBounds.h"
+
+namespace lighting {
+
+struct TileGrid {
+    int widthPixels = 0;
+    int heightPixels = 0;
+    int tileSizePixels = 16;
+    int tileCountX = 0;
+    int tileCountY = 0;
+
+    static TileGrid make(int widthPixels, int heightPixels, int tileSizePixels);
+    int tileCount() const { return tileCountX * tileCountY; }
+    // Pixel range [x0, x1) x [y0, y1) of a tile; edge tiles are clipped to the image.
+    int x0(int tx) const { return tx * tileSizePixels; }
+    int x1(int tx) const { return std::min((tx + 1) * tileSizePixels, widthPixels); }
+    int y0(int ty) const { return ty * tileSizePixels; }
+    int y1(int ty) const { return std::min((ty + 1) * tileSizePixels, heightPixels); }
+};
+
+// Per-tile surface bounds from the G-buffer's covered pixels.
+struct TileSurfaceBounds {
+    bool covered = false;        // false: no covered pixel, the tile gets no bounded light
+    float minDepthMetres = 0.0f; // over covered pixels' decoded positions
+    float maxDepthMetres = 0.0f;
+    uint32_t depthMask = 0; // bit i: some sample in the i-th of 32 bins of [min, max]
+    glm::vec3 normalAxisView{0.0f, 0.0f, 1.0f}; // unit; normalised sum of the unit normals
+    float normalHalfAngle = 3.14159265f;        // radians; >= pi/2 means "faces everywhere"
+};
+
+struct TileBoundsOptions {
+    bool depthMask = false;
+    bool normalCone = false;
+};
+
+std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& gb,
+                                                        const TileGrid& grid,
+                                                        const TileBoundsOptions& options);
+
+// Harada's 2.5D culling: bin of a depth inside [minDepth, maxDepth] split into 32 bins. The
+// same monotone float expression serves samples and light ranges, so a sample whose depth is
+// inside a light's depth range always lands in one of the light's bins.
+inline int depthBin(float depthMetres, float minDepthMetres, float binsPerMetre) {
+    float t = (depthMetres - minDepthMetres) * binsPerMetre;
+    t = std::min(std::max(t, 0.0f), 31.0f);
+    return int(t);
+}
+inline float depthBinsPerMetre(float minDepthMetres, float maxDepthMetres) {
+    const float span = maxDepthMetres - minDepthMetres;
+    return span > 0.0f ? 32.0f / span : 0.0f;
+}
+inline uint32_t depthRangeMask(float lowMetres, float highMetres, float minDepthMetres,
+                               float maxDepthMetres) {
+    const float perMetre = depthBinsPerMetre(minDepthMetres, maxDepthMetres);
+    const int first = depthBin(lowMetres, minDepthMetres, perMetre);
+    const int last = depthBin(highMetres, minDepthMetres, perMetre);
+    const uint32_t upToLast = last >= 31 ? 0xFFFFFFFFu : (2u << last) - 1u;
+    return upToLast & ~((1u << first) - 1u);
+}
+
+// The planes through the eye along the tile grid's edges, shared by all tiles of a column or
+// row: columnPlanes[i] contains the rays of pixel-edge column x = min(i * tile, width), with its
+// unit normal pointing to increasing x; rowPlanes[j] likewise for y = min(j * tile, height),
+// pointing to increasing y (down the image). Rays are view directions scaled to depth 1.
+struct TileEdgePlanes {
+    std::vector<glm::vec3> columnNormals; // tileCountX + 1
+    std::vector<glm::vec3> rowNormals;    // tileCountY + 1
+    std::vector<glm::vec3> cornerRays;    // (tileCountX + 1) * (tileCountY + 1), row-major
+
+    static TileEdgePlanes make(const gbuffer::FrameView& view, const TileGrid& grid);
+    const glm::vec3& cornerRay(const TileGrid& grid, int i, int j) const {
+        return cornerRays[size_t(j) * (grid.tileCountX + 1) + i];
+    }
+};
+
+// Does the sphere reach the wedge between column planes i0 and i1 (i0 < i1)? Conservative.
+inline bool sphereInColumnSlab(const TileEdgePlanes& edges, int i0, int i1, const glm::vec3& c,
+                               float r) {
+    return glm::dot(edges.columnNormals[i0], c) >= -r &&
+           -glm::dot(edges.columnNormals[i1], c) >= -r;
+}
+inline bool sphereInRowSlab(const TileEdgePlanes& edges, int j0, int j1, const glm::vec3& c,
+                            float r) {
+    return glm::dot(edges.rowNormals[j0], c) >= -r && -glm::dot(edges.rowNormals[j1], c) >= -r;
+}
+
+// The 8 corners of a tile's frustum between two depths, and their bounding box.
+struct TileBox {
+    glm::vec3 corners[8];
+    glm::vec3 boxMin{0.0f};
+    glm::vec3 boxMax{0.0f};
+    glm::vec3 centre{0.0f}; // mean of the corners
+};
+TileBox tileBox(const TileEdgePlanes& edges, const TileGrid& grid, int tx, int ty,
+                float minDepthMetres, float maxDepthMetres);
+
+// Squared distance from a point to a box (0 inside).
+inline float distanceSquaredToBox(const glm::vec3& p, const glm::vec3& boxMin,
+                                  const glm::vec3& boxMax) {
+    const glm::vec3 d = glm::max(glm::max(boxMin - p, p - boxMax), glm::vec3(0.0f));
+    return glm::dot(d, d);
+}
+
+// Indices (ascending) of the lights whose sphere may touch the camera's view frustum between
+// the near and far planes (slightly widened); unbounded lights are always kept.
+std::vector<uint32_t> lightsInViewFrustum(const gbuffer::FrameView& view, const TileGrid& grid,
+                                          const TileEdgePlanes& edges,
+                                          const std::vector<LightSphere>& spheres);
+
+// Back-face test of the thesis (Ishmukhametov 2013, ch. 4) made exactly conservative. A light
+// is a point source at its centre for the BRDF: radiance needs dot(n, centre - p) > 0. The
+// directions from the centre to every point p of the tile's (convex) depth-bounded frustum lie
+// within delta of the axis centre->box centre (a cone of half-angle < pi/2 is convex, so the
+// corners bound the hull), every normal lies within alpha of the normal axis, so when
+// angle(axis_n, axis_l) + alpha + delta + slack <= pi/2 every n has dot(n, p - centre) >= 0:
+// the light faces the back of every sample. Returns true when the light can be rejected.
+// Degenerate cases (centre in or on the box, delta >= pi/2, alpha >= pi/2) never reject.
+inline constexpr float kBackfaceSlackRadians = 1e-3f; // >> float error of the angles (~1e-6)
+bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
+                        const glm::vec3& lightCentreView);
+
+} // namespace lighting

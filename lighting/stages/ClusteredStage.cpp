@@ -1,0 +1,165 @@
+// `clustered`: implicit clustered deferred shading (Olsson, Billeter and Assarsson 2012; the CPU
+// variant of Örtegren). The frustum is cut into a fixed grid of screen tiles x depth slices
+// (lighting/culling/ClusterGrid.h); each frame the lights' conservative spheres are assigned to
+// the clusters they may touch, then every covered pixel finds its cluster from its tile and view
+// depth and shades with that cluster's ascending light list (same image as `brute`).
+//
+// Options (defaults first):
+//   grid=24x12x32        tile columns x tile rows x depth slices (each 1..1024, <= 2^20 clusters)
+//   slices=exp|uniform   geometric (self-similar clusters) or linear slice boundaries between the
+//                        nearest and farthest view depth found in the G-buffer (a tighter range
+//                        than the camera's near/far planes, so no slice is wasted on empty space)
+//   assign=walk|binary   candidate ranges by walking the sorted planes or by binary search
+//   test=aabb|frustum    cluster test: sphere vs AABB, or AABB and the four side planes
+// Passes: "assign" (depth range, cluster bounds, light lists), "shading".
+// Conventions: view space right-handed, -Z forward; a pixel's slice comes from the depth of its
+// decoded position by the same comparisons that define the slices, so it always lies in its
+// cluster (up to rounding, which the widened AABBs and spheres cover).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include "lighting/LightBounds.h"
+#include "lighting/LightListShading.h"
+#include "lighting/culling/ClusterGrid.h"
+#include "lighting/stages/Stages.h"
+
+namespace lighting {
+
+namespace {
+
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+}
+
+class ClusteredStage final : public ShadingStage {
+public:
+    explicit ClusteredStage(const ClusterGridOptions& options) : mOptions(options) {}
+    std::string name() const override { return "clustered"; }
+    StageRequirements requirements() const override {
+        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
+                 gbuffer::Channel::Specular},
+                false};
+    }
+
+    void shade(const Frame& frame, StageResult& result) override {
+        const gbuffer::GBuffer& gb = *frame.gbuffer;
+        const int width = gb.width(), height = gb.height();
+        result.resize(width, height, false);
+        const auto assignStart = std::chrono::steady_clock::now();
+
+        // Nearest and farthest covered NDC depth (min/max: order-independent, so deterministic).
+        const std::vector<float>& depth = gb.depth();
+        const float clear = gb.view().clearDepth();
+        using MinMax = std::pair<float, float>;
+        const MinMax ndcRange = tbb::parallel_reduce(
+            tbb::blocked_range<int>(0, height), MinMax{INFINITY, -INFINITY},
+            [&](const tbb::blocked_range<int>& rows, MinMax m) {
+                for (int y = rows.begin(); y < rows.end(); ++y)
+                    for (size_t p = size_t(y) * width, end = p + width; p < end; ++p)
+                        if (depth[p] != clear)
+                            m = {std::min(m.first, depth[p]), std::max(m.second, depth[p])};
+                return m;
+            },
+            [](MinMax a, MinMax b) {
+                return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
+            });
+
+        std::string pairs = "0";
+        if (ndcRange.first <= ndcRange.second) {
+            // View depths of the extremes (depth along -Z does not depend on the pixel for a
+            // pinhole), widened so that rounding in the per-pixel reconstruction stays inside.
+            const float depthA =
+                -gb.reconstructPositionView(width / 2, height / 2, ndcRange.first).z;
+            const float depthB =
+                -gb.reconstructPositionView(width / 2, height / 2, ndcRange.second).z;
+            const float nearDepth = std::max(std::min(depthA, depthB) * (1.0f - 1e-5f), 1e-6f);
+            const float farDepth = std::max(std::max(depthA, depthB) * (1.0f + 1e-5f), nearDepth);
+            if (!mGrid)
+                mGrid.emplace(mOptions, gb.view(), nearDepth, farDepth);
+            else
+                mGrid->build(mOptions, gb.view(), nearDepth, farDepth);
+            ClusterGrid& grid = *mGrid;
+            grid.assign(boundingSpheresView(*frame.lights));
+            result.timingsMs.emplace_back("assign", millisecondsSince(assignStart));
+            pairs = std::to_string(grid.pairCount());
+
+            const auto shadingStart = std::chrono::steady_clock::now();
+            const std::vector<LightInView<float>>& lights = frame.lights->lights;
+            std::vector<int> tileXOfPixel(width);
+            for (int x = 0; x < width; ++x)
+                tileXOfPixel[x] = grid.tileXOfPixel(x);
+            // View depth of a pixel: the z and w rows of GBuffer::reconstructPositionView (the
+            // same position shading decodes; any rounding difference is inside the slack).
+            const glm::mat4& viewFromClip = gb.view().viewFromClip;
+            tbb::parallel_for(0, height, [&](int y) {
+                const int tileY = grid.tileYOfPixel(y);
+                for (int x = 0; x < width; ++x) {
+                    const size_t pixel = size_t(y) * width + x;
+                    if (depth[pixel] == clear)
+                        continue;
+                    const glm::vec2 ndc = gb.view().ndcOfPixel(x, y);
+                    const float z = viewFromClip[0][2] * ndc.x + viewFromClip[1][2] * ndc.y +
+                                    viewFromClip[2][2] * depth[pixel] + viewFromClip[3][2];
+                    const float w = viewFromClip[0][3] * ndc.x + viewFromClip[1][3] * ndc.y +
+                                    viewFromClip[2][3] * depth[pixel] + viewFromClip[3][3];
+                    const float depthMetres = -z / w;
+                    const size_t cluster =
+                        grid.clusterIndex(tileXOfPixel[x], tileY, grid.sliceOfDepth(depthMetres));
+                    shadeWithLightList(gb, x, y, lights, grid.lightsOf(cluster), result);
+                }
+            });
+            result.timingsMs.emplace_back("shading", millisecondsSince(shadingStart));
+        } else {
+            result.timingsMs.emplace_back("assign", millisecondsSince(assignStart));
+            result.timingsMs.emplace_back("shading", 0.0);
+        }
+
+        std::string grid = std::to_string(mOptions.tilesX);
+        grid.append("x")
+            .append(std::to_string(mOptions.tilesY))
+            .append("x")
+            .append(std::to_string(mOptions.slices));
+        result.parameters["grid"] = grid;
+        result.parameters["slices"] =
+            mOptions.spacing == SliceSpacing::Exponential ? "exp" : "uniform";
+        result.parameters["assign"] = mOptions.assign == AssignMethod::Walk ? "walk" : "binary";
+        result.parameters["test"] = mOptions.test == ClusterTest::Aabb ? "aabb" : "frustum";
+        result.parameters["cluster_light_pairs"] = pairs;
+    }
+
+private:
+    ClusterGridOptions mOptions;
+    std::optional<ClusterGrid> mGrid; // reused across frames for its storage
+};
+
+} // namespace
+
+std::unique_ptr<ShadingStage> makeClusteredStage(const StageSpec& spec) {
+    rejectUnknownOptions(spec, {"grid", "slices", "assign", "test"});
+    ClusterGridOptions options;
+    const auto grid = spec.options.find("grid");
+    if (grid != spec.options.end() &&
+        !parseClusterGrid(grid->second, options.tilesX, options.tilesY, options.slices))
+        throw StageError("stage '" + spec.name + "': option grid=" + grid->second +
+                         " is not XxYxZ with each of X, Y, Z in 1.." +
+                         std::to_string(kMaxClusterDimension) + " and at most " +
+                         std::to_string(kMaxClusterCount) + " clusters");
+    options.spacing = choiceOption(spec, "slices", {"exp", "uniform"}) == "exp"
+                          ? SliceSpacing::Exponential
+                          : SliceSpacing::Uniform;
+    options.assign = choiceOption(spec, "assign", {"walk", "binary"}) == "walk"
+                         ? AssignMethod::Walk
+                         : AssignMethod::Binary;
+    options.test = choiceOption(spec, "test", {"aabb", "frustum"}) == "aabb" ? ClusterTest::Aabb
+                                                                             : ClusterTest::Frustum;
+    return std::make_unique<ClusteredStage>(options);
+}
+
+} // namespace lighting

@@ -1,0 +1,138 @@
+// `forward-multipass`: multi-pass, multi-light forward shading with illumination sets (Hargreaves
+// & Harris 2004; O'Rorke 2004). A depth pre-pass ("prepass") lays down depth and the visible
+// triangle; per light, in ascending index order, its illumination set (the objects whose
+// view-space box its conservative sphere touches, "cull") is drawn again with a depth-equal test
+// and each visible fragment evaluates that one light and ADDS it to the pixel ("shading").
+// Directional and ambient lights are unbounded: drawn over every object.
+//
+// Options: none.
+//
+// Why the pre-pass is mandatory: additive passes without an equal test would add the light once
+// per overdrawn fragment. The equal test is closer-or-equal plus the pre-pass's visible triangle
+// (ForwardShading.h depthPrepass), so exact depth ties never add a light twice.
+//
+// Exactness: the fragment's surface and position are the G-buffer's own (ForwardShading.h), and
+// per pixel the lights are added in ascending order starting from zero, the same sequence of
+// float additions as `brute` minus lights that add exactly zero, so the image is bitwise
+// brute's. lightsEvaluated counts one per (light, visible fragment) drawn. Reads no G-buffer
+// channel. Deterministic: draws run one after another; within a draw each pixel is written only
+// by the thread owning its tile.
+#include "lighting/stages/Stages.h"
+
+#include <chrono>
+
+#include <tbb/parallel_for.h>
+
+#include "lighting/ForwardShading.h"
+
+namespace lighting {
+
+namespace {
+
+class ForwardMultipassStage final : public ShadingStage {
+public:
+    std::string name() const override { return "forward-multipass"; }
+    StageRequirements requirements() const override { return {{}, false}; }
+
+    void shade(const Frame& frame, StageResult& result) override {
+        const gbuffer::FrameView& view = *frame.view;
+        const int width = view.width;
+        result.resize(width, view.height, false);
+
+        auto start = std::chrono::steady_clock::now();
+        mForward.prepare(frame);
+        fitRasterizer(mRasterizer, view);
+        result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
+
+        start = std::chrono::steady_clock::now();
+        depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
+        result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
+
+        start = std::chrono::steady_clock::now();
+        buildIlluminationSets(*frame.lights);
+        result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
+
+        start = std::chrono::steady_clock::now();
+        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        const std::vector<ForwardObject>& objects = mForward.objects();
+        const std::vector<uint32_t>& allIndices = frame.geometry->indices;
+        raster::RasterState state;
+        state.cullMode = raster::CullMode::Back;
+        state.depthTest = closerOrEqualTest(view);
+        state.depthWrite = false;
+        for (uint32_t l = 0; l < lights.size(); ++l) {
+            const std::vector<uint32_t>& set = mSets[l];
+            if (set.empty())
+                continue;
+            // The set's triangles as one list; globalTriangle maps a drawn triangle back to the
+            // scene's (null: the whole scene, drawn as is).
+            const uint32_t* globalTriangle = nullptr;
+            std::span<const uint32_t> indices = allIndices;
+            if (set.size() != objects.size()) {
+                mSetIndices.clear();
+                mSetTriangles.clear();
+                for (uint32_t o : set) {
+                    const ForwardObject& object = objects[o];
+                    const auto first = allIndices.begin() + 3 * size_t(object.firstTriangle);
+                    mSetIndices.insert(mSetIndices.end(), first,
+                                       first + 3 * size_t(object.triangleCount));
+                    for (uint32_t t = 0; t < object.triangleCount; ++t)
+                        mSetTriangles.push_back(object.firstTriangle + t);
+                }
+                indices = mSetIndices;
+                globalTriangle = mSetTriangles.data();
+            }
+            const LightInView<float>& light = lights[l];
+            auto addLight = [&](const raster::Fragment& fragment) {
+                const size_t pixel = size_t(fragment.y) * width + fragment.x;
+                const uint32_t triangle =
+                    globalTriangle ? globalTriangle[fragment.triangle] : fragment.triangle;
+                if (mVisible[pixel] != visibilityCode(triangle, fragment.frontFacing))
+                    return;
+                const ShadingPoint<float> point = mForward.surfaceAt(fragment, triangle);
+                const glm::vec3 radiance =
+                    evaluateLight(point, glm::normalize(-point.positionView), light);
+                result.radiance[0][pixel] += radiance.x;
+                result.radiance[1][pixel] += radiance.y;
+                result.radiance[2][pixel] += radiance.z;
+                ++result.lightsEvaluated[pixel];
+            };
+            mRasterizer->draw(raster::TriangleList{mForward.clipPositions(), indices}, state,
+                              mDepth.data(), addLight);
+        }
+        result.timingsMs.emplace_back("shading", forwardElapsedMs(start));
+    }
+
+private:
+    // Per light, the objects its sphere touches, ascending. Lights in parallel, each into its
+    // own list.
+    void buildIlluminationSets(const LightList& lightList) {
+        const std::vector<LightSphere> spheres = boundingSpheresView(lightList);
+        const std::vector<ForwardObject>& objects = mForward.objects();
+        mSets.resize(spheres.size());
+        tbb::parallel_for(size_t(0), spheres.size(), [&](size_t l) {
+            std::vector<uint32_t>& set = mSets[l];
+            set.clear();
+            for (uint32_t o = 0; o < objects.size(); ++o)
+                if (sphereTouchesObject(spheres[l], objects[o]))
+                    set.push_back(o);
+        });
+    }
+
+    ForwardFrame mForward;
+    std::unique_ptr<raster::Rasterizer> mRasterizer;
+    std::vector<float> mDepth;
+    std::vector<uint32_t> mVisible;
+    std::vector<std::vector<uint32_t>> mSets;
+    std::vector<uint32_t> mSetIndices;
+    std::vector<uint32_t> mSetTriangles;
+};
+
+} // namespace
+
+std::unique_ptr<ShadingStage> makeForwardMultipassStage(const StageSpec& spec) {
+    rejectUnknownOptions(spec, {});
+    return std::make_unique<ForwardMultipassStage>();
+}
+
+} // namespace lighting

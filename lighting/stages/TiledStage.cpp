@@ -1,0 +1,213 @@
+// `tiled` and `tiled-backface`: tiled deferred shading (Ishmukhametov 2013, section 2.4.1, after
+// Andersson 2009 and Lauritzen 2010) and the thesis' own extension with per-tile back-face
+// culling of lights (chapter 4).
+//
+// tiled: the screen is split into square tiles; per tile, the view-depth range of its covered
+// pixels bounds a frustum (4 side planes through the eye along the tile's pixel edges, near/far
+// at the min/max depth); every light whose conservative sphere (LightBounds.h) may touch it goes
+// into the tile's list, in ascending light index; then every pixel is shaded with its tile's
+// list (shadeWithLightList), which makes the image bitwise equal to `brute`. Tiles without a
+// covered pixel get no lights.
+// tiled-backface: as tiled, plus a normal cone per tile and a light cone per (tile, light); a
+// light that faces the back of every normal in the tile is dropped (lightBackFacesTile in
+// culling/TileFrusta.h explains why the test is exactly conservative).
+//
+// Options (both stages):
+//   tile=16   tile size in pixels, 4..128
+//   vfc=1     first cull lights against the camera frustum (thesis 4.1 item 4); only speed
+//   mask=0    Harada's 2.5D culling: 32-bin depth mask per tile against the light's depth range
+// Passes: "cull" (light spheres, view-frustum culling, tile bounds and cones, light lists) and
+// "shading". Parameters record the options and counts: lights_after_vfc, vfc_culled,
+// tile_light_pairs and (tiled-backface) backface_rejected.
+// Threads: tiles in parallel; each tile's list and pixels are written by one task only.
+// Cost note (CPU): a light that faces away from a sample is rejected by evaluateLight's n.l test
+// before the specular term, so the samples tiled-backface removes are the cheap ones; the
+// thesis' GPU gains (uniform cost per evaluated light) are larger than what we measure here.
+#include "lighting/stages/Stages.h"
+
+#include <algorithm>
+#include <chrono>
+#include <span>
+
+#include <tbb/parallel_for.h>
+
+#include "lighting/LightBounds.h"
+#include "lighting/LightListShading.h"
+#include "lighting/culling/TileFrusta.h"
+
+namespace lighting {
+
+namespace {
+
+struct TiledOptions {
+    int tileSizePixels = 16;
+    bool viewFrustumCulling = true;
+    bool depthMask = false;
+    bool backface = false;
+};
+
+// A visible light, with the tile columns and rows its sphere may reach (empty when min > max).
+struct CandidateLight {
+    uint32_t index = 0;
+    glm::vec3 centreView{0.0f};
+    float radius = 0.0f;
+    bool unbounded = false;
+    int columnMin = 0, columnMax = -1, rowMin = 0, rowMax = -1;
+};
+
+class TiledStage final : public ShadingStage {
+public:
+    explicit TiledStage(const TiledOptions& options) : mOptions(options) {}
+
+    std::string name() const override { return mOptions.backface ? "tiled-backface" : "tiled"; }
+    StageRequirements requirements() const override {
+        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
+                 gbuffer::Channel::Specular},
+                false};
+    }
+
+    void shade(const Frame& frame, StageResult& result) override {
+        using Clock = std::chrono::steady_clock;
+        const gbuffer::GBuffer& gb = *frame.gbuffer;
+        const gbuffer::FrameView& view = gb.view();
+        result.resize(gb.width(), gb.height(), false);
+        const auto cullStart = Clock::now();
+
+        const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
+        const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
+        const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
+        std::vector<uint32_t> visible;
+        if (mOptions.viewFrustumCulling) {
+            visible = lightsInViewFrustum(view, grid, edges, spheres);
+        } else {
+            visible.resize(spheres.size());
+            for (uint32_t i = 0; i < visible.size(); ++i)
+                visible[i] = i;
+        }
+
+        // The tile columns and rows each light may reach: a cheap integer pre-test per tile.
+        std::vector<CandidateLight> candidates(visible.size());
+        tbb::parallel_for(size_t(0), visible.size(), [&](size_t k) {
+            const LightSphere& s = spheres[visible[k]];
+            CandidateLight& c = candidates[k];
+            c.index = visible[k];
+            c.centreView = s.centreView;
+            c.radius = s.radius;
+            c.unbounded = s.unbounded;
+            if (s.unbounded)
+                return;
+            int columnMin = grid.tileCountX, columnMax = -1, rowMin = grid.tileCountY, rowMax = -1;
+            for (int tx = 0; tx < grid.tileCountX; ++tx)
+                if (sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius)) {
+                    columnMin = std::min(columnMin, tx);
+                    columnMax = tx;
+                }
+            for (int ty = 0; ty < grid.tileCountY; ++ty)
+                if (sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius)) {
+                    rowMin = std::min(rowMin, ty);
+                    rowMax = ty;
+                }
+            c.columnMin = columnMin;
+            c.columnMax = columnMax;
+            c.rowMin = rowMin;
+            c.rowMax = rowMax;
+        });
+
+        const std::vector<TileSurfaceBounds> bounds =
+            computeTileSurfaceBounds(gb, grid, {mOptions.depthMask, mOptions.backface});
+
+        std::vector<std::vector<uint32_t>> tileLights(size_t(grid.tileCount()));
+        std::vector<uint64_t> tileBackfaceRejected(size_t(grid.tileCount()), 0);
+        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
+            const TileSurfaceBounds& b = bounds[size_t(tile)];
+            if (!b.covered)
+                return;
+            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
+            const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
+            std::vector<uint32_t>& list = tileLights[size_t(tile)];
+            uint64_t rejected = 0;
+            for (const CandidateLight& c : candidates) {
+                if (c.unbounded) {
+                    list.push_back(c.index);
+                    continue;
+                }
+                if (tx < c.columnMin || tx > c.columnMax || ty < c.rowMin || ty > c.rowMax)
+                    continue;
+                const float centreDepth = -c.centreView.z;
+                const float low = centreDepth - c.radius, high = centreDepth + c.radius;
+                if (high < b.minDepthMetres || low > b.maxDepthMetres)
+                    continue;
+                if (distanceSquaredToBox(c.centreView, box.boxMin, box.boxMax) >
+                    c.radius * c.radius)
+                    continue;
+                if (mOptions.depthMask &&
+                    (depthRangeMask(low, high, b.minDepthMetres, b.maxDepthMetres) & b.depthMask) ==
+                        0)
+                    continue;
+                if (mOptions.backface && lightBackFacesTile(box, b, c.centreView)) {
+                    ++rejected;
+                    continue;
+                }
+                list.push_back(c.index);
+            }
+            tileBackfaceRejected[size_t(tile)] = rejected;
+        });
+        const double cullMs =
+            std::chrono::duration<double, std::milli>(Clock::now() - cullStart).count();
+
+        const auto shadeStart = Clock::now();
+        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
+            const std::vector<uint32_t>& list = tileLights[size_t(tile)];
+            if (!bounds[size_t(tile)].covered)
+                return;
+            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
+            for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
+                for (int x = grid.x0(tx); x < grid.x1(tx); ++x)
+                    shadeWithLightList(gb, x, y, lights, std::span<const uint32_t>(list), result);
+        });
+        const double shadeMs =
+            std::chrono::duration<double, std::milli>(Clock::now() - shadeStart).count();
+
+        uint64_t pairs = 0, backfaceRejected = 0;
+        for (size_t tile = 0; tile < tileLights.size(); ++tile) {
+            pairs += tileLights[tile].size();
+            backfaceRejected += tileBackfaceRejected[tile];
+        }
+        result.timingsMs.emplace_back("cull", cullMs);
+        result.timingsMs.emplace_back("shading", shadeMs);
+        result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
+        result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
+        result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
+        result.parameters["lights_after_vfc"] = std::to_string(visible.size());
+        result.parameters["vfc_culled"] = std::to_string(spheres.size() - visible.size());
+        result.parameters["tile_light_pairs"] = std::to_string(pairs);
+        if (mOptions.backface)
+            result.parameters["backface_rejected"] = std::to_string(backfaceRejected);
+    }
+
+private:
+    TiledOptions mOptions;
+};
+
+TiledOptions parseTiledOptions(const StageSpec& spec, bool backface) {
+    rejectUnknownOptions(spec, {"tile", "vfc", "mask"});
+    TiledOptions options;
+    options.tileSizePixels = intOption(spec, "tile", 16, 4, 128);
+    options.viewFrustumCulling = boolOption(spec, "vfc", true);
+    options.depthMask = boolOption(spec, "mask", false);
+    options.backface = backface;
+    return options;
+}
+
+} // namespace
+
+std::unique_ptr<ShadingStage> makeTiledStage(const StageSpec& spec) {
+    return std::make_unique<TiledStage>(parseTiledOptions(spec, false));
+}
+
+std::unique_ptr<ShadingStage> makeTiledBackfaceStage(const StageSpec& spec) {
+    return std::make_unique<TiledStage>(parseTiledOptions(spec, true));
+}
+
+} // namespace lighting

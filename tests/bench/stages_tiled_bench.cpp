@@ -1,0 +1,119 @@
+// `tiled` and `tiled-backface` against each other and against `brute`, at 1280x720:
+//   wall, 2500 lights, behind=1000 and behind=0: tiled vs tiled-backface (issue targets:
+//     backface >= 1.3x faster with 1000 behind, not slower with none)
+//   atrium, 1000 lights: brute vs tiled (target: tiled >= 5x faster)
+// Manual time over the stage's shade() only (cull + shading); the G-buffer is rasterized once
+// per scene in a static fixture. Counters: the stage's own cull/shading ms of the last
+// iteration, light samples evaluated, and for tiled-backface the rejected (tile, light) pairs.
+// Compare ratios from one run; the machine's absolute figures vary.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "gbuffer/GBufferPass.h"
+#include "gbuffer/SceneGeometry.h"
+#include "lighting/LightList.h"
+#include "lighting/StageRegistry.h"
+#include "scenes/ProceduralScenes.h"
+
+namespace {
+
+constexpr int kWidth = 1280;
+constexpr int kHeight = 720;
+
+struct PreparedFrame {
+    scenes::Scene scene;
+    gbuffer::SceneGeometry geometry;
+    gbuffer::FrameView view;
+    std::unique_ptr<gbuffer::GBuffer> gbuffer;
+    lighting::LightList lights;
+    lighting::Frame frame;
+
+    PreparedFrame(const std::string& sceneName, int lightCount, int behind) {
+        scenes::SceneRequest request;
+        request.lightCount = lightCount;
+        request.seed = 1;
+        if (sceneName == "wall")
+            request.options = {{"behind", std::to_string(behind)}};
+        scene = scenes::buildProceduralScene(sceneName, request);
+        geometry = gbuffer::SceneGeometry::build(scene);
+        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
+        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
+        raster::Rasterizer rasterizer(kWidth, kHeight);
+        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
+        lights = lighting::LightList::build(scene.lights, view);
+        frame.scene = &scene;
+        frame.geometry = &geometry;
+        frame.view = &view;
+        frame.gbuffer = gbuffer.get();
+        frame.lights = &lights;
+    }
+};
+
+const PreparedFrame& prepared(const std::string& sceneName, int lightCount, int behind) {
+    static std::map<std::string, std::unique_ptr<PreparedFrame>> cache;
+    auto& slot = cache[sceneName + "/" + std::to_string(lightCount) + "/" + std::to_string(behind)];
+    if (!slot)
+        slot = std::make_unique<PreparedFrame>(sceneName, lightCount, behind);
+    return *slot;
+}
+
+double timing(const lighting::StageResult& result, const char* pass) {
+    for (const auto& [name, ms] : result.timingsMs)
+        if (name == pass)
+            return ms;
+    return 0.0;
+}
+
+void shadeStage(benchmark::State& state, const char* sceneName, int lightCount, int behind,
+                const char* spec) {
+    const PreparedFrame& f = prepared(sceneName, lightCount, behind);
+    auto stage = lighting::makeStage(spec);
+    lighting::StageResult result;
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        stage->shade(f.frame, result);
+        state.SetIterationTime(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    uint64_t samples = 0;
+    for (uint32_t n : result.lightsEvaluated)
+        samples += n;
+    state.counters["light_samples"] = double(samples);
+    state.counters["cull_ms"] = timing(result, "cull");
+    state.counters["shading_ms"] = timing(result, "shading");
+    const auto rejected = result.parameters.find("backface_rejected");
+    if (rejected != result.parameters.end())
+        state.counters["backface_rejected"] = std::stod(rejected->second);
+}
+
+BENCHMARK_CAPTURE(shadeStage, wall2500_behind1000_tiled, "wall", 2500, 1000, "tiled")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+BENCHMARK_CAPTURE(shadeStage, wall2500_behind1000_tiled_backface, "wall", 2500, 1000,
+                  "tiled-backface")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+BENCHMARK_CAPTURE(shadeStage, wall2500_behind0_tiled, "wall", 2500, 0, "tiled")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+BENCHMARK_CAPTURE(shadeStage, wall2500_behind0_tiled_backface, "wall", 2500, 0, "tiled-backface")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+BENCHMARK_CAPTURE(shadeStage, atrium1000_brute, "atrium", 1000, 0, "brute")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
+BENCHMARK_CAPTURE(shadeStage, atrium1000_tiled, "atrium", 1000, 0, "tiled")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+
+} // namespace

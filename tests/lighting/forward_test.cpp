@@ -1,0 +1,252 @@
+// The forward stages (`forward`, `forward:prepass=1`, `forward-multipass`) beyond the shared
+// exactness suite: bitwise equality with `brute`, overdraw counted, per-object light lists
+// (unlit objects cost nothing, a light behind the camera still lights what it reaches),
+// thread-count independence, and the shared surface function against the G-buffer it must
+// reproduce.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <memory>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <tbb/task_arena.h>
+
+#include "gbuffer/GBufferPass.h"
+#include "lighting/ForwardShading.h"
+#include "lighting/StageRegistry.h"
+#include "scenes/MeshBuilder.h"
+#include "scenes/ProceduralScenes.h"
+
+namespace {
+
+struct TestFrame {
+    scenes::Scene scene;
+    gbuffer::SceneGeometry geometry;
+    gbuffer::FrameView view;
+    std::unique_ptr<gbuffer::GBuffer> gbuffer;
+    lighting::LightList lights;
+    lighting::Frame frame;
+
+    TestFrame(scenes::Scene s, int width, int height) : scene(std::move(s)) {
+        geometry = gbuffer::SceneGeometry::build(scene);
+        view = gbuffer::FrameView::fromCamera(scene.cameras[0], width, height);
+        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
+        raster::Rasterizer rasterizer(width, height);
+        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
+        lights = lighting::LightList::build(scene.lights, view);
+        frame.scene = &scene;
+        frame.geometry = &geometry;
+        frame.view = &view;
+        frame.gbuffer = gbuffer.get();
+        frame.lights = &lights;
+    }
+};
+
+lighting::StageResult run(const std::string& stage, const TestFrame& f) {
+    lighting::StageResult result;
+    lighting::makeStage(stage)->shade(f.frame, result);
+    return result;
+}
+
+bool sameBits(float a, float b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+uint64_t total(const std::vector<uint32_t>& counts) {
+    uint64_t sum = 0;
+    for (uint32_t n : counts)
+        sum += n;
+    return sum;
+}
+
+const TestFrame& atrium() {
+    static const TestFrame frame = [] {
+        scenes::SceneRequest request;
+        request.lightCount = 200;
+        request.seed = 5;
+        return TestFrame(scenes::buildProceduralScene("atrium", request), 192, 108);
+    }();
+    return frame;
+}
+
+// Three unit boxes in front of a camera at the origin looking down -Z: A (left) lit by a small
+// light in front of it, B (right) lit only by a light BEHIND the camera (view z > 0), and C
+// (below) out of reach of both.
+const TestFrame& threeBoxes() {
+    static const TestFrame frame = [] {
+        scenes::Scene scene;
+        scene.name = "three-boxes";
+        scene.materials.push_back({});
+        scenes::Mesh box;
+        box.name = "box";
+        scenes::appendBox(box, {glm::vec3(-0.5f), glm::vec3(0.5f)}, 0.25f);
+        scene.meshes.push_back(box);
+        for (const glm::vec3 centre : {glm::vec3(-2.0f, 0.0f, -5.0f), glm::vec3(2.0f, 0.0f, -5.0f),
+                                       glm::vec3(0.0f, -2.2f, -5.0f)})
+            scene.instances.push_back({0, glm::translate(glm::mat4(1.0f), centre)});
+        scene.cameras.push_back({});
+        scenes::Light nearA;
+        nearA.positionWorld = {-2.0f, 0.0f, -3.5f};
+        nearA.rangeMetres = 1.5f;
+        nearA.intensity = 5.0f;
+        scenes::Light behindCamera;
+        behindCamera.positionWorld = {3.0f, 0.0f, 1.0f};
+        behindCamera.rangeMetres = 6.2f;
+        behindCamera.intensity = 50.0f;
+        scene.lights = {nearA, behindCamera};
+        scenes::validate(scene);
+        return TestFrame(std::move(scene), 128, 96);
+    }();
+    return frame;
+}
+
+void expectBitwiseEqual(const lighting::StageResult& result, const lighting::StageResult& brute,
+                        const std::string& what) {
+    ASSERT_EQ(result.width, brute.width);
+    ASSERT_EQ(result.height, brute.height);
+    int failures = 0;
+    for (size_t pixel = 0; pixel < brute.radiance[0].size(); ++pixel)
+        for (int ch = 0; ch < 3; ++ch)
+            if (!sameBits(result.radiance[ch][pixel], brute.radiance[ch][pixel]) && failures++ < 5)
+                ADD_FAILURE() << what << ": pixel " << pixel << " channel " << ch << " is "
+                              << result.radiance[ch][pixel] << ", brute "
+                              << brute.radiance[ch][pixel];
+    EXPECT_EQ(failures, 0) << what;
+}
+
+TEST(Forward, EveryVariantIsBitwiseBrute) {
+    for (const TestFrame* f : {&atrium(), &threeBoxes()}) {
+        const lighting::StageResult brute = run("brute", *f);
+        for (const char* stage : {"forward", "forward:prepass=1", "forward-multipass"})
+            expectBitwiseEqual(run(stage, *f), brute, std::string(stage) + " on " + f->scene.name);
+    }
+}
+
+TEST(Forward, PrepassShadesEachPixelOnceAndOverdrawIsCounted) {
+    const TestFrame& f = atrium();
+    const lighting::StageResult single = run("forward", f);
+    const lighting::StageResult prepass = run("forward:prepass=1", f);
+    EXPECT_EQ(single.parameters.at("prepass"), "0");
+    EXPECT_EQ(prepass.parameters.at("prepass"), "1");
+    // Overdraw: every fragment that passed the depth test without a pre-pass was shaded.
+    EXPECT_GT(total(single.lightsEvaluated), total(prepass.lightsEvaluated));
+    for (size_t pixel = 0; pixel < single.lightsEvaluated.size(); ++pixel) {
+        ASSERT_GE(single.lightsEvaluated[pixel], prepass.lightsEvaluated[pixel]) << pixel;
+        if (!f.gbuffer->covered(pixel))
+            ASSERT_EQ(prepass.lightsEvaluated[pixel], 0u) << pixel;
+    }
+    std::vector<std::string> passes;
+    for (const auto& [name, ms] : prepass.timingsMs)
+        passes.push_back(name);
+    EXPECT_NE(std::find(passes.begin(), passes.end(), "prepass"), passes.end());
+    EXPECT_NE(std::find(passes.begin(), passes.end(), "cull"), passes.end());
+    EXPECT_NE(std::find(passes.begin(), passes.end(), "shading"), passes.end());
+}
+
+TEST(Forward, MultipassEvaluatesOnlyVisibleFragments) {
+    // With the pre-pass's equal test, multipass never evaluates more lights at a pixel than the
+    // single-pass stage does for that pixel's visible object (the same culling), and nothing on
+    // the background.
+    const TestFrame& f = atrium();
+    const lighting::StageResult multipass = run("forward-multipass", f);
+    const lighting::StageResult prepass = run("forward:prepass=1", f);
+    for (size_t pixel = 0; pixel < multipass.lightsEvaluated.size(); ++pixel)
+        ASSERT_EQ(multipass.lightsEvaluated[pixel], prepass.lightsEvaluated[pixel]) << pixel;
+}
+
+TEST(Forward, UnlitObjectsCostNothingAndALightBehindTheCameraStillLights) {
+    const TestFrame& f = threeBoxes();
+    lighting::ForwardFrame forward;
+    forward.prepare(f.frame);
+    ASSERT_EQ(forward.objects().size(), 3u);
+    raster::Rasterizer rasterizer(f.view.width, f.view.height);
+    std::vector<float> depth;
+    std::vector<uint32_t> visible;
+    lighting::depthPrepass(rasterizer, forward, f.view, depth, visible);
+
+    for (const char* stage : {"forward", "forward:prepass=1", "forward-multipass"}) {
+        const lighting::StageResult result = run(stage, f);
+        int pixelsOfObject[3] = {0, 0, 0};
+        int litPixelsOfObject[3] = {0, 0, 0};
+        for (size_t pixel = 0; pixel < visible.size(); ++pixel) {
+            if (visible[pixel] == lighting::kNoVisibleTriangle) {
+                EXPECT_EQ(result.lightsEvaluated[pixel], 0u) << stage;
+                continue;
+            }
+            const uint32_t object =
+                forward.objectOfTriangle(visible[pixel] & ~lighting::kBackFaceBit);
+            ++pixelsOfObject[object];
+            litPixelsOfObject[object] += result.radiance[0][pixel] > 0.0f ? 1 : 0;
+            // A and B each have exactly one light in reach; C none.
+            EXPECT_EQ(result.lightsEvaluated[pixel] > 0, object != 2)
+                << stage << " pixel " << pixel;
+            if (object == 2)
+                EXPECT_EQ(result.radiance[0][pixel], 0.0f) << stage;
+        }
+        for (int o = 0; o < 3; ++o)
+            EXPECT_GT(pixelsOfObject[o], 100) << "object " << o << " not in view";
+        EXPECT_GT(litPixelsOfObject[0], 0) << stage;
+        EXPECT_GT(litPixelsOfObject[1], 0) << stage << ": the light behind the camera lit nothing";
+    }
+}
+
+TEST(Forward, SameResultForAnyThreadCount) {
+    const TestFrame& f = atrium();
+    for (const char* stage : {"forward", "forward:prepass=1", "forward-multipass"}) {
+        lighting::StageResult one, two;
+        tbb::task_arena(1).execute([&] { one = run(stage, f); });
+        tbb::task_arena(2).execute([&] { two = run(stage, f); });
+        EXPECT_EQ(one.lightsEvaluated, two.lightsEvaluated) << stage;
+        expectBitwiseEqual(one, two, std::string(stage) + " 1 vs 2 threads");
+    }
+}
+
+TEST(Forward, SharedSurfaceFunctionReproducesTheGBuffer) {
+    // The refactored GBufferPass::resolve and the forward stages share surfaceOfTriangle and
+    // positionViewOfPixel: at every covered pixel, the G-buffer's decoded surface must equal,
+    // bit for bit, the forward frame's surface of the pre-pass's visible fragment.
+    for (const TestFrame* f : {&atrium(), &threeBoxes()}) {
+        lighting::ForwardFrame forward;
+        forward.prepare(f->frame);
+        raster::Rasterizer rasterizer(f->view.width, f->view.height);
+        std::vector<float> depth;
+        std::vector<uint32_t> visible;
+        lighting::depthPrepass(rasterizer, forward, f->view, depth, visible);
+        int covered = 0, failures = 0;
+        for (int y = 0; y < f->view.height; ++y)
+            for (int x = 0; x < f->view.width; ++x) {
+                const size_t pixel = size_t(y) * f->view.width + x;
+                ASSERT_TRUE(sameBits(depth[pixel], f->gbuffer->depth()[pixel])) << pixel;
+                ASSERT_EQ(visible[pixel] != lighting::kNoVisibleTriangle,
+                          f->gbuffer->covered(pixel));
+                if (visible[pixel] == lighting::kNoVisibleTriangle)
+                    continue;
+                ++covered;
+                raster::Fragment fragment;
+                fragment.x = x;
+                fragment.y = y;
+                fragment.depth = depth[pixel];
+                fragment.frontFacing = (visible[pixel] & lighting::kBackFaceBit) == 0;
+                const auto point =
+                    forward.surfaceAt(fragment, visible[pixel] & ~lighting::kBackFaceBit);
+                const gbuffer::Surface decoded = f->gbuffer->decode(x, y);
+                bool same = sameBits(point.specularIntensity, decoded.specularIntensity) &&
+                            sameBits(point.specularPower, decoded.specularPower);
+                for (int c = 0; c < 3; ++c)
+                    same = same && sameBits(point.positionView[c], decoded.positionView[c]) &&
+                           sameBits(point.normalView[c], decoded.normalView[c]) &&
+                           sameBits(point.albedo[c], decoded.albedo[c]);
+                if (!same && failures++ < 5)
+                    ADD_FAILURE() << f->scene.name << ": pixel (" << x << ", " << y << ")";
+            }
+        EXPECT_EQ(failures, 0);
+        EXPECT_GT(covered, 0);
+    }
+}
+
+TEST(Forward, RejectsBadOptions) {
+    EXPECT_THROW(lighting::makeStage("forward:prepass=2"), lighting::StageError);
+    EXPECT_THROW(lighting::makeStage("forward-multipass:prepass=1"), lighting::StageError);
+}
+
+} // namespace

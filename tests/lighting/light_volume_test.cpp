@@ -1,0 +1,291 @@
+// Light volumes (`deferred`, `light-indexed`): option variants and hard cases against `brute`
+// (image within 1e-5 of peak, evaluated >= oracle at every pixel), the proxy's conservativeness,
+// thread-count independence, and that volumes actually cull.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <random>
+
+#include <tbb/task_arena.h>
+
+#include "gbuffer/GBufferPass.h"
+#include "lighting/LightBounds.h"
+#include "lighting/Oracle.h"
+#include "lighting/StageRegistry.h"
+#include "lighting/culling/LightVolumes.h"
+#include "scenes/ProceduralScenes.h"
+
+namespace {
+
+constexpr int kWidth = 256;
+constexpr int kHeight = 144;
+
+struct TestFrame {
+    scenes::Scene scene;
+    gbuffer::SceneGeometry geometry;
+    gbuffer::FrameView view;
+    std::unique_ptr<gbuffer::GBuffer> gbuffer;
+    lighting::LightList lights;
+    lighting::Frame frame;
+    std::vector<uint32_t> oracle;
+    lighting::StageResult brute;
+
+    // Renders the G-buffer of `scene`; call setLights() before shading.
+    explicit TestFrame(scenes::Scene s) : scene(std::move(s)) {
+        geometry = gbuffer::SceneGeometry::build(scene);
+        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
+        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
+        raster::Rasterizer rasterizer(kWidth, kHeight);
+        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
+        setLights(scene.lights);
+    }
+    void setLights(const std::vector<scenes::Light>& sceneLights) {
+        scene.lights = sceneLights;
+        lights = lighting::LightList::build(scene.lights, view);
+        frame.scene = &scene;
+        frame.geometry = &geometry;
+        frame.view = &view;
+        frame.gbuffer = gbuffer.get();
+        frame.lights = &lights;
+        oracle = lighting::countContributingLights(frame);
+        lighting::makeStage("brute")->shade(frame, brute);
+    }
+    glm::vec3 worldFromView(const glm::vec3& p) const {
+        return glm::vec3(glm::inverse(view.viewFromWorld) * glm::vec4(p, 1.0f));
+    }
+    glm::vec3 worldDirectionFromView(const glm::vec3& d) const {
+        return glm::transpose(view.viewFromWorldNormal) * d;
+    }
+};
+
+scenes::Scene proceduralScene(const char* name, int lightCount, std::map<std::string, std::string> options = {}) {
+    scenes::SceneRequest request;
+    request.lightCount = lightCount;
+    request.seed = 7;
+    request.options = std::move(options);
+    return scenes::buildProceduralScene(name, request);
+}
+
+// Shades with `stage` and checks the image against brute and the counts against the oracle.
+void expectMatchesBrute(const TestFrame& f, const std::string& stage, const std::string& where) {
+    lighting::StageResult result;
+    lighting::makeStage(stage)->shade(f.frame, result);
+    float peak = 0.0f;
+    for (int ch = 0; ch < 3; ++ch)
+        for (float v : f.brute.radiance[ch]) peak = std::max(peak, v);
+    int imageFailures = 0, dropped = 0;
+    for (size_t pixel = 0; pixel < f.oracle.size(); ++pixel) {
+        for (int ch = 0; ch < 3; ++ch) {
+            const float difference = std::abs(result.radiance[ch][pixel] - f.brute.radiance[ch][pixel]);
+            if (!(difference <= 1e-5f * peak) && imageFailures++ < 3)
+                ADD_FAILURE() << stage << " " << where << ": pixel (" << pixel % kWidth << ", "
+                              << pixel / kWidth << ") differs by " << difference << " (peak " << peak << ")";
+        }
+        if (result.lightsEvaluated[pixel] < f.oracle[pixel] && dropped++ < 3)
+            ADD_FAILURE() << stage << " " << where << ": pixel (" << pixel % kWidth << ", " << pixel / kWidth
+                          << ") evaluated " << result.lightsEvaluated[pixel] << " < oracle " << f.oracle[pixel];
+    }
+    EXPECT_EQ(imageFailures, 0) << stage << " " << where;
+    EXPECT_EQ(dropped, 0) << stage << " " << where;
+}
+
+const std::vector<std::string> kVariants = {
+    "deferred",
+    "deferred:volume=rect",
+    "deferred:stencil=1",
+    "deferred:vfc=0",
+    "deferred:volume=rect,vfc=0",
+    "light-indexed",
+    "light-indexed:max=1",
+    "light-indexed:stencil=1,max=4",
+    "light-indexed:volume=rect",
+};
+
+TEST(LightVolumes, OptionVariantsMatchBrute) {
+    struct Case {
+        const char* scene;
+        int lights;
+        std::map<std::string, std::string> options;
+    };
+    const Case cases[] = {{"atrium", 300, {}}, {"wall", 400, {{"behind", "200"}}}, {"spheres", 200, {}}};
+    for (const Case& c : cases) {
+        const TestFrame f(proceduralScene(c.scene, c.lights, c.options));
+        for (const std::string& stage : kVariants) expectMatchesBrute(f, stage, c.scene);
+    }
+}
+
+TEST(LightVolumes, LightIndexedOverflowIsReportedAndConservative) {
+    const TestFrame f(proceduralScene("atrium", 300));
+    lighting::StageResult result;
+    lighting::makeStage("light-indexed:max=1")->shade(f.frame, result);
+    ASSERT_TRUE(result.parameters.count("overflow_pixels"));
+    EXPECT_GT(std::stoull(result.parameters.at("overflow_pixels")), 0u);
+    // Overflowed pixels are shaded with every light.
+    EXPECT_NE(std::find(result.lightsEvaluated.begin(), result.lightsEvaluated.end(), uint32_t(f.lights.size())),
+              result.lightsEvaluated.end());
+}
+
+TEST(LightVolumes, ProxyCircumscribesTheUnitSphereAndIsClosed) {
+    const lighting::ProxyMesh& proxy = lighting::unitProxySphere();
+    ASSERT_EQ(proxy.positions.size(), 42u);
+    ASSERT_EQ(proxy.indices.size(), 80u * 3);
+    std::map<std::pair<uint32_t, uint32_t>, int> directedEdges;
+    std::vector<glm::vec4> planes;  // outward unit normal, distance from the origin
+    for (size_t t = 0; t < proxy.indices.size(); t += 3) {
+        const uint32_t i[3] = {proxy.indices[t], proxy.indices[t + 1], proxy.indices[t + 2]};
+        const glm::dvec3 a(proxy.positions[i[0]]), b(proxy.positions[i[1]]), c(proxy.positions[i[2]]);
+        const glm::dvec3 normal = glm::normalize(glm::cross(b - a, c - a));
+        const double distance = glm::dot(normal, a);
+        EXPECT_GE(distance, 1.0) << "face " << t / 3 << " cuts into the unit sphere";
+        EXPECT_GT(glm::dot(normal, a + b + c), 0.0) << "face " << t / 3 << " is not counter-clockwise outside";
+        planes.emplace_back(glm::vec3(normal), float(distance));
+        for (int e = 0; e < 3; ++e) ++directedEdges[{i[e], i[(e + 1) % 3]}];
+    }
+    // Closed and consistently wound: every directed edge once, and its reverse once.
+    for (const auto& [edge, count] : directedEdges) {
+        EXPECT_EQ(count, 1);
+        EXPECT_EQ(directedEdges.count({edge.second, edge.first}), 1u);
+    }
+    for (const glm::vec3& p : proxy.positions) EXPECT_LE(glm::length(p), proxy.circumradius);
+    // Random points of the unit sphere are inside every face plane.
+    std::mt19937 random(1);
+    std::normal_distribution<float> gaussian;
+    for (int s = 0; s < 20000; ++s) {
+        const glm::vec3 p = glm::normalize(glm::vec3(gaussian(random), gaussian(random), gaussian(random)));
+        for (const glm::vec4& plane : planes) ASSERT_LE(glm::dot(glm::vec3(plane), p), plane.w);
+    }
+}
+
+// Adds hard lights to `f`'s scene in view space: camera inside a volume, a volume crossing the
+// near plane, range zero, a volume covering the whole screen and crossing the far plane, lights
+// behind the camera, and lights just touching (or just reaching through) visible surfaces.
+std::vector<scenes::Light> hardLights(const TestFrame& f) {
+    std::vector<scenes::Light> lights = f.scene.lights;
+    auto point = [&](glm::vec3 positionView, float range, glm::vec3 color = glm::vec3(1.0f)) {
+        scenes::Light light;
+        light.type = scenes::LightType::Point;
+        light.positionWorld = f.worldFromView(positionView);
+        light.rangeMetres = range;
+        light.color = color;
+        light.intensity = 2.0f;
+        lights.push_back(light);
+    };
+    const float nearMetres = f.view.nearMetres;
+    point({0.0f, 0.0f, -0.5f}, 4.0f);                   // camera inside the volume
+    point({0.2f, 0.1f, -nearMetres}, 1.5f);             // centred on the near plane
+    point({-0.3f, 0.0f, 0.05f}, 0.8f);                  // just behind the eye, reaching in front
+    point({0.0f, 0.0f, 3.0f}, 2.0f);                    // wholly behind the camera
+    point({0.0f, 0.0f, 1.0f}, 50.0f);                   // behind, covering everything in view
+    point({0.0f, 0.0f, -20.0f}, 2.0f * f.view.farMetres);  // whole screen, beyond the far plane
+    // Surfaces: range zero on a surface, and spheres barely touching or reaching through it.
+    int placed = 0;
+    for (int y = 5; y < kHeight; y += 23)
+        for (int x = 7; x < kWidth; x += 31) {
+            const size_t pixel = size_t(y) * kWidth + x;
+            if (!f.gbuffer->covered(pixel)) continue;
+            const gbuffer::Surface s = f.gbuffer->decode(x, y);
+            const float distance = glm::length(s.positionView);
+            const float range = 0.02f * distance + 0.05f;
+            switch (placed++ % 4) {
+            case 0: point(s.positionView, 0.0f); break;
+            case 1: point(s.positionView + s.normalView * (range * 0.999f), range); break;
+            case 2: point(s.positionView - s.normalView * (range * 0.999f), range); break;
+            default: {
+                // Grazing: along the surface, slightly above it.
+                const glm::vec3 along = glm::normalize(glm::cross(s.normalView, glm::vec3(0.0f, 1.0f, 0.3f)));
+                point(s.positionView + along * (range * 0.9f) + s.normalView * (range * 0.05f), range);
+            }
+            }
+        }
+    // A spot light inside the camera's volume, pointing forward.
+    scenes::Light spot;
+    spot.type = scenes::LightType::Spot;
+    spot.positionWorld = f.worldFromView({0.1f, -0.1f, -0.3f});
+    spot.directionWorld = f.worldDirectionFromView({0.0f, 0.0f, -1.0f});
+    spot.rangeMetres = 30.0f;
+    lights.push_back(spot);
+    return lights;
+}
+
+TEST(LightVolumes, HardCasesMatchBrute) {
+    for (const char* sceneName : {"atrium", "spheres", "wall"}) {
+        TestFrame f(proceduralScene(sceneName, 20));
+        f.setLights(hardLights(f));
+        for (const std::string& stage : kVariants) expectMatchesBrute(f, stage, std::string("hard ") + sceneName);
+    }
+}
+
+TEST(LightVolumes, StandardDepthMatchesBrute) {
+    scenes::Scene scene = proceduralScene("atrium", 200);
+    TestFrame f(scene);
+    f.view = gbuffer::FrameView::fromCamera(f.scene.cameras[0], kWidth, kHeight, gbuffer::DepthConvention::Standard);
+    f.gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), f.view);
+    raster::Rasterizer rasterizer(kWidth, kHeight);
+    gbuffer::GBufferPass(f.scene, f.geometry).render(rasterizer, *f.gbuffer);
+    f.setLights(hardLights(f));
+    for (const std::string& stage : kVariants) expectMatchesBrute(f, stage, "standard depth");
+}
+
+TEST(LightVolumes, SameResultForOneAndTwoThreads) {
+    const TestFrame f(proceduralScene("atrium", 300));
+    for (const char* stage : {"deferred", "deferred:stencil=1", "light-indexed:max=2"}) {
+        lighting::StageResult one, two;
+        tbb::task_arena(1).execute([&] { lighting::makeStage(stage)->shade(f.frame, one); });
+        tbb::task_arena(2).execute([&] { lighting::makeStage(stage)->shade(f.frame, two); });
+        for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(one.radiance[ch], two.radiance[ch]) << stage;
+        EXPECT_EQ(one.lightsEvaluated, two.lightsEvaluated) << stage;
+    }
+}
+
+TEST(LightVolumes, DeferredCullsOnAtrium) {
+    const TestFrame f(proceduralScene("atrium", 300));
+    for (const char* stage : {"deferred", "deferred:stencil=1", "light-indexed"}) {
+        lighting::StageResult result;
+        lighting::makeStage(stage)->shade(f.frame, result);
+        uint64_t evaluated = 0, brute = 0;
+        for (uint32_t n : result.lightsEvaluated) evaluated += n;
+        for (uint32_t n : f.brute.lightsEvaluated) brute += n;
+        EXPECT_LT(evaluated * 4, brute) << stage << " evaluated " << evaluated << " of brute's " << brute;
+    }
+}
+
+TEST(LightVolumes, FrustumCullingAndScreenRectAreConservative) {
+    const TestFrame f(proceduralScene("atrium", 8));
+    lighting::LightVolumeRasterizer volumes(*f.gbuffer, lighting::VolumeShape::Rect, false);
+    std::mt19937 random(5);
+    std::uniform_real_distribution<float> coordinate(-30.0f, 30.0f), radius(0.01f, 10.0f);
+    int visibleCount = 0;
+    for (int s = 0; s < 800; ++s) {
+        lighting::LightSphere sphere;
+        sphere.centreView = {coordinate(random), coordinate(random), coordinate(random) - 20.0f};
+        sphere.radius = radius(random);
+        // Brute force: any pixel-centre ray point within [near, far] inside the sphere.
+        const lighting::LightVolumeRasterizer::PixelRect rect = volumes.screenRect(sphere);
+        bool anyInside = false;
+        for (int y = 0; y < kHeight; y += 1)
+            for (int x = 0; x < kWidth; x += 1) {
+                const glm::vec2 ndc = f.view.ndcOfPixel(x, y);
+                const glm::vec4 h = f.view.viewFromClip * glm::vec4(ndc, 0.5f, 1.0f);
+                const glm::vec3 ray = glm::normalize(glm::vec3(h) / h.w);
+                // Closest approach of the ray to the centre, clamped to the view depth range.
+                float t = glm::dot(sphere.centreView, ray);
+                const float tNear = f.view.nearMetres / -ray.z, tFar = f.view.farMetres / -ray.z;
+                t = std::clamp(t, tNear, tFar);
+                if (glm::length(ray * t - sphere.centreView) < sphere.radius) {
+                    anyInside = true;
+                    ASSERT_TRUE(x >= rect.minX && x <= rect.maxX && y >= rect.minY && y <= rect.maxY)
+                        << "pixel (" << x << ", " << y << ") outside the rectangle of sphere " << s;
+                }
+            }
+        if (anyInside) {
+            ++visibleCount;
+            ASSERT_TRUE(volumes.inViewFrustum(sphere)) << "sphere " << s << " culled but visible";
+        }
+    }
+    EXPECT_GT(visibleCount, 30);
+}
+
+}  // namespace
