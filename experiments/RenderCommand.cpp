@@ -44,6 +44,9 @@ void writeOutputs(const RenderRun& run, const RenderCommandOptions& options, con
     const std::vector<float> z = viewDepthMetres(gb);
     const std::vector<float> evaluated = toFloat(run.result.lightsEvaluated);
     const std::vector<float> oracle = toFloat(run.oracle);
+    // Evaluations that added nothing: the culling stage's waste at each pixel.
+    std::vector<float> wasted(evaluated.size());
+    for (size_t pixel = 0; pixel < wasted.size(); ++pixel) wasted[pixel] = evaluated[pixel] - oracle[pixel];
     std::vector<ImagePlane> planes = {
         {"R", run.result.radiance[0].data()},
         {"G", run.result.radiance[1].data()},
@@ -57,6 +60,7 @@ void writeOutputs(const RenderRun& run, const RenderCommandOptions& options, con
         {"albedo.B", gb.albedoPlane(2).data()},
         {"lights.evaluated", evaluated.data()},
         {"lights.oracle", oracle.data()},
+        {"lights.wasted", wasted.data()},
     };
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"testbed:scene", run.options.scene},

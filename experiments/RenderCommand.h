@@ -1,6 +1,7 @@
 // RenderCommand: `testbed render`: runs a RenderJob and writes its results into --out:
 //   render.exr   multi-layer OpenEXR (beauty R,G,B; N.X,N.Y,N.Z; Z; albedo.R,G,B;
-//                lights.evaluated; lights.oracle), options and timings in the header
+//                lights.evaluated; lights.oracle; lights.wasted = evaluated - oracle), options
+//                and timings in the header
 //   preview.png  tone-mapped beauty
 //   heatmap.png  lights evaluated per pixel, false colour with a legend
 //   stats.json   configuration, machine, commit, timings, light counts, error metrics

@@ -153,7 +153,8 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
     auto input = OIIO::ImageInput::open((out / "render.exr").string());
     ASSERT_TRUE(input);
     const std::vector<std::string> expected = {"R", "G", "B", "N.X", "N.Y", "N.Z", "Z", "albedo.R",
-                                               "albedo.G", "albedo.B", "lights.evaluated", "lights.oracle"};
+                                               "albedo.G", "albedo.B", "lights.evaluated", "lights.oracle",
+                                               "lights.wasted"};
     for (const std::string& name : expected) {
         const auto& names = input->spec().channelnames;
         EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
