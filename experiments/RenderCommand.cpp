@@ -39,7 +39,7 @@ std::vector<float> toFloat(const std::vector<uint32_t>& counts) {
 }
 
 void writeOutputs(const RenderRun& run, const RenderCommandOptions& options, const nlohmann::json& stats) {
-    const gbuffer::GBuffer& gb = *run.gbuffer;
+    const gbuffer::GBuffer& gb = run.gbuffer();
     const int w = gb.width(), h = gb.height();
     const std::vector<float> z = viewDepthMetres(gb);
     const std::vector<float> evaluated = toFloat(run.result.lightsEvaluated);
@@ -81,7 +81,7 @@ void writeOutputs(const RenderRun& run, const RenderCommandOptions& options, con
 
 nlohmann::json statsJson(const RenderRun& run) {
     nlohmann::json stats;
-    stats["scene"] = run.scene.name;
+    stats["scene"] = run.scene().name;
     stats["scene_source"] = run.options.scene;
     stats["scene_options"] = run.options.sceneOptions;
     stats["stage"] = run.options.stage;
@@ -91,11 +91,11 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["threads"] = run.threads;
     stats["hardware_threads"] = std::thread::hardware_concurrency();
     stats["commit"] = TESTBED_COMMIT;
-    stats["triangles"] = run.scene.triangleCount();
-    stats["lights"] = run.scene.lights.size();
+    stats["triangles"] = run.scene().triangleCount();
+    stats["lights"] = run.scene().lights.size();
     stats["generated_lights"] = run.options.lights;
     stats["seed"] = run.options.seed;
-    const gbuffer::GBufferLayout& layout = run.gbuffer->layout();
+    const gbuffer::GBufferLayout& layout = run.gbuffer().layout();
     nlohmann::json planes = nlohmann::json::array();
     for (const gbuffer::ChannelDesc& channel : layout.channels)
         for (const gbuffer::PlaneDesc& plane : channel.planes)
@@ -109,21 +109,21 @@ nlohmann::json statsJson(const RenderRun& run) {
     nlohmann::json timings = nlohmann::json::object();
     for (const auto& [pass, ms] : run.timingsMs) timings[pass] = ms;
     stats["timings_ms"] = timings;
-    stats["gbuffer_steps_ms"] = {{"transform", run.gbufferDetail.transformMs},
-                                 {"raster", run.gbufferDetail.rasterMs},
-                                 {"resolve", run.gbufferDetail.resolveMs},
-                                 {"exact_surface", run.gbufferDetail.exactMs}};
+    stats["gbuffer_steps_ms"] = {{"transform", run.prepared->gbufferTimings.transformMs},
+                                 {"raster", run.prepared->gbufferTimings.rasterMs},
+                                 {"resolve", run.prepared->gbufferTimings.resolveMs},
+                                 {"exact_surface", run.prepared->gbufferTimings.exactMs}};
     stats["measurement_ms"] = {{"oracle", run.oracleMs}, {"reference", run.referenceMs}};
     const uint64_t evaluations = run.lightEvaluations(), oracle = run.oracleLightEvaluations();
     stats["light_evaluations"] = evaluations;
     stats["oracle_light_evaluations"] = oracle;
     stats["culling_efficiency"] = evaluations > 0 ? double(oracle) / double(evaluations) : 1.0;
-    stats["raster"] = {{"triangles_in", run.rasterStats.trianglesIn},
-                       {"triangles_culled", run.rasterStats.trianglesCulled},
-                       {"triangles_clipped", run.rasterStats.trianglesClipped},
-                       {"triangles_set_up", run.rasterStats.trianglesSetUp},
-                       {"samples_covered", run.rasterStats.samplesCovered},
-                       {"samples_passed", run.rasterStats.samplesPassed}};
+    stats["raster"] = {{"triangles_in", run.prepared->rasterStats.trianglesIn},
+                       {"triangles_culled", run.prepared->rasterStats.trianglesCulled},
+                       {"triangles_clipped", run.prepared->rasterStats.trianglesClipped},
+                       {"triangles_set_up", run.prepared->rasterStats.trianglesSetUp},
+                       {"samples_covered", run.prepared->rasterStats.samplesCovered},
+                       {"samples_passed", run.prepared->rasterStats.samplesPassed}};
     if (run.error) {
         stats["error"] = {{"reference", "reference"},
                           {"rmse", run.error->rmse},
@@ -132,7 +132,7 @@ nlohmann::json statsJson(const RenderRun& run) {
                           {"psnr", std::isfinite(run.error->psnr) ? nlohmann::json(run.error->psnr)
                                                                   : nlohmann::json("inf")}};
     }
-    stats["warnings"] = run.scene.warnings;
+    stats["warnings"] = run.scene().warnings;
     return stats;
 }
 
@@ -151,8 +151,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
         progress("writing outputs");
         const nlohmann::json stats = statsJson(run);
         writeOutputs(run, options, stats);
-        std::cout << "testbed: " << run.options.stage << " on " << run.scene.name << " ("
-                  << run.scene.triangleCount() << " triangles, " << run.scene.lights.size()
+        std::cout << "testbed: " << run.options.stage << " on " << run.scene().name << " ("
+                  << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
                   << " lights) at " << run.options.width << "x" << run.options.height << ", "
                   << run.threads << " threads\n";
         for (const auto& [pass, ms] : run.timingsMs)

@@ -9,9 +9,6 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <tbb/task_arena.h>
 
-#include "gbuffer/GBufferPass.h"
-#include "gbuffer/SceneGeometry.h"
-#include "lighting/LightList.h"
 #include "lighting/Oracle.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
@@ -123,34 +120,17 @@ RenderRun runRender(const RenderOptions& options,
         request.lightCount = options.lights;
         request.seed = options.seed;
         request.options = options.sceneOptions;
-        run.scene = scenes::loadScene(options.scene, request);
-        const gbuffer::SceneGeometry geometry = gbuffer::SceneGeometry::build(run.scene);
-        const gbuffer::FrameView view =
-            gbuffer::FrameView::fromCamera(run.scene.cameras.front(), options.width, options.height);
-
+        scenes::Scene scene = scenes::loadScene(options.scene, request);
         std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage(options.stage);
         const lighting::StageRequirements needs = stage->requirements();
-        run.gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
-        if (needs.exactSurface || options.compareReference)
-            run.exact = std::make_unique<gbuffer::ExactSurface>();
 
         step("G-buffer pass");
-        raster::Rasterizer rasterizer(options.width, options.height);
-        gbuffer::GBufferPass pass(run.scene, geometry);
-        const gbuffer::GBufferPassTimings passTimings = pass.render(rasterizer, *run.gbuffer, run.exact.get());
-        run.rasterStats = rasterizer.lastStats();
-        run.gbufferDetail = passTimings;
+        run.prepared = std::make_unique<lighting::PreparedFrame>(
+            std::move(scene), options.width, options.height, needs.exactSurface || options.compareReference);
+        const gbuffer::GBufferPassTimings& passTimings = run.prepared->gbufferTimings;
         run.timingsMs.emplace_back("gbuffer", passTimings.transformMs + passTimings.rasterMs + passTimings.resolveMs);
         if (needs.exactSurface) run.timingsMs.emplace_back("exact_surface", passTimings.exactMs);
-
-        const lighting::LightList lights = lighting::LightList::build(run.scene.lights, view);
-        lighting::Frame frame;
-        frame.scene = &run.scene;
-        frame.geometry = &geometry;
-        frame.view = &view;
-        frame.gbuffer = run.gbuffer.get();
-        frame.exact = run.exact.get();
-        frame.lights = &lights;
+        const lighting::Frame& frame = run.prepared->frame;
         step("shading: " + options.stage);
         stage->shade(frame, run.result);
         for (const auto& timing : run.result.timingsMs) run.timingsMs.push_back(timing);

@@ -12,11 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "gbuffer/ExactSurface.h"
-#include "gbuffer/GBuffer.h"
-#include "gbuffer/GBufferPass.h"
+#include "lighting/PreparedFrame.h"
 #include "lighting/ShadingStage.h"
-#include "raster/Rasterizer.h"
 #include "scenes/Scene.h"
 
 namespace experiments {
@@ -58,19 +55,17 @@ struct ErrorMetrics {
 struct RenderRun {
     RenderOptions options;
     int threads = 0;  // effective
-    scenes::Scene scene;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    std::unique_ptr<gbuffer::ExactSurface> exact;
+    std::unique_ptr<lighting::PreparedFrame> prepared;  // scene, G-buffer, exact surface, lights
     lighting::StageResult result;
     std::vector<uint32_t> oracle;  // per pixel, from the stage or counted by brute force
     std::vector<std::pair<std::string, double>> timingsMs;  // gbuffer, stage passes, total
-    gbuffer::GBufferPassTimings gbufferDetail;  // the G-buffer pass's own steps
     double oracleMs = 0.0;
     double referenceMs = 0.0;
-    raster::RasterStats rasterStats;
     std::optional<ErrorMetrics> error;
     lighting::StageResult reference;  // filled when compareReference
 
+    const scenes::Scene& scene() const { return prepared->scene; }
+    const gbuffer::GBuffer& gbuffer() const { return *prepared->gbuffer; }
     uint64_t lightEvaluations() const;
     uint64_t oracleLightEvaluations() const;
 };

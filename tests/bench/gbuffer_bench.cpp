@@ -4,46 +4,24 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
-#include <memory>
 
 #include <tbb/task_arena.h>
 
-#include "gbuffer/GBufferPass.h"
-#include "gbuffer/SceneGeometry.h"
-#include "lighting/LightList.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "tests/bench/BenchScenes.h"
 
 namespace {
 
-constexpr int kWidth = 1280;
-constexpr int kHeight = 720;
-
-struct AtriumFixture {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-
-    explicit AtriumFixture(int lightCount) {
-        scenes::SceneRequest request;
-        request.lightCount = lightCount;
-        request.seed = 1;
-        scene = scenes::buildProceduralScene("atrium", request);
-        geometry = gbuffer::SceneGeometry::build(scene);
-        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
-    }
-};
-
-const AtriumFixture& atrium() {
-    static const AtriumFixture fixture(256);
-    return fixture;
+const bench::BenchFrame& atrium() {
+    static const bench::BenchFrame frame("atrium", 256);
+    return frame;
 }
 
 void gbufferPass(benchmark::State& state) {
-    const AtriumFixture& f = atrium();
+    const bench::BenchFrame& f = atrium();
     tbb::task_arena arena(int(state.range(0)));
     gbuffer::GBuffer target(gbuffer::GBufferLayout::reference(), f.view);
-    raster::Rasterizer rasterizer(kWidth, kHeight);
+    raster::Rasterizer rasterizer(bench::kWidth, bench::kHeight);
     gbuffer::GBufferPass pass(f.scene, f.geometry);
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
@@ -58,26 +36,15 @@ void gbufferPass(benchmark::State& state) {
 BENCHMARK(gbufferPass)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void bruteShading(benchmark::State& state) {
-    const AtriumFixture& f = atrium();
+    const bench::BenchFrame& f = atrium();
     tbb::task_arena arena(int(state.range(0)));
-    gbuffer::GBuffer target(gbuffer::GBufferLayout::reference(), f.view);
-    raster::Rasterizer rasterizer(kWidth, kHeight);
-    gbuffer::GBufferPass pass(f.scene, f.geometry);
-    arena.execute([&] { pass.render(rasterizer, target); });
-    const lighting::LightList lights = lighting::LightList::build(f.scene.lights, f.view);
-    lighting::Frame frame;
-    frame.scene = &f.scene;
-    frame.geometry = &f.geometry;
-    frame.view = &f.view;
-    frame.gbuffer = &target;
-    frame.lights = &lights;
     auto stage = lighting::makeStage("brute");
     lighting::StageResult result;
     uint64_t samples = 0;
     double seconds = 0.0;
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
-        arena.execute([&] { stage->shade(frame, result); });
+        arena.execute([&] { stage->shade(f.frame, result); });
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         state.SetIterationTime(elapsed);
         seconds += elapsed;
@@ -91,5 +58,3 @@ void bruteShading(benchmark::State& state) {
 BENCHMARK(bruteShading)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace
-
-

@@ -20,39 +20,15 @@
 #include "lighting/LightListShading.h"
 #include "lighting/Oracle.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "tests/bench/BenchScenes.h"
 
 namespace {
 
-constexpr int kWidth = 1280;
-constexpr int kHeight = 720;
-
 // One prepared frame per light count: scene, G-buffer, lights and the oracle, built once.
-struct ClusteredBenchFrame {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
+struct ClusteredBenchFrame : bench::BenchFrame {
     uint64_t oracleSamples = 0;
 
-    explicit ClusteredBenchFrame(int lightCount) {
-        scenes::SceneRequest request;
-        request.lightCount = lightCount;
-        request.seed = 1;
-        scene = scenes::buildProceduralScene("atrium", request);
-        geometry = gbuffer::SceneGeometry::build(scene);
-        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
-        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
-        raster::Rasterizer rasterizer(kWidth, kHeight);
-        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
-        lights = lighting::LightList::build(scene.lights, view);
-        frame.scene = &scene;
-        frame.geometry = &geometry;
-        frame.view = &view;
-        frame.gbuffer = gbuffer.get();
-        frame.lights = &lights;
+    explicit ClusteredBenchFrame(int lightCount) : bench::BenchFrame("atrium", lightCount) {
         for (uint32_t n : lighting::countContributingLights(frame))
             oracleSamples += n;
     }

@@ -17,40 +17,11 @@
 #include "gbuffer/SceneGeometry.h"
 #include "lighting/LightList.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "tests/bench/BenchScenes.h"
 
 namespace {
 
-constexpr int kWidth = 1280;
-constexpr int kHeight = 720;
-
-struct VolumeFixture {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
-
-    VolumeFixture(const char* sceneName, int lightCount, std::map<std::string, std::string> options) {
-        scenes::SceneRequest request;
-        request.lightCount = lightCount;
-        request.seed = 1;
-        request.options = std::move(options);
-        scene = scenes::buildProceduralScene(sceneName, request);
-        geometry = gbuffer::SceneGeometry::build(scene);
-        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
-        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
-        raster::Rasterizer rasterizer(kWidth, kHeight);
-        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
-        lights = lighting::LightList::build(scene.lights, view);
-        frame.scene = &scene;
-        frame.geometry = &geometry;
-        frame.view = &view;
-        frame.gbuffer = gbuffer.get();
-        frame.lights = &lights;
-    }
-};
+using VolumeFixture = bench::BenchFrame;
 
 const VolumeFixture& wallFixture() {
     static const VolumeFixture fixture("wall", 2500, {{"behind", "1000"}});

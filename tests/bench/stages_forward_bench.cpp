@@ -13,38 +13,12 @@
 #include "gbuffer/GBufferPass.h"
 #include "lighting/LightList.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "tests/bench/BenchScenes.h"
 
 namespace {
 
-constexpr int kWidth = 1280;
-constexpr int kHeight = 720;
-
-struct ForwardBenchFrame {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
-
-    explicit ForwardBenchFrame(int lightCount) {
-        scenes::SceneRequest request;
-        request.lightCount = lightCount;
-        request.seed = 1;
-        scene = scenes::buildProceduralScene("atrium", request);
-        geometry = gbuffer::SceneGeometry::build(scene);
-        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
-        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
-        raster::Rasterizer rasterizer(kWidth, kHeight);
-        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
-        lights = lighting::LightList::build(scene.lights, view);
-        frame.scene = &scene;
-        frame.geometry = &geometry;
-        frame.view = &view;
-        frame.gbuffer = gbuffer.get();
-        frame.lights = &lights;
-    }
+struct ForwardBenchFrame : bench::BenchFrame {
+    explicit ForwardBenchFrame(int lightCount) : bench::BenchFrame("atrium", lightCount) {}
 };
 
 const ForwardBenchFrame& forwardBenchFrame(int lightCount) {

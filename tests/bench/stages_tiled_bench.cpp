@@ -17,40 +17,16 @@
 #include "gbuffer/SceneGeometry.h"
 #include "lighting/LightList.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "tests/bench/BenchScenes.h"
 
 namespace {
 
-constexpr int kWidth = 1280;
-constexpr int kHeight = 720;
-
-struct PreparedFrame {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
-
-    PreparedFrame(const std::string& sceneName, int lightCount, int behind) {
-        scenes::SceneRequest request;
-        request.lightCount = lightCount;
-        request.seed = 1;
-        if (sceneName == "wall")
-            request.options = {{"behind", std::to_string(behind)}};
-        scene = scenes::buildProceduralScene(sceneName, request);
-        geometry = gbuffer::SceneGeometry::build(scene);
-        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
-        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
-        raster::Rasterizer rasterizer(kWidth, kHeight);
-        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
-        lights = lighting::LightList::build(scene.lights, view);
-        frame.scene = &scene;
-        frame.geometry = &geometry;
-        frame.view = &view;
-        frame.gbuffer = gbuffer.get();
-        frame.lights = &lights;
-    }
+// wall takes its lights-behind count as a scene option; other scenes take none.
+struct PreparedFrame : bench::BenchFrame {
+    PreparedFrame(const std::string& sceneName, int lightCount, int behind)
+        : bench::BenchFrame(sceneName, lightCount,
+                            sceneName == "wall" ? std::map<std::string, std::string>{{"behind", std::to_string(behind)}}
+                                                : std::map<std::string, std::string>{}) {}
 };
 
 const PreparedFrame& prepared(const std::string& sceneName, int lightCount, int behind) {

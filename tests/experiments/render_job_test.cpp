@@ -39,15 +39,15 @@ TEST(RenderJob, BitwiseIdenticalForAnyThreadCount) {
     const RenderRun one = runRender(smallAtrium(1));
     for (int threads : {2, 7}) {
         const RenderRun many = runRender(smallAtrium(threads));
-        EXPECT_TRUE(bitwiseEqual(one.gbuffer->depth(), many.gbuffer->depth())) << threads;
+        EXPECT_TRUE(bitwiseEqual(one.gbuffer().depth(), many.gbuffer().depth())) << threads;
         for (int c = 0; c < 3; ++c) {
-            EXPECT_TRUE(bitwiseEqual(one.gbuffer->normalPlane(c), many.gbuffer->normalPlane(c))) << threads;
-            EXPECT_TRUE(bitwiseEqual(one.gbuffer->albedoPlane(c), many.gbuffer->albedoPlane(c))) << threads;
+            EXPECT_TRUE(bitwiseEqual(one.gbuffer().normalPlane(c), many.gbuffer().normalPlane(c))) << threads;
+            EXPECT_TRUE(bitwiseEqual(one.gbuffer().albedoPlane(c), many.gbuffer().albedoPlane(c))) << threads;
             EXPECT_TRUE(bitwiseEqual(one.result.radiance[c], many.result.radiance[c])) << threads;
         }
         EXPECT_TRUE(bitwiseEqual(one.result.lightsEvaluated, many.result.lightsEvaluated));
         EXPECT_TRUE(bitwiseEqual(one.oracle, many.oracle));
-        EXPECT_EQ(one.rasterStats.samplesPassed, many.rasterStats.samplesPassed);
+        EXPECT_EQ(one.prepared->rasterStats.samplesPassed, many.prepared->rasterStats.samplesPassed);
     }
 }
 
@@ -66,10 +66,10 @@ TEST(RenderJob, BruteMatchesReferenceOnAtrium) {
 
 TEST(RenderJob, BruteEvaluatesEveryLightAndCountsTheOracle) {
     const RenderRun run = runRender(smallAtrium(0));
-    const uint32_t lightCount = uint32_t(run.scene.lights.size());
+    const uint32_t lightCount = uint32_t(run.scene().lights.size());
     uint64_t covered = 0, oracle = 0;
     for (size_t pixel = 0; pixel < run.oracle.size(); ++pixel) {
-        const bool isCovered = run.gbuffer->covered(pixel);
+        const bool isCovered = run.gbuffer().covered(pixel);
         covered += isCovered;
         EXPECT_EQ(run.result.lightsEvaluated[pixel], isCovered ? lightCount : 0u);
         EXPECT_LE(run.oracle[pixel], run.result.lightsEvaluated[pixel]);

@@ -13,6 +13,7 @@
 
 #include "gbuffer/GBufferPass.h"
 #include "lighting/Oracle.h"
+#include "lighting/PreparedFrame.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/ClusterGrid.h"
 #include "scenes/ProceduralScenes.h"
@@ -26,46 +27,31 @@ using lighting::LightSphere;
 constexpr int kWidth = 160;
 constexpr int kHeight = 96;
 
-struct PreparedFrame {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
+// A prepared frame plus its oracle and brute's image.
+struct ClusterFrame : lighting::PreparedFrame {
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
+
+    explicit ClusterFrame(scenes::Scene scene) : lighting::PreparedFrame(std::move(scene), kWidth, kHeight) {
+        oracle = lighting::countContributingLights(frame);
+        lighting::makeStage("brute")->shade(frame, brute);
+    }
 };
 
-const PreparedFrame& prepared(const std::string& sceneName, int lightCount) {
-    static std::map<std::string, std::unique_ptr<PreparedFrame>> cache;
+const ClusterFrame& prepared(const std::string& sceneName, int lightCount) {
+    static std::map<std::string, std::unique_ptr<ClusterFrame>> cache;
     auto& slot = cache[sceneName + std::to_string(lightCount)];
-    if (slot)
-        return *slot;
-    slot = std::make_unique<PreparedFrame>();
-    PreparedFrame& f = *slot;
-    scenes::SceneRequest request;
-    request.lightCount = lightCount;
-    request.seed = 5;
-    f.scene = scenes::buildProceduralScene(sceneName, request);
-    f.geometry = gbuffer::SceneGeometry::build(f.scene);
-    f.view = gbuffer::FrameView::fromCamera(f.scene.cameras[0], kWidth, kHeight);
-    f.gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), f.view);
-    raster::Rasterizer rasterizer(kWidth, kHeight);
-    gbuffer::GBufferPass(f.scene, f.geometry).render(rasterizer, *f.gbuffer);
-    f.lights = lighting::LightList::build(f.scene.lights, f.view);
-    f.frame.scene = &f.scene;
-    f.frame.geometry = &f.geometry;
-    f.frame.view = &f.view;
-    f.frame.gbuffer = f.gbuffer.get();
-    f.frame.lights = &f.lights;
-    f.oracle = lighting::countContributingLights(f.frame);
-    lighting::makeStage("brute")->shade(f.frame, f.brute);
-    return f;
+    if (!slot) {
+        scenes::SceneRequest request;
+        request.lightCount = lightCount;
+        request.seed = 5;
+        slot = std::make_unique<ClusterFrame>(scenes::buildProceduralScene(sceneName, request));
+    }
+    return *slot;
 }
 
 // Image within 1e-5 of peak of brute, and never fewer lights evaluated than contribute.
-void expectExact(const PreparedFrame& f, const lighting::StageResult& result,
+void expectExact(const ClusterFrame& f, const lighting::StageResult& result,
                  const std::string& what) {
     float peak = 0.0f;
     for (int ch = 0; ch < 3; ++ch)
@@ -87,7 +73,7 @@ void expectExact(const PreparedFrame& f, const lighting::StageResult& result,
 
 TEST(ClusteredStage, EveryOptionCombinationMatchesBrute) {
     for (const char* scene : {"spheres", "atrium"}) {
-        const PreparedFrame& f = prepared(scene, 120);
+        const ClusterFrame& f = prepared(scene, 120);
         for (const char* grid : {"1x1x1", "24x12x32", "64x32x64", "7x5x3"})
             for (const char* slices : {"exp", "uniform"})
                 for (const char* test : {"aabb", "frustum"}) {
@@ -112,7 +98,7 @@ TEST(ClusteredStage, EveryOptionCombinationMatchesBrute) {
 }
 
 TEST(ClusteredStage, IndependentOfThreadCountAndRecordsPasses) {
-    const PreparedFrame& f = prepared("atrium", 120);
+    const ClusterFrame& f = prepared("atrium", 120);
     lighting::StageResult one, many;
     tbb::task_arena(1).execute([&] { lighting::makeStage("clustered")->shade(f.frame, one); });
     lighting::makeStage("clustered")->shade(f.frame, many);
@@ -130,8 +116,8 @@ TEST(ClusteredStage, IndependentOfThreadCountAndRecordsPasses) {
 }
 
 TEST(ClusteredStage, ReusedAcrossFramesEqualsFresh) {
-    const PreparedFrame& atrium = prepared("atrium", 120);
-    const PreparedFrame& spheres = prepared("spheres", 120);
+    const ClusterFrame& atrium = prepared("atrium", 120);
+    const ClusterFrame& spheres = prepared("spheres", 120);
     auto reused = lighting::makeStage("clustered:grid=64x32x64");
     lighting::StageResult first, second, third, fresh;
     reused->shade(atrium.frame, first);

@@ -13,33 +13,15 @@
 
 #include "gbuffer/GBufferPass.h"
 #include "lighting/ForwardShading.h"
+#include "lighting/PreparedFrame.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/MeshBuilder.h"
 #include "scenes/ProceduralScenes.h"
 
 namespace {
 
-struct TestFrame {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
-
-    TestFrame(scenes::Scene s, int width, int height) : scene(std::move(s)) {
-        geometry = gbuffer::SceneGeometry::build(scene);
-        view = gbuffer::FrameView::fromCamera(scene.cameras[0], width, height);
-        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
-        raster::Rasterizer rasterizer(width, height);
-        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
-        lights = lighting::LightList::build(scene.lights, view);
-        frame.scene = &scene;
-        frame.geometry = &geometry;
-        frame.view = &view;
-        frame.gbuffer = gbuffer.get();
-        frame.lights = &lights;
-    }
+struct TestFrame : lighting::PreparedFrame {
+    TestFrame(scenes::Scene s, int width, int height) : lighting::PreparedFrame(std::move(s), width, height) {}
 };
 
 lighting::StageResult run(const std::string& stage, const TestFrame& f) {

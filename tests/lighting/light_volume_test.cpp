@@ -14,6 +14,7 @@
 #include "gbuffer/GBufferPass.h"
 #include "lighting/LightBounds.h"
 #include "lighting/Oracle.h"
+#include "lighting/PreparedFrame.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/LightVolumes.h"
 #include "scenes/ProceduralScenes.h"
@@ -23,33 +24,18 @@ namespace {
 constexpr int kWidth = 256;
 constexpr int kHeight = 144;
 
-struct TestFrame {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
+// A prepared frame plus the oracle and brute's image for its current lights.
+struct TestFrame : lighting::PreparedFrame {
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
 
-    // Renders the G-buffer of `scene`; call setLights() before shading.
-    explicit TestFrame(scenes::Scene s) : scene(std::move(s)) {
-        geometry = gbuffer::SceneGeometry::build(scene);
-        view = gbuffer::FrameView::fromCamera(scene.cameras[0], kWidth, kHeight);
-        gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
-        raster::Rasterizer rasterizer(kWidth, kHeight);
-        gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer);
+    // Renders the G-buffer of `scene`; setLights() replaces the lights and re-runs the oracles.
+    explicit TestFrame(scenes::Scene s, gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed)
+        : lighting::PreparedFrame(std::move(s), kWidth, kHeight, false, depth) {
         setLights(scene.lights);
     }
     void setLights(const std::vector<scenes::Light>& sceneLights) {
-        scene.lights = sceneLights;
-        lights = lighting::LightList::build(scene.lights, view);
-        frame.scene = &scene;
-        frame.geometry = &geometry;
-        frame.view = &view;
-        frame.gbuffer = gbuffer.get();
-        frame.lights = &lights;
+        lighting::PreparedFrame::setLights(sceneLights);
         oracle = lighting::countContributingLights(frame);
         lighting::makeStage("brute")->shade(frame, brute);
     }
@@ -219,12 +205,8 @@ TEST(LightVolumes, HardCasesMatchBrute) {
 }
 
 TEST(LightVolumes, StandardDepthMatchesBrute) {
-    scenes::Scene scene = proceduralScene("atrium", 200);
-    TestFrame f(scene);
-    f.view = gbuffer::FrameView::fromCamera(f.scene.cameras[0], kWidth, kHeight, gbuffer::DepthConvention::Standard);
-    f.gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), f.view);
-    raster::Rasterizer rasterizer(kWidth, kHeight);
-    gbuffer::GBufferPass(f.scene, f.geometry).render(rasterizer, *f.gbuffer);
+    TestFrame f(proceduralScene("atrium", 200), gbuffer::DepthConvention::Standard);
+    ASSERT_FALSE(f.view.reversedZ());
     f.setLights(hardLights(f));
     for (const std::string& stage : kVariants) expectMatchesBrute(f, stage, "standard depth");
 }

@@ -10,8 +10,8 @@
 
 #include <tbb/task_arena.h>
 
-#include "gbuffer/GBufferPass.h"
 #include "lighting/Oracle.h"
+#include "lighting/PreparedFrame.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
 
@@ -34,42 +34,27 @@ const SceneCase kScenes[] = {
     {"spheres", "spheres", 200, {}},
 };
 
-struct PreparedFrame {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
+// One frame per scene case, its oracle and brute's image, shared by every stage's test.
+struct PreparedCase {
+    std::unique_ptr<lighting::PreparedFrame> prepared;
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
 };
 
-const PreparedFrame& prepared(const SceneCase& c) {
-    static std::map<std::string, std::unique_ptr<PreparedFrame>> cache;
+const PreparedCase& prepared(const SceneCase& c) {
+    static std::map<std::string, std::unique_ptr<PreparedCase>> cache;
     auto& slot = cache[c.name];
     if (slot) return *slot;
-    slot = std::make_unique<PreparedFrame>();
-    PreparedFrame& f = *slot;
+    slot = std::make_unique<PreparedCase>();
     scenes::SceneRequest request;
     request.lightCount = c.lights;
     request.seed = 3;
     request.options = c.options;
-    f.scene = scenes::buildProceduralScene(c.scene, request);
-    f.geometry = gbuffer::SceneGeometry::build(f.scene);
-    f.view = gbuffer::FrameView::fromCamera(f.scene.cameras[0], kWidth, kHeight);
-    f.gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), f.view);
-    raster::Rasterizer rasterizer(kWidth, kHeight);
-    gbuffer::GBufferPass(f.scene, f.geometry).render(rasterizer, *f.gbuffer);
-    f.lights = lighting::LightList::build(f.scene.lights, f.view);
-    f.frame.scene = &f.scene;
-    f.frame.geometry = &f.geometry;
-    f.frame.view = &f.view;
-    f.frame.gbuffer = f.gbuffer.get();
-    f.frame.lights = &f.lights;
-    f.oracle = lighting::countContributingLights(f.frame);
-    lighting::makeStage("brute")->shade(f.frame, f.brute);
-    return f;
+    slot->prepared = std::make_unique<lighting::PreparedFrame>(
+        scenes::buildProceduralScene(c.scene, request), kWidth, kHeight);
+    slot->oracle = lighting::countContributingLights(slot->prepared->frame);
+    lighting::makeStage("brute")->shade(slot->prepared->frame, slot->brute);
+    return *slot;
 }
 
 std::vector<std::string> exactStageNames() {
@@ -84,9 +69,9 @@ class ExactStage : public ::testing::TestWithParam<std::tuple<std::string, int>>
 TEST_P(ExactStage, MatchesBruteAndNeverDropsALight) {
     const auto& [stageName, sceneIndex] = GetParam();
     const SceneCase& c = kScenes[sceneIndex];
-    const PreparedFrame& f = prepared(c);
+    const PreparedCase& f = prepared(c);
     lighting::StageResult result;
-    lighting::makeStage(stageName)->shade(f.frame, result);
+    lighting::makeStage(stageName)->shade(f.prepared->frame, result);
     ASSERT_EQ(result.width, kWidth);
     ASSERT_EQ(result.height, kHeight);
 

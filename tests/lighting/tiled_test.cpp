@@ -14,6 +14,7 @@
 
 #include "gbuffer/GBufferPass.h"
 #include "lighting/Oracle.h"
+#include "lighting/PreparedFrame.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/TileFrusta.h"
 #include "scenes/ProceduralScenes.h"
@@ -23,38 +24,21 @@ namespace {
 constexpr int kWidth = 320;
 constexpr int kHeight = 180;
 
-struct TestFrame {
-    scenes::Scene scene;
-    gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
-    std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    lighting::LightList lights;
-    lighting::Frame frame;
+// A prepared frame plus the oracle and brute's image for its current lights.
+struct TestFrame : lighting::PreparedFrame {
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
+    TestFrame(scenes::Scene scene, int width, int height)
+        : lighting::PreparedFrame(std::move(scene), width, height) {}
 };
 
 // Rasterizes the scene's G-buffer only (lights can be changed afterwards with setLights).
-std::unique_ptr<TestFrame> rasterize(scenes::Scene scene, int width = kWidth,
-                                     int height = kHeight) {
-    auto f = std::make_unique<TestFrame>();
-    f->scene = std::move(scene);
-    f->geometry = gbuffer::SceneGeometry::build(f->scene);
-    f->view = gbuffer::FrameView::fromCamera(f->scene.cameras[0], width, height);
-    f->gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), f->view);
-    raster::Rasterizer rasterizer(width, height);
-    gbuffer::GBufferPass(f->scene, f->geometry).render(rasterizer, *f->gbuffer);
-    f->frame.scene = &f->scene;
-    f->frame.geometry = &f->geometry;
-    f->frame.view = &f->view;
-    f->frame.gbuffer = f->gbuffer.get();
-    return f;
+std::unique_ptr<TestFrame> rasterize(scenes::Scene scene, int width = kWidth, int height = kHeight) {
+    return std::make_unique<TestFrame>(std::move(scene), width, height);
 }
 
 void setLights(TestFrame& f, const std::vector<scenes::Light>& lights) {
-    f.scene.lights = lights;
-    f.lights = lighting::LightList::build(f.scene.lights, f.view);
-    f.frame.lights = &f.lights;
+    f.setLights(lights);
     f.oracle = lighting::countContributingLights(f.frame);
     lighting::makeStage("brute")->shade(f.frame, f.brute);
 }

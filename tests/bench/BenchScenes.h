@@ -1,0 +1,31 @@
+// Shared set-up for the benchmarks: every benchmark renders its frame through
+// lighting::PreparedFrame at 1280x720 with seed 1, so their figures compare like for like.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "lighting/PreparedFrame.h"
+#include "scenes/ProceduralScenes.h"
+
+namespace bench {
+
+inline constexpr int kWidth = 1280;
+inline constexpr int kHeight = 720;
+
+inline scenes::Scene proceduralScene(const std::string& name, int lightCount,
+                                     std::map<std::string, std::string> options = {}) {
+    scenes::SceneRequest request;
+    request.lightCount = lightCount;
+    request.seed = 1;
+    request.options = std::move(options);
+    return scenes::buildProceduralScene(name, request);
+}
+
+// A benchmark frame: the prepared frame of a built-in scene at 1280x720.
+struct BenchFrame : lighting::PreparedFrame {
+    BenchFrame(const std::string& name, int lightCount, std::map<std::string, std::string> options = {})
+        : lighting::PreparedFrame(proceduralScene(name, lightCount, std::move(options)), kWidth, kHeight) {}
+};
+
+}  // namespace bench
