@@ -90,6 +90,15 @@ LightVolumeRasterizer::LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, Vo
     mClipFromViewExact = glm::inverse(view.viewFromClipExact);
 }
 
+std::vector<uint32_t> LightVolumeRasterizer::lightsToDraw(const std::vector<LightSphere>& spheres,
+                                                          bool frustumCull) const {
+    std::vector<uint32_t> drawn;
+    drawn.reserve(spheres.size());
+    for (uint32_t i = 0; i < uint32_t(spheres.size()); ++i)
+        if (!frustumCull || inViewFrustum(spheres[i])) drawn.push_back(i);
+    return drawn;
+}
+
 bool LightVolumeRasterizer::inViewFrustum(const LightSphere& sphere) const {
     if (sphere.unbounded) return true;
     const glm::dvec3 c(sphere.centreView);

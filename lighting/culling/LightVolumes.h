@@ -82,6 +82,9 @@ public:
 
     // True when the sphere may touch the view frustum (conservative; six planes).
     bool inViewFrustum(const LightSphere& sphere) const;
+    // Indices (ascending) of the lights to draw: all of them, or with `frustumCull` only those
+    // whose sphere may touch the view frustum (CPU view-frustum culling).
+    std::vector<uint32_t> lightsToDraw(const std::vector<LightSphere>& spheres, bool frustumCull) const;
 
     // Draws the volumes of `lightIndices` (ascending; unbounded lights included) in one pass and
     // calls fn(light, x, y, pixel) as described in the file comment. Cost: set-up of 80 (160 with

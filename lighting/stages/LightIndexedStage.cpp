@@ -62,10 +62,7 @@ public:
         auto start = std::chrono::steady_clock::now();
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
         LightVolumeRasterizer volumes(gb, mShape, mStencil);
-        std::vector<uint32_t> drawn;  // ascending
-        drawn.reserve(spheres.size());
-        for (uint32_t i = 0; i < uint32_t(spheres.size()); ++i)
-            if (!mFrustumCull || volumes.inViewFrustum(spheres[i])) drawn.push_back(i);
+        const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mFrustumCull);  // ascending
         const size_t culled = spheres.size() - drawn.size();
         result.timingsMs.emplace_back("cull", millisecondsSince(start));
 
