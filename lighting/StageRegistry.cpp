@@ -36,6 +36,15 @@ const std::vector<StageEntry>& registry() {
          makeForwardStage},
         {{"forward-multipass", "one additive pass per light over its illumination set", StageKind::Exact},
          makeForwardMultipassStage},
+        {{"light-prepass", "Light Pre-Pass: thin G-buffer, diffuse RGB + monochrome specular light buffer, "
+                           "material pass (spec=grey|chroma, tile=16)", StageKind::Approximate},
+         makeLightPrepassStage},
+        {{"inferred", "inferred lighting: L-buffer at 1/scale resolution, DSF upsampling in the material "
+                      "pass (scale=2, depth=0.1, normal=0.9, tile=16)", StageKind::Approximate},
+         makeInferredStage},
+        {{"tiled-forward", "Forward+: depth pre-pass, per-tile light lists, forward shading (tile=16, vfc=1)",
+          StageKind::Exact},
+         makeTiledForwardStage},
     };
     return entries;
 }

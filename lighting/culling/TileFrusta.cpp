@@ -6,6 +6,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "gbuffer/GBufferPass.h"
+
 namespace lighting {
 
 TileGrid TileGrid::make(int widthPixels, int heightPixels, int tileSizePixels) {
@@ -18,9 +20,14 @@ TileGrid TileGrid::make(int widthPixels, int heightPixels, int tileSizePixels) {
     return grid;
 }
 
-std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& gb,
-                                                        const TileGrid& grid,
-                                                        const TileBoundsOptions& options) {
+namespace {
+
+// The bounds of every tile from its samples. sampleAt(x, y, depthMetres, normalView) returns
+// false for an uncovered pixel, else sets the sample's positive view depth and (read only when
+// options.normalCone) its normal. Templated so the per-pixel call is inlined, not virtual.
+template <typename SampleAt>
+std::vector<TileSurfaceBounds>
+boundsOfSamples(const TileGrid& grid, const TileBoundsOptions& options, const SampleAt& sampleAt) {
     std::vector<TileSurfaceBounds> bounds(size_t(grid.tileCount()));
     const size_t maxSamples = size_t(grid.tileSizePixels) * grid.tileSizePixels;
     tbb::parallel_for(
@@ -39,20 +46,20 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
                 glm::vec3 normalSum(0.0f);
                 for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
                     for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
-                        if (!gb.covered(size_t(y) * gb.width() + x))
+                        float depth = 0.0f;
+                        glm::vec3 normalView(0.0f);
+                        if (!sampleAt(x, y, depth, normalView))
                             continue;
-                        const gbuffer::Surface s = gb.decode(x, y);
-                        const float depth = -s.positionView.z;
                         minDepth = std::min(minDepth, depth);
                         maxDepth = std::max(maxDepth, depth);
                         if (options.depthMask)
                             depths.push_back(depth);
                         if (options.normalCone) {
-                            const float length = glm::length(s.normalView);
+                            const float length = glm::length(normalView);
                             // A zero normal has no facing: the BRDF's sign test then never passes,
                             // but keep the tile's cone open rather than reason about it.
                             const glm::vec3 n =
-                                length > 0.0f ? s.normalView / length : glm::vec3(0.0f);
+                                length > 0.0f ? normalView / length : glm::vec3(0.0f);
                             normals.push_back(n);
                             normalSum += n;
                         }
@@ -87,6 +94,36 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
             }
         });
     return bounds;
+}
+
+} // namespace
+
+std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& gb,
+                                                        const TileGrid& grid,
+                                                        const TileBoundsOptions& options) {
+    return boundsOfSamples(grid, options,
+                           [&gb](int x, int y, float& depthMetres, glm::vec3& normalView) {
+                               if (!gb.covered(size_t(y) * gb.width() + x))
+                                   return false;
+                               const gbuffer::Surface s = gb.decode(x, y);
+                               depthMetres = -s.positionView.z;
+                               normalView = s.normalView;
+                               return true;
+                           });
+}
+
+std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::FrameView& view,
+                                                      std::span<const float> depth,
+                                                      const TileGrid& grid, bool depthMask) {
+    const float clearDepth = view.clearDepth();
+    return boundsOfSamples(grid, {depthMask, false},
+                           [&](int x, int y, float& depthMetres, glm::vec3&) {
+                               const float d = depth[size_t(y) * grid.widthPixels + x];
+                               if (d == clearDepth)
+                                   return false;
+                               depthMetres = -gbuffer::positionViewOfPixel(view, x, y, d).z;
+                               return true;
+                           });
 }
 
 TileEdgePlanes TileEdgePlanes::make(const gbuffer::FrameView& view, const TileGrid& grid) {
@@ -192,6 +229,46 @@ bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
     const float axisAngle =
         std::acos(std::clamp(glm::dot(bounds.normalAxisView, lightAxis), -1.0f, 1.0f));
     return axisAngle + bounds.normalHalfAngle + delta + kBackfaceSlackRadians <= kHalfPi;
+}
+
+std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, const TileGrid& grid,
+                                            const TileEdgePlanes& edges,
+                                            const std::vector<LightSphere>& spheres, bool frustumCull) {
+    std::vector<uint32_t> visible;
+    if (frustumCull) {
+        visible = lightsInViewFrustum(view, grid, edges, spheres);
+    } else {
+        visible.resize(spheres.size());
+        for (uint32_t i = 0; i < visible.size(); ++i)
+            visible[i] = i;
+    }
+    std::vector<CandidateLight> candidates(visible.size());
+    tbb::parallel_for(size_t(0), visible.size(), [&](size_t k) {
+        const LightSphere& s = spheres[visible[k]];
+        CandidateLight& c = candidates[k];
+        c.index = visible[k];
+        c.centreView = s.centreView;
+        c.radius = s.radius;
+        c.unbounded = s.unbounded;
+        if (s.unbounded)
+            return;
+        int columnMin = grid.tileCountX, columnMax = -1, rowMin = grid.tileCountY, rowMax = -1;
+        for (int tx = 0; tx < grid.tileCountX; ++tx)
+            if (sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius)) {
+                columnMin = std::min(columnMin, tx);
+                columnMax = tx;
+            }
+        for (int ty = 0; ty < grid.tileCountY; ++ty)
+            if (sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius)) {
+                rowMin = std::min(rowMin, ty);
+                rowMax = ty;
+            }
+        c.columnMin = columnMin;
+        c.columnMax = columnMax;
+        c.rowMin = rowMin;
+        c.rowMax = rowMax;
+    });
+    return candidates;
 }
 
 } // namespace lighting

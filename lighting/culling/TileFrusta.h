@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -62,6 +63,15 @@ struct TileBoundsOptions {
 std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& gb,
                                                         const TileGrid& grid,
                                                         const TileBoundsOptions& options);
+
+// Depth bounds (and optionally the depth mask; no normal cone) from a depth plane in the view's
+// convention, for stages without a G-buffer (tiled forward's depth pre-pass). A pixel is covered
+// when its depth differs from view.clearDepth(), as GBuffer::covered; positions come from
+// gbuffer::positionViewOfPixel, bitwise the floats GBuffer::decode and forward shading use, so
+// the same depth plane gives bitwise computeTileSurfaceBounds' depth bounds.
+std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::FrameView& view,
+                                                      std::span<const float> depth,
+                                                      const TileGrid& grid, bool depthMask);
 
 // Harada's 2.5D culling: bin of a depth inside [minDepth, maxDepth] split into 32 bins. The
 // same monotone float expression serves samples and light ranges, so a sample whose depth is
@@ -132,6 +142,22 @@ inline float distanceSquaredToBox(const glm::vec3& p, const glm::vec3& boxMin,
 std::vector<uint32_t> lightsInViewFrustum(const gbuffer::FrameView& view, const TileGrid& grid,
                                           const TileEdgePlanes& edges,
                                           const std::vector<LightSphere>& spheres);
+
+// A light that survived view-frustum culling, with the tile columns and rows its sphere may
+// reach (empty when min > max): the cheap integer pre-test before per-tile tests.
+struct CandidateLight {
+    uint32_t index = 0;
+    glm::vec3 centreView{0.0f};
+    float radius = 0.0f;
+    bool unbounded = false;
+    int columnMin = 0, columnMax = -1, rowMin = 0, rowMax = -1;
+};
+
+// The candidates in ascending light order: every light, or with `frustumCull` only those
+// lightsInViewFrustum keeps. Parallel over lights.
+std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, const TileGrid& grid,
+                                            const TileEdgePlanes& edges,
+                                            const std::vector<LightSphere>& spheres, bool frustumCull);
 
 // Back-face test of the thesis (Ishmukhametov 2013, ch. 4) made exactly conservative. A light
 // is a point source at its centre for the BRDF: radiance needs dot(n, centre - p) > 0. The

@@ -29,5 +29,8 @@ std::unique_ptr<ShadingStage> makeTiledStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeTiledBackfaceStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeForwardStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeForwardMultipassStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeLightPrepassStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeInferredStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeTiledForwardStage(const StageSpec& spec);
 
 }  // namespace lighting

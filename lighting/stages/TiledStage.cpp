@@ -46,14 +46,6 @@ struct TiledOptions {
     bool backface = false;
 };
 
-// A visible light, with the tile columns and rows its sphere may reach (empty when min > max).
-struct CandidateLight {
-    uint32_t index = 0;
-    glm::vec3 centreView{0.0f};
-    float radius = 0.0f;
-    bool unbounded = false;
-    int columnMin = 0, columnMax = -1, rowMin = 0, rowMax = -1;
-};
 
 class TiledStage final : public ShadingStage {
 public:
@@ -76,42 +68,8 @@ public:
         const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
         const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
-        std::vector<uint32_t> visible;
-        if (mOptions.viewFrustumCulling) {
-            visible = lightsInViewFrustum(view, grid, edges, spheres);
-        } else {
-            visible.resize(spheres.size());
-            for (uint32_t i = 0; i < visible.size(); ++i)
-                visible[i] = i;
-        }
-
-        // The tile columns and rows each light may reach: a cheap integer pre-test per tile.
-        std::vector<CandidateLight> candidates(visible.size());
-        tbb::parallel_for(size_t(0), visible.size(), [&](size_t k) {
-            const LightSphere& s = spheres[visible[k]];
-            CandidateLight& c = candidates[k];
-            c.index = visible[k];
-            c.centreView = s.centreView;
-            c.radius = s.radius;
-            c.unbounded = s.unbounded;
-            if (s.unbounded)
-                return;
-            int columnMin = grid.tileCountX, columnMax = -1, rowMin = grid.tileCountY, rowMax = -1;
-            for (int tx = 0; tx < grid.tileCountX; ++tx)
-                if (sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius)) {
-                    columnMin = std::min(columnMin, tx);
-                    columnMax = tx;
-                }
-            for (int ty = 0; ty < grid.tileCountY; ++ty)
-                if (sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius)) {
-                    rowMin = std::min(rowMin, ty);
-                    rowMax = ty;
-                }
-            c.columnMin = columnMin;
-            c.columnMax = columnMax;
-            c.rowMin = rowMin;
-            c.rowMax = rowMax;
-        });
+        const std::vector<CandidateLight> candidates =
+            candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
 
         const std::vector<TileSurfaceBounds> bounds =
             computeTileSurfaceBounds(gb, grid, {mOptions.depthMask, mOptions.backface});
@@ -179,8 +137,8 @@ public:
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
-        result.parameters["lights_after_vfc"] = std::to_string(visible.size());
-        result.parameters["vfc_culled"] = std::to_string(spheres.size() - visible.size());
+        result.parameters["lights_after_vfc"] = std::to_string(candidates.size());
+        result.parameters["vfc_culled"] = std::to_string(spheres.size() - candidates.size());
         result.parameters["tile_light_pairs"] = std::to_string(pairs);
         if (mOptions.backface)
             result.parameters["backface_rejected"] = std::to_string(backfaceRejected);

@@ -1,0 +1,305 @@
+// `inferred`: Inferred Lighting (Kircher & Lawrance 2009; Ishmukhametov 2013, section 2.2).
+// An APPROXIMATE stage: lighting is computed at reduced resolution and upsampled with
+// discontinuity-sensitive filtering (DSF); its error against `reference` is measured.
+//
+// Passes:
+//   "cull"      tiled light culling (culling/TileFrusta.h, widened spheres of LightBounds.h,
+//               ascending light indices). Tiles are tile x tile LOW-RES samples, i.e.
+//               tile*scale full-res pixels; their bounds come from every full-res pixel of the
+//               tile, a superset of its samples, so the lists stay conservative for the samples.
+//   "lighting"  the L-buffer at ceil(W/scale) x ceil(H/scale). Low-res sample (i, j) reads the
+//               G-buffer pixel (min(i*scale + scale/2, W-1), min(j*scale + scale/2, H-1)) -- the
+//               full-res pixel at the sample's location; this stands in for the technique's
+//               low-res G-buffer (whose pixel centres would lie between full-res pixels for even
+//               scales). It stores diffuse RGB (the BRDF's diffuse part without albedo, plus
+//               ambient radiance) and specular RGB (without the specular intensity), both from
+//               the one BRDF (evaluateLight with albedo 1 / intensity 0, then albedo 0 /
+//               intensity 1). Specular is kept in colour (as Pre-Lighting, Lee 2008, does) so
+//               that this stage's error is the resolution alone; `light-prepass` measures the
+//               monochromatic-specular approximation separately. With scale=1 the image equals
+//               brute's up to float summation order.
+//   "material"  the second geometry pass: the scene is rasterized again into a visibility
+//               buffer (lighting/ForwardShading.h depthPrepass, the G-buffer pass's culling and
+//               depth test) and each fragment's albedo and specular intensity come from
+//               gbuffer::surfaceOfTriangle. DSF per full-res pixel: the 4 nearest low-res
+//               samples with bilinear weights, each weight zeroed when the sample is background,
+//               its view depth differs from the pixel's by more than depth * pixel depth, or the
+//               cosine between the normals is below `normal`; the weights are renormalised. When
+//               all four are rejected the nearest covered one of the four is used (zero light if
+//               none is covered). The technique's object/normal-group IDs are not in our
+//               G-buffer; depth and normal tests stand in for them.
+// Options:
+//   scale=2      lighting resolution divisor per axis, 1..8
+//   depth=0.1    DSF relative view-depth threshold, > 0
+//   normal=0.9   DSF minimum normal cosine, -1..1
+//   tile=16      culling tile size in low-res samples, 4..128
+// G-buffer: depth, normal and specular (only the specular power is read from it; the layout has
+// no power-only channel). Parameters record the options, the L-buffer size and dsf_fallbacks.
+// lightsEvaluated: the tile list size at the full-res pixel each low-res sample reads, zero
+// elsewhere, so its sum is the number of light evaluations actually done.
+// Cost note (CPU): a contributing light costs two evaluateLight calls (diffuse, then specular
+// part) where `tiled` needs one; this keeps a single BRDF definition at the price of roughly
+// twice the per-light work in "lighting" (a GPU light buffer pays nothing comparable).
+// Threads: tiles in parallel for culling and lighting, rows for the material pass; every sample
+// and pixel written by one task only, light sums in ascending order: deterministic.
+#include "lighting/stages/Stages.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <span>
+
+#include <tbb/parallel_for.h>
+
+#include "lighting/EveryLight.h"
+#include "lighting/ForwardShading.h"
+#include "lighting/LightBounds.h"
+#include "lighting/culling/TileFrusta.h"
+
+namespace lighting {
+
+namespace {
+
+struct InferredOptions {
+    int scale = 2;
+    float depthThreshold = 0.1f;
+    float normalThreshold = 0.9f;
+    int tileSizeSamples = 16;
+};
+
+// One L-buffer sample: the full-res pixel it reads, its surface for DSF, and its light.
+struct LightSample {
+    bool covered = false;
+    float depthMetres = 0.0f;
+    glm::vec3 normalView{0.0f, 0.0f, 1.0f};
+    glm::vec3 diffuse{0.0f};
+    glm::vec3 specular{0.0f};
+};
+
+float floatOption(const StageSpec& spec, const char* key, float defaultValue, float minValue,
+                  float maxValue, bool minExclusive) {
+    const auto found = spec.options.find(key);
+    if (found == spec.options.end())
+        return defaultValue;
+    size_t used = 0;
+    float value = 0.0f;
+    try {
+        value = std::stof(found->second, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    const bool aboveMin = minExclusive ? value > minValue : value >= minValue;
+    if (used != found->second.size() || found->second.empty() || !std::isfinite(value) || !aboveMin ||
+        value > maxValue)
+        throw StageError("stage '" + spec.name + "': option " + key + "=" + found->second +
+                         " is not a number in " + (minExclusive ? "(" : "[") + std::to_string(minValue) +
+                         ", " + std::to_string(maxValue) + "]");
+    return value;
+}
+
+class InferredStage final : public ShadingStage {
+public:
+    explicit InferredStage(const InferredOptions& options) : mOptions(options) {}
+
+    std::string name() const override { return "inferred"; }
+    StageRequirements requirements() const override {
+        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Specular}, false};
+    }
+
+    void shade(const Frame& frame, StageResult& result) override {
+        using Clock = std::chrono::steady_clock;
+        const gbuffer::GBuffer& gb = *frame.gbuffer;
+        const gbuffer::FrameView& view = gb.view();
+        const int width = gb.width(), height = gb.height();
+        const int scale = mOptions.scale;
+        const int lowWidth = (width + scale - 1) / scale, lowHeight = (height + scale - 1) / scale;
+        result.resize(width, height, false);
+        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        auto sampleX = [&](int i) { return std::min(i * scale + scale / 2, width - 1); };
+        auto sampleY = [&](int j) { return std::min(j * scale + scale / 2, height - 1); };
+
+        // Cull on the full-res grid with tiles of tile*scale pixels: full-res tile (tx, ty) holds
+        // exactly the samples of low-res tile (tx, ty), since sample i lies in block i.
+        const auto cullStart = Clock::now();
+        const TileGrid grid = TileGrid::make(width, height, mOptions.tileSizeSamples * scale);
+        const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
+        const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
+        const std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {false, false});
+        std::vector<std::vector<uint32_t>> tileLights(size_t(grid.tileCount()));
+        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
+            const TileSurfaceBounds& b = bounds[size_t(tile)];
+            if (!b.covered)
+                return;
+            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
+            const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
+            std::vector<uint32_t>& list = tileLights[size_t(tile)];
+            for (uint32_t i = 0; i < spheres.size(); ++i) {
+                const LightSphere& s = spheres[i];
+                if (!s.unbounded) {
+                    const float centreDepth = -s.centreView.z;
+                    if (centreDepth + s.radius < b.minDepthMetres || centreDepth - s.radius > b.maxDepthMetres)
+                        continue;
+                    if (!sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius) ||
+                        !sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius))
+                        continue;
+                    if (distanceSquaredToBox(s.centreView, box.boxMin, box.boxMax) > s.radius * s.radius)
+                        continue;
+                }
+                list.push_back(i);
+            }
+        });
+        const double cullMs = forwardElapsedMs(cullStart);
+
+        // L-buffer at low resolution.
+        const auto lightingStart = Clock::now();
+        mSamples.assign(size_t(lowWidth) * lowHeight, LightSample{});
+        const int tileSamples = mOptions.tileSizeSamples;
+        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
+            if (!bounds[size_t(tile)].covered)
+                return;
+            const std::vector<uint32_t>& list = tileLights[size_t(tile)];
+            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
+            const int j1 = std::min((ty + 1) * tileSamples, lowHeight);
+            const int i1 = std::min((tx + 1) * tileSamples, lowWidth);
+            for (int j = ty * tileSamples; j < j1; ++j)
+                for (int i = tx * tileSamples; i < i1; ++i) {
+                    const int x = sampleX(i), y = sampleY(j);
+                    ShadingPoint<float> point;
+                    if (!gbufferSurfaceAt(gb, x, y, point))
+                        continue;
+                    LightSample& sample = mSamples[size_t(j) * lowWidth + i];
+                    sample.covered = true;
+                    sample.depthMetres = -point.positionView.z;
+                    sample.normalView = point.normalView;
+                    const glm::vec3 toViewer = glm::normalize(-point.positionView);
+                    ShadingPoint<float> diffusePoint = point, specularPoint = point;
+                    diffusePoint.albedo = glm::vec3(1.0f);
+                    diffusePoint.specularIntensity = 0.0f;
+                    specularPoint.albedo = glm::vec3(0.0f);
+                    specularPoint.specularIntensity = 1.0f;
+                    glm::vec3 diffuse(0.0f), specular(0.0f);
+                    for (uint32_t index : list) {
+                        const glm::vec3 d = evaluateLight(diffusePoint, toViewer, lights[index]);
+                        diffuse += d;
+                        // Zero diffuse means zero att * n.l, hence zero specular: skip the call.
+                        if (contributes(d) && lights[index].type != scenes::LightType::Ambient)
+                            specular += evaluateLight(specularPoint, toViewer, lights[index]);
+                    }
+                    sample.diffuse = diffuse;
+                    sample.specular = specular;
+                    result.lightsEvaluated[size_t(y) * width + x] = uint32_t(list.size());
+                }
+        });
+        const double lightingMs = forwardElapsedMs(lightingStart);
+
+        // Material pass: second geometry pass, DSF upsampling, combine.
+        const auto materialStart = Clock::now();
+        mForward.prepare(frame);
+        fitRasterizer(mRasterizer, view);
+        depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
+        std::vector<uint32_t> rowFallbacks(size_t(height), 0);
+        const float halfScale = float(scale / 2);
+        tbb::parallel_for(0, height, [&](int y) {
+            const float v = (float(y) - halfScale) / float(scale);
+            const int j0 = int(std::floor(v));
+            const float fy = v - float(j0);
+            const int ja = std::clamp(j0, 0, lowHeight - 1), jb = std::clamp(j0 + 1, 0, lowHeight - 1);
+            uint32_t fallbacks = 0;
+            for (int x = 0; x < width; ++x) {
+                const size_t pixel = size_t(y) * width + x;
+                const uint32_t code = mVisible[pixel];
+                if (code == kNoVisibleTriangle || !gb.covered(pixel))
+                    continue;
+                const gbuffer::Surface s = gbuffer::surfaceOfTriangle(
+                    *frame.geometry, *frame.scene, mForward.clipPositions(), mForward.normalsView(),
+                    code & ~kBackFaceBit, (code & kBackFaceBit) != 0, view.ndcOfPixel(x, y));
+                const gbuffer::Surface here = gb.decode(x, y);
+                const float depth = -here.positionView.z;
+
+                const float u = (float(x) - halfScale) / float(scale);
+                const int i0 = int(std::floor(u));
+                const float fx = u - float(i0);
+                const int ia = std::clamp(i0, 0, lowWidth - 1), ib = std::clamp(i0 + 1, 0, lowWidth - 1);
+                const LightSample* taps[4] = {&mSamples[size_t(ja) * lowWidth + ia],
+                                              &mSamples[size_t(ja) * lowWidth + ib],
+                                              &mSamples[size_t(jb) * lowWidth + ia],
+                                              &mSamples[size_t(jb) * lowWidth + ib]};
+                const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+                glm::vec3 diffuse(0.0f), specular(0.0f);
+                float weightSum = 0.0f;
+                int nearest = -1;
+                float nearestWeight = -1.0f;
+                for (int k = 0; k < 4; ++k) {
+                    const LightSample& t = *taps[k];
+                    if (!t.covered)
+                        continue;
+                    if (bilinear[k] > nearestWeight) {
+                        nearestWeight = bilinear[k];
+                        nearest = k;
+                    }
+                    if (std::abs(t.depthMetres - depth) > mOptions.depthThreshold * depth ||
+                        glm::dot(t.normalView, here.normalView) < mOptions.normalThreshold)
+                        continue;
+                    diffuse += bilinear[k] * t.diffuse;
+                    specular += bilinear[k] * t.specular;
+                    weightSum += bilinear[k];
+                }
+                if (weightSum > 0.0f) {
+                    diffuse /= weightSum;
+                    specular /= weightSum;
+                } else if (nearest >= 0) {
+                    diffuse = taps[nearest]->diffuse;
+                    specular = taps[nearest]->specular;
+                    ++fallbacks;
+                } else {
+                    ++fallbacks;
+                }
+                const glm::vec3 radiance = s.albedo * diffuse + s.specularIntensity * specular;
+                result.radiance[0][pixel] = radiance.r;
+                result.radiance[1][pixel] = radiance.g;
+                result.radiance[2][pixel] = radiance.b;
+            }
+            rowFallbacks[size_t(y)] = fallbacks;
+        });
+        const double materialMs = forwardElapsedMs(materialStart);
+
+        uint64_t pairs = 0, fallbacks = 0;
+        for (const auto& list : tileLights)
+            pairs += list.size();
+        for (uint32_t f : rowFallbacks)
+            fallbacks += f;
+        result.timingsMs.emplace_back("cull", cullMs);
+        result.timingsMs.emplace_back("lighting", lightingMs);
+        result.timingsMs.emplace_back("material", materialMs);
+        result.parameters["scale"] = std::to_string(scale);
+        result.parameters["depth"] = std::to_string(mOptions.depthThreshold);
+        result.parameters["normal"] = std::to_string(mOptions.normalThreshold);
+        result.parameters["tile"] = std::to_string(mOptions.tileSizeSamples);
+        result.parameters["lbuffer"] = std::to_string(lowWidth) + "x" + std::to_string(lowHeight);
+        result.parameters["tile_light_pairs"] = std::to_string(pairs);
+        result.parameters["dsf_fallbacks"] = std::to_string(fallbacks);
+    }
+
+private:
+    InferredOptions mOptions;
+    // Per-frame scratch, kept to avoid reallocation between repetitions.
+    std::vector<LightSample> mSamples;
+    ForwardFrame mForward;
+    std::unique_ptr<raster::Rasterizer> mRasterizer;
+    std::vector<float> mDepth;
+    std::vector<uint32_t> mVisible;
+};
+
+} // namespace
+
+std::unique_ptr<ShadingStage> makeInferredStage(const StageSpec& spec) {
+    rejectUnknownOptions(spec, {"scale", "depth", "normal", "tile"});
+    InferredOptions options;
+    options.scale = intOption(spec, "scale", 2, 1, 8);
+    options.depthThreshold = floatOption(spec, "depth", 0.1f, 0.0f, 1e30f, true);
+    options.normalThreshold = floatOption(spec, "normal", 0.9f, -1.0f, 1.0f, false);
+    options.tileSizeSamples = intOption(spec, "tile", 16, 4, 128);
+    return std::make_unique<InferredStage>(options);
+}
+
+} // namespace lighting

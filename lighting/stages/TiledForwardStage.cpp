@@ -1,0 +1,174 @@
+// `tiled-forward`: tile-based forward shading, "Forward+" (Ishmukhametov 2013, section 2.4.2,
+// after Harada et al. 2012). Three passes over the scene's own geometry, no G-buffer:
+//   1. "prepass": depth-only pre-pass (ForwardShading.h depthPrepass), which also records each
+//      pixel's visible triangle;
+//   2. "cull": the screen is split into square tiles; the pre-pass depths bound each tile's
+//      frustum (computeTileDepthBounds in culling/TileFrusta.h: min/max view depth of the
+//      covered pixels' reconstructed positions) and every light whose conservative sphere
+//      (LightBounds.h) may touch it goes into the tile's list, in ascending light index. The tests
+//      are exactly `tiled`'s (tile-column/row slabs, depth range, box distance), so the same
+//      depths give the same lists;
+//   3. "shading": the scene is rasterized again with a closer-or-equal test and no depth writes;
+//      only the pre-pass's visible fragment of each pixel is shaded (exact "depth equal"), with
+//      its tile's list. "transform" (vertices to clip/view space) precedes them.
+//
+// Options:
+//   tile=16   tile size in pixels, 4..128
+//   vfc=1     first cull lights against the camera frustum (lightsInViewFrustum); only speed
+// Parameters record the options and lights_after_vfc, vfc_culled and tile_light_pairs.
+//
+// Exactness: the visible fragment's surface and position are computed by the G-buffer's own
+// functions (ForwardFrame::surfaceAt) and each pixel sums its tile's lights in ascending order,
+// so the image is bitwise `brute`'s. Per pixel, lightsEvaluated is the list length of its one
+// shaded fragment (0 for background); with the G-buffer's depth equal to the pre-pass depth this
+// equals `tiled`'s count at the same tile size.
+// Deterministic: tiles' lists are built in parallel, each by one task; the shading draw writes each
+// pixel from the thread owning its raster tile, and only one fragment per pixel passes the
+// visible-triangle test.
+#include "lighting/stages/Stages.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <span>
+
+#include <tbb/parallel_for.h>
+
+#include "lighting/ForwardShading.h"
+#include "lighting/LightBounds.h"
+#include "lighting/culling/TileFrusta.h"
+
+namespace lighting {
+
+namespace {
+
+struct TiledForwardOptions {
+    int tileSizePixels = 16;
+    bool viewFrustumCulling = true;
+};
+
+class TiledForwardStage final : public ShadingStage {
+public:
+    explicit TiledForwardStage(const TiledForwardOptions& options) : mOptions(options) {}
+
+    std::string name() const override { return "tiled-forward"; }
+    // Reads no G-buffer channel: it rasterizes the scene itself (frame.scene, .geometry).
+    StageRequirements requirements() const override { return {{}, false}; }
+
+    void shade(const Frame& frame, StageResult& result) override {
+        const gbuffer::FrameView& view = *frame.view;
+        const int width = view.width;
+        result.resize(width, view.height, false);
+
+        auto start = std::chrono::steady_clock::now();
+        mForward.prepare(frame);
+        fitRasterizer(mRasterizer, view);
+        result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
+
+        start = std::chrono::steady_clock::now();
+        depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
+        result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
+
+        start = std::chrono::steady_clock::now();
+        const TileGrid grid = TileGrid::make(width, view.height, mOptions.tileSizePixels);
+        const size_t lightsAfterVfc = buildTileLightLists(view, grid, *frame.lights);
+        result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
+
+        start = std::chrono::steady_clock::now();
+        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
+        auto shadeFragment = [&](const raster::Fragment& fragment) {
+            const size_t pixel = size_t(fragment.y) * width + fragment.x;
+            if (mVisible[pixel] != visibilityCode(fragment.triangle, fragment.frontFacing))
+                return;
+            const std::vector<uint32_t>& list =
+                mTileLights[size_t(fragment.y / tileSize) * tileCountX + fragment.x / tileSize];
+            const ShadingPoint<float> point = mForward.surfaceAt(fragment, fragment.triangle);
+            const glm::vec3 toViewer = glm::normalize(-point.positionView);
+            glm::vec3 sum(0.0f);
+            for (uint32_t index : list)
+                sum += evaluateLight(point, toViewer, lights[index]);
+            result.radiance[0][pixel] = sum.x;
+            result.radiance[1][pixel] = sum.y;
+            result.radiance[2][pixel] = sum.z;
+            result.lightsEvaluated[pixel] = uint32_t(list.size());
+        };
+        raster::RasterState state;
+        state.cullMode = raster::CullMode::Back;
+        state.depthTest = closerOrEqualTest(view);
+        state.depthWrite = false;
+        mRasterizer->draw(mForward.triangles(), state, mDepth.data(), shadeFragment);
+        result.timingsMs.emplace_back("shading", forwardElapsedMs(start));
+
+        uint64_t pairs = 0;
+        for (const std::vector<uint32_t>& list : mTileLights)
+            pairs += list.size();
+        result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
+        result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
+        result.parameters["lights_after_vfc"] = std::to_string(lightsAfterVfc);
+        result.parameters["vfc_culled"] =
+            std::to_string(frame.lights->lights.size() - lightsAfterVfc);
+        result.parameters["tile_light_pairs"] = std::to_string(pairs);
+    }
+
+private:
+    // Fills mTileLights from the pre-pass depth (mDepth); returns the number of lights kept by
+    // view-frustum culling. The same tests, in the same order, as `tiled` without its mask.
+    size_t buildTileLightLists(const gbuffer::FrameView& view, const TileGrid& grid,
+                               const LightList& lightList) {
+        const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
+        const std::vector<LightSphere> spheres = boundingSpheresView(lightList);
+        const std::vector<CandidateLight> candidates =
+            candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
+
+        const std::vector<TileSurfaceBounds> bounds =
+            computeTileDepthBounds(view, std::span<const float>(mDepth), grid, false);
+
+        mTileLights.resize(size_t(grid.tileCount()));
+        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
+            std::vector<uint32_t>& list = mTileLights[size_t(tile)];
+            list.clear(); // keeps the capacity from the previous frame
+            const TileSurfaceBounds& b = bounds[size_t(tile)];
+            if (!b.covered)
+                return; // no visible fragment will ask for this list
+            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
+            const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
+            for (const CandidateLight& c : candidates) {
+                if (c.unbounded) {
+                    list.push_back(c.index);
+                    continue;
+                }
+                if (tx < c.columnMin || tx > c.columnMax || ty < c.rowMin || ty > c.rowMax)
+                    continue;
+                const float centreDepth = -c.centreView.z;
+                if (centreDepth + c.radius < b.minDepthMetres ||
+                    centreDepth - c.radius > b.maxDepthMetres)
+                    continue;
+                if (distanceSquaredToBox(c.centreView, box.boxMin, box.boxMax) >
+                    c.radius * c.radius)
+                    continue;
+                list.push_back(c.index);
+            }
+        });
+        return candidates.size();
+    }
+
+    TiledForwardOptions mOptions;
+    ForwardFrame mForward;
+    std::unique_ptr<raster::Rasterizer> mRasterizer;
+    std::vector<float> mDepth;                      // pre-pass depth, the frame's convention
+    std::vector<uint32_t> mVisible;                 // pre-pass visibility codes
+    std::vector<std::vector<uint32_t>> mTileLights; // per tile, ascending light indices
+};
+
+} // namespace
+
+std::unique_ptr<ShadingStage> makeTiledForwardStage(const StageSpec& spec) {
+    rejectUnknownOptions(spec, {"tile", "vfc"});
+    TiledForwardOptions options;
+    options.tileSizePixels = intOption(spec, "tile", 16, 4, 128);
+    options.viewFrustumCulling = boolOption(spec, "vfc", true);
+    return std::make_unique<TiledForwardStage>(options);
+}
+
+} // namespace lighting
