@@ -1,6 +1,6 @@
 // testbed: the command-line front end. Subcommands:
 //   render  one scene, one stage -> render.exr, preview.png, heatmap.png, stats.json
-//   list    scenes, stages (and later encodings) known to this build
+//   list    scenes, stages and normal encodings known to this build
 // Every option's default is stated by --help; unknown options are errors.
 #include <iostream>
 #include <string>
@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "experiments/RenderCommand.h"
+#include "gbuffer/NormalCodec.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
 
@@ -41,6 +42,14 @@ int listEverything() {
     std::cout << "stages:\n";
     for (const lighting::StageInfo& info : lighting::stageInfos())
         std::cout << "  " << info.name << "  - " << info.description << "\n";
+    std::cout << "normal encodings (NAME:BITS, total bits; gbuffer/NormalCodec.h):\n";
+    const std::vector<gbuffer::NormalCodecSpec> specs = gbuffer::allNormalCodecSpecs();
+    for (size_t i = 0; i < specs.size(); ++i) {  // grouped by codec, in registry order
+        const bool first = i == 0 || specs[i - 1].kind != specs[i].kind;
+        const bool last = i + 1 == specs.size() || specs[i + 1].kind != specs[i].kind;
+        if (first) std::cout << "  " << gbuffer::normalCodecName(specs[i].kind) << ":";
+        std::cout << (first ? "" : "|") << specs[i].bits << (last ? "\n" : "");
+    }
     return 0;
 }
 
