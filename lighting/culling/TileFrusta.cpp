@@ -271,4 +271,35 @@ std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, cons
     return candidates;
 }
 
+std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb, const TileGrid& grid,
+                                                     const std::vector<LightSphere>& spheres,
+                                                     std::vector<TileSurfaceBounds>& bounds) {
+    const TileEdgePlanes edges = TileEdgePlanes::make(gb.view(), grid);
+    bounds = computeTileSurfaceBounds(gb, grid, {false, false});
+    std::vector<std::vector<uint32_t>> lists(size_t(grid.tileCount()));
+    tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
+        const TileSurfaceBounds& b = bounds[size_t(tile)];
+        if (!b.covered)
+            return;
+        const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
+        const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
+        std::vector<uint32_t>& list = lists[size_t(tile)];
+        for (uint32_t i = 0; i < spheres.size(); ++i) {
+            const LightSphere& s = spheres[i];
+            if (!s.unbounded) {
+                const float centreDepth = -s.centreView.z;
+                if (centreDepth + s.radius < b.minDepthMetres || centreDepth - s.radius > b.maxDepthMetres)
+                    continue;
+                if (!sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius) ||
+                    !sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius))
+                    continue;
+                if (distanceSquaredToBox(s.centreView, box.boxMin, box.boxMax) > s.radius * s.radius)
+                    continue;
+            }
+            list.push_back(i);
+        }
+    });
+    return lists;
+}
+
 } // namespace lighting

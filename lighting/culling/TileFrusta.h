@@ -171,4 +171,11 @@ inline constexpr float kBackfaceSlackRadians = 1e-3f; // >> float error of the a
 bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
                         const glm::vec3& lightCentreView);
 
+// Per-tile light lists (ascending indices) for the covered tiles of `grid` over `gb`, with the
+// conservative tests of `tiled` and none of its optional extras (vfc, masks, cones); `bounds`
+// receives the tiles' surface bounds. Used by the stages that only need plain tile culling.
+std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb, const TileGrid& grid,
+                                                       const std::vector<LightSphere>& spheres,
+                                                       std::vector<TileSurfaceBounds>& bounds);
+
 } // namespace lighting

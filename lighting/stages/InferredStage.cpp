@@ -122,32 +122,9 @@ public:
         // exactly the samples of low-res tile (tx, ty), since sample i lies in block i.
         const auto cullStart = Clock::now();
         const TileGrid grid = TileGrid::make(width, height, mOptions.tileSizeSamples * scale);
-        const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
-        const std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {false, false});
-        std::vector<std::vector<uint32_t>> tileLights(size_t(grid.tileCount()));
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            const TileSurfaceBounds& b = bounds[size_t(tile)];
-            if (!b.covered)
-                return;
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-            std::vector<uint32_t>& list = tileLights[size_t(tile)];
-            for (uint32_t i = 0; i < spheres.size(); ++i) {
-                const LightSphere& s = spheres[i];
-                if (!s.unbounded) {
-                    const float centreDepth = -s.centreView.z;
-                    if (centreDepth + s.radius < b.minDepthMetres || centreDepth - s.radius > b.maxDepthMetres)
-                        continue;
-                    if (!sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius) ||
-                        !sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius))
-                        continue;
-                    if (distanceSquaredToBox(s.centreView, box.boxMin, box.boxMax) > s.radius * s.radius)
-                        continue;
-                }
-                list.push_back(i);
-            }
-        });
+        std::vector<TileSurfaceBounds> bounds;
+        const std::vector<std::vector<uint32_t>> tileLights = basicTileLightLists(gb, grid, spheres, bounds);
         const double cullMs = forwardElapsedMs(cullStart);
 
         // L-buffer at low resolution.

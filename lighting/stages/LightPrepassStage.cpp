@@ -53,39 +53,6 @@ namespace {
 
 inline float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 
-// Per-tile light lists (ascending indices) for the covered tiles of `grid` over `gb`. The
-// conservative tests of `tiled` without its optional extras (vfc, masks, cones).
-std::vector<std::vector<uint32_t>> cullLightsPerTile(const gbuffer::GBuffer& gb, const TileGrid& grid,
-                                                     const std::vector<LightSphere>& spheres,
-                                                     std::vector<TileSurfaceBounds>& bounds) {
-    const TileEdgePlanes edges = TileEdgePlanes::make(gb.view(), grid);
-    bounds = computeTileSurfaceBounds(gb, grid, {false, false});
-    std::vector<std::vector<uint32_t>> lists(size_t(grid.tileCount()));
-    tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-        const TileSurfaceBounds& b = bounds[size_t(tile)];
-        if (!b.covered)
-            return;
-        const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-        const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-        std::vector<uint32_t>& list = lists[size_t(tile)];
-        for (uint32_t i = 0; i < spheres.size(); ++i) {
-            const LightSphere& s = spheres[i];
-            if (!s.unbounded) {
-                const float centreDepth = -s.centreView.z;
-                if (centreDepth + s.radius < b.minDepthMetres || centreDepth - s.radius > b.maxDepthMetres)
-                    continue;
-                if (!sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius) ||
-                    !sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius))
-                    continue;
-                if (distanceSquaredToBox(s.centreView, box.boxMin, box.boxMax) > s.radius * s.radius)
-                    continue;
-            }
-            list.push_back(i);
-        }
-    });
-    return lists;
-}
-
 class LightPrepassStage final : public ShadingStage {
 public:
     LightPrepassStage(bool chroma, int tileSizePixels) : mChroma(chroma), mTileSizePixels(tileSizePixels) {}
@@ -107,7 +74,7 @@ public:
         const TileGrid grid = TileGrid::make(width, height, mTileSizePixels);
         std::vector<TileSurfaceBounds> bounds;
         const std::vector<std::vector<uint32_t>> tileLights =
-            cullLightsPerTile(gb, grid, boundingSpheresView(*frame.lights), bounds);
+            basicTileLightLists(gb, grid, boundingSpheresView(*frame.lights), bounds);
         const double cullMs = forwardElapsedMs(cullStart);
 
         // Light buffer: diffuse RGB + monochromatic specular, per pixel.
