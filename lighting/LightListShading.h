@@ -31,4 +31,32 @@ inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
     result.lightsEvaluated[pixel] = uint32_t(lightIndices.size());
 }
 
+// The lighting at one point split the way light buffers store it (light pre-pass, inferred
+// lighting): `diffuse` is the diffuse term with albedo 1, `specular` the specular term with
+// intensity 1, summed over `lightIndices`. Both come from the one BRDF; a light whose diffuse
+// part is zero (beyond range, facing away) has zero specular too, so it is not evaluated twice.
+struct SplitLighting {
+    glm::vec3 diffuse{0.0f};
+    glm::vec3 specular{0.0f};
+};
+
+inline SplitLighting splitLighting(const ShadingPoint<float>& point,
+                                   const std::vector<LightInView<float>>& lights,
+                                   std::span<const uint32_t> lightIndices) {
+    const glm::vec3 toViewer = glm::normalize(-point.positionView);
+    ShadingPoint<float> diffusePoint = point, specularPoint = point;
+    diffusePoint.albedo = glm::vec3(1.0f);
+    diffusePoint.specularIntensity = 0.0f;
+    specularPoint.albedo = glm::vec3(0.0f);
+    specularPoint.specularIntensity = 1.0f;
+    SplitLighting sum;
+    for (uint32_t index : lightIndices) {
+        const glm::vec3 d = evaluateLight(diffusePoint, toViewer, lights[index]);
+        sum.diffuse += d;
+        if (contributes(d) && lights[index].type != scenes::LightType::Ambient)
+            sum.specular += evaluateLight(specularPoint, toViewer, lights[index]);
+    }
+    return sum;
+}
+
 }  // namespace lighting

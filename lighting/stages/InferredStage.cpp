@@ -54,6 +54,7 @@
 #include "lighting/EveryLight.h"
 #include "lighting/ForwardShading.h"
 #include "lighting/LightBounds.h"
+#include "lighting/LightListShading.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
@@ -148,22 +149,9 @@ public:
                     sample.covered = true;
                     sample.depthMetres = -point.positionView.z;
                     sample.normalView = point.normalView;
-                    const glm::vec3 toViewer = glm::normalize(-point.positionView);
-                    ShadingPoint<float> diffusePoint = point, specularPoint = point;
-                    diffusePoint.albedo = glm::vec3(1.0f);
-                    diffusePoint.specularIntensity = 0.0f;
-                    specularPoint.albedo = glm::vec3(0.0f);
-                    specularPoint.specularIntensity = 1.0f;
-                    glm::vec3 diffuse(0.0f), specular(0.0f);
-                    for (uint32_t index : list) {
-                        const glm::vec3 d = evaluateLight(diffusePoint, toViewer, lights[index]);
-                        diffuse += d;
-                        // Zero diffuse means zero att * n.l, hence zero specular: skip the call.
-                        if (contributes(d) && lights[index].type != scenes::LightType::Ambient)
-                            specular += evaluateLight(specularPoint, toViewer, lights[index]);
-                    }
-                    sample.diffuse = diffuse;
-                    sample.specular = specular;
+                    const SplitLighting lighting = splitLighting(point, lights, list);
+                    sample.diffuse = lighting.diffuse;
+                    sample.specular = lighting.specular;
                     result.lightsEvaluated[size_t(y) * width + x] = uint32_t(list.size());
                 }
         });

@@ -45,6 +45,7 @@
 #include "lighting/EveryLight.h"
 #include "lighting/ForwardShading.h"
 #include "lighting/LightBounds.h"
+#include "lighting/LightListShading.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
@@ -92,22 +93,9 @@ public:
                     ShadingPoint<float> point;
                     if (!gbufferSurfaceAt(gb, x, y, point))
                         continue;
-                    const glm::vec3 toViewer = glm::normalize(-point.positionView);
-                    ShadingPoint<float> diffusePoint = point, specularPoint = point;
-                    diffusePoint.albedo = glm::vec3(1.0f);
-                    diffusePoint.specularIntensity = 0.0f;
-                    specularPoint.albedo = glm::vec3(0.0f);
-                    specularPoint.specularIntensity = 1.0f;
-                    glm::vec3 diffuse(0.0f);
-                    float specular = 0.0f;
-                    for (uint32_t index : list) {
-                        const glm::vec3 d = evaluateLight(diffusePoint, toViewer, lights[index]);
-                        diffuse += d;
-                        if (contributes(d) && lights[index].type != scenes::LightType::Ambient)
-                            specular += luminance(evaluateLight(specularPoint, toViewer, lights[index]));
-                    }
-                    mDiffuse[pixel] = diffuse;
-                    mSpecular[pixel] = specular;
+                    const SplitLighting lighting = splitLighting(point, lights, list);
+                    mDiffuse[pixel] = lighting.diffuse;
+                    mSpecular[pixel] = luminance(lighting.specular);  // one monochrome scalar
                     result.lightsEvaluated[pixel] = uint32_t(list.size());
                 }
         });
