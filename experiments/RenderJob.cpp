@@ -1,5 +1,6 @@
 #include "experiments/RenderJob.h"
 
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -69,6 +70,52 @@ void validate(const RenderOptions& options) {
         }
         if (!std::filesystem::is_regular_file(path))
             throw UsageError("scene file '" + options.scene + "' not found");
+    }
+}
+
+namespace {
+
+template <typename Number>
+Number parseNumber(const std::string& key, const std::string& value) {
+    Number number{};
+    const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
+    if (error != std::errc() || end != value.data() + value.size())
+        throw UsageError("option '" + key + "': '" + value + "' is not a valid number");
+    return number;
+}
+
+}  // namespace
+
+std::vector<std::string> renderOptionKeys() {
+    return {"scene", "stage",  "lights", "seed",   "width",    "height",
+            "resolution", "threads", "layout", "normals", "depth", "position",
+            "scene-option.<key>"};
+}
+
+void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
+    static const std::string kSceneOption = "scene-option.";
+    if (key == "scene") options.scene = value;
+    else if (key == "stage") options.stage = value;
+    else if (key == "lights") options.lights = parseNumber<int>(key, value);
+    else if (key == "seed") options.seed = parseNumber<uint64_t>(key, value);
+    else if (key == "width") options.width = parseNumber<int>(key, value);
+    else if (key == "height") options.height = parseNumber<int>(key, value);
+    else if (key == "threads") options.threads = parseNumber<int>(key, value);
+    else if (key == "layout") options.layout = value;
+    else if (key == "normals") options.normals = value;
+    else if (key == "depth") options.depth = value;
+    else if (key == "position") options.position = value;
+    else if (key == "resolution") {
+        const size_t x = value.find('x');
+        if (x == std::string::npos) throw UsageError("option 'resolution': '" + value + "' is not WIDTHxHEIGHT");
+        options.width = parseNumber<int>(key, value.substr(0, x));
+        options.height = parseNumber<int>(key, value.substr(x + 1));
+    } else if (key.rfind(kSceneOption, 0) == 0 && key.size() > kSceneOption.size()) {
+        options.sceneOptions[key.substr(kSceneOption.size())] = value;
+    } else {
+        std::string keys;
+        for (const std::string& k : renderOptionKeys()) keys += (keys.empty() ? "" : ", ") + k;
+        throw UsageError("unknown render option '" + key + "'; valid: " + keys);
     }
 }
 

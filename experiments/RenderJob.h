@@ -29,7 +29,22 @@ struct RenderOptions {
     int height = 720;
     int threads = 0;  // 0 = every hardware thread
     bool compareReference = false;
+    // G-buffer: a preset name ("" = derived from the scene and the stage, gbuffer/LayoutDerivation.h),
+    // then overrides of its normal encoding ("NAME:BITS"), depth format and position method.
+    std::string layout;
+    std::string normals;
+    std::string depth;
+    std::string position;
 };
+
+// Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
+// seed, width, height, resolution (WxH), threads, layout, normals, depth, position, and
+// scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown
+// key throws UsageError naming it. The sweep runner goes through this, so every stage, encoding
+// or scene added later is reachable without touching the runner.
+void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
+// The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
+std::vector<std::string> renderOptionKeys();
 
 // Limits checked before any work or allocation (issue: 100000x100000 must be refused up front).
 inline constexpr int kMaxImageSide = 16384;

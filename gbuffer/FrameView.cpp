@@ -5,8 +5,9 @@
 namespace gbuffer {
 
 FrameView FrameView::fromCamera(const scenes::Camera& camera, int width, int height,
-                                DepthConvention convention) {
+                                DepthConvention convention, bool infiniteFar) {
     FrameView view;
+    view.infiniteFar = infiniteFar;
     view.depthConvention = convention;
     view.width = width;
     view.height = height;
@@ -18,6 +19,12 @@ FrameView FrameView::fromCamera(const scenes::Camera& camera, int width, int hei
     view.viewFromWorldExact = glm::lookAtRH(eye, eye + forward, up);
     glm::dmat4 clipFromViewExact = glm::perspectiveRH_ZO(
         double(camera.verticalFovRadians), aspect, double(camera.nearMetres), double(camera.farMetres));
+    if (infiniteFar) {
+        // The limit f -> infinity of the zero-to-one perspective: z_clip = d - n, w = d, so
+        // z_ndc = 1 - n / d (far plane at infinity, no far clipping).
+        clipFromViewExact[2][2] = -1.0;
+        clipFromViewExact[3][2] = -double(camera.nearMetres);
+    }
     if (convention == DepthConvention::Reversed) {
         // z' = w - z maps [0, w] onto [w, 0]: near -> 1, far -> 0.
         glm::dmat4 reverse(1.0);

@@ -20,6 +20,7 @@ struct FrameView {
     float nearMetres = 0.1f;
     float farMetres = 100.0f;
     DepthConvention depthConvention = DepthConvention::Reversed;
+    bool infiniteFar = false;  // far plane at infinity: farMetres is then only the scene's extent
     glm::mat4 viewFromWorld{1.0f};
     glm::mat4 clipFromView{1.0f};
     glm::mat4 viewFromClip{1.0f};   // inverse projection, for position reconstruction
@@ -28,7 +29,8 @@ struct FrameView {
     glm::dmat4 viewFromClipExact{1.0};
 
     static FrameView fromCamera(const scenes::Camera& camera, int width, int height,
-                                DepthConvention convention = DepthConvention::Reversed);
+                                DepthConvention convention = DepthConvention::Reversed,
+                                bool infiniteFar = false);
 
     bool reversedZ() const { return depthConvention == DepthConvention::Reversed; }
     // Depth of "nothing here": the far plane's value.

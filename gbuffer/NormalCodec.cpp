@@ -355,7 +355,7 @@ double normalAngleRadians(glm::vec3 a, glm::vec3 b) {
     return std::atan2(glm::length(glm::cross(da, db)), glm::dot(da, db));
 }
 
-NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView) {
+NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView, glm::vec3 /*viewRayView*/) {
     const int b = componentBits(spec);
     const glm::dvec3 d = unitOrFallback(unitNormalView);
     NormalCode code;
@@ -404,7 +404,7 @@ NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView) {
     return code;
 }
 
-glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code) {
+glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code, glm::vec3 /*viewRayView*/) {
     const int b = componentBits(spec);
     switch (spec.kind) {
     case NormalCodecKind::Float32: {

@@ -56,6 +56,8 @@ struct NormalCode {
 // What invalid inputs (NaN/Inf, zero vector) encode to and what invalid float32 codes decode to:
 // facing the camera, the least surprising direction for shading.
 inline constexpr glm::vec3 kFallbackNormalView{0.0f, 0.0f, 1.0f};
+// The ray through the image centre: what `pixel-view` assumes when no pixel is given.
+inline constexpr glm::vec3 kCentralViewRay{0.0f, 0.0f, -1.0f};
 
 struct NormalCodecSpec {
     NormalCodecKind kind = NormalCodecKind::Octahedral;
@@ -77,9 +79,14 @@ std::vector<NormalCodecSpec> allNormalCodecSpecs(); // every name x every suppor
 
 // Encodes a view-space normal; see the robustness contract above. Throws std::invalid_argument
 // only for a spec with unsupported bits (a programming error: parse() never makes one).
-NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView);
-// Decodes to a unit vector; bits of `code` above spec.bits are ignored.
-glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code);
+// `viewRayView` is the direction from the camera through the pixel (view space, any length, z < 0);
+// only `pixel-view` reads it. The default is the central ray, for studies without a camera.
+NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView,
+                        glm::vec3 viewRayView = kCentralViewRay);
+// Decodes to a unit vector; bits of `code` above spec.bits are ignored. `viewRayView` must be the
+// ray given to encodeNormal (only `pixel-view` reads it).
+glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code,
+                       glm::vec3 viewRayView = kCentralViewRay);
 
 // Angle between two directions in radians, computed in double as atan2(|a x b|, a . b), which
 // stays accurate for tiny angles (acos of a dot product loses ~1e-4 rad near 0). Lengths do not
