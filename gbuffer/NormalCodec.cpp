@@ -38,6 +38,7 @@ const std::vector<CodecInfo>& codecTable() {
         {NormalCodecKind::Spheremap, "spheremap", {16, 20, 24, 32}},
         {NormalCodecKind::Stereographic, "stereographic", {16, 20, 24, 32}},
         {NormalCodecKind::StereographicScaled, "stereographic-scaled", {16, 20, 24, 32}},
+        {NormalCodecKind::PixelView, "pixel-view", {16, 20, 24, 32}},
         {NormalCodecKind::BestFit, "best-fit", {24}},
         {NormalCodecKind::Octahedral, "octahedral", {16, 20, 24, 32}},
         {NormalCodecKind::OctahedralPrecise, "octahedral-precise", {16, 20, 24, 32}},
@@ -290,6 +291,58 @@ glm::vec3 stereographicDecode(std::uint64_t code, double scale, int b) {
     return toUnitFloat(glm::dvec3(2.0 * a, 1.0 - a2) / (1.0 + a2));
 }
 
+// --- pixel-view -------------------------------------------------------------------------------
+
+// The thesis' per-pixel view frame, in double. Rows x, y, z are orthonormal and right-handed.
+struct PixelViewFrame {
+    glm::dvec3 x{1.0, 0.0, 0.0};
+    glm::dvec3 y{0.0, 1.0, 0.0};
+    glm::dvec3 z{0.0, 0.0, 1.0}; // towards the camera: -normalize(viewRay)
+};
+
+PixelViewFrame pixelViewFrame(glm::vec3 viewRayView) {
+    PixelViewFrame frame; // the central ray's frame, also the fallback for degenerate rays
+    if (!std::isfinite(viewRayView.x) || !std::isfinite(viewRayView.y) ||
+        !std::isfinite(viewRayView.z))
+        return frame;
+    const glm::dvec3 ray(viewRayView);
+    const double length = std::sqrt(glm::dot(ray, ray)); // float inputs: no overflow in double
+    if (!(length > 0.0))
+        return frame;
+    const glm::dvec3 z = -ray / length;
+    // x = normalize(z.z, 0, -z.x) is undefined for a ray along the view Y axis. The frame is exact
+    // for any non-zero horizontal part (double has range to spare for float inputs).
+    const double horizontal = std::hypot(z.z, z.x);
+    if (!(horizontal > 0.0))
+        return frame;
+    frame.z = z;
+    frame.x = glm::dvec3(z.z / horizontal, 0.0, -z.x / horizontal);
+    frame.y = glm::cross(z, frame.x);
+    return frame;
+}
+
+std::uint64_t pixelViewEncode(const glm::dvec3& d, glm::vec3 viewRayView, int b) {
+    const PixelViewFrame frame = pixelViewFrame(viewRayView);
+    glm::dvec2 local(glm::dot(d, frame.x), glm::dot(d, frame.y));
+    if (glm::dot(d, frame.z) < 0.0) {
+        // Faces away from the ray: invisible to a pinhole camera. Clamp to the silhouette (the
+        // nearest direction with local z = 0) instead of mirroring it as xy-z does.
+        const double radius = std::hypot(local.x, local.y);
+        local = radius > 0.0 ? local / radius : glm::dvec2(1.0, 0.0);
+    }
+    return pack2(quantizeSnorm(local.x, b), quantizeSnorm(local.y, b), b);
+}
+
+glm::vec3 pixelViewDecode(std::uint64_t code, glm::vec3 viewRayView, int b) {
+    const glm::dvec2 local(dequantizeSnorm(field(code, 0, b), b),
+                           dequantizeSnorm(field(code, 1, b), b));
+    // Outside the unit disc (never written) z = 0: the nearest silhouette direction after the
+    // final normalisation. Same expression as xy-z, so the central ray gives its bits exactly.
+    const double z = std::sqrt(std::max(0.0, 1.0 - local.x * local.x - local.y * local.y));
+    const PixelViewFrame frame = pixelViewFrame(viewRayView);
+    return toUnitFloat(local.x * frame.x + local.y * frame.y + z * frame.z);
+}
+
 } // namespace
 
 const char* normalCodecName(NormalCodecKind kind) {
@@ -355,7 +408,8 @@ double normalAngleRadians(glm::vec3 a, glm::vec3 b) {
     return std::atan2(glm::length(glm::cross(da, db)), glm::dot(da, db));
 }
 
-NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView, glm::vec3 /*viewRayView*/) {
+NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView,
+                        glm::vec3 viewRayView) {
     const int b = componentBits(spec);
     const glm::dvec3 d = unitOrFallback(unitNormalView);
     NormalCode code;
@@ -386,6 +440,9 @@ NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView, g
     case NormalCodecKind::StereographicScaled:
         code.low = stereographicEncode(d, kStereographicScale, b);
         break;
+    case NormalCodecKind::PixelView:
+        code.low = pixelViewEncode(d, viewRayView, b);
+        break;
     case NormalCodecKind::BestFit:
         code.low = bestFitEncode(d);
         break;
@@ -404,7 +461,7 @@ NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView, g
     return code;
 }
 
-glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code, glm::vec3 /*viewRayView*/) {
+glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code, glm::vec3 viewRayView) {
     const int b = componentBits(spec);
     switch (spec.kind) {
     case NormalCodecKind::Float32: {
@@ -431,6 +488,8 @@ glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code, glm::vec3 /
         return stereographicDecode(code.low, 1.0, b);
     case NormalCodecKind::StereographicScaled:
         return stereographicDecode(code.low, kStereographicScale, b);
+    case NormalCodecKind::PixelView:
+        return pixelViewDecode(code.low, viewRayView, b);
     case NormalCodecKind::BestFit:
         // (127,127,127) is the zero vector (never written): toUnitFloat falls back to +Z.
         return toUnitFloat(
@@ -442,6 +501,90 @@ glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code, glm::vec3 /
         return octahedralDecode(code.low, b);
     }
     return kFallbackNormalView;
+}
+
+// --- Derived bounds ----------------------------------------------------------------------------
+// b = bits per component, N = 2^(b-1) - 1 (SNORM steps per unit: step 1/N, half step 1/(2N)).
+// Every bound is a path-length argument: the decoded point is reached from the input's exact
+// (unquantised) image by a short straight path in the code domain, and the angle is at most the
+// length of that path's image on the sphere. Float output adds kNormalFloatSlackRadians.
+//
+// xyz: each component moves by <= 1/(2N), so |v - n| <= sqrt(3)/(2N) = e; a vector within e of a
+//   unit vector is at most asin(e) away in angle. 8 bits: 0.39 deg.
+// xy-z (z >= 0 only) and pixel-view (local z >= 0 only; the same map in a rotated frame):
+//   (x, y) moves by <= e = sqrt(2)/(2N) in the unit disc, and the decoder is the inverse
+//   orthographic projection. Radially, theta = asin(r) has slope 1/cos(theta), unbounded at the
+//   rim: the worst radial step of length e is the last one, pi/2 - asin(1 - e). Tangentially the
+//   sphere arc equals the disc arc (sin(theta) = r), and the arc at radius |q| from q to p's
+//   azimuth is <= (pi/2) * (2e). Total <= pi/2 - asin(1 - e) + pi e. 8 bits: 6.0 + 2.0 deg; the
+//   rim (grazing normals) costs sqrt(2e) rad.
+// spherical: theta in UNORM over M = 2^b - 1 steps of pi/M, phi over 2^b steps of 2pi/2^b; move
+//   along the meridian (<= pi/(2M)) then along the parallel (sin(theta) * pi/2^b <= pi/2^b).
+// spheremap: s = sin(theta/2) * azimuth in the unit disc; in Lambert units rho = 2|s| in [0, 2]
+//   a half-cell diagonal is e = 2 * sqrt(2)/(2N) = sqrt(2)/N. theta = 2 asin(rho/2) has slope
+//   1/cos(theta/2), unbounded at the rim (-Z), so the worst radial step is
+//   pi - 2 asin(1 - e/2); tangentially sphere arc = rho cos(theta/2) dphi <= disc arc <= pi e.
+//   Total <= pi - 2 asin(1 - e/2) + pi e: large at 8 bits (~14 deg), only near -Z.
+// stereographic (scale S): a = S s, s in [-1,1]^2; the inverse projection is conformal with
+//   factor 2/(1 + |a|^2) <= 2, so angle <= 2 * S * sqrt(2)/(2N) = sqrt(2) S / N, valid where no
+//   clamping happens: |a| <= S, i.e. z >= (1 - S^2)/(1 + S^2) (0 for S = 1, -0.519 for 1.7777).
+//   Beyond that the codec clamps to the square's border: up to ~180 deg at -Z, by design.
+// octahedral: p moves by <= e = sqrt(2)/(2N) (half diagonal). The octahedron point
+//   (px, py, 1-|px|-|py|) (folded or not, piecewise affine) moves by <= sqrt(e^2 + (|dx|+|dy|)^2)
+//   <= sqrt(3) e, and projecting onto the sphere stretches by 1/|o| <= sqrt(3) (the octahedron's
+//   face centres are 1/sqrt(3) from the origin). Total <= 3 e = 3 sqrt(2)/(2N). 8 bits: 0.96 deg.
+// octahedral-precise: never worse than octahedral per direction, so the same bound.
+// best-fit: among the candidates is major length 127 with the two minors rounded: error vector
+//   <= sqrt(2)/2 against a vector of length >= 127, so angle <= asin((sqrt(2)/2)/127) = 0.32 deg.
+// float32: only the float cast, so 0 (+ slack).
+double normalErrorBoundRadians(const NormalCodecSpec& spec) {
+    const int b = componentBits(spec);
+    const double n = static_cast<double>(snormMax(b));
+    switch (spec.kind) {
+    case NormalCodecKind::Float32:
+        return 0.0;
+    case NormalCodecKind::Xyz:
+        return std::asin(std::sqrt(3.0) / (2.0 * n));
+    case NormalCodecKind::XyReconstructZ:
+    case NormalCodecKind::PixelView: {
+        const double e = std::sqrt(2.0) / (2.0 * n);
+        return kPi / 2 - std::asin(1.0 - e) + kPi * e;
+    }
+    case NormalCodecKind::Spherical:
+        return kPi / (2.0 * (std::ldexp(1.0, b) - 1.0)) + kPi / std::ldexp(1.0, b);
+    case NormalCodecKind::Spheremap: {
+        const double e = std::sqrt(2.0) / n;
+        return kPi - 2.0 * std::asin(1.0 - e / 2.0) + kPi * e;
+    }
+    case NormalCodecKind::Stereographic:
+        return std::sqrt(2.0) / n;
+    case NormalCodecKind::StereographicScaled:
+        return std::sqrt(2.0) * kStereographicScale / n;
+    case NormalCodecKind::BestFit:
+        return std::asin(std::sqrt(0.5) / kBestFitComponentMax);
+    case NormalCodecKind::Octahedral:
+    case NormalCodecKind::OctahedralPrecise:
+        return 3.0 * std::sqrt(2.0) / (2.0 * n);
+    }
+    return 0.0;
+}
+
+bool inNormalErrorBoundRegion(const NormalCodecSpec& spec, glm::vec3 unitNormalView,
+                              glm::vec3 viewRayView) {
+    const glm::dvec3 d = unitOrFallback(unitNormalView);
+    switch (spec.kind) {
+    case NormalCodecKind::XyReconstructZ:
+    case NormalCodecKind::Stereographic:
+        return d.z >= 0.0;
+    case NormalCodecKind::StereographicScaled: {
+        const double s2 = kStereographicScale * kStereographicScale;
+        return d.z >= (1.0 - s2) / (1.0 + s2);
+    }
+    case NormalCodecKind::PixelView:
+        return glm::dot(d, pixelViewFrame(viewRayView).z) >= 0.0;
+    default:
+        return true;
+    }
 }
 
 } // namespace gbuffer

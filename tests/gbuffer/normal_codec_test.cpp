@@ -30,13 +30,10 @@ using gbuffer::NormalCodecSpec;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kDegreesPerRadian = 180.0 / kPi;
-// Slack for the final float cast of a decoded direction: each component is rounded with relative
-// error 2^-24, which tilts a unit vector by at most ~1e-7 rad; 4e-7 leaves a factor of 4.
-constexpr double kFloatSlackRadians = 4e-7;
+constexpr double kFloatSlackRadians = gbuffer::kNormalFloatSlackRadians;
 // 2^20 >= 10^6 directions: dense enough that every codec's worst cell is approached, and the
 // whole file still runs in a few seconds at -O2.
 constexpr int kDenseDirectionCount = 1 << 20;
-constexpr double kStereographicScale = 1.7777; // the thesis' value, mirrored from the codec
 
 // SplitMix64 (Steele et al. 2014): tiny, full-period, identical everywhere.
 struct SplitMix64 {
@@ -143,84 +140,14 @@ double snormMax(int b) {
     return std::ldexp(1.0, b - 1) - 1.0;
 }
 
-// --- Derived bounds ----------------------------------------------------------------------------
-// b = bits per component, N = 2^(b-1) - 1 (SNORM steps per unit: step 1/N, half step 1/(2N)).
-// Every bound is a path-length argument: the decoded point is reached from the input's exact
-// (unquantised) image by a short straight path in the code domain, and the angle is at most the
-// length of that path's image on the sphere. Float output adds kFloatSlackRadians.
-//
-// xyz: each component moves by <= 1/(2N), so |v - n| <= sqrt(3)/(2N) = e; a vector within e of a
-//   unit vector is at most asin(e) away in angle. 8 bits: 0.39 deg.
-// xy-z (z >= 0 only): (x, y) moves by <= e = sqrt(2)/(2N) in the unit disc, and the decoder is
-//   the inverse orthographic projection. Radially, theta = asin(r) has slope 1/cos(theta),
-//   unbounded at the rim: the worst radial step of length e is the last one, pi/2 - asin(1 - e).
-//   Tangentially the sphere arc equals the disc arc (sin(theta) = r), and the arc at radius |q|
-//   from q to p's azimuth is <= (pi/2) * (2e). Total <= pi/2 - asin(1 - e) + pi e.
-//   8 bits: 6.0 + 2.0 deg; the rim (grazing normals) costs sqrt(2e) rad.
-// spherical: theta in UNORM over M = 2^b - 1 steps of pi/M, phi over 2^b steps of 2pi/2^b; move
-//   along the meridian (<= pi/(2M)) then along the parallel (sin(theta) * pi/2^b <= pi/2^b).
-// spheremap: s = sin(theta/2) * azimuth in the unit disc; in Lambert units rho = 2|s| in [0, 2]
-//   a half-cell diagonal is e = 2 * sqrt(2)/(2N) = sqrt(2)/N. theta = 2 asin(rho/2) has slope
-//   1/cos(theta/2), unbounded at the rim (-Z), so the worst radial step is
-//   pi - 2 asin(1 - e/2); tangentially sphere arc = rho cos(theta/2) dphi <= disc arc <= pi e.
-//   Total <= pi - 2 asin(1 - e/2) + pi e: large at 8 bits (~14 deg), only near -Z.
-// stereographic (scale S): a = S s, s in [-1,1]^2; the inverse projection is conformal with
-//   factor 2/(1 + |a|^2) <= 2, so angle <= 2 * S * sqrt(2)/(2N) = sqrt(2) S / N, valid where no
-//   clamping happens: |a| <= S, i.e. z >= (1 - S^2)/(1 + S^2) (0 for S = 1, -0.519 for 1.7777).
-//   Beyond that the codec clamps to the square's border: up to ~180 deg at -Z, by design.
-// octahedral: p moves by <= e = sqrt(2)/(2N) (half diagonal). The octahedron point
-//   (px, py, 1-|px|-|py|) (folded or not, piecewise affine) moves by <= sqrt(e^2 + (|dx|+|dy|)^2)
-//   <= sqrt(3) e, and projecting onto the sphere stretches by 1/|o| <= sqrt(3) (the octahedron's
-//   face centres are 1/sqrt(3) from the origin). Total <= 3 e = 3 sqrt(2)/(2N). 8 bits: 0.96 deg.
-// octahedral-precise: never worse than octahedral per direction, so the same bound.
-// best-fit: among the candidates is major length 127 with the two minors rounded: error vector
-//   <= sqrt(2)/2 against a vector of length >= 127, so angle <= asin((sqrt(2)/2)/127) = 0.32 deg.
-// float32: only the float cast, so 0 + slack.
+// The derived bounds and their regions live in the library (normalErrorBoundRadians, derived in
+// NormalCodec.cpp) because the precision study reports them too; these tests hold every codec to
+// them on dense and hard inputs.
 double errorBoundRadians(const NormalCodecSpec& spec) {
-    const int b = componentBits(spec);
-    const double n = snormMax(b);
-    switch (spec.kind) {
-    case NormalCodecKind::Float32:
-        return 0.0;
-    case NormalCodecKind::Xyz:
-        return std::asin(std::sqrt(3.0) / (2.0 * n));
-    case NormalCodecKind::XyReconstructZ: {
-        const double e = std::sqrt(2.0) / (2.0 * n);
-        return kPi / 2 - std::asin(1.0 - e) + kPi * e;
-    }
-    case NormalCodecKind::Spherical:
-        return kPi / (2.0 * (std::ldexp(1.0, b) - 1.0)) + kPi / std::ldexp(1.0, b);
-    case NormalCodecKind::Spheremap: {
-        const double e = std::sqrt(2.0) / n;
-        return kPi - 2.0 * std::asin(1.0 - e / 2.0) + kPi * e;
-    }
-    case NormalCodecKind::Stereographic:
-        return std::sqrt(2.0) / n;
-    case NormalCodecKind::StereographicScaled:
-        return std::sqrt(2.0) * kStereographicScale / n;
-    case NormalCodecKind::BestFit:
-        return std::asin(std::sqrt(0.5) / 127.0);
-    case NormalCodecKind::Octahedral:
-    case NormalCodecKind::OctahedralPrecise:
-        return 3.0 * std::sqrt(2.0) / (2.0 * n);
-    }
-    return 0.0;
+    return gbuffer::normalErrorBoundRadians(spec);
 }
-
-// The region where errorBoundRadians holds (whole sphere unless the codec gives up somewhere).
 bool inBoundRegion(const NormalCodecSpec& spec, glm::vec3 n) {
-    switch (spec.kind) {
-    case NormalCodecKind::XyReconstructZ:
-        return n.z >= 0.0f;
-    case NormalCodecKind::Stereographic:
-        return n.z >= 0.0f;
-    case NormalCodecKind::StereographicScaled: {
-        const double s2 = kStereographicScale * kStereographicScale;
-        return n.z >= (1.0 - s2) / (1.0 + s2);
-    }
-    default:
-        return true;
-    }
+    return gbuffer::inNormalErrorBoundRegion(spec, n);
 }
 
 double roundTripError(const NormalCodecSpec& spec, glm::vec3 n) {
@@ -289,6 +216,7 @@ TEST(NormalCodecRegistry, NamesAreTheCliContract) {
                                                "spheremap",
                                                "stereographic",
                                                "stereographic-scaled",
+                                               "pixel-view",
                                                "best-fit",
                                                "octahedral",
                                                "octahedral-precise"};
@@ -376,7 +304,8 @@ TEST_P(NormalCodecTest, AnyCodeDecodesToAFiniteUnitVector) {
 // - spherical: all codes except the poles (theta code 0 or M, where every azimuth is the pole).
 // - spheremap: codes strictly inside the unit disc (the rim is -Z; outside the disc is clamped).
 // - stereographic(-scaled): every code (the square is inside the plane, the map is a bijection).
-// - xy-z: codes inside the closed unit disc (outside, z would be imaginary and is clamped to 0).
+// - xy-z, pixel-view: codes inside the closed unit disc (outside, z would be imaginary and is
+//   clamped to 0).
 // Not for xyz, best-fit (decode normalises: every multiple of a vector is one direction) or
 // float32 (decode renormalises the stored floats).
 TEST_P(NormalCodecTest, RepresentableCodesRoundTripExactly) {
@@ -400,6 +329,7 @@ TEST_P(NormalCodecTest, RepresentableCodesRoundTripExactly) {
         case NormalCodecKind::StereographicScaled:
             return q0 <= 2 * n && q1 <= 2 * n;
         case NormalCodecKind::XyReconstructZ:
+        case NormalCodecKind::PixelView: // at the central ray, where the frame is the view frame
             return q0 <= 2 * n && q1 <= 2 * n && x * x + y * y <= 1.0;
         default:
             return false;
@@ -507,6 +437,162 @@ TEST(NormalCodecExact, OctahedralAxesAreExact) {
             for (glm::vec3 axis : axes)
                 EXPECT_EQ(gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, axis)), axis)
                     << spec.text();
+        }
+    }
+}
+
+// --- pixel-view: the per-pixel view frame ----------------------------------------------------
+
+// Rays through uniformly random pixels of a wide camera (90 degree vertical field of view, 16:9),
+// plus extreme rays: nearly horizontal, nearly vertical (close to the frame's degenerate axis)
+// and pointing backwards (not a pinhole ray, but the codec must still be consistent).
+std::vector<glm::vec3> testViewRays() {
+    std::vector<glm::vec3> rays = {{0, 0, -1},       {1, 0, -1e-3f},   {-1, 0, 1e-6f},
+                                   {0, 1, -1e-3f},   {1e-6f, -1, 0},   {0.3f, 0.2f, 0.9f},
+                                   {5e3f, -2e3f, -1e4f}, {1e-30f, 2e-30f, -3e-30f}};
+    SplitMix64 rng{90};
+    const double tanHalf = std::tan(kPi / 4), aspect = 16.0 / 9.0;
+    for (int i = 0; i < 64; ++i) {
+        const double u = 2.0 * rng.uniform() - 1.0, v = 2.0 * rng.uniform() - 1.0;
+        rays.emplace_back(glm::vec3(u * tanHalf * aspect, v * tanHalf, -1.0));
+    }
+    return rays;
+}
+
+std::vector<NormalCodecSpec> pixelViewSpecs() {
+    std::vector<NormalCodecSpec> specs;
+    for (int bits : gbuffer::supportedBits(NormalCodecKind::PixelView))
+        specs.push_back({NormalCodecKind::PixelView, bits});
+    return specs;
+}
+
+// At the image centre the per-pixel frame is the view frame: same codes as xy-z for every
+// front-facing normal (back-facing ones differ on purpose: xy-z mirrors, pixel-view clamps).
+TEST(NormalCodecPixelView, CentralRayGivesTheXyzCodes) {
+    for (const NormalCodecSpec& spec : pixelViewSpecs()) {
+        const NormalCodecSpec xyz{NormalCodecKind::XyReconstructZ, spec.bits};
+        int checked = 0;
+        for (int i = 0; i < 100000; ++i) {
+            const glm::vec3 n = denseDirections()[i];
+            if (n.z < 0.0f)
+                continue;
+            ++checked;
+            ASSERT_EQ(gbuffer::encodeNormal(spec, n), gbuffer::encodeNormal(xyz, n)) << spec.text();
+            ASSERT_EQ(gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, n)),
+                      gbuffer::decodeNormal(xyz, gbuffer::encodeNormal(xyz, n)))
+                << spec.text();
+        }
+        EXPECT_GT(checked, 40000);
+    }
+}
+
+// Off-centre pixels: every normal facing the camera along the pixel's ray is within the derived
+// bound (the xy-z bound, in the rotated frame), and every representable code round-trips.
+TEST(NormalCodecPixelView, OffAxisRaysStayWithinTheDerivedBound) {
+    const std::vector<glm::vec3> rays = testViewRays();
+    for (const NormalCodecSpec& spec : pixelViewSpecs()) {
+        const double bound = gbuffer::normalErrorBoundRadians(spec) + kFloatSlackRadians;
+        double maxError = 0.0;
+        long checked = 0;
+        for (size_t i = 0; i < 200000; ++i) {
+            const glm::vec3 ray = rays[i % rays.size()];
+            glm::vec3 n = denseDirections()[i];
+            if (glm::dot(glm::dvec3(n), glm::dvec3(ray)) > 0.0)
+                n = -n; // front-facing for this pixel
+            ASSERT_TRUE(gbuffer::inNormalErrorBoundRegion(spec, n, ray));
+            const glm::vec3 decoded =
+                gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, n, ray), ray);
+            maxError = std::max(maxError, gbuffer::normalAngleRadians(n, decoded));
+            ++checked;
+        }
+        EXPECT_LE(maxError, bound) << spec.text();
+        EXPECT_GT(maxError * 25.0, bound) << spec.text() << " bound far above the measured max";
+
+        // Representable codes (inside the closed unit disc) round-trip under any fixed ray.
+        const int b = spec.bits / 2;
+        const double n = snormMax(b);
+        SplitMix64 rng{12};
+        long roundTrips = 0;
+        for (int i = 0; i < 20000; ++i) {
+            const glm::vec3 ray = rays[i % rays.size()];
+            const std::uint64_t q0 = rng.next() % std::uint64_t(2 * n + 1);
+            const std::uint64_t q1 = rng.next() % std::uint64_t(2 * n + 1);
+            const double x = (double(q0) - n) / n, y = (double(q1) - n) / n;
+            if (x * x + y * y > 1.0)
+                continue;
+            const NormalCode code{q0 | (q1 << b), 0};
+            const glm::vec3 decoded = gbuffer::decodeNormal(spec, code, ray);
+            ASSERT_EQ(gbuffer::encodeNormal(spec, decoded, ray), code)
+                << spec.text() << " ray (" << ray.x << ", " << ray.y << ", " << ray.z << ")";
+            ++roundTrips;
+        }
+        EXPECT_GT(roundTrips, 10000) << spec.text();
+    }
+}
+
+// A normal facing away from the pixel's ray is invisible to a pinhole camera; the codec stores
+// the nearest silhouette direction (local z = 0) instead, so the decoded normal is within the
+// bound of that direction and (almost) perpendicular to the ray.
+TEST(NormalCodecPixelView, BackFacingNormalsClampToTheSilhouette) {
+    const std::vector<glm::vec3> rays = testViewRays();
+    for (const NormalCodecSpec& spec : pixelViewSpecs()) {
+        const double bound = gbuffer::normalErrorBoundRadians(spec) + kFloatSlackRadians;
+        for (size_t i = 0; i < 50000; ++i) {
+            const glm::vec3 ray = rays[i % rays.size()];
+            const glm::dvec3 towardsCamera = -glm::normalize(glm::dvec3(ray));
+            glm::dvec3 n(denseDirections()[i]);
+            if (glm::dot(n, towardsCamera) > 0.0)
+                n = -n;
+            const glm::dvec3 tangent = n - glm::dot(n, towardsCamera) * towardsCamera;
+            if (glm::length(tangent) < 1e-3)
+                continue; // straight away from the camera: any silhouette point is right
+            const glm::vec3 silhouette(glm::normalize(tangent));
+            const glm::vec3 decoded =
+                gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, glm::vec3(n), ray), ray);
+            ASSERT_TRUE(finiteUnit(decoded));
+            ASSERT_FALSE(gbuffer::inNormalErrorBoundRegion(spec, glm::vec3(n), ray) &&
+                         glm::dot(n, towardsCamera) < -1e-6);
+            ASSERT_LE(gbuffer::normalAngleRadians(silhouette, decoded), bound)
+                << spec.text() << " ray (" << ray.x << ", " << ray.y << ", " << ray.z << ")";
+        }
+        // Exactly away from the camera: local +x of the central frame, i.e. view +X.
+        const glm::vec3 away = gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, {0, 0, -1}));
+        EXPECT_EQ(away, glm::vec3(1, 0, 0)) << spec.text();
+    }
+}
+
+// Degenerate rays (zero, subnormal-free zero length, NaN/Inf, parallel to view Y) fall back to
+// the central ray in encode and decode; no ray and no input gives NaN/Inf.
+TEST(NormalCodecPixelView, DegenerateRaysFallBackToTheCentralRay) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    const std::vector<glm::vec3> degenerate = {
+        {0, 0, 0}, {-0.0f, 0, -0.0f}, {nan, 0, -1}, {0, inf, -1}, {0, 0, -inf},
+        {0, 1, 0}, {0, -3, 0},        {0, 1e-30f, 0}};
+    std::vector<glm::vec3> rays = testViewRays();
+    rays.insert(rays.end(), degenerate.begin(), degenerate.end());
+    for (const NormalCodecSpec& spec : pixelViewSpecs()) {
+        for (glm::vec3 input : hardInputs()) {
+            const NormalCode central = gbuffer::encodeNormal(spec, input);
+            for (glm::vec3 ray : degenerate) {
+                EXPECT_EQ(gbuffer::encodeNormal(spec, input, ray), central) << spec.text();
+                EXPECT_EQ(gbuffer::decodeNormal(spec, central, ray),
+                          gbuffer::decodeNormal(spec, central))
+                    << spec.text();
+            }
+            for (glm::vec3 ray : rays) {
+                const glm::vec3 decoded =
+                    gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, input, ray), ray);
+                EXPECT_TRUE(finiteUnit(decoded))
+                    << spec.text() << " input (" << input.x << ", " << input.y << ", "
+                    << input.z << ") ray (" << ray.x << ", " << ray.y << ", " << ray.z << ")";
+            }
+        }
+        SplitMix64 rng{3};
+        for (int i = 0; i < 2000; ++i) {
+            const NormalCode code{rng.next(), 0};
+            for (glm::vec3 ray : {rays[i % rays.size()], degenerate[i % degenerate.size()]})
+                EXPECT_TRUE(finiteUnit(gbuffer::decodeNormal(spec, code, ray))) << spec.text();
         }
     }
 }
