@@ -1,12 +1,14 @@
 // testbed: the command-line front end. Subcommands:
 //   render  one scene, one stage -> render.exr, preview.png, heatmap.png, stats.json
 //   list    scenes, stages and normal encodings known to this build
+//   normals normal-encoding precision study -> normals.csv, normals.json, plots
 // Every option's default is stated by --help; unknown options are errors.
 #include <iostream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "experiments/NormalStudy.h"
 #include "experiments/RenderCommand.h"
 #include "gbuffer/NormalCodec.h"
 #include "lighting/StageRegistry.h"
@@ -63,6 +65,34 @@ int main(int argc, char** argv) {
     CLI::App* render = app.add_subcommand("render", "render one scene with one shading stage");
     addRenderOptions(*render, renderOptions, sceneOptionTexts);
     CLI::App* list = app.add_subcommand("list", "list scenes and stages");
+    experiments::NormalStudyOptions normalsOptions;
+    std::uint64_t normalsDirections = experiments::kNormalStudyDirections;
+    std::string normalsModels = experiments::kNormalStudyModelsDir;
+    CLI::App* normals = app.add_subcommand(
+        "normals", "normal-encoding precision study: every codec x bits -> normals.csv/json, plots");
+    normals->add_option("--out", normalsOptions.out, "output folder")->required();
+    normals->add_option("--directions", normalsDirections, "uniform sphere directions (--quick: 100000)")
+        ->capture_default_str();
+    normals->add_option("--seed", normalsOptions.seed, "seed of every random set")->capture_default_str();
+    normals->add_option("--scene", normalsOptions.scenes, "built-in scene or scene file (repeatable)")
+        ->capture_default_str();
+    normals->add_option("--models", normalsModels,
+                        "folder searched for .gltf/.glb models, skipped with a warning if missing "
+                        "(--quick: none unless given)")
+        ->capture_default_str();
+    normals->add_option("--width", normalsOptions.sceneWidth, "scene render width (--quick: 160)")
+        ->capture_default_str();
+    normals->add_option("--height", normalsOptions.sceneHeight, "scene render height (--quick: 90)")
+        ->capture_default_str();
+    normals->add_option("--threads", normalsOptions.threads, "worker threads, 0 = all hardware threads")
+        ->capture_default_str();
+    normals->add_flag("--quick", normalsOptions.quick,
+                      "10^5 directions, 160x90 atrium, no models, sampled occupancy (seconds)");
+    normals->add_flag("!--no-plots", normalsOptions.plots, "skip the matplotlib plots");
+    normals->add_option("--plots-script", normalsOptions.plotsScript,
+                        "matplotlib script (default: experiments/plots/normals.py of the source tree)");
+    normals->add_option("--python", normalsOptions.python,
+                        "Python with matplotlib (default: python3, else /usr/bin/python3)");
     CLI11_PARSE(app, argc, argv);
     if (render->parsed()) {
         for (const std::string& text : sceneOptionTexts) {
@@ -76,5 +106,10 @@ int main(int argc, char** argv) {
         return experiments::runRenderCommand(renderOptions);
     }
     if (list->parsed()) return listEverything();
+    if (normals->parsed()) {
+        if (normals->count("--directions") > 0) normalsOptions.directions = normalsDirections;
+        if (normals->count("--models") > 0) normalsOptions.modelsDir = normalsModels;
+        return experiments::runNormalStudyCommand(normalsOptions);
+    }
     return 1;
 }

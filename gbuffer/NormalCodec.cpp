@@ -311,8 +311,9 @@ PixelViewFrame pixelViewFrame(glm::vec3 viewRayView) {
         return frame;
     const glm::dvec3 z = -ray / length;
     // x = normalize(z.z, 0, -z.x) is undefined for a ray along the view Y axis. The frame is exact
-    // for any non-zero horizontal part (double has range to spare for float inputs).
-    const double horizontal = std::hypot(z.z, z.x);
+    // for any non-zero horizontal part: z is a unit double vector made from floats, so its squares
+    // neither overflow nor vanish (plain sqrt, not the slower hypot).
+    const double horizontal = std::sqrt(z.z * z.z + z.x * z.x);
     if (!(horizontal > 0.0))
         return frame;
     frame.z = z;
