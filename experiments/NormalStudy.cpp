@@ -68,7 +68,7 @@ constexpr std::size_t kThroughputNormals = std::size_t{1} << 16;
 constexpr std::size_t kThroughputQuickNormals = std::size_t{1} << 10;
 constexpr int kThroughputRepeats = 3;
 // Error maps: equirectangular grid, each cell the max over sub x sub stratified samples.
-constexpr int kMapWidth = 720, kMapHeight = 360, kMapSub = 4;  // 0.5 degree cells
+constexpr int kMapWidth = 720, kMapHeight = 360, kMapSub = 4; // 0.5 degree cells
 constexpr int kQuickMapWidth = 90, kQuickMapHeight = 45, kQuickMapSub = 2;
 constexpr int kQuickSceneWidth = 160, kQuickSceneHeight = 90;
 // Salts separating the datasets' random streams.
@@ -77,7 +77,7 @@ constexpr std::uint64_t kSaltSphere = 1, kSaltVisible = 2, kSaltNegativeZ = 3, k
 
 // --- counter-based random numbers --------------------------------------------------------------
 
-std::uint64_t mix64(std::uint64_t z) {  // SplitMix64's finaliser (Steele et al. 2014)
+std::uint64_t mix64(std::uint64_t z) { // SplitMix64's finaliser (Steele et al. 2014)
     z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     return z ^ (z >> 31);
@@ -87,8 +87,11 @@ std::uint64_t mix64(std::uint64_t z) {  // SplitMix64's finaliser (Steele et al.
 // generation identical to sequential generation.
 struct CounterRng {
     std::uint64_t base;
-    CounterRng(std::uint64_t seed, std::uint64_t salt) : base(mix64(seed ^ (salt * 0xD1B54A32D192ED03ull))) {}
-    std::uint64_t bits(std::uint64_t k) const { return mix64(base + (k + 1) * 0x9E3779B97F4A7C15ull); }
+    CounterRng(std::uint64_t seed, std::uint64_t salt)
+        : base(mix64(seed ^ (salt * 0xD1B54A32D192ED03ull))) {}
+    std::uint64_t bits(std::uint64_t k) const {
+        return mix64(base + (k + 1) * 0x9E3779B97F4A7C15ull);
+    }
     double uniform(std::uint64_t k) const { return static_cast<double>(bits(k) >> 11) * 0x1.0p-53; }
 };
 
@@ -131,11 +134,11 @@ glm::dvec3 randomPixelRay(double u1, double u2, double verticalFovDegrees, doubl
 struct Dataset {
     std::string name;
     std::vector<glm::vec3> normals;
-    std::vector<glm::vec3> rays;  // empty: every sample is seen along kCentralViewRay
+    std::vector<glm::vec3> rays; // empty: every sample is seen along kCentralViewRay
 };
 
 template <typename Fn>
-void forEachChunk(std::uint64_t count, Fn&& fn) {  // fn(chunkIndex, begin, end)
+void forEachChunk(std::uint64_t count, Fn&& fn) { // fn(chunkIndex, begin, end)
     const std::uint64_t chunks = (count + kChunkSamples - 1) / kChunkSamples;
     tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, chunks, 1),
                       [&](const tbb::blocked_range<std::uint64_t>& range) {
@@ -162,8 +165,8 @@ Dataset visibleDataset(std::uint64_t count, std::uint64_t seed) {
             const glm::dvec3 ray = randomPixelRay(rng.uniform(4 * i), rng.uniform(4 * i + 1),
                                                   kVisibleFovDegrees, kVisibleAspect);
             data.rays[i] = glm::vec3(ray);
-            data.normals[i] = glm::vec3(hemisphereAround(-glm::normalize(ray), rng.uniform(4 * i + 2),
-                                                         rng.uniform(4 * i + 3), true));
+            data.normals[i] = glm::vec3(hemisphereAround(
+                -glm::normalize(ray), rng.uniform(4 * i + 2), rng.uniform(4 * i + 3), true));
         }
     });
     return data;
@@ -176,12 +179,14 @@ glm::vec3 unitFloat(double x, double y, double z) {
     return glm::vec3(x / l, y / l, z / l);
 }
 
-}  // namespace
+} // namespace
 
 std::vector<HardNormalCase> hardNormalCases() {
     const glm::vec3 central = gbuffer::kCentralViewRay;
     std::vector<HardNormalCase> cases;
-    auto add = [&](glm::vec3 n, const char* group, glm::vec3 ray) { cases.push_back({n, ray, group}); };
+    auto add = [&](glm::vec3 n, const char* group, glm::vec3 ray) {
+        cases.push_back({n, ray, group});
+    };
     const float sub = std::numeric_limits<float>::denorm_min();
     const float big = std::numeric_limits<float>::max();
     const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -238,7 +243,8 @@ std::vector<HardNormalCase> hardNormalCases() {
                         glm::vec3(0, 0, -sub), glm::vec3(sub, sub, sub), glm::vec3(-sub, sub, -sub),
                         glm::vec3(1e-40f, -1e-40f, 1e-40f), glm::vec3(1e-30f, 2e-30f, -3e-30f)})
         add(n, "subnormal", central);
-    for (glm::vec3 n : {glm::vec3(big, big, big), glm::vec3(-big, 0, big), glm::vec3(1e38f, -1e38f, -1e38f)})
+    for (glm::vec3 n :
+         {glm::vec3(big, big, big), glm::vec3(-big, 0, big), glm::vec3(1e38f, -1e38f, -1e38f)})
         add(n, "huge", central);
     // No direction at all.
     for (glm::vec3 n : {glm::vec3(0, 0, 0), glm::vec3(-0.0f, -0.0f, -0.0f), glm::vec3(0, -0.0f, 0)})
@@ -251,8 +257,9 @@ std::vector<HardNormalCase> hardNormalCases() {
     // and a nearly vertical ray) with a normal facing the ray, grazing it and slightly behind it;
     // degenerate rays (zero, NaN/Inf, along view Y) that must fall back to the central ray.
     const double t = std::tan(kPi / 4.0), a = 16.0 / 9.0;
-    for (glm::dvec3 ray : {glm::dvec3(t * a, t, -1), glm::dvec3(-t * a, t, -1), glm::dvec3(0, -t, -1),
-                           glm::dvec3(t * a, 0, -1), glm::dvec3(1, 0, -1e-3), glm::dvec3(0, 1, -1e-3)}) {
+    for (glm::dvec3 ray :
+         {glm::dvec3(t * a, t, -1), glm::dvec3(-t * a, t, -1), glm::dvec3(0, -t, -1),
+          glm::dvec3(t * a, 0, -1), glm::dvec3(1, 0, -1e-3), glm::dvec3(0, 1, -1e-3)}) {
         const glm::dvec3 towards = -glm::normalize(ray);
         glm::dvec3 u, v;
         basisAround(towards, u, v);
@@ -264,7 +271,8 @@ std::vector<HardNormalCase> hardNormalCases() {
     }
     for (glm::vec3 ray : {glm::vec3(0, 0, 0), glm::vec3(nan, 0, -1), glm::vec3(0, inf, -1),
                           glm::vec3(0, 1, 0), glm::vec3(0, -1e-30f, 0)})
-        for (glm::vec3 n : {glm::vec3(0, 0, 1), unitFloat(0.6, 0.0, 0.8), unitFloat(0.3, -0.4, -0.1)})
+        for (glm::vec3 n :
+             {glm::vec3(0, 0, 1), unitFloat(0.6, 0.0, 0.8), unitFloat(0.3, -0.4, -0.1)})
             add(n, "degenerate-ray", ray);
     return cases;
 }
@@ -282,7 +290,9 @@ Dataset hardDataset() {
 
 // --- evaluation ----------------------------------------------------------------------------------
 
-bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite3(glm::vec3 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 struct ChunkStats {
     std::uint64_t samples = 0, nanInf = 0, region = 0, negative = 0;
@@ -298,9 +308,10 @@ std::string vecText(glm::vec3 v) {
 }
 
 // Errors of one codec on one dataset. `errors` is scratch (reused across codecs).
-NormalStudyRow evaluate(const NormalCodecSpec& spec, const Dataset& data, std::vector<float>& errors) {
+NormalStudyRow evaluate(const NormalCodecSpec& spec, const Dataset& data,
+                        std::vector<float>& errors) {
     const std::uint64_t count = data.normals.size();
-    errors.assign(count, -1.0f);  // -1: no direction (not counted in the percentile)
+    errors.assign(count, -1.0f); // -1: no direction (not counted in the percentile)
     const std::uint64_t chunks = (count + kChunkSamples - 1) / kChunkSamples;
     std::vector<ChunkStats> stats(chunks);
     const bool precise = spec.kind == NormalCodecKind::OctahedralPrecise;
@@ -310,11 +321,12 @@ NormalStudyRow evaluate(const NormalCodecSpec& spec, const Dataset& data, std::v
         for (std::uint64_t i = begin; i < end; ++i) {
             const glm::vec3 n = data.normals[i];
             const glm::vec3 ray = data.rays.empty() ? gbuffer::kCentralViewRay : data.rays[i];
-            const glm::vec3 decoded = gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, n, ray), ray);
+            const glm::vec3 decoded =
+                gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, n, ray), ray);
             const bool finiteOut = finite3(decoded);
             s.nanInf += finiteOut ? 0 : 1;
             if (!finite3(n) || n == glm::vec3(0.0f))
-                continue;  // no direction to compare with
+                continue; // no direction to compare with
             const double error = finiteOut ? gbuffer::normalAngleRadians(n, decoded) : kPi;
             errors[i] = static_cast<float>(error);
             ++s.samples;
@@ -338,7 +350,7 @@ NormalStudyRow evaluate(const NormalCodecSpec& spec, const Dataset& data, std::v
         stats[chunk] = s;
     });
     ChunkStats total;
-    for (const ChunkStats& s : stats) {  // fixed order: deterministic sums
+    for (const ChunkStats& s : stats) { // fixed order: deterministic sums
         total.samples += s.samples;
         total.nanInf += s.nanInf;
         total.region += s.region;
@@ -365,21 +377,23 @@ NormalStudyRow evaluate(const NormalCodecSpec& spec, const Dataset& data, std::v
         row.maxDegrees = total.max * kDegreesPerRadian;
         // Nearest-rank 99.9th percentile over the samples with a direction.
         auto last = std::remove_if(errors.begin(), errors.end(), [](float e) { return e < 0.0f; });
-        const std::size_t rank =
-            static_cast<std::size_t>(std::ceil(0.999 * n)) - 1;
+        const std::size_t rank = static_cast<std::size_t>(std::ceil(0.999 * n)) - 1;
         std::nth_element(errors.begin(), errors.begin() + rank, last);
         row.p999Degrees = static_cast<double>(errors[rank]) * kDegreesPerRadian;
     }
-    row.boundDegrees = (gbuffer::normalErrorBoundRadians(spec) + gbuffer::kNormalFloatSlackRadians) *
-                       kDegreesPerRadian;
+    row.boundDegrees =
+        (gbuffer::normalErrorBoundRadians(spec) + gbuffer::kNormalFloatSlackRadians) *
+        kDegreesPerRadian;
     row.boundRegionSamples = total.region;
     row.maxInBoundRegionDegrees = total.regionMax * kDegreesPerRadian;
     row.negativeZSamples = total.negative;
     if (total.negative > 0) {
-        row.meanNegativeZDegrees = total.negativeSum / static_cast<double>(total.negative) * kDegreesPerRadian;
+        row.meanNegativeZDegrees =
+            total.negativeSum / static_cast<double>(total.negative) * kDegreesPerRadian;
         row.maxNegativeZDegrees = total.negativeMax * kDegreesPerRadian;
     }
-    if (precise) row.worseThanOctahedral = total.worse;
+    if (precise)
+        row.worseThanOctahedral = total.worse;
     return row;
 }
 
@@ -391,7 +405,8 @@ struct Occupancy {
 };
 
 NormalCode codeFromBits(const NormalCodecSpec& spec, std::uint64_t low, std::uint64_t high) {
-    if (spec.bits >= 64) return {low, spec.bits > 64 ? static_cast<std::uint32_t>(high) : 0u};
+    if (spec.bits >= 64)
+        return {low, spec.bits > 64 ? static_cast<std::uint32_t>(high) : 0u};
     return {low & ((std::uint64_t{1} << spec.bits) - 1), 0u};
 }
 
@@ -406,20 +421,22 @@ Occupancy measureOccupancy(const NormalCodecSpec& spec, bool quick, std::uint64_
     forEachChunk(count, [&](std::uint64_t chunk, std::uint64_t begin, std::uint64_t end) {
         std::uint64_t fixed = 0;
         for (std::uint64_t i = begin; i < end; ++i) {
-            const NormalCode code = exhaustive ? codeFromBits(spec, i, 0)
-                                               : codeFromBits(spec, rng.bits(2 * i), rng.bits(2 * i + 1));
+            const NormalCode code = exhaustive
+                                        ? codeFromBits(spec, i, 0)
+                                        : codeFromBits(spec, rng.bits(2 * i), rng.bits(2 * i + 1));
             fixed += gbuffer::encodeNormal(spec, gbuffer::decodeNormal(spec, code)) == code ? 1 : 0;
         }
         fixedPerChunk[chunk] = fixed;
     });
     std::uint64_t fixed = 0;
-    for (std::uint64_t f : fixedPerChunk) fixed += f;
+    for (std::uint64_t f : fixedPerChunk)
+        fixed += f;
     return {static_cast<double>(fixed) / static_cast<double>(count), count};
 }
 
 // Normals per second on the calling thread, SoA arrays, best of kThroughputRepeats.
-void measureThroughput(const NormalCodecSpec& spec, std::size_t count, int repeats, std::uint64_t seed,
-                       double& encodePerSecond, double& decodePerSecond) {
+void measureThroughput(const NormalCodecSpec& spec, std::size_t count, int repeats,
+                       std::uint64_t seed, double& encodePerSecond, double& decodePerSecond) {
     std::vector<float> nx(count), ny(count), nz(count), rx(count), ry(count), rz(count);
     std::vector<float> ox(count), oy(count), oz(count);
     std::vector<std::uint64_t> low(count);
@@ -437,17 +454,21 @@ void measureThroughput(const NormalCodecSpec& spec, std::size_t count, int repea
     for (int r = 0; r < repeats; ++r) {
         auto start = Clock::now();
         for (std::size_t i = 0; i < count; ++i) {
-            const NormalCode code = gbuffer::encodeNormal(spec, {nx[i], ny[i], nz[i]}, {rx[i], ry[i], rz[i]});
+            const NormalCode code =
+                gbuffer::encodeNormal(spec, {nx[i], ny[i], nz[i]}, {rx[i], ry[i], rz[i]});
             low[i] = code.low;
             high[i] = code.high;
         }
-        bestEncode = std::min(bestEncode, std::chrono::duration<double>(Clock::now() - start).count());
+        bestEncode =
+            std::min(bestEncode, std::chrono::duration<double>(Clock::now() - start).count());
         start = Clock::now();
         for (std::size_t i = 0; i < count; ++i) {
-            const glm::vec3 n = gbuffer::decodeNormal(spec, {low[i], high[i]}, {rx[i], ry[i], rz[i]});
+            const glm::vec3 n =
+                gbuffer::decodeNormal(spec, {low[i], high[i]}, {rx[i], ry[i], rz[i]});
             ox[i] = n.x, oy[i] = n.y, oz[i] = n.z;
         }
-        bestDecode = std::min(bestDecode, std::chrono::duration<double>(Clock::now() - start).count());
+        bestDecode =
+            std::min(bestDecode, std::chrono::duration<double>(Clock::now() - start).count());
     }
     // The outputs are read once so the loops cannot be dropped.
     volatile float sink = ox[count / 2] + oy[count / 3] + oz[count - 1];
@@ -456,7 +477,7 @@ void measureThroughput(const NormalCodecSpec& spec, std::size_t count, int repea
     decodePerSecond = static_cast<double>(count) / std::max(bestDecode, 1e-9);
 }
 
-int mapBits(NormalCodecKind kind) {  // the depth each codec's error map is drawn at
+int mapBits(NormalCodecKind kind) { // the depth each codec's error map is drawn at
     const std::vector<int> bits = gbuffer::supportedBits(kind);
     return std::find(bits.begin(), bits.end(), 16) != bits.end() ? 16 : bits.front();
 }
@@ -474,8 +495,10 @@ std::vector<float> errorMap(const NormalCodecSpec& spec, int width, int height, 
                     const double lat = 0.5 * kPi - kPi * (y + (sy + 0.5) / sub) / height;
                     const glm::vec3 n(glm::dvec3(std::cos(lat) * std::cos(lon),
                                                  std::cos(lat) * std::sin(lon), std::sin(lat)));
-                    const glm::vec3 decoded = gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, n));
-                    worst = std::max(worst, finite3(decoded) ? gbuffer::normalAngleRadians(n, decoded) : kPi);
+                    const glm::vec3 decoded =
+                        gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, n));
+                    worst = std::max(
+                        worst, finite3(decoded) ? gbuffer::normalAngleRadians(n, decoded) : kPi);
                 }
             map[std::size_t(y) * width + x] = static_cast<float>(worst * kDegreesPerRadian);
         }
@@ -483,24 +506,31 @@ std::vector<float> errorMap(const NormalCodecSpec& spec, int width, int height, 
     return map;
 }
 
-// --- visible negative-z fractions ------------------------------------------------------------------
+// --- visible negative-z fractions
+// ------------------------------------------------------------------
 
 NegativeZFraction negativeZFraction(double fovDegrees, double aspect, std::uint64_t count,
                                     std::uint64_t seed) {
     const CounterRng rng(seed, kSaltNegativeZ);
-    std::vector<std::pair<std::uint64_t, std::uint64_t>> perChunk((count + kChunkSamples - 1) / kChunkSamples);
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> perChunk((count + kChunkSamples - 1) /
+                                                                  kChunkSamples);
     forEachChunk(count, [&](std::uint64_t chunk, std::uint64_t begin, std::uint64_t end) {
         std::uint64_t uniform = 0, weighted = 0;
         for (std::uint64_t i = begin; i < end; ++i) {
             const glm::dvec3 towards = -glm::normalize(
                 randomPixelRay(rng.uniform(6 * i), rng.uniform(6 * i + 1), fovDegrees, aspect));
-            uniform += hemisphereAround(towards, rng.uniform(6 * i + 2), rng.uniform(6 * i + 3), false).z < 0.0;
-            weighted += hemisphereAround(towards, rng.uniform(6 * i + 4), rng.uniform(6 * i + 5), true).z < 0.0;
+            uniform +=
+                hemisphereAround(towards, rng.uniform(6 * i + 2), rng.uniform(6 * i + 3), false).z <
+                0.0;
+            weighted +=
+                hemisphereAround(towards, rng.uniform(6 * i + 4), rng.uniform(6 * i + 5), true).z <
+                0.0;
         }
         perChunk[chunk] = {uniform, weighted};
     });
     std::uint64_t uniform = 0, weighted = 0;
-    for (const auto& [u, w] : perChunk) uniform += u, weighted += w;
+    for (const auto& [u, w] : perChunk)
+        uniform += u, weighted += w;
     NegativeZFraction result{fovDegrees, aspect, double(uniform) / double(count),
                              double(weighted) / double(count)};
     // Closed forms per ray, a = angle between the ray and -Z: the front-facing hemisphere (pole
@@ -511,8 +541,9 @@ NegativeZFraction negativeZFraction(double fovDegrees, double aspect, std::uint6
     double uniformSum = 0.0, weightedSum = 0.0;
     for (int y = 0; y < kGrid; ++y)
         for (int x = 0; x < kGrid; ++x) {
-            const glm::dvec3 ray = randomPixelRay((x + 0.5) / kGrid, (y + 0.5) / kGrid, fovDegrees, aspect);
-            const double cosA = 1.0 / glm::length(ray);  // ray.z = -1
+            const glm::dvec3 ray =
+                randomPixelRay((x + 0.5) / kGrid, (y + 0.5) / kGrid, fovDegrees, aspect);
+            const double cosA = 1.0 / glm::length(ray); // ray.z = -1
             uniformSum += std::acos(cosA) / kPi;
             weightedSum += 0.5 * (1.0 - cosA);
         }
@@ -525,9 +556,10 @@ NegativeZFraction negativeZFraction(double fovDegrees, double aspect, std::uint6
 
 Dataset sceneDataset(const std::string& source, const std::string& label, int width, int height,
                      NormalStudyScene& info, std::vector<std::string>& warnings) {
-    scenes::SceneRequest request;  // no generated lights: only the geometry matters here
+    scenes::SceneRequest request; // no generated lights: only the geometry matters here
     scenes::Scene scene = scenes::loadScene(source, request);
-    for (const std::string& warning : scene.warnings) warnings.push_back(label + ": " + warning);
+    for (const std::string& warning : scene.warnings)
+        warnings.push_back(label + ": " + warning);
     lighting::PreparedFrame prepared(std::move(scene), width, height);
     const gbuffer::GBuffer& gb = *prepared.gbuffer;
     const gbuffer::FrameView& view = prepared.view;
@@ -535,7 +567,8 @@ Dataset sceneDataset(const std::string& source, const std::string& label, int wi
     std::uint64_t negative = 0, backFacing = 0;
     for (int y = 0; y < gb.height(); ++y)
         for (int x = 0; x < gb.width(); ++x) {
-            if (!gb.covered(std::size_t(y) * gb.width() + x)) continue;
+            if (!gb.covered(std::size_t(y) * gb.width() + x))
+                continue;
             const glm::vec3 n = gb.decode(x, y).normalView;
             const glm::vec3 ray = gbuffer::viewRayOfNdc(view, view.ndcOfPixel(x, y));
             data.normals.push_back(n);
@@ -558,7 +591,8 @@ std::vector<std::filesystem::path> findModels(const std::filesystem::path& dir) 
     std::vector<std::filesystem::path> models;
     for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
         const std::string ext = entry.path().extension().string();
-        if (entry.is_regular_file() && (ext == ".gltf" || ext == ".glb")) models.push_back(entry.path());
+        if (entry.is_regular_file() && (ext == ".gltf" || ext == ".glb"))
+            models.push_back(entry.path());
     }
     std::sort(models.begin(), models.end());
     return models;
@@ -598,14 +632,16 @@ std::string csvText(const std::vector<NormalStudyRow>& rows) {
     csv << "codec,name,bits,dataset,samples,nan_inf_outputs,mean_deg,rms_deg,p999_deg,max_deg,"
            "bound_deg,bound_region_samples,max_in_bound_region_deg,within_bound,negative_z_samples,"
            "mean_negative_z_deg,max_negative_z_deg,worse_than_octahedral,zero_vector_decodes_to,"
-           "occupancy,occupancy_codes_tested,encode_per_s_1thread_study,decode_per_s_1thread_study\n";
+           "occupancy,occupancy_codes_tested,encode_per_s_1thread_study,decode_per_s_1thread_"
+           "study\n";
     for (const NormalStudyRow& r : rows)
-        csv << r.codec << "," << r.name << "," << r.bits << "," << r.dataset << "," << r.samples << ","
-            << r.nanInfOutputs << "," << r.meanDegrees << "," << r.rmsDegrees << "," << r.p999Degrees
-            << "," << r.maxDegrees << "," << r.boundDegrees << "," << r.boundRegionSamples << ","
-            << r.maxInBoundRegionDegrees << "," << (r.withinBound() ? "true" : "false") << ","
-            << r.negativeZSamples << "," << r.meanNegativeZDegrees << "," << r.maxNegativeZDegrees
-            << "," << r.worseThanOctahedral << ",\"" << r.zeroVectorDecodesTo << "\"," << r.occupancy
+        csv << r.codec << "," << r.name << "," << r.bits << "," << r.dataset << "," << r.samples
+            << "," << r.nanInfOutputs << "," << r.meanDegrees << "," << r.rmsDegrees << ","
+            << r.p999Degrees << "," << r.maxDegrees << "," << r.boundDegrees << ","
+            << r.boundRegionSamples << "," << r.maxInBoundRegionDegrees << ","
+            << (r.withinBound() ? "true" : "false") << "," << r.negativeZSamples << ","
+            << r.meanNegativeZDegrees << "," << r.maxNegativeZDegrees << ","
+            << r.worseThanOctahedral << ",\"" << r.zeroVectorDecodesTo << "\"," << r.occupancy
             << "," << r.occupancyCodesTested << "," << r.encodePerSecond << "," << r.decodePerSecond
             << "\n";
     return csv.str();
@@ -616,7 +652,8 @@ void writeFloats(const std::filesystem::path& path, const std::vector<float>& va
         std::ofstream file(temp, std::ios::binary);
         file.write(reinterpret_cast<const char*>(values.data()),
                    static_cast<std::streamsize>(values.size() * sizeof(float)));
-        if (!file) throw std::runtime_error("cannot write " + temp.string());
+        if (!file)
+            throw std::runtime_error("cannot write " + temp.string());
     });
 }
 
@@ -627,38 +664,46 @@ bool pythonHasMatplotlib(const std::string& python) {
 
 int runProcess(const std::vector<std::string>& args) {
     std::vector<char*> argv;
-    for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+    for (const std::string& arg : args)
+        argv.push_back(const_cast<char*>(arg.c_str()));
     argv.push_back(nullptr);
     pid_t pid = 0;
-    if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+    if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0)
+        return -1;
     int status = 0;
-    if (waitpid(pid, &status, 0) != pid) return -1;
+    if (waitpid(pid, &status, 0) != pid)
+        return -1;
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-}  // namespace
+} // namespace
 
 std::string findPlotPython(const std::string& requested) {
-    if (!requested.empty()) return pythonHasMatplotlib(requested) ? requested : "";
+    if (!requested.empty())
+        return pythonHasMatplotlib(requested) ? requested : "";
     for (const char* candidate : {"python3", "/usr/bin/python3"})
-        if (pythonHasMatplotlib(candidate)) return candidate;
+        if (pythonHasMatplotlib(candidate))
+            return candidate;
     return "";
 }
 
 NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
                                  const std::function<void(const std::string&)>& progress) {
     auto step = [&](const std::string& what) {
-        if (progress) progress(what);
+        if (progress)
+            progress(what);
     };
     // Validate everything before any work.
-    if (options.out.empty()) throw std::invalid_argument("--out: an output folder is required");
-    const std::uint64_t directions =
-        options.directions.value_or(options.quick ? kNormalStudyQuickDirections : kNormalStudyDirections);
+    if (options.out.empty())
+        throw std::invalid_argument("--out: an output folder is required");
+    const std::uint64_t directions = options.directions.value_or(
+        options.quick ? kNormalStudyQuickDirections : kNormalStudyDirections);
     if (directions < 1000 || directions > 1'000'000'000)
         throw std::invalid_argument("--directions " + std::to_string(directions) +
                                     ": expected 1000 .. 1000000000");
     if (options.threads < 0 || options.threads > 1024)
-        throw std::invalid_argument("--threads " + std::to_string(options.threads) + ": expected 0 .. 1024");
+        throw std::invalid_argument("--threads " + std::to_string(options.threads) +
+                                    ": expected 0 .. 1024");
     const int sceneWidth = options.quick ? kQuickSceneWidth : options.sceneWidth;
     const int sceneHeight = options.quick ? kQuickSceneHeight : options.sceneHeight;
     if (sceneWidth < 1 || sceneHeight < 1 || sceneWidth > 8192 || sceneHeight > 8192)
@@ -667,13 +712,14 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
     for (const std::string& scene : options.scenes)
         if (!scenes::isProceduralScene(scene) && !std::filesystem::is_regular_file(scene)) {
             std::string names;
-            for (const std::string& name : scenes::proceduralSceneNames()) names += " " + name;
-            throw std::invalid_argument("--scene '" + scene + "': not a built-in scene (" + names.substr(1) +
-                                        ") and no such file");
+            for (const std::string& name : scenes::proceduralSceneNames())
+                names += " " + name;
+            throw std::invalid_argument("--scene '" + scene + "': not a built-in scene (" +
+                                        names.substr(1) + ") and no such file");
         }
-    std::string plotsScript = options.plotsScript.empty()
-                                  ? std::string(TESTBED_SOURCE_DIR) + "/experiments/plots/normals.py"
-                                  : options.plotsScript;
+    std::string plotsScript = options.plotsScript.empty() ? std::string(TESTBED_SOURCE_DIR) +
+                                                                "/experiments/plots/normals.py"
+                                                          : options.plotsScript;
     if (options.plots && !std::filesystem::is_regular_file(plotsScript))
         throw std::invalid_argument("--plots-script '" + plotsScript + "': no such file");
     ensureWritableDirectory(options.out);
@@ -694,9 +740,11 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
     if (options.modelsDir || !options.quick) {
         modelsDir = options.modelsDir.value_or(kNormalStudyModelsDir);
         if (std::filesystem::is_directory(modelsDir)) {
-            for (const std::filesystem::path& model : findModels(modelsDir)) modelSources.push_back(model.string());
+            for (const std::filesystem::path& model : findModels(modelsDir))
+                modelSources.push_back(model.string());
         } else {
-            result.warnings.push_back("models folder " + modelsDir.string() + " not found: no glTF models studied");
+            result.warnings.push_back("models folder " + modelsDir.string() +
+                                      " not found: no glTF models studied");
         }
     }
 
@@ -706,7 +754,8 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
     arena.execute([&] {
         std::vector<float> errors;
         auto addDataset = [&](const Dataset& data) {
-            for (std::size_t s = 0; s < specs.size(); ++s) rowsBySpec[s].push_back(evaluate(specs[s], data, errors));
+            for (std::size_t s = 0; s < specs.size(); ++s)
+                rowsBySpec[s].push_back(evaluate(specs[s], data, errors));
         };
         timed("sphere", [&] {
             step("sphere: " + std::to_string(directions) + " uniform directions x " +
@@ -718,14 +767,18 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
             addDataset(visibleDataset(directions, options.seed));
         });
         timed("scenes", [&] {
-            std::vector<std::pair<std::string, std::string>> sources;  // source, label
+            std::vector<std::pair<std::string, std::string>> sources; // source, label
             for (const std::string& s : options.scenes)
-                sources.emplace_back(s, scenes::isProceduralScene(s) ? s : std::filesystem::path(s).stem().string());
-            for (const std::string& s : modelSources) sources.emplace_back(s, std::filesystem::path(s).stem().string());
+                sources.emplace_back(
+                    s, scenes::isProceduralScene(s) ? s : std::filesystem::path(s).stem().string());
+            for (const std::string& s : modelSources)
+                sources.emplace_back(s, std::filesystem::path(s).stem().string());
             for (const auto& [source, label] : sources) {
-                step("scene " + label + " at " + std::to_string(sceneWidth) + "x" + std::to_string(sceneHeight));
+                step("scene " + label + " at " + std::to_string(sceneWidth) + "x" +
+                     std::to_string(sceneHeight));
                 NormalStudyScene info;
-                const Dataset data = sceneDataset(source, label, sceneWidth, sceneHeight, info, result.warnings);
+                const Dataset data =
+                    sceneDataset(source, label, sceneWidth, sceneHeight, info, result.warnings);
                 result.scenes.push_back(info);
                 addDataset(data);
             }
@@ -735,7 +788,8 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
             const Dataset hard = hardDataset();
             for (std::size_t s = 0; s < specs.size(); ++s) {
                 NormalStudyRow row = evaluate(specs[s], hard, errors);
-                row.zeroVectorDecodesTo = vecText(gbuffer::decodeNormal(specs[s], gbuffer::encodeNormal(specs[s], glm::vec3(0.0f))));
+                row.zeroVectorDecodesTo = vecText(gbuffer::decodeNormal(
+                    specs[s], gbuffer::encodeNormal(specs[s], glm::vec3(0.0f))));
                 rowsBySpec[s].push_back(row);
             }
         });
@@ -743,7 +797,8 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
             step("negative view-space z fractions at 45/60/90 degrees");
             for (double fov : {45.0, 60.0, 90.0})
                 for (double aspect : {16.0 / 9.0, 1.0})
-                    result.negativeZ.push_back(negativeZFraction(fov, aspect, directions, options.seed));
+                    result.negativeZ.push_back(
+                        negativeZFraction(fov, aspect, directions, options.seed));
         });
         timed("occupancy", [&] {
             step("occupancy (encode(decode(code)) == code)");
@@ -761,7 +816,8 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
             const int h = options.quick ? kQuickMapHeight : kMapHeight;
             const int sub = options.quick ? kQuickMapSub : kMapSub;
             for (const NormalCodecSpec& spec : specs) {
-                if (spec.bits != mapBits(spec.kind)) continue;
+                if (spec.bits != mapBits(spec.kind))
+                    continue;
                 const std::string stem = std::string(gbuffer::normalCodecName(spec.kind)) + "-" +
                                          std::to_string(spec.bits);
                 const std::vector<float> grid = errorMap(spec, w, h, sub);
@@ -799,29 +855,35 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
     json["study"] = "normals";
     json["commit"] = TESTBED_COMMIT;
     json["hardware_threads"] = std::thread::hardware_concurrency();
-    json["config"] = {{"directions", directions},
-                      {"seed", options.seed},
-                      {"scenes", options.scenes},
-                      {"models_dir", modelsDir.string()},
-                      {"models", modelSources},
-                      {"scene_width", sceneWidth},
-                      {"scene_height", sceneHeight},
-                      {"threads", threads},
-                      {"quick", options.quick},
-                      {"visible_fov_deg", kVisibleFovDegrees},
-                      {"visible_aspect", kVisibleAspect},
-                      {"throughput_normals", options.quick ? kThroughputQuickNormals : kThroughputNormals},
-                      {"occupancy_exhaustive_max_bits", options.quick ? 16 : kOccupancyExhaustiveBits}};
+    json["config"] = {
+        {"directions", directions},
+        {"seed", options.seed},
+        {"scenes", options.scenes},
+        {"models_dir", modelsDir.string()},
+        {"models", modelSources},
+        {"scene_width", sceneWidth},
+        {"scene_height", sceneHeight},
+        {"threads", threads},
+        {"quick", options.quick},
+        {"visible_fov_deg", kVisibleFovDegrees},
+        {"visible_aspect", kVisibleAspect},
+        {"throughput_normals", options.quick ? kThroughputQuickNormals : kThroughputNormals},
+        {"occupancy_exhaustive_max_bits", options.quick ? 16 : kOccupancyExhaustiveBits}};
     json["datasets"] = {
         {"sphere", "directions uniform on the sphere, central view ray"},
-        {"visible-60", "front-facing normals weighted by projected area (cosine around -ray) for a "
-                       "uniformly random pixel of a 60 deg vertical FOV 16:9 camera; pixel-view gets the ray"},
-        {"scene:NAME", "view-space normals of the covered pixels of a render of NAME (first camera), with "
-                       "each pixel's view ray"},
-        {"hard", "hardNormalCases(): axes, -Z and poles, octahedral edges, one zero component, back "
-                 "faces, near-unit, subnormal, huge, zero and non-finite inputs, off-axis and degenerate rays"}};
+        {"visible-60",
+         "front-facing normals weighted by projected area (cosine around -ray) for a "
+         "uniformly random pixel of a 60 deg vertical FOV 16:9 camera; pixel-view gets the ray"},
+        {"scene:NAME",
+         "view-space normals of the covered pixels of a render of NAME (first camera), with "
+         "each pixel's view ray"},
+        {"hard",
+         "hardNormalCases(): axes, -Z and poles, octahedral edges, one zero component, back "
+         "faces, near-unit, subnormal, huge, zero and non-finite inputs, off-axis and degenerate "
+         "rays"}};
     json["rows"] = nlohmann::json::array();
-    for (const NormalStudyRow& row : result.rows) json["rows"].push_back(rowJson(row));
+    for (const NormalStudyRow& row : result.rows)
+        json["rows"].push_back(rowJson(row));
     json["scenes"] = nlohmann::json::array();
     for (const NormalStudyScene& scene : result.scenes)
         json["scenes"].push_back({{"dataset", scene.dataset},
@@ -861,8 +923,9 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
                 "normals.csv and normals.json were written to " + options.out.string());
         const int status = runProcess({python, plotsScript, "--out", options.out.string()});
         if (status != 0)
-            throw std::runtime_error("plots: " + python + " " + plotsScript + " --out " + options.out.string() +
-                                     " failed with exit status " + std::to_string(status) +
+            throw std::runtime_error("plots: " + python + " " + plotsScript + " --out " +
+                                     options.out.string() + " failed with exit status " +
+                                     std::to_string(status) +
                                      "; normals.csv and normals.json were written");
     }
     return result;
@@ -873,43 +936,50 @@ namespace {
 void printSummary(const NormalStudyResult& result, std::ostream& out) {
     auto find = [&](const std::string& codec, const std::string& dataset) -> const NormalStudyRow* {
         for (const NormalStudyRow& row : result.rows)
-            if (row.codec == codec && row.dataset == dataset) return &row;
+            if (row.codec == codec && row.dataset == dataset)
+                return &row;
         return nullptr;
     };
-    out << "angular error in degrees; sphere = uniform directions, visible-60 = normals a 60 deg FOV "
+    out << "angular error in degrees; sphere = uniform directions, visible-60 = normals a 60 deg "
+           "FOV "
            "camera sees\n";
     char line[400];
-    std::snprintf(line, sizeof line, "%-24s | %9s %9s %9s | %9s %9s | %9s %5s | %8s | %7s %7s | %s\n",
-                  "codec", "mean", "p99.9", "max", "vis.mean", "vis.max", "bound", "ok", "occupied",
-                  "enc M/s", "dec M/s", "hard: NaN, max finite");
+    std::snprintf(line, sizeof line,
+                  "%-24s | %9s %9s %9s | %9s %9s | %9s %5s | %8s | %7s %7s | %s\n", "codec", "mean",
+                  "p99.9", "max", "vis.mean", "vis.max", "bound", "ok", "occupied", "enc M/s",
+                  "dec M/s", "hard: NaN, max finite");
     out << line;
     std::vector<std::string> seen;
     for (const NormalStudyRow& row : result.rows) {
-        if (std::find(seen.begin(), seen.end(), row.codec) != seen.end()) continue;
+        if (std::find(seen.begin(), seen.end(), row.codec) != seen.end())
+            continue;
         seen.push_back(row.codec);
         const NormalStudyRow* sphere = find(row.codec, "sphere");
         const NormalStudyRow* visible = find(row.codec, "visible-60");
         const NormalStudyRow* hard = find(row.codec, "hard");
-        if (!sphere || !visible || !hard) continue;
+        if (!sphere || !visible || !hard)
+            continue;
         // "ok": the measured max inside the bound region is within the derived bound on sphere
         // and visible-60.
         const bool ok = sphere->withinBound() && visible->withinBound();
         std::snprintf(line, sizeof line,
-                      "%-24s | %9.5f %9.5f %9.5f | %9.5f %9.5f | %9.5f %5s | %7.3f%% | %7.1f %7.1f | %llu, %.3g\n",
-                      row.codec.c_str(), sphere->meanDegrees, sphere->p999Degrees, sphere->maxDegrees,
-                      visible->meanDegrees, visible->maxDegrees, sphere->boundDegrees, ok ? "yes" : "NO",
-                      100.0 * sphere->occupancy, sphere->encodePerSecond * 1e-6,
-                      sphere->decodePerSecond * 1e-6, static_cast<unsigned long long>(hard->nanInfOutputs),
-                      hard->maxDegrees);
+                      "%-24s | %9.5f %9.5f %9.5f | %9.5f %9.5f | %9.5f %5s | %7.3f%% | %7.1f %7.1f "
+                      "| %llu, %.3g\n",
+                      row.codec.c_str(), sphere->meanDegrees, sphere->p999Degrees,
+                      sphere->maxDegrees, visible->meanDegrees, visible->maxDegrees,
+                      sphere->boundDegrees, ok ? "yes" : "NO", 100.0 * sphere->occupancy,
+                      sphere->encodePerSecond * 1e-6, sphere->decodePerSecond * 1e-6,
+                      static_cast<unsigned long long>(hard->nanInfOutputs), hard->maxDegrees);
         out << line;
     }
-    out << "(bound = derived max error incl. float slack, checked inside each codec's bound region; "
+    out << "(bound = derived max error incl. float slack, checked inside each codec's bound "
+           "region; "
            "enc/dec M/s = one thread, wall clock of this run)\n\n";
     out << "rendered scenes: visible normals with view-space z < 0 and what xy-z does there\n";
     for (const NormalStudyScene& scene : result.scenes) {
-        std::snprintf(line, sizeof line, "  %-22s %8llu px  z<0: %6.3f%%  back-facing: %6.3f%%", scene.dataset.c_str(),
-                      static_cast<unsigned long long>(scene.coveredPixels), 100.0 * scene.negativeZFraction,
-                      100.0 * scene.backFacingFraction);
+        std::snprintf(line, sizeof line, "  %-22s %8llu px  z<0: %6.3f%%  back-facing: %6.3f%%",
+                      scene.dataset.c_str(), static_cast<unsigned long long>(scene.coveredPixels),
+                      100.0 * scene.negativeZFraction, 100.0 * scene.backFacingFraction);
         out << line;
         for (const char* codec : {"xy-z:32", "pixel-view:32"})
             if (const NormalStudyRow* row = find(codec, scene.dataset)) {
@@ -922,16 +992,17 @@ void printSummary(const NormalStudyResult& result, std::ostream& out) {
     out << "\nfraction of visible surface orientations with view-space z < 0 (random pixel, "
            "front-facing orientation)\n";
     for (const NegativeZFraction& f : result.negativeZ) {
-        std::snprintf(line, sizeof line,
-                      "  vertical FOV %4.0f deg, aspect %5.3f: area-weighted %6.3f%% (exact %6.3f%%), "
-                      "uniform %6.3f%% (exact %6.3f%%)\n",
-                      f.verticalFovDegrees, f.aspect, 100.0 * f.areaWeightedFraction,
-                      100.0 * f.areaWeightedExact, 100.0 * f.uniformFraction, 100.0 * f.uniformExact);
+        std::snprintf(
+            line, sizeof line,
+            "  vertical FOV %4.0f deg, aspect %5.3f: area-weighted %6.3f%% (exact %6.3f%%), "
+            "uniform %6.3f%% (exact %6.3f%%)\n",
+            f.verticalFovDegrees, f.aspect, 100.0 * f.areaWeightedFraction,
+            100.0 * f.areaWeightedExact, 100.0 * f.uniformFraction, 100.0 * f.uniformExact);
         out << line;
     }
 }
 
-}  // namespace
+} // namespace
 
 int runNormalStudyCommand(const NormalStudyOptions& options) {
     const auto start = Clock::now();
@@ -941,7 +1012,8 @@ int runNormalStudyCommand(const NormalStudyOptions& options) {
     };
     try {
         const NormalStudyResult result = runNormalStudy(options, progress);
-        for (const std::string& warning : result.warnings) std::cerr << "testbed normals: warning: " << warning << "\n";
+        for (const std::string& warning : result.warnings)
+            std::cerr << "testbed normals: warning: " << warning << "\n";
         printSummary(result, std::cout);
         std::cout << "outputs in " << std::filesystem::absolute(options.out).string() << "\n";
         return 0;
@@ -951,4 +1023,4 @@ int runNormalStudyCommand(const NormalStudyOptions& options) {
     }
 }
 
-}  // namespace experiments
+} // namespace experiments

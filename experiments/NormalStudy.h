@@ -43,18 +43,18 @@ inline constexpr const char* kNormalStudyModelsDir = "../shared/scenes/gltf";
 
 // Every option of `testbed normals`, defaults in one place (--help prints them).
 struct NormalStudyOptions {
-    std::filesystem::path out;                   // required
-    std::optional<std::uint64_t> directions;     // unset: kNormalStudyDirections (quick: 10^5)
+    std::filesystem::path out;               // required
+    std::optional<std::uint64_t> directions; // unset: kNormalStudyDirections (quick: 10^5)
     std::uint64_t seed = 1;
     std::vector<std::string> scenes = {"atrium"}; // built-in names or scene files
-    std::optional<std::string> modelsDir;  // unset: kNormalStudyModelsDir (quick: no models)
-    int sceneWidth = 1280;                 // quick: 160 x 90
+    std::optional<std::string> modelsDir;         // unset: kNormalStudyModelsDir (quick: no models)
+    int sceneWidth = 1280;                        // quick: 160 x 90
     int sceneHeight = 720;
-    int threads = 0;                       // 0 = every hardware thread
-    bool quick = false;                    // small sizes for tests, see above
-    bool plots = true;                     // run the matplotlib script
-    std::string plotsScript;               // "" = <source dir>/experiments/plots/normals.py
-    std::string python;                    // "" = first of python3, /usr/bin/python3 with matplotlib
+    int threads = 0;         // 0 = every hardware thread
+    bool quick = false;      // small sizes for tests, see above
+    bool plots = true;       // run the matplotlib script
+    std::string plotsScript; // "" = <source dir>/experiments/plots/normals.py
+    std::string python;      // "" = first of python3, /usr/bin/python3 with matplotlib
 };
 
 // One hard input: a normal, the view ray it is seen along (pixel-view reads it) and its group.
@@ -68,31 +68,31 @@ std::vector<HardNormalCase> hardNormalCases();
 
 // Summary statistics of one codec x bits x dataset.
 struct NormalStudyRow {
-    std::string codec;  // spec text "NAME:BITS"
+    std::string codec; // spec text "NAME:BITS"
     std::string name;
     int bits = 0;
     std::string dataset;
-    std::uint64_t samples = 0;        // inputs with a direction (finite, non-zero)
-    std::uint64_t nanInfOutputs = 0;  // decoded vectors with a NaN/Inf component, over all inputs
+    std::uint64_t samples = 0;       // inputs with a direction (finite, non-zero)
+    std::uint64_t nanInfOutputs = 0; // decoded vectors with a NaN/Inf component, over all inputs
     double meanDegrees = 0.0, rmsDegrees = 0.0, p999Degrees = 0.0, maxDegrees = 0.0;
-    double boundDegrees = 0.0;                 // normalErrorBoundRadians + float slack
-    std::uint64_t boundRegionSamples = 0;      // samples inside inNormalErrorBoundRegion
+    double boundDegrees = 0.0;            // normalErrorBoundRadians + float slack
+    std::uint64_t boundRegionSamples = 0; // samples inside inNormalErrorBoundRegion
     double maxInBoundRegionDegrees = 0.0;
-    std::uint64_t negativeZSamples = 0;        // samples with view-space z < 0
+    std::uint64_t negativeZSamples = 0; // samples with view-space z < 0
     double meanNegativeZDegrees = 0.0, maxNegativeZDegrees = 0.0;
-    std::int64_t worseThanOctahedral = -1;     // octahedral-precise: inputs where plain wins
-    std::string zeroVectorDecodesTo;           // hard: what (0,0,0) decodes to
+    std::int64_t worseThanOctahedral = -1; // octahedral-precise: inputs where plain wins
+    std::string zeroVectorDecodesTo;       // hard: what (0,0,0) decodes to
     // Per codec x bits (the same on each of its rows):
-    double occupancy = 0.0;                    // fraction of codes c with encode(decode(c)) == c
-    std::uint64_t occupancyCodesTested = 0;    // 2^bits when exhaustive, else a random sample
-    double encodePerSecond = 0.0, decodePerSecond = 0.0;  // study run, one thread
+    double occupancy = 0.0;                 // fraction of codes c with encode(decode(c)) == c
+    std::uint64_t occupancyCodesTested = 0; // 2^bits when exhaustive, else a random sample
+    double encodePerSecond = 0.0, decodePerSecond = 0.0; // study run, one thread
     bool withinBound() const { return maxInBoundRegionDegrees <= boundDegrees; }
 };
 
 // Per rendered scene: how many visible normals xy-z gets wrong.
 struct NormalStudyScene {
-    std::string dataset;  // "scene:NAME"
-    std::string source;   // name or file
+    std::string dataset; // "scene:NAME"
+    std::string source;  // name or file
     int width = 0, height = 0;
     std::uint64_t coveredPixels = 0;
     double negativeZFraction = 0.0;  // view-space z < 0 (xy-z's failure case)
@@ -102,9 +102,9 @@ struct NormalStudyScene {
 // Fraction of visible surface orientations with view-space z < 0 at one field of view.
 struct NegativeZFraction {
     double verticalFovDegrees = 0.0;
-    double aspect = 0.0;           // width / height
-    double uniformFraction = 0.0;  // orientation uniform over the front-facing hemisphere
-    double areaWeightedFraction = 0.0;  // weighted by projected area (what pixels see)
+    double aspect = 0.0;               // width / height
+    double uniformFraction = 0.0;      // orientation uniform over the front-facing hemisphere
+    double areaWeightedFraction = 0.0; // weighted by projected area (what pixels see)
     // The same from closed forms: for a ray at angle a from the view axis the fraction is a / pi
     // (uniform) and (1 - cos a) / 2 (area-weighted); averaged over the image by the midpoint rule
     // on a 1024 x 1024 grid. The Monte Carlo figures above must agree within their noise.
@@ -116,8 +116,8 @@ struct NormalStudyResult {
     std::vector<NormalStudyRow> rows;
     std::vector<NormalStudyScene> scenes;
     std::vector<NegativeZFraction> negativeZ;
-    std::vector<std::string> warnings;  // skipped model folder, scene loader warnings
-    nlohmann::json json;                // what normals.json holds
+    std::vector<std::string> warnings; // skipped model folder, scene loader warnings
+    nlohmann::json json;               // what normals.json holds
 };
 
 // Runs the study and writes DIR/normals.csv, DIR/normals.json and the error grids; then the
@@ -136,4 +136,4 @@ int runNormalStudyCommand(const NormalStudyOptions& options);
 // python3 (PATH) and /usr/bin/python3 that imports matplotlib; "" if none.
 std::string findPlotPython(const std::string& requested);
 
-}  // namespace experiments
+} // namespace experiments

@@ -25,12 +25,12 @@
 // - `pixel-view` (the thesis' "per-pixel view space", Ishmukhametov 2013, section "Compact normal
 //   storage") expresses the normal in a frame built from the pixel's view ray r: z =
 //   -normalize(r), x = normalize(z.z, 0, -z.x), y = cross(z, x) (at the image centre this is the
-//   view frame, so the codec equals `xy-z` there). It stores local x, y as SNORM and reconstructs local z = +sqrt(max(0, 1 - x^2 -
-//   y^2)). A pinhole camera never sees a normal with local z < 0 (it faces away from the ray), so
-//   such inputs are clamped to the silhouette: the nearest local-z = 0 direction (local (x, y)
-//   normalised; exactly -z goes to local +x). Degenerate rays (zero, NaN/Inf, or parallel to the
-//   view Y axis, where x is undefined) fall back to kCentralViewRay, in encode and decode alike,
-//   so a pair given the same ray always agrees.
+//   view frame, so the codec equals `xy-z` there). It stores local x, y as SNORM and reconstructs
+//   local z = +sqrt(max(0, 1 - x^2 - y^2)). A pinhole camera never sees a normal with local z < 0
+//   (it faces away from the ray), so such inputs are clamped to the silhouette: the nearest local-z
+//   = 0 direction (local (x, y) normalised; exactly -z goes to local +x). Degenerate rays (zero,
+//   NaN/Inf, or parallel to the view Y axis, where x is undefined) fall back to kCentralViewRay, in
+//   encode and decode alike, so a pair given the same ray always agrees.
 // - normalErrorBoundRadians() gives each codec's derived worst-case angular error, valid inside
 //   inNormalErrorBoundRegion() (the comment in NormalCodec.cpp derives every bound).
 #pragma once

@@ -41,9 +41,11 @@ const NormalArrays& inputs() {
             const double z = 1.0 - 2.0 * uniform(), phi = 2.0 * std::numbers::pi * uniform();
             const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
             glm::dvec3 n(r * std::cos(phi), r * std::sin(phi), z);
-            if (glm::dot(n, ray) > 0.0) n = -n;
+            if (glm::dot(n, ray) > 0.0)
+                n = -n;
             a.x.push_back(float(n.x)), a.y.push_back(float(n.y)), a.z.push_back(float(n.z));
-            a.rayX.push_back(float(ray.x)), a.rayY.push_back(float(ray.y)), a.rayZ.push_back(float(ray.z));
+            a.rayX.push_back(float(ray.x)), a.rayY.push_back(float(ray.y)),
+                a.rayZ.push_back(float(ray.z));
         }
         return a;
     }();
@@ -73,15 +75,16 @@ void normalDecode(benchmark::State& state, gbuffer::NormalCodecSpec spec) {
     std::vector<std::uint64_t> low(kNormalCount);
     std::vector<std::uint32_t> high(kNormalCount);
     for (std::size_t i = 0; i < kNormalCount; ++i) {
-        const gbuffer::NormalCode code =
-            gbuffer::encodeNormal(spec, {in.x[i], in.y[i], in.z[i]}, {in.rayX[i], in.rayY[i], in.rayZ[i]});
+        const gbuffer::NormalCode code = gbuffer::encodeNormal(
+            spec, {in.x[i], in.y[i], in.z[i]}, {in.rayX[i], in.rayY[i], in.rayZ[i]});
         low[i] = code.low;
         high[i] = code.high;
     }
     std::vector<float> x(kNormalCount), y(kNormalCount), z(kNormalCount);
     for (auto _ : state) {
         for (std::size_t i = 0; i < kNormalCount; ++i) {
-            const glm::vec3 n = gbuffer::decodeNormal(spec, {low[i], high[i]}, {in.rayX[i], in.rayY[i], in.rayZ[i]});
+            const glm::vec3 n = gbuffer::decodeNormal(spec, {low[i], high[i]},
+                                                      {in.rayX[i], in.rayY[i], in.rayZ[i]});
             x[i] = n.x, y[i] = n.y, z[i] = n.z;
         }
         benchmark::DoNotOptimize(x.data());
@@ -103,4 +106,4 @@ const bool kRegistered = [] {
     return true;
 }();
 
-}  // namespace
+} // namespace

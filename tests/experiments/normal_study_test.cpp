@@ -28,7 +28,8 @@ using experiments::NormalStudyResult;
 using experiments::NormalStudyRow;
 
 fs::path outputDir(const std::string& test) {
-    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / "normal_study" / test;
+    const fs::path dir =
+        fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / "normal_study" / test;
     fs::remove_all(dir);
     return dir;
 }
@@ -49,17 +50,19 @@ std::string deterministicText(const NormalStudyRow& r) {
     std::ostringstream text;
     text.precision(17);
     text << r.codec << " " << r.dataset << " " << r.samples << " " << r.nanInfOutputs << " "
-         << r.meanDegrees << " " << r.rmsDegrees << " " << r.p999Degrees << " " << r.maxDegrees << " "
-         << r.boundRegionSamples << " " << r.maxInBoundRegionDegrees << " " << r.negativeZSamples << " "
-         << r.meanNegativeZDegrees << " " << r.maxNegativeZDegrees << " " << r.worseThanOctahedral << " "
-         << r.zeroVectorDecodesTo << " " << r.occupancy << " " << r.occupancyCodesTested;
+         << r.meanDegrees << " " << r.rmsDegrees << " " << r.p999Degrees << " " << r.maxDegrees
+         << " " << r.boundRegionSamples << " " << r.maxInBoundRegionDegrees << " "
+         << r.negativeZSamples << " " << r.meanNegativeZDegrees << " " << r.maxNegativeZDegrees
+         << " " << r.worseThanOctahedral << " " << r.zeroVectorDecodesTo << " " << r.occupancy
+         << " " << r.occupancyCodesTested;
     return text.str();
 }
 
 std::vector<std::string> csvLines(const fs::path& path) {
     std::ifstream file(path);
     std::vector<std::string> lines;
-    for (std::string line; std::getline(file, line);) lines.push_back(line);
+    for (std::string line; std::getline(file, line);)
+        lines.push_back(line);
     return lines;
 }
 
@@ -73,7 +76,7 @@ TEST(NormalStudy, QuickRunWritesEveryCodecBitsDatasetRowAndThePlots) {
     const std::vector<gbuffer::NormalCodecSpec> specs = gbuffer::allNormalCodecSpecs();
     ASSERT_EQ(result.rows.size(), specs.size() * kDatasets.size());
     const std::vector<std::string> lines = csvLines(out / "normals.csv");
-    ASSERT_EQ(lines.size(), result.rows.size() + 1);  // header + one line per row
+    ASSERT_EQ(lines.size(), result.rows.size() + 1); // header + one line per row
     EXPECT_EQ(lines[0].rfind("codec,name,bits,dataset,samples,nan_inf_outputs,mean_deg", 0), 0u);
     std::set<std::string> csvKeys;
     for (size_t i = 1; i < lines.size(); ++i) {
@@ -90,20 +93,24 @@ TEST(NormalStudy, QuickRunWritesEveryCodecBitsDatasetRowAndThePlots) {
     const nlohmann::json json = nlohmann::json::parse(jsonFile);
     ASSERT_EQ(json["rows"].size(), result.rows.size());
     EXPECT_EQ(json["config"]["directions"], experiments::kNormalStudyQuickDirections);
-    EXPECT_EQ(json["negative_z_fractions"].size(), 6u);  // 45/60/90 degrees x 16:9, 1:1
+    EXPECT_EQ(json["negative_z_fractions"].size(), 6u); // 45/60/90 degrees x 16:9, 1:1
 
     for (const gbuffer::NormalCodecSpec& spec : specs)
         for (const std::string& dataset : kDatasets) {
-            EXPECT_TRUE(csvKeys.count(spec.text() + "|" + dataset)) << spec.text() << " " << dataset;
-            const auto row = std::find_if(result.rows.begin(), result.rows.end(), [&](const NormalStudyRow& r) {
-                return r.codec == spec.text() && r.dataset == dataset;
-            });
+            EXPECT_TRUE(csvKeys.count(spec.text() + "|" + dataset))
+                << spec.text() << " " << dataset;
+            const auto row =
+                std::find_if(result.rows.begin(), result.rows.end(), [&](const NormalStudyRow& r) {
+                    return r.codec == spec.text() && r.dataset == dataset;
+                });
             ASSERT_NE(row, result.rows.end()) << spec.text() << " " << dataset;
             EXPECT_GT(row->samples, 0u) << spec.text() << " " << dataset;
             EXPECT_EQ(row->nanInfOutputs, 0u) << spec.text() << " " << dataset;
-            // The derived bound holds wherever it applies, on every dataset (the hard set included).
-            EXPECT_TRUE(row->withinBound()) << spec.text() << " " << dataset << ": max in region "
-                                            << row->maxInBoundRegionDegrees << " > " << row->boundDegrees;
+            // The derived bound holds wherever it applies, on every dataset (the hard set
+            // included).
+            EXPECT_TRUE(row->withinBound())
+                << spec.text() << " " << dataset << ": max in region "
+                << row->maxInBoundRegionDegrees << " > " << row->boundDegrees;
             if (spec.kind == gbuffer::NormalCodecKind::OctahedralPrecise) {
                 EXPECT_EQ(row->worseThanOctahedral, 0) << spec.text() << " " << dataset;
             }
@@ -118,9 +125,10 @@ TEST(NormalStudy, QuickRunWritesEveryCodecBitsDatasetRowAndThePlots) {
     ASSERT_EQ(result.scenes.size(), 1u);
     EXPECT_GT(result.scenes[0].coveredPixels, 1000u);
 
-    if (python.empty()) GTEST_SKIP() << "no python3 with matplotlib: plots not checked";
+    if (python.empty())
+        GTEST_SKIP() << "no python3 with matplotlib: plots not checked";
     EXPECT_TRUE(fs::is_regular_file(out / "error_vs_bits.png"));
-    ASSERT_EQ(json["maps"].size(), gbuffer::normalCodecNames().size());  // one map per codec
+    ASSERT_EQ(json["maps"].size(), gbuffer::normalCodecNames().size()); // one map per codec
     for (const nlohmann::json& map : json["maps"]) {
         EXPECT_TRUE(fs::is_regular_file(out / map["png"].get<std::string>())) << map["png"];
         EXPECT_EQ(fs::file_size(out / map["data"].get<std::string>()),
@@ -129,8 +137,10 @@ TEST(NormalStudy, QuickRunWritesEveryCodecBitsDatasetRowAndThePlots) {
 }
 
 TEST(NormalStudy, FiguresDoNotDependOnTheThreadCount) {
-    const NormalStudyResult one = experiments::runNormalStudy(quickOptions(outputDir("threads1"), 1));
-    const NormalStudyResult two = experiments::runNormalStudy(quickOptions(outputDir("threads2"), 2));
+    const NormalStudyResult one =
+        experiments::runNormalStudy(quickOptions(outputDir("threads1"), 1));
+    const NormalStudyResult two =
+        experiments::runNormalStudy(quickOptions(outputDir("threads2"), 2));
     ASSERT_EQ(one.rows.size(), two.rows.size());
     for (size_t i = 0; i < one.rows.size(); ++i)
         EXPECT_EQ(deterministicText(one.rows[i]), deterministicText(two.rows[i]));
@@ -141,7 +151,8 @@ TEST(NormalStudy, FiguresDoNotDependOnTheThreadCount) {
     }
     // Monte Carlo (10^5 samples, standard error <= 0.0016) against the closed forms.
     for (const experiments::NegativeZFraction& f : one.negativeZ) {
-        EXPECT_NEAR(f.uniformFraction, f.uniformExact, 0.008) << f.verticalFovDegrees << " " << f.aspect;
+        EXPECT_NEAR(f.uniformFraction, f.uniformExact, 0.008)
+            << f.verticalFovDegrees << " " << f.aspect;
         EXPECT_NEAR(f.areaWeightedFraction, f.areaWeightedExact, 0.008) << f.verticalFovDegrees;
     }
     // Wider fields of view show more normals with z < 0.
@@ -164,17 +175,17 @@ TEST(NormalStudy, HardCaseSetCoversTheListedCases) {
         const double length = glm::length(glm::dvec3(n));
         nearUnit |= std::abs(length - 1.001) < 1e-6 || std::abs(length - 0.999) < 1e-6;
     }
-    for (const char* group : {"axes", "minus-z", "plus-z-pole", "octahedral-edge", "one-zero-component",
-                              "back-facing", "near-unit", "subnormal", "zero", "non-finite", "off-axis-ray",
-                              "degenerate-ray"})
+    for (const char* group :
+         {"axes", "minus-z", "plus-z-pole", "octahedral-edge", "one-zero-component", "back-facing",
+          "near-unit", "subnormal", "zero", "non-finite", "off-axis-ray", "degenerate-ray"})
         EXPECT_TRUE(groups.count(group)) << group;
     EXPECT_TRUE(backFacingRange && subnormal && nan && inf && nearUnit);
     // Every codec: no NaN/Inf output for any hard case (the study rows count the same thing; this
     // is the direct check with the pixel's ray).
     for (const gbuffer::NormalCodecSpec& spec : gbuffer::allNormalCodecSpecs())
         for (const experiments::HardNormalCase& c : cases) {
-            const glm::vec3 d =
-                gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, c.normalView, c.viewRayView), c.viewRayView);
+            const glm::vec3 d = gbuffer::decodeNormal(
+                spec, gbuffer::encodeNormal(spec, c.normalView, c.viewRayView), c.viewRayView);
             ASSERT_TRUE(std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z))
                 << spec.text() << " " << c.group;
         }
@@ -200,4 +211,4 @@ TEST(NormalStudy, BadOptionsFailBeforeAnyWork) {
     EXPECT_FALSE(fs::exists(bad / "normals.csv"));
 }
 
-}  // namespace
+} // namespace

@@ -19,8 +19,10 @@
 
 namespace gbuffer {
 // Test names and messages show "octahedral:24", not the spec's bytes.
-void PrintTo(const NormalCodecSpec& spec, std::ostream* os) { *os << spec.text(); }
-}  // namespace gbuffer
+void PrintTo(const NormalCodecSpec& spec, std::ostream* os) {
+    *os << spec.text();
+}
+} // namespace gbuffer
 
 namespace {
 
@@ -447,9 +449,9 @@ TEST(NormalCodecExact, OctahedralAxesAreExact) {
 // plus extreme rays: nearly horizontal, nearly vertical (close to the frame's degenerate axis)
 // and pointing backwards (not a pinhole ray, but the codec must still be consistent).
 std::vector<glm::vec3> testViewRays() {
-    std::vector<glm::vec3> rays = {{0, 0, -1},       {1, 0, -1e-3f},   {-1, 0, 1e-6f},
-                                   {0, 1, -1e-3f},   {1e-6f, -1, 0},   {0.3f, 0.2f, 0.9f},
-                                   {5e3f, -2e3f, -1e4f}, {1e-30f, 2e-30f, -3e-30f}};
+    std::vector<glm::vec3> rays = {
+        {0, 0, -1},     {1, 0, -1e-3f},     {-1, 0, 1e-6f},       {0, 1, -1e-3f},
+        {1e-6f, -1, 0}, {0.3f, 0.2f, 0.9f}, {5e3f, -2e3f, -1e4f}, {1e-30f, 2e-30f, -3e-30f}};
     SplitMix64 rng{90};
     const double tanHalf = std::tan(kPi / 4), aspect = 16.0 / 9.0;
     for (int i = 0; i < 64; ++i) {
@@ -566,9 +568,9 @@ TEST(NormalCodecPixelView, BackFacingNormalsClampToTheSilhouette) {
 TEST(NormalCodecPixelView, DegenerateRaysFallBackToTheCentralRay) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const float inf = std::numeric_limits<float>::infinity();
-    const std::vector<glm::vec3> degenerate = {
-        {0, 0, 0}, {-0.0f, 0, -0.0f}, {nan, 0, -1}, {0, inf, -1}, {0, 0, -inf},
-        {0, 1, 0}, {0, -3, 0},        {0, 1e-30f, 0}};
+    const std::vector<glm::vec3> degenerate = {{0, 0, 0},    {-0.0f, 0, -0.0f}, {nan, 0, -1},
+                                               {0, inf, -1}, {0, 0, -inf},      {0, 1, 0},
+                                               {0, -3, 0},   {0, 1e-30f, 0}};
     std::vector<glm::vec3> rays = testViewRays();
     rays.insert(rays.end(), degenerate.begin(), degenerate.end());
     for (const NormalCodecSpec& spec : pixelViewSpecs()) {
@@ -584,8 +586,8 @@ TEST(NormalCodecPixelView, DegenerateRaysFallBackToTheCentralRay) {
                 const glm::vec3 decoded =
                     gbuffer::decodeNormal(spec, gbuffer::encodeNormal(spec, input, ray), ray);
                 EXPECT_TRUE(finiteUnit(decoded))
-                    << spec.text() << " input (" << input.x << ", " << input.y << ", "
-                    << input.z << ") ray (" << ray.x << ", " << ray.y << ", " << ray.z << ")";
+                    << spec.text() << " input (" << input.x << ", " << input.y << ", " << input.z
+                    << ") ray (" << ray.x << ", " << ray.y << ", " << ray.z << ")";
             }
         }
         SplitMix64 rng{3};
