@@ -1,11 +1,17 @@
 #include "experiments/RenderCommand.h"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <thread>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <tbb/parallel_for.h>
 
 #include <unistd.h>
 
@@ -22,62 +28,128 @@ namespace experiments {
 
 namespace {
 
-// Z layer: view-space depth in metres (positive, along the view direction), 0 = background.
-std::vector<float> viewDepthMetres(const gbuffer::GBuffer& gb) {
-    std::vector<float> depth(gb.pixelCount(), 0.0f);
-    for (int y = 0; y < gb.height(); ++y)
+// Decoded G-buffer layers for the EXR: what the stage read, after its layout's encodings.
+// Z is view-space depth in metres (positive, along the view direction), 0 = background; a
+// channel the layout does not provide is not written.
+struct DecodedLayers {
+    std::vector<float> z;
+    std::vector<float> normal[3];
+    std::vector<float> albedo[3];
+};
+
+DecodedLayers decodeLayers(const gbuffer::GBuffer& gb) {
+    const size_t n = gb.pixelCount();
+    const gbuffer::GBufferLayout& layout = gb.layout();
+    DecodedLayers layers;
+    layers.z.assign(n, 0.0f);
+    const bool normals = layout.provides(gbuffer::Channel::Normal);
+    const bool albedo = layout.provides(gbuffer::Channel::Albedo);
+    for (int c = 0; c < 3; ++c) {
+        if (normals) layers.normal[c].assign(n, 0.0f);
+        if (albedo) layers.albedo[c].assign(n, 0.0f);
+    }
+    tbb::parallel_for(0, gb.height(), [&](int y) {
         for (int x = 0; x < gb.width(); ++x) {
             const size_t pixel = size_t(y) * gb.width() + x;
-            if (gb.covered(pixel))
-                depth[pixel] = -gb.reconstructPositionView(x, y, gb.depth()[pixel]).z;
+            if (!gb.covered(pixel)) continue;
+            const gbuffer::Surface s = gb.decode(x, y);
+            layers.z[pixel] = -s.positionView.z;
+            for (int c = 0; c < 3; ++c) {
+                if (normals) layers.normal[c][pixel] = s.normalView[c];
+                if (albedo) layers.albedo[c][pixel] = s.albedo[c];
+            }
         }
-    return depth;
+    });
+    return layers;
 }
 
 std::vector<float> toFloat(const std::vector<uint32_t>& counts) {
     return std::vector<float>(counts.begin(), counts.end());
 }
 
-void writeOutputs(const RenderRun& run, const RenderCommandOptions& options, const nlohmann::json& stats) {
+// |image - reference| per channel, through ImageBufAlgo; empty planes without a reference.
+std::array<std::vector<float>, 3> errorPlanes(const RenderRun& run) {
+    std::array<std::vector<float>, 3> planes;
+    if (!run.error) return planes;
+    const int w = run.result.width, h = run.result.height;
+    auto toBuffer = [&](const lighting::StageResult& image) {
+        OIIO::ImageBuf buffer(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::FLOAT));
+        for (int c = 0; c < 3; ++c)
+            buffer.set_pixels(OIIO::ROI(0, w, 0, h, 0, 1, c, c + 1), OIIO::TypeDesc::FLOAT, image.radiance[c].data());
+        return buffer;
+    };
+    const OIIO::ImageBuf difference = OIIO::ImageBufAlgo::absdiff(toBuffer(run.result), toBuffer(run.reference));
+    for (int c = 0; c < 3; ++c) {
+        planes[size_t(c)].resize(size_t(w) * h);
+        difference.get_pixels(OIIO::ROI(0, w, 0, h, 0, 1, c, c + 1), OIIO::TypeDesc::FLOAT, planes[size_t(c)].data());
+    }
+    return planes;
+}
+
+// False-colour PNG of the largest channel error per pixel, Turbo from 0 to the image's maximum
+// (ImageBufAlgo::color_map), for thumbnails; the exact values are the EXR's error layers.
+void writeErrorPng(const std::filesystem::path& path, int w, int h, const std::array<std::vector<float>, 3>& error) {
+    OIIO::ImageBuf largest(OIIO::ImageSpec(w, h, 1, OIIO::TypeDesc::FLOAT));
+    std::vector<float> values(size_t(w) * h);
+    float peak = 0.0f;
+    for (size_t i = 0; i < values.size(); ++i) {
+        values[i] = std::max({error[0][i], error[1][i], error[2][i]});
+        if (std::isfinite(values[i])) peak = std::max(peak, values[i]);
+    }
+    for (float& v : values) v = peak > 0.0f && std::isfinite(v) ? std::min(v / peak, 1.0f) : (std::isfinite(v) ? 0.0f : 1.0f);
+    largest.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values.data());
+    const OIIO::ImageBuf coloured = OIIO::ImageBufAlgo::color_map(largest, 0, "turbo");
+    writeFileAtomically(path, [&](const std::filesystem::path& temp) {
+        if (!coloured.write(temp.string(), OIIO::TypeDesc::UINT8))
+            throw std::runtime_error("cannot write " + path.string() + ": " + coloured.geterror());
+    });
+}
+
+}  // namespace
+
+void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir, uint32_t heatmapMax) {
     const gbuffer::GBuffer& gb = run.gbuffer();
     const int w = gb.width(), h = gb.height();
-    const std::vector<float> z = viewDepthMetres(gb);
+    const nlohmann::json stats = statsJson(run);
+    const DecodedLayers layers = decodeLayers(gb);
     const std::vector<float> evaluated = toFloat(run.result.lightsEvaluated);
     const std::vector<float> oracle = toFloat(run.oracle);
     // Evaluations that added nothing: the culling stage's waste at each pixel.
     std::vector<float> wasted(evaluated.size());
     for (size_t pixel = 0; pixel < wasted.size(); ++pixel) wasted[pixel] = evaluated[pixel] - oracle[pixel];
+    const std::array<std::vector<float>, 3> error = errorPlanes(run);
     std::vector<ImagePlane> planes = {
         {"R", run.result.radiance[0].data()},
         {"G", run.result.radiance[1].data()},
         {"B", run.result.radiance[2].data()},
-        {"N.X", gb.normalPlane(0).data()},
-        {"N.Y", gb.normalPlane(1).data()},
-        {"N.Z", gb.normalPlane(2).data()},
-        {"Z", z.data()},
-        {"albedo.R", gb.albedoPlane(0).data()},
-        {"albedo.G", gb.albedoPlane(1).data()},
-        {"albedo.B", gb.albedoPlane(2).data()},
+        {"Z", layers.z.data()},
         {"lights.evaluated", evaluated.data()},
         {"lights.oracle", oracle.data()},
         {"lights.wasted", wasted.data()},
     };
+    const char* xyz[] = {"X", "Y", "Z"};
+    const char* rgb[] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+        if (!layers.normal[c].empty()) planes.push_back({std::string("N.") + xyz[c], layers.normal[c].data()});
+        if (!layers.albedo[c].empty()) planes.push_back({std::string("albedo.") + rgb[c], layers.albedo[c].data()});
+        if (!error[size_t(c)].empty()) planes.push_back({std::string("error.") + rgb[c], error[size_t(c)].data()});
+    }
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"testbed:scene", run.options.scene},
         {"testbed:stage", run.options.stage},
+        {"testbed:layout", gb.layout().name},
         {"testbed:commit", TESTBED_COMMIT},
         {"testbed:stats", stats.dump()},
-        {"testbed:Z", "view-space depth in metres, 0 = background"},
+        {"testbed:Z", "view-space depth in metres decoded from the G-buffer, 0 = background"},
+        {"testbed:error", "error.R,G,B = |R,G,B - reference| (double-precision reference)"},
     };
-    writeMultiLayerExr(options.out / "render.exr", w, h, planes, metadata);
-    writePreviewPng(options.out / "preview.png", w, h, run.result.radiance[0].data(),
-                    run.result.radiance[1].data(), run.result.radiance[2].data());
-    writeHeatmapPng(options.out / "heatmap.png", w, h, run.result.lightsEvaluated.data(),
-                    options.heatmapMax);
-    writeTextAtomically(options.out / "stats.json", stats.dump(2) + "\n");
+    writeMultiLayerExr(dir / "render.exr", w, h, planes, metadata);
+    writePreviewPng(dir / "preview.png", w, h, run.result.radiance[0].data(), run.result.radiance[1].data(),
+                    run.result.radiance[2].data());
+    writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(), heatmapMax);
+    if (run.error) writeErrorPng(dir / "error.png", w, h, error);
+    writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
 }
-
-}  // namespace
 
 nlohmann::json statsJson(const RenderRun& run) {
     nlohmann::json stats;
@@ -97,18 +169,36 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["seed"] = run.options.seed;
     const gbuffer::GBufferLayout& layout = run.gbuffer().layout();
     nlohmann::json planes = nlohmann::json::array();
-    for (const gbuffer::ChannelDesc& channel : layout.channels)
-        for (const gbuffer::PlaneDesc& plane : channel.planes)
-            planes.push_back({{"name", plane.name},
-                              {"channel", gbuffer::channelName(channel.channel)},
-                              {"encoding", channel.encoding},
-                              {"format", plane.format},
-                              {"bits", plane.bits}});
-    stats["layout"] = {{"name", layout.name}, {"planes", planes}, {"bytes_per_pixel", layout.bytesPerPixel()}};
+    for (const gbuffer::PlaneDesc& plane : layout.planes())
+        planes.push_back({{"name", plane.name},
+                          {"channel", plane.channel},
+                          {"format", plane.format},
+                          {"bits", plane.bits},
+                          {"allocated", !plane.unmodelled}});
+    nlohmann::json reasons = nlohmann::json::object();
+    for (const auto& [channel, reason] : layout.reasons) reasons[gbuffer::channelName(channel)] = reason;
+    stats["layout"] = {{"name", layout.name},
+                       {"depth", layout.depth.text()},
+                       {"position", gbuffer::positionMethodName(layout.position)},
+                       {"normals", layout.hasNormals ? layout.normals.text() : "none"},
+                       {"albedo", gbuffer::albedoEncodingName(layout.albedo)},
+                       {"specular", gbuffer::specularEncodingName(layout.specular)},
+                       {"planes", planes},
+                       {"reasons", reasons},
+                       {"notes", layout.notes},
+                       {"bytes_per_pixel", layout.bytesPerPixel()},
+                       {"allocated_bytes_per_pixel", layout.allocatedBytesPerPixel()}};
     stats["bytes_per_pixel"] = layout.bytesPerPixel();
     nlohmann::json timings = nlohmann::json::object();
     for (const auto& [pass, ms] : run.timingsMs) timings[pass] = ms;
-    stats["timings_ms"] = timings;
+    stats["timings_ms"] = timings;  // medians over the repetitions
+    nlohmann::json spread = nlohmann::json::object();
+    for (const PassTiming& timing : run.passTimings)
+        spread[timing.pass] = {{"median", timing.medianMs()}, {"min", timing.minMs()}, {"max", timing.maxMs()},
+                               {"samples", timing.samplesMs}};
+    stats["timings"] = {{"warmup", run.options.warmup}, {"repetitions", run.options.repetitions}, {"passes_ms", spread}};
+    stats["oracle_surface"] = run.oracleFromLosslessGBuffer ? "lossless G-buffer (the layout lacks BRDF channels)"
+                                                            : "the stage's G-buffer";
     stats["gbuffer_steps_ms"] = {{"transform", run.prepared->gbufferTimings.transformMs},
                                  {"raster", run.prepared->gbufferTimings.rasterMs},
                                  {"resolve", run.prepared->gbufferTimings.resolveMs},
@@ -130,7 +220,9 @@ nlohmann::json statsJson(const RenderRun& run) {
                           {"relative_rmse", run.error->relativeRmse},
                           {"max_abs", run.error->maxAbs},
                           {"psnr", std::isfinite(run.error->psnr) ? nlohmann::json(run.error->psnr)
-                                                                  : nlohmann::json("inf")}};
+                                                                  : nlohmann::json("inf")},
+                          {"relative_mean", run.error->relativeMean},
+                          {"p99_abs", run.error->p99Abs}};
     }
     stats["warnings"] = run.scene().warnings;
     return stats;
@@ -139,6 +231,11 @@ nlohmann::json statsJson(const RenderRun& run) {
 int runRenderCommand(const RenderCommandOptions& options) {
     try {
         validate(options.render);
+        if (options.explainLayout) {
+            std::cout << "stage " << options.render.stage << " on " << options.render.scene << ":\n"
+                      << renderLayout(options.render).explain();
+            return 0;
+        }
         ensureWritableDirectory(options.out);
         const bool terminal = isatty(STDERR_FILENO);
         const auto start = std::chrono::steady_clock::now();
@@ -149,8 +246,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         };
         const RenderRun run = runRender(options.render, progress);
         progress("writing outputs");
-        const nlohmann::json stats = statsJson(run);
-        writeOutputs(run, options, stats);
+        writeRenderOutputs(run, options.out, options.heatmapMax);
         std::cout << "testbed: " << run.options.stage << " on " << run.scene().name << " ("
                   << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
                   << " lights) at " << run.options.width << "x" << run.options.height << ", "
@@ -162,8 +258,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
                       << ", max_abs " << run.error->maxAbs << ", relative rmse "
                       << run.error->relativeRmse << "\n";
         std::cout << "outputs in " << std::filesystem::absolute(options.out).string() << ":\n";
-        for (const char* file : {"render.exr", "preview.png", "heatmap.png", "stats.json"})
-            std::cout << "  " << (options.out / file).string() << "\n";
+        for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
+            if (std::filesystem::exists(options.out / file)) std::cout << "  " << (options.out / file).string() << "\n";
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "testbed: error: " << e.what() << "\n";

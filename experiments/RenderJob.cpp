@@ -1,5 +1,6 @@
 #include "experiments/RenderJob.h"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -71,6 +72,47 @@ void validate(const RenderOptions& options) {
         if (!std::filesystem::is_regular_file(path))
             throw UsageError("scene file '" + options.scene + "' not found");
     }
+    if (options.warmup < 0 || options.warmup > kMaxRepetitions || options.repetitions < 1 ||
+        options.repetitions > kMaxRepetitions)
+        throw UsageError("--warmup " + std::to_string(options.warmup) + " / --repetitions " +
+                         std::to_string(options.repetitions) + " refused: warmup 0.." +
+                         std::to_string(kMaxRepetitions) + ", repetitions 1.." + std::to_string(kMaxRepetitions));
+    layoutRequest(options);  // throws UsageError for bad encodings, formats or presets
+}
+
+gbuffer::LayoutRequest layoutRequest(const RenderOptions& options) {
+    gbuffer::LayoutRequest request;
+    try {
+        if (!options.layout.empty()) {
+            const std::vector<std::string> presets = gbuffer::layoutPresetNames();
+            if (std::find(presets.begin(), presets.end(), options.layout) == presets.end()) {
+                std::string valid;
+                for (const std::string& preset : presets) valid += (valid.empty() ? "" : ", ") + preset;
+                throw std::invalid_argument("unknown G-buffer layout '" + options.layout + "'; valid: " + valid);
+            }
+            request.preset = options.layout;
+        }
+        if (!options.normals.empty()) request.normals = gbuffer::NormalCodecSpec::parse(options.normals);
+        if (!options.depth.empty()) request.depth = gbuffer::DepthFormatSpec::parse(options.depth);
+        if (!options.position.empty()) request.position = gbuffer::parsePositionMethod(options.position);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+    }
+    return request;
+}
+
+double PassTiming::medianMs() const {
+    if (samplesMs.empty()) return 0.0;
+    std::vector<double> sorted = samplesMs;
+    std::sort(sorted.begin(), sorted.end());
+    const size_t n = sorted.size();
+    return n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+}
+double PassTiming::minMs() const {
+    return samplesMs.empty() ? 0.0 : *std::min_element(samplesMs.begin(), samplesMs.end());
+}
+double PassTiming::maxMs() const {
+    return samplesMs.empty() ? 0.0 : *std::max_element(samplesMs.begin(), samplesMs.end());
 }
 
 namespace {
@@ -148,53 +190,161 @@ ErrorMetrics compareImages(const lighting::StageResult& image, const lighting::S
     metrics.relativeRmse = referenceRms > 0.0 ? metrics.rmse / referenceRms : 0.0;
     metrics.psnr = metrics.rmse > 0.0 && peak > 0.0 ? 20.0 * std::log10(peak / metrics.rmse)
                                                     : std::numeric_limits<double>::infinity();
+    // Mean and percentile of |a - b| over every pixel and channel: the difference image comes from
+    // ImageBufAlgo; the percentile is a selection over its values.
+    const OIIO::ImageBuf difference = OIIO::ImageBufAlgo::absdiff(a, b);
+    const auto differenceStats = OIIO::ImageBufAlgo::computePixelStats(difference);
+    double meanDifference = 0.0, meanReference = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        meanDifference += differenceStats.avg[size_t(c)] / 3.0;
+        meanReference += std::abs(double(referenceStats.avg[size_t(c)])) / 3.0;
+    }
+    metrics.relativeMean = meanReference > 0.0 ? meanDifference / meanReference : 0.0;
+    std::vector<float> values(size_t(image.width) * image.height * 3);
+    difference.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values.data());
+    if (!values.empty()) {
+        const size_t rank = std::min(values.size() - 1, size_t(std::ceil(0.99 * double(values.size()))) - 1);
+        std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(rank), values.end());
+        metrics.p99Abs = values[rank];
+    }
     return metrics;
 }
 
-RenderRun runRender(const RenderOptions& options,
-                    const std::function<void(const std::string&)>& progress) {
+namespace {
+
+scenes::Scene loadRequestedScene(const RenderOptions& options) {
+    scenes::SceneRequest request;
+    request.lightCount = options.lights;
+    request.seed = options.seed;
+    request.options = options.sceneOptions;
+    return scenes::loadScene(options.scene, request);
+}
+
+// Adds one repetition's pass times to `timings`, keeping the passes' first-seen order and
+// summing a pass that a stage reports twice.
+void addRepetition(std::vector<PassTiming>& timings, const std::vector<std::pair<std::string, double>>& passes) {
+    std::vector<std::pair<std::string, double>> merged;
+    for (const auto& [pass, ms] : passes) {
+        auto it = std::find_if(merged.begin(), merged.end(), [&](const auto& m) { return m.first == pass; });
+        if (it == merged.end()) merged.emplace_back(pass, ms);
+        else it->second += ms;
+    }
+    for (const auto& [pass, ms] : merged) {
+        auto it = std::find_if(timings.begin(), timings.end(), [&](const PassTiming& t) { return t.pass == pass; });
+        if (it == timings.end()) {
+            timings.push_back({pass, {}});
+            it = timings.end() - 1;
+        }
+        it->samplesMs.push_back(ms);
+    }
+}
+
+}  // namespace
+
+gbuffer::GBufferLayout renderLayout(const RenderOptions& options) {
+    validate(options);
+    const scenes::Scene scene = loadRequestedScene(options);
+    const std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage(options.stage);
+    try {
+        return gbuffer::makeLayout(scene, stage->requirements().channels, stage->name(), layoutRequest(options));
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+    }
+}
+
+lighting::StageResult renderReference(const RenderOptions& options) {
+    validate(options);
+    lighting::StageResult reference;
+    tbb::task_arena arena(effectiveThreads(options.threads));
+    arena.execute([&] {
+        lighting::PreparedFrame frame(loadRequestedScene(options), options.width, options.height, true);
+        lighting::makeStage("reference")->shade(frame.frame, reference);
+    });
+    return reference;
+}
+
+RenderRun runRender(const RenderOptions& options, const std::function<void(const std::string&)>& progress,
+                    const lighting::StageResult* givenReference) {
     auto step = [&](const std::string& what) {
         if (progress) progress(what);
     };
     validate(options);
+    if (givenReference && (givenReference->width != options.width || givenReference->height != options.height))
+        throw UsageError("the given reference image is " + std::to_string(givenReference->width) + "x" +
+                         std::to_string(givenReference->height) + ", the render " +
+                         std::to_string(options.width) + "x" + std::to_string(options.height));
+    const bool compare = options.compareReference || givenReference;
     RenderRun run;
     run.options = options;
     run.threads = effectiveThreads(options.threads);
     tbb::task_arena arena(run.threads);
     arena.execute([&] {
         step("loading scene " + options.scene);
-        scenes::SceneRequest request;
-        request.lightCount = options.lights;
-        request.seed = options.seed;
-        request.options = options.sceneOptions;
-        scenes::Scene scene = scenes::loadScene(options.scene, request);
+        scenes::Scene scene = loadRequestedScene(options);
         std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage(options.stage);
         const lighting::StageRequirements needs = stage->requirements();
+        gbuffer::GBufferLayout layout;
+        try {
+            layout = gbuffer::makeLayout(scene, needs.channels, stage->name(), layoutRequest(options));
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(e.what());
+        }
 
         step("G-buffer pass");
-        run.prepared = std::make_unique<lighting::PreparedFrame>(
-            std::move(scene), options.width, options.height, needs.exactSurface || options.compareReference);
-        const gbuffer::GBufferPassTimings& passTimings = run.prepared->gbufferTimings;
-        run.timingsMs.emplace_back("gbuffer", passTimings.transformMs + passTimings.rasterMs + passTimings.resolveMs);
-        if (needs.exactSurface) run.timingsMs.emplace_back("exact_surface", passTimings.exactMs);
+        const bool needExact = needs.exactSurface || (compare && !givenReference);
+        run.prepared = std::make_unique<lighting::PreparedFrame>(std::move(scene), options.width, options.height,
+                                                                 needExact, layout);
         const lighting::Frame& frame = run.prepared->frame;
-        step("shading: " + options.stage);
-        stage->shade(frame, run.result);
-        for (const auto& timing : run.result.timingsMs) run.timingsMs.push_back(timing);
-        double total = 0.0;
-        for (const auto& [pass, ms] : run.timingsMs) total += ms;
-        run.timingsMs.emplace_back("total", total);
+        const int runs = options.warmup + options.repetitions;
+        for (int i = 0; i < runs; ++i) {
+            const bool timed = i >= options.warmup;
+            step(std::string(timed ? "" : "warm-up ") + "shading: " + options.stage +
+                 (runs > 1 ? " (" + std::to_string(i + 1) + "/" + std::to_string(runs) + ")" : ""));
+            if (i > 0) run.prepared->renderGBuffer();
+            const gbuffer::GBufferPassTimings& passTimings = run.prepared->gbufferTimings;
+            std::vector<std::pair<std::string, double>> passes;
+            passes.emplace_back("gbuffer", passTimings.transformMs + passTimings.rasterMs + passTimings.resolveMs);
+            if (needs.exactSurface) passes.emplace_back("exact_surface", passTimings.exactMs);
+            lighting::StageResult result;
+            stage->shade(frame, result);
+            for (const auto& timing : result.timingsMs) passes.push_back(timing);
+            double total = 0.0;
+            for (const auto& [pass, ms] : passes) total += ms;
+            passes.emplace_back("total", total);
+            if (timed) addRepetition(run.passTimings, passes);
+            run.result = std::move(result);
+        }
+        for (const PassTiming& timing : run.passTimings) run.timingsMs.emplace_back(timing.pass, timing.medianMs());
 
-        // The oracle and the reference are measurement, not part of the stage: timed apart.
+        // The oracle and the reference are measurement, not part of the stage: timed apart. The
+        // oracle counts lights on the surface the stage shades: its G-buffer when that holds every
+        // channel the BRDF reads, else the lossless G-buffer (what forward stages shade).
         step("counting contributing lights (oracle)");
         auto start = Clock::now();
-        run.oracle = run.result.lightsOracle.empty() ? lighting::countContributingLights(frame)
-                                                     : run.result.lightsOracle;
+        if (!run.result.lightsOracle.empty()) {
+            run.oracle = run.result.lightsOracle;
+        } else {
+            const gbuffer::GBufferLayout& stored = run.prepared->gbuffer->layout();
+            const bool complete = stored.provides(gbuffer::Channel::Normal) &&
+                                  stored.provides(gbuffer::Channel::Albedo) &&
+                                  stored.provides(gbuffer::Channel::Specular);
+            if (complete) {
+                run.oracle = lighting::countContributingLights(frame);
+            } else {
+                run.oracleFromLosslessGBuffer = true;
+                const std::unique_ptr<gbuffer::GBuffer> lossless = run.prepared->renderLosslessGBuffer();
+                lighting::Frame losslessFrame = frame;
+                losslessFrame.gbuffer = lossless.get();
+                run.oracle = lighting::countContributingLights(losslessFrame);
+            }
+        }
         run.oracleMs = millisecondsSince(start);
-        if (options.compareReference) {
+        if (compare) {
             step("reference (double precision)");
             start = Clock::now();
-            if (stage->name() == "reference") {
+            if (givenReference) {
+                run.reference = *givenReference;
+            } else if (stage->name() == "reference") {
                 run.reference = run.result;
             } else {
                 lighting::makeStage("reference")->shade(frame, run.reference);

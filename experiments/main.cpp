@@ -35,6 +35,18 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
     render.add_flag("--compare-reference", r.compareReference,
                     "also render the double-precision reference and record the error");
+    render.add_option("--layout", r.layout,
+                      "G-buffer preset: reference, compact, stalker, clear-sky, killzone2, bf3, thesis "
+                      "(default: derived from the scene's materials and the stage's needs)");
+    render.add_option("--normals", r.normals, "normal encoding NAME:BITS, e.g. octahedral:24 (testbed list)");
+    render.add_option("--depth", r.depth,
+                      "depth format: f32, f32-reversed, unorm24, unorm16, f16-linear, optionally :infinite");
+    render.add_option("--position", r.position, "position reconstruction: inverse-projection or view-ray");
+    render.add_flag("--explain-layout", options.explainLayout,
+                    "print the G-buffer layout and why each plane is there, then exit without rendering");
+    render.add_option("--warmup", r.warmup, "untimed runs before the timed ones")->capture_default_str();
+    render.add_option("--repetitions", r.repetitions, "timed runs (median, min, max are recorded)")
+        ->capture_default_str();
 }
 
 int listEverything() {

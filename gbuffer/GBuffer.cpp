@@ -1,40 +1,197 @@
 #include "gbuffer/GBuffer.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+#include <Imath/half.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace gbuffer {
 
+namespace {
+
+// Specular power range of the 8-bit log encoding: 2^0 .. 2^13 (Blinn-Phong exponents of 1..8192).
+constexpr float kLogPowerBits = 13.0f;
+
+float srgbFromLinear(float v) {
+    v = std::clamp(v, 0.0f, 1.0f);
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+const std::array<float, 256>& linearOfSrgb8() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) {
+            const double s = i / 255.0;
+            t[size_t(i)] = float(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4));
+        }
+        return t;
+    }();
+    return table;
+}
+
+uint32_t unorm8(float v) { return uint32_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+
+}  // namespace
+
 GBuffer::GBuffer(const GBufferLayout& layout, const FrameView& view)
-    : mLayout(layout), mView(view), mClearDepth(view.clearDepth()) {
+    : mLayout(layout), mView(view), mProjection(DepthProjection::of(view)), mClearDepth(view.clearDepth()) {
+    if (layout.depth.convention() != view.depthConvention || layout.depth.infiniteFar != view.infiniteFar)
+        throw std::invalid_argument("G-buffer layout '" + layout.name + "' stores depth as " +
+                                    layout.depth.text() + ", which needs a " +
+                                    (layout.depth.convention() == DepthConvention::Reversed ? "reversed" : "standard") +
+                                    "-Z view" + (layout.depth.infiniteFar ? " with an infinite far plane" : "") +
+                                    "; the frame's view differs");
     const size_t n = pixelCount();
     mDepth.assign(n, mClearDepth);  // depth is always there: coverage and positions come from it
-    if (layout.has(Channel::Normal))
-        for (auto& plane : mNormal) plane.assign(n, 0.0f);
-    if (layout.has(Channel::Albedo))
+    if (layout.hasNormals) {
+        if (layout.normals.kind == NormalCodecKind::Float32)
+            for (auto& plane : mNormal) plane.assign(n, 0.0f);
+        else if (layout.normals.bits <= 32)
+            mNormalCode32.assign(n, 0);
+        else
+            mNormalCode64.assign(n, 0);
+    }
+    if (layout.albedo == AlbedoEncoding::Float32)
         for (auto& plane : mAlbedo) plane.assign(n, 0.0f);
-    if (layout.has(Channel::Specular))
+    if (layout.albedo == AlbedoEncoding::Rgb8Srgb) mAlbedoPacked.assign(n, 0);
+    if (layout.specular == SpecularEncoding::Float32)
         for (auto& plane : mSpecular) plane.assign(n, 0.0f);
+    if (layout.specular == SpecularEncoding::Unorm8Half || layout.specular == SpecularEncoding::Unorm8Log8)
+        mSpecularPacked.assign(n, 0);
+    if (layout.hasMaterialIndex()) mMaterial.assign(n, 0);
 }
 
 void GBuffer::clearDepth() { std::fill(mDepth.begin(), mDepth.end(), mClearDepth); }
 
-glm::vec3 GBuffer::reconstructPositionView(int x, int y, float depth) const {
+void GBuffer::quantiseDepth() {
+    const DepthFormatKind kind = mLayout.depth.kind;
+    if (kind == DepthFormatKind::F32 || kind == DepthFormatKind::F32Reversed) return;  // lossless
+    const bool reversed = mView.reversedZ();
+    // One float step nearer than the clear value: where a covered pixel goes if its rounded depth
+    // would read as background (e.g. f16-linear rounding past the far plane).
+    const float nearestCovered = std::nextafter(mClearDepth, reversed ? 1.0f : 0.0f);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, mDepth.size(), 16384), [&](const auto& range) {
+        for (size_t pixel = range.begin(); pixel != range.end(); ++pixel) {
+            const float z = mDepth[pixel];
+            if (z == mClearDepth) continue;
+            float q = decodeDepthNdc(mLayout.depth, mProjection, encodeDepth(mLayout.depth, mProjection, z));
+            if (reversed ? !(q > mClearDepth) : !(q < mClearDepth)) q = nearestCovered;
+            mDepth[pixel] = q;
+        }
+    });
+}
+
+glm::vec3 GBuffer::viewRayOfPixel(size_t pixel) const {
+    const int x = int(pixel % size_t(mView.width)), y = int(pixel / size_t(mView.width));
+    return viewRayOfNdc(mView, mView.ndcOfPixel(x, y));
+}
+
+void GBuffer::writeBackground(size_t pixel) {
+    Surface background;
+    background.normalView = glm::vec3(0.0f, 0.0f, 1.0f);
+    background.specularPower = 1.0f;
+    writeSurface(pixel, background);
+}
+
+void GBuffer::writeSurface(size_t pixel, const Surface& s) {
+    if (!mNormal[0].empty()) {
+        mNormal[0][pixel] = s.normalView.x;
+        mNormal[1][pixel] = s.normalView.y;
+        mNormal[2][pixel] = s.normalView.z;
+    } else if (!mNormalCode32.empty() || !mNormalCode64.empty()) {
+        const NormalCode code = encodeNormal(mLayout.normals, s.normalView, viewRayOfPixel(pixel));
+        if (!mNormalCode32.empty()) mNormalCode32[pixel] = uint32_t(code.low);
+        else mNormalCode64[pixel] = code.low;
+    }
+    if (!mAlbedo[0].empty()) {
+        mAlbedo[0][pixel] = s.albedo.r;
+        mAlbedo[1][pixel] = s.albedo.g;
+        mAlbedo[2][pixel] = s.albedo.b;
+    } else if (!mAlbedoPacked.empty()) {
+        mAlbedoPacked[pixel] = unorm8(srgbFromLinear(s.albedo.r)) | unorm8(srgbFromLinear(s.albedo.g)) << 8 |
+                               unorm8(srgbFromLinear(s.albedo.b)) << 16;
+    }
+    if (!mSpecular[0].empty()) {
+        mSpecular[0][pixel] = s.specularIntensity;
+        mSpecular[1][pixel] = s.specularPower;
+    } else if (!mSpecularPacked.empty()) {
+        uint32_t power = 0;
+        if (mLayout.specular == SpecularEncoding::Unorm8Half) {
+            power = Imath::half(std::clamp(s.specularPower, 0.0f, 65504.0f)).bits();
+        } else {
+            power = unorm8(std::log2(std::clamp(s.specularPower, 1.0f, 8192.0f)) / kLogPowerBits);
+        }
+        mSpecularPacked[pixel] = unorm8(s.specularIntensity) | power << 8;
+    }
+    if (!mMaterial.empty()) mMaterial[pixel] = uint16_t(s.material);
+}
+
+glm::vec3 GBuffer::reconstructPositionView(int x, int y, float depthNdc) const {
     const glm::vec2 ndc = mView.ndcOfPixel(x, y);
-    const glm::vec4 p = mView.viewFromClip * glm::vec4(ndc, depth, 1.0f);
-    return glm::vec3(p) / p.w;
+    if (mLayout.position == PositionMethod::InverseProjection)
+        return positionByInverseProjection(mView, ndc, depthNdc);
+    return positionByViewRay(mView, ndc, mProjection.viewDepthFromNdcFloat(depthNdc));
 }
 
 Surface GBuffer::decode(int x, int y) const {
     const size_t pixel = size_t(y) * mView.width + x;
     Surface s;
     s.positionView = reconstructPositionView(x, y, mDepth[pixel]);
-    if (!mNormal[0].empty())
+    if (!mNormal[0].empty()) {
         s.normalView = glm::vec3(mNormal[0][pixel], mNormal[1][pixel], mNormal[2][pixel]);
-    if (!mAlbedo[0].empty())
-        s.albedo = glm::vec3(mAlbedo[0][pixel], mAlbedo[1][pixel], mAlbedo[2][pixel]);
-    if (!mSpecular[0].empty()) {
+    } else if (!mNormalCode32.empty() || !mNormalCode64.empty()) {
+        NormalCode code;
+        code.low = !mNormalCode32.empty() ? mNormalCode32[pixel] : mNormalCode64[pixel];
+        s.normalView = decodeNormal(mLayout.normals, code, viewRayOfNdc(mView, mView.ndcOfPixel(x, y)));
+    }
+    if (!mMaterial.empty()) s.material = mMaterial[pixel];
+    const MaterialConstants* material =
+        !mMaterial.empty() && s.material < mLayout.materials.size() ? &mLayout.materials[s.material] : nullptr;
+    switch (mLayout.albedo) {
+    case AlbedoEncoding::Float32: s.albedo = {mAlbedo[0][pixel], mAlbedo[1][pixel], mAlbedo[2][pixel]}; break;
+    case AlbedoEncoding::Rgb8Srgb: {
+        const uint32_t packed = mAlbedoPacked[pixel];
+        const auto& linear = linearOfSrgb8();
+        s.albedo = {linear[packed & 0xff], linear[(packed >> 8) & 0xff], linear[(packed >> 16) & 0xff]};
+        break;
+    }
+    case AlbedoEncoding::Material: s.albedo = material ? material->albedo : glm::vec3(0.0f); break;
+    case AlbedoEncoding::Constant: s.albedo = mLayout.constant.albedo; break;
+    case AlbedoEncoding::None: break;
+    }
+    switch (mLayout.specular) {
+    case SpecularEncoding::Float32:
         s.specularIntensity = mSpecular[0][pixel];
         s.specularPower = mSpecular[1][pixel];
+        break;
+    case SpecularEncoding::Unorm8Half:
+    case SpecularEncoding::Unorm8Log8: {
+        const uint32_t packed = mSpecularPacked[pixel];
+        s.specularIntensity = float(packed & 0xff) / 255.0f;
+        if (mLayout.specular == SpecularEncoding::Unorm8Half) {
+            Imath::half power;
+            power.setBits(uint16_t(packed >> 8));
+            s.specularPower = float(power);
+        } else {
+            s.specularPower = std::exp2(float((packed >> 8) & 0xff) / 255.0f * kLogPowerBits);
+        }
+        break;
+    }
+    case SpecularEncoding::Material:
+        if (material) {
+            s.specularIntensity = material->specularIntensity;
+            s.specularPower = material->specularPower;
+        }
+        break;
+    case SpecularEncoding::Constant:
+        s.specularIntensity = mLayout.constant.specularIntensity;
+        s.specularPower = mLayout.constant.specularPower;
+        break;
+    case SpecularEncoding::None: break;
     }
     return s;
 }

@@ -1,10 +1,21 @@
 // GBuffer: the planes of one frame's G-buffer, stored as separate arrays (structure of arrays)
 // in the encodings of its GBufferLayout, and the decoder every reader goes through.
 //
-// Depth is NDC z in [0, 1] in the FrameView's convention (reversed by default), cleared to the
-// far plane's value, which marks background. View-space
-// position is reconstructed from depth and the inverse projection. Decoding is const and
-// thread-safe; writing a pixel is safe concurrently with writing other pixels.
+// Storage (see GBufferLayout.h for the encodings):
+// - Depth: one float plane of NDC depth in the FrameView's convention (reversed by default),
+//   cleared to the far plane's value, which marks background. The rasterizer depth-tests in it;
+//   afterwards quantiseDepth() rounds every covered pixel through the layout's depth format, so
+//   every reader (decode, and the culling code that reads depth() directly) sees exactly what the
+//   format can hold. It stays a float array in memory whatever the format (allocatedBytesPerPixel
+//   says so); the layout's bits are the format's.
+// - Normals: three float planes for float32, else one array of codes (32- or 64-bit words).
+//   pixel-view codes are built on the pixel's view ray, which encode and decode compute.
+// - Albedo: three float planes (f32), one packed RGB8 sRGB word, or nothing (material index,
+//   constant, none). Specular: two float planes, one packed word, or nothing. Material index:
+//   one 16-bit array when albedo or specular decode from the material table.
+// View-space position is reconstructed from depth by the layout's method (inverse projection or
+// view ray). Decoding is const and thread-safe; writing a pixel is safe concurrently with writing
+// other pixels.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +23,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gbuffer/DepthFormat.h"
 #include "gbuffer/FrameView.h"
 #include "gbuffer/GBufferLayout.h"
 
@@ -24,10 +36,13 @@ struct Surface {
     glm::vec3 albedo{0.0f};
     float specularIntensity = 0.0f;
     float specularPower = 1.0f;
+    uint32_t material = 0;  // index into the scene's materials (written, not always stored)
 };
 
 class GBuffer {
 public:
+    // Throws std::invalid_argument when the layout's depth format does not match the view's depth
+    // convention or far plane (FrameView::fromCamera must be called with the format's).
     GBuffer(const GBufferLayout& layout, const FrameView& view);
 
     const GBufferLayout& layout() const { return mLayout; }
@@ -39,47 +54,39 @@ public:
     // Resets depth to the far plane's value. Other planes are written for every pixel by the G-buffer
     // pass (zero for background), so clearing them too would only cost bandwidth.
     void clearDepth();
-    // Writes the background value (zero) to every plane but depth at one pixel.
-    void writeBackground(size_t pixel) { writeSurface(pixel, glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, 0.0f); }
-
-    // Writes one pixel's surface attributes (depth is written by the rasterizer directly).
-    void writeSurface(size_t pixel, const glm::vec3& normalView, const glm::vec3& albedo,
-                      float specularIntensity, float specularPower) {
-        if (!mNormal[0].empty()) {
-            mNormal[0][pixel] = normalView.x;
-            mNormal[1][pixel] = normalView.y;
-            mNormal[2][pixel] = normalView.z;
-        }
-        if (!mAlbedo[0].empty()) {
-            mAlbedo[0][pixel] = albedo.r;
-            mAlbedo[1][pixel] = albedo.g;
-            mAlbedo[2][pixel] = albedo.b;
-        }
-        if (!mSpecular[0].empty()) {
-            mSpecular[0][pixel] = specularIntensity;
-            mSpecular[1][pixel] = specularPower;
-        }
-    }
+    // Rounds every covered pixel's depth through the layout's format (no-op for the float format
+    // of the view's own convention). Parallel (TBB). A covered pixel stays covered.
+    void quantiseDepth();
+    // Writes the background value (zero codes) to every plane but depth at one pixel.
+    void writeBackground(size_t pixel);
+    // Encodes one pixel's surface attributes (depth is written by the rasterizer directly).
+    void writeSurface(size_t pixel, const Surface& surface);
 
     bool covered(size_t pixel) const { return mDepth[pixel] != mClearDepth; }
-    // Reconstructs view-space position from depth and decodes the other channels.
+    // Reconstructs view-space position from depth and decodes the other channels; channels the
+    // layout does not provide are left at Surface's defaults.
     Surface decode(int x, int y) const;
-    glm::vec3 reconstructPositionView(int x, int y, float depth) const;
+    glm::vec3 reconstructPositionView(int x, int y, float depthNdc) const;
 
     float* depthPlane() { return mDepth.data(); }
     const std::vector<float>& depth() const { return mDepth; }
-    // Decoded planes for output layers (EXR); empty when the layout has no such channel.
-    const std::vector<float>& normalPlane(int component) const { return mNormal[component]; }
-    const std::vector<float>& albedoPlane(int component) const { return mAlbedo[component]; }
 
 private:
+    glm::vec3 viewRayOfPixel(size_t pixel) const;
+
     GBufferLayout mLayout;
     FrameView mView;
+    DepthProjection mProjection;
     float mClearDepth;
     std::vector<float> mDepth;
-    std::vector<float> mNormal[3];
-    std::vector<float> mAlbedo[3];
-    std::vector<float> mSpecular[2];
+    std::vector<float> mNormal[3];          // float32 normals
+    std::vector<uint32_t> mNormalCode32;    // codes of up to 32 bits
+    std::vector<uint64_t> mNormalCode64;    // longer codes (xyz:48)
+    std::vector<float> mAlbedo[3];          // f32
+    std::vector<uint32_t> mAlbedoPacked;    // rgb8-srgb
+    std::vector<float> mSpecular[2];        // f32
+    std::vector<uint32_t> mSpecularPacked;  // unorm8+f16, unorm8+log8
+    std::vector<uint16_t> mMaterial;        // material index
 };
 
 }  // namespace gbuffer

@@ -1,42 +1,94 @@
-// GBufferLayout: what the G-buffer stores, as data (Falcor-style channel table): one row per
-// channel with its encoding and planes (structure of arrays), and the reason it is there.
-// Consumers declare the channels they need; only those are allocated.
+// GBufferLayout: what the G-buffer stores, as data (Falcor-style channel table). A layout says,
+// for each channel a lighting stage can read, how it is encoded; the stored planes (structure of
+// arrays), their formats and bits, and the reason each is there follow from that.
 //
-// This first version knows the reference layout (float32 everything). Encodings and derived
-// layouts extend the table; readers always go through GBuffer::decode, never the raw planes.
+// Channels are what stages read (Depth, Normal, Albedo, Specular). How each is stored:
+//   depth     a DepthFormatSpec (always present: coverage and position come from it) and the
+//             position reconstruction method (inverse projection or view ray)
+//   normal    a NormalCodecSpec (absent when no reader needs normals)
+//   albedo    f32 (3 x float), rgb8-srgb (24 bits), material (decoded from the per-pixel material
+//             index and the layout's material table), constant (one value for the whole scene,
+//             0 bits), none
+//   specular  f32 (intensity, power as floats), unorm8+f16 (8-bit intensity, half power: the
+//             thesis' layout), unorm8+log8 (8-bit intensity, 8-bit log power: Killzone 2's),
+//             material, constant, none
+// A material index plane (8 or 16 bits) exists when albedo or specular is `material`.
+// Historical presets also carry `unmodelled` planes: data the original layout stored that no stage
+// here reads (ambient occlusion, motion vectors, stencil...). They count in bytesPerPixel, so the
+// preset's size is the published one, but are never allocated.
+//
+// Readers never touch planes: they call GBuffer::decode. Layouts are built by LayoutDerivation.h.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gbuffer/DepthFormat.h"
+#include "gbuffer/NormalCodec.h"
 
 namespace gbuffer {
 
 enum class Channel { Depth, Normal, Albedo, Specular };
-
 const char* channelName(Channel channel);
 
-struct PlaneDesc {
-    std::string name;    // EXR-style channel name, e.g. "N.X"
-    std::string format;  // storage format, e.g. "f32"
-    int bits = 32;
+enum class AlbedoEncoding { None, Constant, Material, Rgb8Srgb, Float32 };
+enum class SpecularEncoding { None, Constant, Material, Unorm8Log8, Unorm8Half, Float32 };
+const char* albedoEncodingName(AlbedoEncoding encoding);      // "none", "constant", ...
+const char* specularEncodingName(SpecularEncoding encoding);
+AlbedoEncoding parseAlbedoEncoding(const std::string& text);  // throws std::invalid_argument
+SpecularEncoding parseSpecularEncoding(const std::string& text);
+
+// Per-material values the `material` and `constant` encodings decode from.
+struct MaterialConstants {
+    glm::vec3 albedo{0.0f};
+    float specularIntensity = 0.0f;
+    float specularPower = 1.0f;
+    friend bool operator==(const MaterialConstants&, const MaterialConstants&) = default;
 };
 
-struct ChannelDesc {
-    Channel channel;
-    std::string encoding;  // e.g. "float32", later "octahedral:24"
-    std::vector<PlaneDesc> planes;
-    std::string reason;  // why the plane is there (printed by --explain-layout)
+// One stored plane, as stats.json and --explain-layout show it.
+struct PlaneDesc {
+    std::string name;    // e.g. "N" (a packed code), "albedo.R", "Z"
+    std::string format;  // e.g. "f32", "u32 code of octahedral-precise:24", "unorm8 x3 sRGB"
+    int bits = 32;       // bits this plane costs per pixel in the layout's budget
+    std::string channel; // "depth", "normal", "albedo", "specular", "material", or "unmodelled"
+    bool unmodelled = false;
 };
 
 struct GBufferLayout {
-    std::string name;
-    std::vector<ChannelDesc> channels;
+    std::string name = "reference";
+    DepthFormatSpec depth;
+    PositionMethod position = PositionMethod::InverseProjection;
+    bool hasNormals = true;
+    NormalCodecSpec normals{NormalCodecKind::Float32, 96};
+    AlbedoEncoding albedo = AlbedoEncoding::Float32;
+    SpecularEncoding specular = SpecularEncoding::Float32;
+    std::vector<MaterialConstants> materials;  // index = scene material, for `material`
+    MaterialConstants constant;                // for `constant`
+    std::vector<PlaneDesc> unmodelled;         // historical presets only
+    std::map<Channel, std::string> reasons;    // why each channel is stored as it is
+    std::vector<std::string> notes;            // e.g. where a preset departs from its source
 
-    bool has(Channel channel) const;
-    const ChannelDesc& channel(Channel channel) const;  // throws std::out_of_range naming it
+    // Whether a reader can decode this channel (a `constant` channel can, with no plane).
+    bool provides(Channel channel) const;
+    bool hasMaterialIndex() const {
+        return albedo == AlbedoEncoding::Material || specular == SpecularEncoding::Material;
+    }
+    int materialIndexBits() const { return materials.size() <= 256 ? 8 : 16; }
+    // Every plane of the layout, including unmodelled ones.
+    std::vector<PlaneDesc> planes() const;
+    // Sum of the planes' bits / 8: the layout's size as a GPU packs it (bits, not our CPU arrays).
     double bytesPerPixel() const;
+    // Bytes per pixel this program actually allocates for the layout (planes are padded to 8,
+    // 16, 32 or 64-bit arrays, unmodelled planes are not allocated, depth is a float working plane).
+    double allocatedBytesPerPixel() const;
+    // One line per plane with its format, bits and the reason it is there, then the notes.
+    std::string explain() const;
 
-    // float32 reversed-Z depth (NDC z), float32 view-space normal, float32 albedo RGB, float32 specular
+    // float32 reversed-Z depth, float32 view-space normal, float32 albedo RGB, float32 specular
     // (intensity, power): lossless with respect to what the rasterizer computes.
     static GBufferLayout reference();
 };

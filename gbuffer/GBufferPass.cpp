@@ -41,7 +41,8 @@ Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& sc
     const float length2 = glm::dot(normal, normal);
     normal = length2 > 0.0f ? normal * (1.0f / std::sqrt(length2)) : glm::vec3(0.0f, 0.0f, 1.0f);
     surface.normalView = backFace ? -normal : normal;  // two-sided draws light the visible side
-    const scenes::Material& material = scene.materials[geometry.triangleMaterial[triangle]];
+    surface.material = geometry.triangleMaterial[triangle];
+    const scenes::Material& material = scene.materials[surface.material];
     glm::vec3 albedo(material.baseColorFactor);
     if (material.baseColorTexture >= 0) {
         const glm::vec2 uv = raster::interpolate(geometry.uv[i0], geometry.uv[i1], geometry.uv[i2], weights);
@@ -93,8 +94,7 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
             const bool backFace = (visible & kBackFaceBit) != 0;
             const Surface surface = surfaceOfTriangle(mGeometry, mScene, mClipPositions, mNormalView, t,
                                                       backFace, view.ndcOfPixel(x, y));
-            target.writeSurface(pixel, surface.normalView, surface.albedo, surface.specularIntensity,
-                                surface.specularPower);
+            target.writeSurface(pixel, surface);
             if (exact) {
                 exact->triangle[pixel] = t;
                 exact->backFacing[pixel] = backFace ? 1 : 0;
@@ -132,6 +132,7 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     timings.rasterMs = millisecondsSince(start);
 
     start = std::chrono::steady_clock::now();
+    target.quantiseDepth();
     if (exact) exact->resize(view.width, view.height);
     resolve(target, exact);
     timings.resolveMs = millisecondsSince(start);

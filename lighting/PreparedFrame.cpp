@@ -2,16 +2,25 @@
 
 namespace lighting {
 
+gbuffer::GBufferLayout losslessLayout(gbuffer::DepthConvention depth, bool infiniteFar) {
+    gbuffer::GBufferLayout layout = gbuffer::GBufferLayout::reference();
+    layout.depth.kind = depth == gbuffer::DepthConvention::Reversed ? gbuffer::DepthFormatKind::F32Reversed
+                                                                    : gbuffer::DepthFormatKind::F32;
+    layout.depth.infiniteFar = infiniteFar;
+    return layout;
+}
+
 PreparedFrame::PreparedFrame(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
-                             gbuffer::DepthConvention depth)
+                             const gbuffer::GBufferLayout& layout)
     : scene(std::move(sceneIn)) {
     geometry = gbuffer::SceneGeometry::build(scene);
-    view = gbuffer::FrameView::fromCamera(scene.cameras.front(), width, height, depth);
-    gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
+    view = gbuffer::FrameView::fromCamera(scene.cameras.front(), width, height, layout.depth.convention(),
+                                          layout.depth.infiniteFar);
+    gbuffer = std::make_unique<gbuffer::GBuffer>(layout, view);
     if (withExactSurface) exact = std::make_unique<gbuffer::ExactSurface>();
-    raster::Rasterizer rasterizer(width, height);
-    gbufferTimings = gbuffer::GBufferPass(scene, geometry).render(rasterizer, *gbuffer, exact.get());
-    rasterStats = rasterizer.lastStats();
+    mRasterizer = std::make_unique<raster::Rasterizer>(width, height);
+    mPass = std::make_unique<gbuffer::GBufferPass>(scene, geometry);
+    renderGBuffer();
     setLights(scene.lights);
     frame.scene = &scene;
     frame.geometry = &geometry;
@@ -19,6 +28,21 @@ PreparedFrame::PreparedFrame(scenes::Scene sceneIn, int width, int height, bool 
     frame.gbuffer = gbuffer.get();
     frame.exact = exact.get();
     frame.lights = &lights;
+}
+
+PreparedFrame::PreparedFrame(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
+                             gbuffer::DepthConvention depth)
+    : PreparedFrame(std::move(sceneIn), width, height, withExactSurface, losslessLayout(depth)) {}
+
+void PreparedFrame::renderGBuffer() {
+    gbufferTimings = mPass->render(*mRasterizer, *gbuffer, exact.get());
+    rasterStats = mRasterizer->lastStats();
+}
+
+std::unique_ptr<gbuffer::GBuffer> PreparedFrame::renderLosslessGBuffer() {
+    auto lossless = std::make_unique<gbuffer::GBuffer>(losslessLayout(view.depthConvention, view.infiniteFar), view);
+    mPass->render(*mRasterizer, *lossless, nullptr);
+    return lossless;
 }
 
 void PreparedFrame::setLights(const std::vector<scenes::Light>& sceneLights) {

@@ -1,7 +1,7 @@
 // PreparedFrame: everything a shading stage reads for one frame, owned in one place: the scene,
-// its flattened geometry, the camera matrices, the rasterized G-buffer (and, on request, the
-// exact surface for the reference) and the view-space lights. The runner, the tests and the
-// benchmarks all build frames this way, so a stage sees the same inputs everywhere.
+// its flattened geometry, the camera matrices, the rasterized G-buffer in a given layout (and, on
+// request, the exact surface for the reference) and the view-space lights. The runner, the tests
+// and the benchmarks all build frames this way, so a stage sees the same inputs everywhere.
 // Construction rasterizes the G-buffer (parallel, under the caller's tbb::task_arena); the
 // object is immovable because `frame` points into it.
 #pragma once
@@ -11,6 +11,7 @@
 #include "gbuffer/ExactSurface.h"
 #include "gbuffer/FrameView.h"
 #include "gbuffer/GBuffer.h"
+#include "gbuffer/GBufferLayout.h"
 #include "gbuffer/GBufferPass.h"
 #include "gbuffer/SceneGeometry.h"
 #include "lighting/LightList.h"
@@ -31,15 +32,35 @@ struct PreparedFrame {
     raster::RasterStats rasterStats;
     gbuffer::GBufferPassTimings gbufferTimings;
 
-    // Renders `scene` from its first camera at width x height into the reference layout.
+    // Renders `scene` from its first camera at width x height into `layout`; the view's depth
+    // convention and far plane follow the layout's depth format.
+    PreparedFrame(scenes::Scene scene, int width, int height, bool withExactSurface,
+                  const gbuffer::GBufferLayout& layout);
+    // The reference layout (float32 everything), with standard or reversed float depth.
     PreparedFrame(scenes::Scene scene, int width, int height, bool withExactSurface = false,
                   gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed);
+
+    // Rasterizes the G-buffer (and the exact surface, if any) again: for timing repetitions.
+    // The result is bitwise the same; gbufferTimings and rasterStats are replaced.
+    void renderGBuffer();
+    // A G-buffer of the same view in the lossless reference layout (float32 depth in the view's
+    // convention): what forward stages shade, for measurements on frames whose layout lacks
+    // channels. Costs one more G-buffer pass.
+    std::unique_ptr<gbuffer::GBuffer> renderLosslessGBuffer();
+
     // Replaces the scene's lights (the G-buffer does not depend on them); for tests that place
     // lights by hand after seeing the geometry.
     void setLights(const std::vector<scenes::Light>& sceneLights);
 
     PreparedFrame(const PreparedFrame&) = delete;
     PreparedFrame& operator=(const PreparedFrame&) = delete;
+
+private:
+    std::unique_ptr<raster::Rasterizer> mRasterizer;
+    std::unique_ptr<gbuffer::GBufferPass> mPass;
 };
+
+// The reference layout for a view with the given float depth convention and far plane.
+gbuffer::GBufferLayout losslessLayout(gbuffer::DepthConvention depth, bool infiniteFar = false);
 
 }  // namespace lighting
