@@ -17,6 +17,8 @@ namespace {
 using experiments::RenderOptions;
 using experiments::RenderRun;
 using experiments::runRender;
+using experiments::PassTiming;
+using experiments::renderReference;
 
 RenderOptions smallAtrium(int threads) {
     RenderOptions options;
@@ -93,6 +95,72 @@ TEST(RenderJob, BruteEvaluatesEveryLightAndCountsTheOracle) {
     EXPECT_LT(oracle, covered * lightCount);  // the falloff has finite support
 }
 
+// Culling on a lossy G-buffer must stay conservative for the surface it shades: the normal cone
+// of tiled-backface, the depth bounds of tiled and clustered come from decoded values, and the
+// oracle is counted on the same decoded surface.
+TEST(RenderJob, CullingStaysConservativeOnLossyLayouts) {
+    for (const char* stage : {"tiled-backface", "clustered", "deferred", "light-indexed"})
+        for (const auto& [normals, depth] : {std::pair{"octahedral:16", "unorm16"},
+                                             std::pair{"pixel-view:16", "f16-linear"},
+                                             std::pair{"xy-z:16", "unorm24"}}) {
+            RenderOptions options = smallAtrium(0);
+            options.scene = "wall";
+            options.sceneOptions["behind"] = "24";
+            options.stage = stage;
+            options.normals = normals;
+            options.depth = depth;
+            const RenderRun run = runRender(options);
+            EXPECT_EQ(run.gbuffer().layout().normals.text(), normals);
+            size_t dropped = 0;
+            for (size_t pixel = 0; pixel < run.oracle.size(); ++pixel)
+                dropped += run.result.lightsEvaluated[pixel] < run.oracle[pixel];
+            EXPECT_EQ(dropped, 0u) << stage << " " << normals << " " << depth;
+        }
+}
+
+// Issue 4's acceptance check at test size: spheremap:16 costs more error than
+// octahedral-precise:32 and fewer bytes per pixel than float32.
+TEST(RenderJob, NormalEncodingsTradeBytesForError) {
+    auto render = [](const char* normals) {
+        RenderOptions options = smallAtrium(0);
+        options.compareReference = true;
+        options.normals = normals;
+        return runRender(options);
+    };
+    const RenderRun spheremap = render("spheremap:16");
+    const RenderRun octahedral = render("octahedral-precise:32");
+    const RenderRun exact = render("float32:96");
+    ASSERT_TRUE(spheremap.error && octahedral.error && exact.error);
+    EXPECT_GT(spheremap.error->rmse, octahedral.error->rmse);
+    EXPECT_GT(octahedral.error->rmse, exact.error->rmse);
+    EXPECT_LT(spheremap.gbuffer().layout().bytesPerPixel(), exact.gbuffer().layout().bytesPerPixel());
+    EXPECT_GT(spheremap.error->p99Abs, 0.0);
+    EXPECT_LE(spheremap.error->p99Abs, spheremap.error->maxAbs);
+}
+
+TEST(RenderJob, RepetitionsRecordEveryPassAndAGivenReferenceIsReused) {
+    RenderOptions options = smallAtrium(0);
+    options.stage = "tiled";
+    options.warmup = 1;
+    options.repetitions = 3;
+    const lighting::StageResult reference = renderReference(options);
+    const RenderRun run = runRender(options, {}, &reference);
+    ASSERT_TRUE(run.error.has_value());
+    EXPECT_EQ(run.prepared->exact, nullptr) << "the given reference must not be rendered again";
+    std::vector<std::string> passes;
+    for (const PassTiming& timing : run.passTimings) {
+        passes.push_back(timing.pass);
+        EXPECT_EQ(timing.samplesMs.size(), 3u) << timing.pass;
+        EXPECT_LE(timing.minMs(), timing.medianMs());
+        EXPECT_LE(timing.medianMs(), timing.maxMs());
+    }
+    EXPECT_EQ(passes, (std::vector<std::string>{"gbuffer", "cull", "shading", "total"}));
+    // The same reference rendered inside the job gives the same error.
+    options.compareReference = true;
+    const RenderRun inside = runRender(options);
+    EXPECT_EQ(inside.error->rmse, run.error->rmse);
+}
+
 struct BadCase {
     const char* name;
     RenderOptions options;
@@ -160,14 +228,14 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
     testing::internal::CaptureStdout();
     ASSERT_EQ(experiments::runRenderCommand(options), 0);
     testing::internal::GetCapturedStdout();
-    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "stats.json"})
+    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
         EXPECT_TRUE(std::filesystem::is_regular_file(out / file)) << file;
 
     auto input = OIIO::ImageInput::open((out / "render.exr").string());
     ASSERT_TRUE(input);
     const std::vector<std::string> expected = {"R", "G", "B", "N.X", "N.Y", "N.Z", "Z", "albedo.R",
                                                "albedo.G", "albedo.B", "lights.evaluated", "lights.oracle",
-                                               "lights.wasted"};
+                                               "lights.wasted", "error.R", "error.G", "error.B"};
     for (const std::string& name : expected) {
         const auto& names = input->spec().channelnames;
         EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
@@ -181,8 +249,15 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
         EXPECT_TRUE(stats.contains(key)) << key;
     for (const char* pass : {"gbuffer", "shading", "total"})
         EXPECT_TRUE(stats["timings_ms"].contains(pass)) << pass;
-    for (const char* metric : {"rmse", "max_abs", "psnr"})
+    for (const char* metric : {"rmse", "max_abs", "psnr", "relative_mean", "p99_abs"})
         EXPECT_TRUE(stats["error"].contains(metric)) << metric;
+    // The layout: every plane with name, format and bits, and the bytes per pixel they add up to.
+    int bits = 0;
+    for (const auto& plane : stats["layout"]["planes"]) {
+        for (const char* key : {"name", "format", "bits"}) EXPECT_TRUE(plane.contains(key)) << key;
+        bits += plane["bits"].get<int>();
+    }
+    EXPECT_DOUBLE_EQ(stats["bytes_per_pixel"].get<double>(), bits / 8.0);
     EXPECT_GE(stats["triangles"].get<uint64_t>(), 250000u);
 }
 
