@@ -2,9 +2,19 @@
 // stage tests these and never the raw range, so a light is never dropped by rounding: the radius
 // is widened by kCullingSlack (relative) + kCullingSlackMetres (absolute), far more than the
 // float error of the positions a stage reconstructs, and the widening only ever adds work.
-// Directional and ambient lights are unbounded (they reach every pixel).
+// Directional and ambient lights are unbounded (they reach every pixel). A spot light lights only
+// the points within its range AND its outer cone, so its sphere is the smallest sphere around that
+// spherical sector (cone plus cap), which for narrow cones is far smaller than the range sphere:
+//   half-angle t <= 45 deg: centre apex + r / (2 cos t) along the axis, radius r / (2 cos t)
+//   45 deg < t < 90 deg:    centre apex + r cos t along the axis,     radius r sin t
+//   t >= 90 deg:            the range sphere
+// (each contains the apex, the rim and the whole cap; derivation in the function). The emitter's
+// own position stays in `positionView`: tests about where light comes from (back-face culling)
+// use it, tests about where light lands use the sphere.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -17,9 +27,10 @@ inline constexpr float kCullingSlack = 1e-4f;         // relative to the range
 inline constexpr float kCullingSlackMetres = 1e-4f;   // absolute, for tiny ranges
 
 struct LightSphere {
-    glm::vec3 centreView{0.0f};
+    glm::vec3 centreView{0.0f};  // centre of the bounding sphere of the lit region
     float radius = 0.0f;
-    bool unbounded = false;  // directional / ambient
+    bool unbounded = false;        // directional / ambient
+    glm::vec3 positionView{0.0f};  // the emitter (equal to centreView for point lights)
 };
 
 inline std::vector<LightSphere> boundingSpheresView(const LightList& lights) {
@@ -28,9 +39,27 @@ inline std::vector<LightSphere> boundingSpheresView(const LightList& lights) {
     for (const LightInView<float>& light : lights.lights) {
         LightSphere sphere;
         sphere.centreView = light.positionView;
+        sphere.positionView = light.positionView;
         sphere.unbounded = light.type == scenes::LightType::Directional ||
                            light.type == scenes::LightType::Ambient;
-        sphere.radius = light.rangeMetres * (1.0f + kCullingSlack) + kCullingSlackMetres;
+        double radius = light.rangeMetres;
+        if (light.type == scenes::LightType::Spot && light.spotOuterCos > 0.0f) {
+            // A lit point p = apex + d u with d < r and u . axis > cos t. For a centre c = apex + k
+            // axis, |p - c|^2 = d^2 + k^2 - 2 d k (u . axis) <= d^2 + k^2 - 2 d k cos t, largest
+            // at d = r (it is convex in d and d = 0 gives k^2 <= R^2). With k = R = r / (2 cos t)
+            // this is r^2 - 2 r R cos t + R^2 = R^2; with k = r cos t, R = r sin t it is
+            // r^2 - r^2 cos^2 t = R^2, and k <= R (the apex) holds for t >= 45 degrees.
+            const double cosT = light.spotOuterCos, r = light.rangeMetres;
+            const double sinT = std::sqrt(std::max(0.0, 1.0 - cosT * cosT));
+            const bool narrow = cosT >= std::sqrt(0.5);
+            const double offset = narrow ? r / (2.0 * cosT) : r * cosT;
+            radius = narrow ? offset : r * sinT;
+            const glm::dvec3 axis = glm::normalize(glm::dvec3(light.directionView));
+            sphere.centreView = glm::vec3(glm::dvec3(light.positionView) + offset * axis);
+            // The centre was rounded to float: grow by its rounding (relative to its magnitude).
+            radius += 4e-7 * (glm::length(glm::dvec3(sphere.centreView)) + r);
+        }
+        sphere.radius = float(radius) * (1.0f + kCullingSlack) + kCullingSlackMetres;
         spheres.push_back(sphere);
     }
     return spheres;

@@ -248,6 +248,7 @@ std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, cons
         CandidateLight& c = candidates[k];
         c.index = visible[k];
         c.centreView = s.centreView;
+        c.positionView = s.positionView;
         c.radius = s.radius;
         c.unbounded = s.unbounded;
         if (s.unbounded)

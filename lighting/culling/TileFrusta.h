@@ -148,6 +148,7 @@ std::vector<uint32_t> lightsInViewFrustum(const gbuffer::FrameView& view, const 
 struct CandidateLight {
     uint32_t index = 0;
     glm::vec3 centreView{0.0f};
+    glm::vec3 positionView{0.0f};  // the emitter (LightSphere::positionView)
     float radius = 0.0f;
     bool unbounded = false;
     int columnMin = 0, columnMax = -1, rowMin = 0, rowMax = -1;

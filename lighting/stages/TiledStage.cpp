@@ -102,7 +102,7 @@ public:
                     (depthRangeMask(low, high, b.minDepthMetres, b.maxDepthMetres) & b.depthMask) ==
                         0)
                     continue;
-                if (mOptions.backface && lightBackFacesTile(box, b, c.centreView)) {
+                if (mOptions.backface && lightBackFacesTile(box, b, c.positionView)) {
                     ++rejected;
                     continue;
                 }

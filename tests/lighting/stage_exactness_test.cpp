@@ -22,6 +22,7 @@ struct SceneCase {
     const char* scene;
     int lights;
     std::map<std::string, std::string> options;
+    bool spots = false;  // turn the generated point lights into spot lights of varied cones
 };
 
 // Small images keep the suite fast; light counts are high enough that culling matters.
@@ -32,7 +33,26 @@ const SceneCase kScenes[] = {
     {"atrium", "atrium", 300, {}},
     {"wall_behind", "wall", 400, {{"behind", "200"}}},
     {"spheres", "spheres", 200, {}},
+    {"atrium_spots", "atrium", 300, {}, true},
 };
+
+// Deterministic spot lights from the generated point lights: axes spread over the lower
+// hemisphere, outer half-angles from 5 to 100 degrees (both sides of the 45- and 90-degree cases
+// of the cone bound in LightBounds.h), inner cone at 80% of the outer.
+void makeSpots(scenes::Scene& scene) {
+    int index = 0;
+    for (scenes::Light& light : scene.lights) {
+        if (light.type != scenes::LightType::Point) continue;
+        const float a = 2.399963f * float(index);  // golden angle: spread without clumping
+        light.type = scenes::LightType::Spot;
+        light.directionWorld = glm::normalize(glm::vec3(std::cos(a), -0.2f - 0.8f * float(index % 5) / 4.0f, std::sin(a)));
+        const float outer = glm::radians(5.0f + 95.0f * float(index % 11) / 10.0f);
+        light.spotOuterCos = std::cos(outer);
+        light.spotInnerCos = std::cos(0.8f * outer);
+        light.rangeMetres *= 1.5f;  // spots reach farther: more pixels to cull correctly
+        ++index;
+    }
+}
 
 // One frame per scene case, its oracle and brute's image, shared by every stage's test.
 struct PreparedCase {
@@ -50,8 +70,9 @@ const PreparedCase& prepared(const SceneCase& c) {
     request.lightCount = c.lights;
     request.seed = 3;
     request.options = c.options;
-    slot->prepared = std::make_unique<lighting::PreparedFrame>(
-        scenes::buildProceduralScene(c.scene, request), kWidth, kHeight);
+    scenes::Scene scene = scenes::buildProceduralScene(c.scene, request);
+    if (c.spots) makeSpots(scene);
+    slot->prepared = std::make_unique<lighting::PreparedFrame>(std::move(scene), kWidth, kHeight);
     slot->oracle = lighting::countContributingLights(slot->prepared->frame);
     lighting::makeStage("brute")->shade(slot->prepared->frame, slot->brute);
     return *slot;
@@ -109,6 +130,30 @@ INSTANTIATE_TEST_SUITE_P(
         std::replace(name.begin(), name.end(), '-', '_');
         return name;
     });
+
+// The cone bound must cut work: on atrium with spot lights, tiled evaluates markedly fewer lights
+// than it would with the range spheres of point lights at the same places.
+TEST(SpotBounds, ConeBoundsCullMoreThanRangeSpheres) {
+    const PreparedCase& spots = prepared(kScenes[3]);
+    lighting::StageResult withCones;
+    lighting::makeStage("tiled")->shade(spots.prepared->frame, withCones);
+    scenes::SceneRequest request;
+    request.lightCount = kScenes[3].lights;
+    request.seed = 3;
+    scenes::Scene scene = scenes::buildProceduralScene("atrium", request);
+    makeSpots(scene);
+    for (scenes::Light& light : scene.lights)
+        if (light.type == scenes::LightType::Spot) light.spotOuterCos = -1.0f;  // whole sphere, same range
+    lighting::PreparedFrame spheres(std::move(scene), kWidth, kHeight);
+    lighting::StageResult withSpheres;
+    lighting::makeStage("tiled")->shade(spheres.frame, withSpheres);
+    uint64_t cones = 0, rangeSpheres = 0;
+    for (size_t pixel = 0; pixel < withCones.lightsEvaluated.size(); ++pixel) {
+        cones += withCones.lightsEvaluated[pixel];
+        rangeSpheres += withSpheres.lightsEvaluated[pixel];
+    }
+    EXPECT_LT(double(cones), 0.8 * double(rangeSpheres)) << cones << " vs " << rangeSpheres;
+}
 
 TEST(StageRegistry, EveryStageRejectsUnknownOptions) {
     for (const lighting::StageInfo& info : lighting::stageInfos())
