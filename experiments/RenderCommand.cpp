@@ -181,6 +181,7 @@ nlohmann::json statsJson(const RenderRun& run) {
                        {"depth", layout.depth.text()},
                        {"position", gbuffer::positionMethodName(layout.position)},
                        {"normals", layout.hasNormals ? layout.normals.text() : "none"},
+                       {"normal_space", gbuffer::normalSpaceName(layout.normalSpace)},
                        {"albedo", gbuffer::albedoEncodingName(layout.albedo)},
                        {"specular", gbuffer::specularEncodingName(layout.specular)},
                        {"planes", planes},

@@ -95,6 +95,7 @@ gbuffer::LayoutRequest layoutRequest(const RenderOptions& options) {
         if (!options.normals.empty()) request.normals = gbuffer::NormalCodecSpec::parse(options.normals);
         if (!options.depth.empty()) request.depth = gbuffer::DepthFormatSpec::parse(options.depth);
         if (!options.position.empty()) request.position = gbuffer::parsePositionMethod(options.position);
+        if (!options.normalSpace.empty()) request.normalSpace = gbuffer::parseNormalSpace(options.normalSpace);
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
     }
@@ -130,7 +131,7 @@ Number parseNumber(const std::string& key, const std::string& value) {
 
 std::vector<std::string> renderOptionKeys() {
     return {"scene", "stage",  "lights", "seed",   "width",    "height",
-            "resolution", "threads", "layout", "normals", "depth", "position",
+            "resolution", "threads", "layout", "normals", "normal-space", "depth", "position",
             "scene-option.<key>"};
 }
 
@@ -145,6 +146,7 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
     else if (key == "threads") options.threads = parseNumber<int>(key, value);
     else if (key == "layout") options.layout = value;
     else if (key == "normals") options.normals = value;
+    else if (key == "normal-space") options.normalSpace = value;
     else if (key == "depth") options.depth = value;
     else if (key == "position") options.position = value;
     else if (key == "resolution") {

@@ -42,6 +42,7 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
     render.add_option("--depth", r.depth,
                       "depth format: f32, f32-reversed, unorm24, unorm16, f16-linear, optionally :infinite");
     render.add_option("--position", r.position, "position reconstruction: inverse-projection or view-ray");
+    render.add_option("--normal-space", r.normalSpace, "space normals are encoded in: view (default) or world");
     render.add_flag("--explain-layout", options.explainLayout,
                     "print the G-buffer layout and why each plane is there, then exit without rendering");
     render.add_option("--warmup", r.warmup, "untimed runs before the timed ones")->capture_default_str();

@@ -45,6 +45,7 @@ GBuffer::GBuffer(const GBufferLayout& layout, const FrameView& view)
                                     (layout.depth.convention() == DepthConvention::Reversed ? "reversed" : "standard") +
                                     "-Z view" + (layout.depth.infiniteFar ? " with an infinite far plane" : "") +
                                     "; the frame's view differs");
+    mWorldFromView = glm::transpose(view.viewFromWorldNormal);
     const size_t n = pixelCount();
     mDepth.assign(n, mClearDepth);  // depth is always there: coverage and positions come from it
     if (layout.hasNormals) {
@@ -103,7 +104,9 @@ void GBuffer::writeSurface(size_t pixel, const Surface& s) {
         mNormal[1][pixel] = s.normalView.y;
         mNormal[2][pixel] = s.normalView.z;
     } else if (!mNormalCode32.empty() || !mNormalCode64.empty()) {
-        const NormalCode code = encodeNormal(mLayout.normals, s.normalView, viewRayOfPixel(pixel));
+        const glm::vec3 normal =
+            mLayout.normalSpace == NormalSpace::World ? mWorldFromView * s.normalView : s.normalView;
+        const NormalCode code = encodeNormal(mLayout.normals, normal, viewRayOfPixel(pixel));
         if (!mNormalCode32.empty()) mNormalCode32[pixel] = uint32_t(code.low);
         else mNormalCode64[pixel] = code.low;
     }
@@ -147,6 +150,7 @@ Surface GBuffer::decode(int x, int y) const {
         NormalCode code;
         code.low = !mNormalCode32.empty() ? mNormalCode32[pixel] : mNormalCode64[pixel];
         s.normalView = decodeNormal(mLayout.normals, code, viewRayOfNdc(mView, mView.ndcOfPixel(x, y)));
+        if (mLayout.normalSpace == NormalSpace::World) s.normalView = mView.viewFromWorldNormal * s.normalView;
     }
     if (!mMaterial.empty()) s.material = mMaterial[pixel];
     const MaterialConstants* material =

@@ -77,6 +77,7 @@ private:
     GBufferLayout mLayout;
     FrameView mView;
     DepthProjection mProjection;
+    glm::mat3 mWorldFromView{1.0f};  // for world-space normal codes (viewFromWorldNormal is a rotation)
     float mClearDepth;
     std::vector<float> mDepth;
     std::vector<float> mNormal[3];          // float32 normals

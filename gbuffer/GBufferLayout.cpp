@@ -45,6 +45,18 @@ const char* channelName(Channel channel) {
     return "?";
 }
 
+const char* normalSpaceName(NormalSpace space) { return space == NormalSpace::View ? "view" : "world"; }
+
+NormalSpace parseNormalSpace(const std::string& text) {
+    if (text == "view") return NormalSpace::View;
+    if (text == "world") return NormalSpace::World;
+    throw std::invalid_argument("unknown normal space '" + text + "'; valid: view, world");
+}
+
+bool codecWorksInWorldSpace(NormalCodecKind kind) {
+    return kind != NormalCodecKind::XyReconstructZ && kind != NormalCodecKind::PixelView;
+}
+
 const char* albedoEncodingName(AlbedoEncoding encoding) {
     for (const AlbedoInfo& info : kAlbedoEncodings)
         if (info.encoding == encoding) return info.name;
@@ -90,9 +102,11 @@ std::vector<PlaneDesc> GBufferLayout::planes() const {
     result.push_back({"Z", depth.text(), depth.bits(), "depth"});
     if (hasNormals) {
         if (normals.kind == NormalCodecKind::Float32) {
-            for (const char* name : {"N.X", "N.Y", "N.Z"}) result.push_back({name, "f32", 32, "normal"});
+            for (const char* name : {"N.X", "N.Y", "N.Z"})
+                result.push_back({name, std::string("f32, ") + normalSpaceName(normalSpace) + " space", 32, "normal"});
         } else {
-            result.push_back({"N", "code of " + normals.text(), normals.bits, "normal"});
+            result.push_back({"N", "code of " + normals.text() + ", " + normalSpaceName(normalSpace) + " space",
+                              normals.bits, "normal"});
         }
     }
     switch (albedo) {

@@ -34,6 +34,16 @@ namespace gbuffer {
 enum class Channel { Depth, Normal, Albedo, Specular };
 const char* channelName(Channel channel);
 
+// Where normals are encoded. View space suits the hemisphere codecs (xy-z, pixel-view,
+// stereographic put their precision where visible normals are); world space keeps codes
+// independent of the camera (e.g. for temporal reuse) but needs full-sphere codecs.
+enum class NormalSpace { View, World };
+const char* normalSpaceName(NormalSpace space);  // "view", "world"
+NormalSpace parseNormalSpace(const std::string& text);
+// Whether a codec can hold world-space normals (every direction is equally likely there):
+// false for xy-z and pixel-view, which assume a visible hemisphere.
+bool codecWorksInWorldSpace(NormalCodecKind kind);
+
 enum class AlbedoEncoding { None, Constant, Material, Rgb8Srgb, Float32 };
 enum class SpecularEncoding { None, Constant, Material, Unorm8Log8, Unorm8Half, Float32 };
 const char* albedoEncodingName(AlbedoEncoding encoding);      // "none", "constant", ...
@@ -64,6 +74,7 @@ struct GBufferLayout {
     PositionMethod position = PositionMethod::InverseProjection;
     bool hasNormals = true;
     NormalCodecSpec normals{NormalCodecKind::Float32, 96};
+    NormalSpace normalSpace = NormalSpace::View;
     AlbedoEncoding albedo = AlbedoEncoding::Float32;
     SpecularEncoding specular = SpecularEncoding::Float32;
     std::vector<MaterialConstants> materials;  // index = scene material, for `material`

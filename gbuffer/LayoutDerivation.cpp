@@ -210,8 +210,12 @@ GBufferLayout makeLayout(const scenes::Scene& scene, const std::vector<Channel>&
                                                                                  : PositionMethod::InverseProjection;
     }
     if (request.position) layout.position = *request.position;
-    if (request.preset.empty() && (request.normals || request.depth || request.position)) layout.name = "derived+overrides";
-    if (!request.preset.empty() && (request.normals || request.depth || request.position)) layout.name += "+overrides";
+    if (request.normalSpace) layout.normalSpace = *request.normalSpace;
+    if (layout.hasNormals && layout.normalSpace == NormalSpace::World && !codecWorksInWorldSpace(layout.normals.kind))
+        throw std::invalid_argument("normal encoding " + layout.normals.text() +
+                                    " assumes view-space normals facing the camera; it cannot store world-space normals");
+    if (request.preset.empty() && (request.normals || request.depth || request.position || request.normalSpace)) layout.name = "derived+overrides";
+    if (!request.preset.empty() && (request.normals || request.depth || request.position || request.normalSpace)) layout.name += "+overrides";
     for (Channel channel : stageReads)
         if (!layout.provides(channel))
             throw std::invalid_argument("stage '" + stageName + "' reads the " + channelName(channel) +

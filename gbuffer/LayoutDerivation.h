@@ -32,6 +32,7 @@ struct LayoutRequest {
     std::optional<NormalCodecSpec> normals;  // overrides
     std::optional<DepthFormatSpec> depth;
     std::optional<PositionMethod> position;
+    std::optional<NormalSpace> normalSpace;
 };
 
 std::vector<std::string> layoutPresetNames();

@@ -202,3 +202,29 @@ TEST(GBufferStorage, LossyEncodingsDecodeCloseToTheLosslessSurface) {
 }
 
 }  // namespace
+
+namespace {
+
+// World-space codes decode back to the same view-space normals (within the codec's error), and
+// the hemisphere codecs refuse world space.
+TEST(GBufferStorage, WorldSpaceNormalsDecodeToViewSpace) {
+    const scenes::Scene scene = scenes::buildProceduralScene("atrium", {});
+    lighting::PreparedFrame lossless(scenes::Scene(scene), 160, 90, false, gbuffer::deriveLayout(scene, kEverything));
+    gbuffer::LayoutRequest request;
+    request.normals = gbuffer::NormalCodecSpec::parse("octahedral:24");
+    request.normalSpace = gbuffer::NormalSpace::World;
+    const gbuffer::GBufferLayout world = gbuffer::makeLayout(scene, kEverything, "brute", request);
+    lighting::PreparedFrame encoded(scenes::Scene(scene), 160, 90, false, world);
+    double worst = 0.0;
+    for (int y = 0; y < 90; ++y)
+        for (int x = 0; x < 160; ++x) {
+            if (!lossless.gbuffer->covered(size_t(y) * 160 + x)) continue;
+            worst = std::max(worst, gbuffer::normalAngleRadians(lossless.gbuffer->decode(x, y).normalView,
+                                                                encoded.gbuffer->decode(x, y).normalView));
+        }
+    EXPECT_LT(glm::degrees(worst), 0.1);  // octahedral 2x12 bits: max ~0.06 degrees
+    request.normals = gbuffer::NormalCodecSpec::parse("xy-z:16");
+    EXPECT_THROW(gbuffer::makeLayout(scene, kEverything, "brute", request), std::invalid_argument);
+}
+
+}  // namespace
