@@ -14,6 +14,7 @@ packages=(
     libglm-dev libtbb-dev libopenimageio-dev openimageio-tools libopenexr-dev
     libtinygltf-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev
     fonts-dejavu-core
+    libtomlplusplus-dev
 )
 missing=()
 for p in "${packages[@]}"; do

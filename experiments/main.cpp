@@ -1,6 +1,8 @@
 // testbed: the command-line front end. Subcommands:
 //   render  one scene, one stage -> render.exr, preview.png, heatmap.png, stats.json
 //   list    scenes, stages and normal encodings known to this build
+//   sweep   a sweep file -> one job folder per job, results.csv/json (resumable, shardable)
+//   merge   shard outputs of one sweep -> one results set
 //   normals normal-encoding precision study -> normals.csv, normals.json, plots
 // Every option's default is stated by --help; unknown options are errors.
 #include <iostream>
@@ -10,6 +12,8 @@
 
 #include "experiments/NormalStudy.h"
 #include "experiments/RenderCommand.h"
+#include "experiments/SweepFile.h"
+#include "experiments/SweepRunner.h"
 #include "gbuffer/NormalCodec.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
@@ -106,6 +110,23 @@ int main(int argc, char** argv) {
                         "matplotlib script (default: experiments/plots/normals.py of the source tree)");
     normals->add_option("--python", normalsOptions.python,
                         "Python with matplotlib (default: python3, else /usr/bin/python3)");
+    experiments::SweepOptions sweepOptions;
+    std::string shardText = "1/1";
+    int sweepThreads = -1;
+    CLI::App* sweep = app.add_subcommand("sweep", "run a sweep file (JSON or TOML; experiments/README.md)");
+    sweep->add_option("file", sweepOptions.file, "sweep file")->required();
+    sweep->add_option("--out", sweepOptions.out, "output folder (resumable: finished jobs are skipped)")
+        ->capture_default_str();
+    sweep->add_option("--shard", shardText, "run shard I of N (1-based): a deterministic 1/N of the jobs")
+        ->capture_default_str();
+    sweep->add_flag("--quick", sweepOptions.quick, "apply the file's \"quick\" block (CI size)");
+    sweep->add_option("--threads", sweepThreads,
+                      "worker threads of every job, 0 = all hardware threads (default: the file's)");
+    std::vector<std::filesystem::path> mergeInputs;
+    std::filesystem::path mergeOut;
+    CLI::App* merge = app.add_subcommand("merge", "combine the output folders of a sweep's shards");
+    merge->add_option("dirs", mergeInputs, "sweep output folders")->required();
+    merge->add_option("--out", mergeOut, "merged output folder (may be one of the inputs)")->required();
     CLI11_PARSE(app, argc, argv);
     if (render->parsed()) {
         for (const std::string& text : sceneOptionTexts) {
@@ -119,6 +140,17 @@ int main(int argc, char** argv) {
         return experiments::runRenderCommand(renderOptions);
     }
     if (list->parsed()) return listEverything();
+    if (sweep->parsed()) {
+        try {
+            std::tie(sweepOptions.shardIndex, sweepOptions.shardCount) = experiments::parseShard(shardText);
+        } catch (const std::exception& e) {
+            std::cerr << "testbed: error: " << e.what() << "\n";
+            return 2;
+        }
+        if (sweepThreads >= 0) sweepOptions.threads = sweepThreads;
+        return experiments::runSweepCommand(sweepOptions);
+    }
+    if (merge->parsed()) return experiments::runMergeCommand(mergeInputs, mergeOut);
     if (normals->parsed()) {
         if (normals->count("--directions") > 0) normalsOptions.directions = normalsDirections;
         if (normals->count("--models") > 0) normalsOptions.modelsDir = normalsModels;

@@ -1,0 +1,220 @@
+#include "experiments/ResultsTable.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <system_error>
+
+#include "experiments/AtomicFile.h"
+#include "experiments/SweepFile.h"
+
+namespace experiments {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+namespace {
+
+const std::string kTimePrefix = "time_";
+const std::string kMedianSuffix = "_median_ms";
+
+// Pipeline order of the passes stages report; anything else goes after them by name.
+const std::vector<std::string> kPassOrder = {"gbuffer", "exact_surface", "transform", "prepass",
+                                             "cull",    "assign",        "index",     "shading",
+                                             "lighting", "material", "stage"};
+const std::vector<std::string> kMetricColumns = {
+    "light_evaluations", "oracle_evaluations", "culling_efficiency", "bytes_per_pixel", "rmse",
+    "relative_rmse",     "psnr",               "max_abs",            "relative_mean",   "p99_abs"};
+
+bool endsWith(const std::string& text, const std::string& suffix) {
+    return text.size() >= suffix.size() &&
+           text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string csvField(const Json& value) {
+    if (value.is_null()) return "";
+    std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+    const bool quote = text.find_first_of(",\"\r\n") != std::string::npos ||
+                       (!text.empty() && (text.front() == ' ' || text.back() == ' '));
+    if (!quote) return text;
+    std::string quoted = "\"";
+    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return quoted + "\"";
+}
+
+std::string readText(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw SweepError(path.string() + ": cannot open");
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+// Hard link when the file system allows it (no copy of EXRs), else a copy.
+void linkOrCopy(const fs::path& from, const fs::path& to) {
+    std::error_code error;
+    fs::remove(to, error);
+    fs::create_hard_link(from, to, error);
+    if (error) fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+}
+
+bool samePath(const fs::path& a, const fs::path& b) {
+    std::error_code error;
+    return fs::exists(a) && fs::exists(b) && fs::equivalent(a, b, error);
+}
+
+}  // namespace
+
+std::vector<std::string> metricColumns(const std::vector<Json>& rows) {
+    std::set<std::string> passes;
+    for (const Json& row : rows)
+        for (const auto& [key, value] : row.items())
+            if (!value.is_null() && key.rfind(kTimePrefix, 0) == 0 && endsWith(key, kMedianSuffix))
+                passes.insert(key.substr(kTimePrefix.size(),
+                                         key.size() - kTimePrefix.size() - kMedianSuffix.size()));
+    std::vector<std::string> ordered;
+    for (const std::string& pass : kPassOrder)
+        if (passes.count(pass)) ordered.push_back(pass);
+    for (const std::string& pass : passes)  // std::set: by name
+        if (std::find(kPassOrder.begin(), kPassOrder.end(), pass) == kPassOrder.end() && pass != "total")
+            ordered.push_back(pass);
+    if (passes.count("total")) ordered.push_back("total");
+    std::vector<std::string> columns;
+    for (const std::string& pass : ordered)
+        for (const char* statistic : {"median", "min", "max"})
+            columns.push_back(kTimePrefix + pass + "_" + statistic + "_ms");
+    columns.insert(columns.end(), kMetricColumns.begin(), kMetricColumns.end());
+    return columns;
+}
+
+Json resultsJson(const Json& sweep, const std::string& sweepFile, bool quick,
+                 const std::vector<std::string>& axisColumns, std::vector<Json> rows) {
+    std::vector<std::string> columns = {"job_id", "status", "error"};
+    columns.insert(columns.end(), axisColumns.begin(), axisColumns.end());
+    const std::vector<std::string> metrics = metricColumns(rows);
+    columns.insert(columns.end(), metrics.begin(), metrics.end());
+    std::sort(rows.begin(), rows.end(), [](const Json& a, const Json& b) {
+        return a.value("job_id", "") < b.value("job_id", "");
+    });
+    Json jobs = Json::array();
+    for (const Json& row : rows) {
+        Json complete = Json::object();
+        for (const std::string& column : columns)
+            complete[column] = row.contains(column) ? row[column] : Json(nullptr);
+        jobs.push_back(std::move(complete));
+    }
+    Json results = Json::object();
+    results["sweep"] = sweep;
+    results["sweep_file"] = sweepFile;
+    results["quick"] = quick;
+    results["columns"] = columns;
+    results["axis_columns"] = axisColumns;
+    results["jobs"] = std::move(jobs);
+    return results;
+}
+
+std::string resultsCsv(const Json& results) {
+    std::string csv;
+    const Json& columns = results.at("columns");
+    for (size_t c = 0; c < columns.size(); ++c) {
+        if (c) csv += ',';
+        csv += csvField(columns[c]);
+    }
+    csv += "\n";
+    for (const Json& job : results.at("jobs")) {
+        for (size_t c = 0; c < columns.size(); ++c) {
+            const std::string name = columns[c].get<std::string>();
+            if (c) csv += ',';
+            csv += csvField(job.contains(name) ? job[name] : Json(nullptr));
+        }
+        csv += "\n";
+    }
+    return csv;
+}
+
+void writeResults(const fs::path& dir, const Json& results) {
+    writeTextAtomically(dir / "results.json", results.dump(2) + "\n");
+    writeTextAtomically(dir / "results.csv", resultsCsv(results));
+}
+
+Json readResults(const fs::path& dir) {
+    const fs::path file = dir / "results.json";
+    if (!fs::is_regular_file(file))
+        throw SweepError(file.string() + ": not found (is " + dir.string() + " a sweep output folder?)");
+    Json results;
+    try {
+        results = Json::parse(readText(file));
+    } catch (const nlohmann::json::parse_error& e) {
+        throw SweepError(file.string() + ": not valid JSON: " + e.what());
+    }
+    for (const char* key : {"sweep", "sweep_file", "quick", "columns", "axis_columns", "jobs"})
+        if (!results.contains(key)) throw SweepError(file.string() + ": lacks '" + key + "'");
+    return results;
+}
+
+size_t mergeSweepOutputs(const std::vector<fs::path>& inputs, const fs::path& out) {
+    if (inputs.empty()) throw SweepError("merge: no input folders");
+    std::vector<Json> results;
+    for (const fs::path& input : inputs) results.push_back(readResults(input));
+    const Json& first = results.front();
+    for (size_t i = 1; i < results.size(); ++i)
+        for (const char* key : {"sweep", "quick", "axis_columns"})
+            if (results[i][key] != first[key])
+                throw SweepError("merge: " + inputs[i].string() + " and " + inputs[0].string() +
+                                 " are not outputs of the same sweep: their '" + key + "' differ");
+
+    struct Source {
+        fs::path folder;
+        Json row;
+    };
+    std::map<std::string, Source> jobs;  // by job_id
+    for (size_t i = 0; i < results.size(); ++i)
+        for (const Json& listed : results[i]["jobs"]) {
+            const std::string id = listed.at("job_id").get<std::string>();
+            const fs::path folder = inputs[i] / "jobs" / id;
+            if (!fs::is_regular_file(folder / kDoneMarker))
+                throw SweepError("merge: " + (folder / kDoneMarker).string() +
+                                 " missing although results.json lists the job");
+            // The marker's row, not the table's (which is padded with the table's columns).
+            Json marker;
+            try {
+                marker = Json::parse(readText(folder / kDoneMarker));
+            } catch (const nlohmann::json::parse_error& e) {
+                throw SweepError("merge: " + (folder / kDoneMarker).string() + ": " + e.what());
+            }
+            if (!marker.contains("row") || marker["row"].value("job_id", "") != id)
+                throw SweepError("merge: " + (folder / kDoneMarker).string() + " is not job " + id + "'s marker");
+            const auto [it, inserted] = jobs.emplace(id, Source{folder, marker["row"]});
+            if (!inserted && it->second.row != marker["row"])
+                throw SweepError("merge: job " + id + " differs between " + it->second.folder.string() +
+                                 " and " + folder.string() + "; refusing to pick one");
+        }
+
+    ensureWritableDirectory(out);
+    std::vector<Json> rows;
+    for (const auto& [id, source] : jobs) {
+        const fs::path target = out / "jobs" / id;
+        if (!samePath(source.folder, target)) {
+            fs::create_directories(target);
+            fs::remove(target / kDoneMarker);  // unfinished until its marker is copied, last
+            for (const fs::directory_entry& entry : fs::directory_iterator(source.folder)) {
+                const std::string name = entry.path().filename().string();
+                if (!entry.is_regular_file() || name == kDoneMarker || name.front() == '.') continue;
+                linkOrCopy(entry.path(), target / name);
+            }
+            writeFileAtomically(target / kDoneMarker, [&](const fs::path& temporary) {
+                fs::copy_file(source.folder / kDoneMarker, temporary, fs::copy_options::overwrite_existing);
+            });
+        }
+        rows.push_back(source.row);
+    }
+    std::vector<std::string> axis;
+    for (const Json& column : first["axis_columns"]) axis.push_back(column.get<std::string>());
+    writeResults(out, resultsJson(first["sweep"], first["sweep_file"].get<std::string>(),
+                                  first["quick"].get<bool>(), axis, std::move(rows)));
+    return jobs.size();
+}
+
+}  // namespace experiments

@@ -1,0 +1,253 @@
+// Sweep files: parsing (JSON and TOML), strict keys, quick overrides, expansion into jobs with
+// stable ids, validation of every job before any runs, reference grouping, and sharding.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+
+#include "experiments/SweepFile.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using experiments::SweepError;
+using experiments::SweepJob;
+using Json = nlohmann::ordered_json;
+
+fs::path testDir(const std::string& name) {
+    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / ("sweep-file-" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+Json baseSweep() {
+    return Json::parse(R"({
+        "name": "unit",
+        "fixed": {"scene": "spheres", "resolution": "160x90", "seed": 3},
+        "axes": {"stage": ["brute", "tiled:tile=8", "clustered"], "lights": [4, 8]},
+        "cases": [{"scene-option.segments": 16}, {"scene-option.segments": 32}],
+        "warmup": 0, "repetitions": 2,
+        "quick": {"fixed": {"resolution": "80x45"}, "axes": {"stage": ["brute"]}, "repetitions": 1}
+    })");
+}
+
+std::string errorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const SweepError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(SweepFile, ExpandsCasesTimesAxesWithStableIds) {
+    const auto spec = experiments::parseSweep(baseSweep(), "unit.json");
+    const auto expansion = experiments::expandSweep(spec);
+    ASSERT_EQ(expansion.jobs.size(), 2u * 3u * 2u);
+    std::set<std::string> ids;
+    std::set<size_t> ordinals;
+    const std::regex idPattern("^[0-9]{4}-[0-9a-f]{8}$");
+    for (const SweepJob& job : expansion.jobs) {
+        EXPECT_TRUE(std::regex_match(job.id, idPattern)) << job.id;
+        EXPECT_EQ(job.id.substr(0, 4), std::string(4 - std::to_string(job.ordinal).size(), '0') +
+                                           std::to_string(job.ordinal));
+        ids.insert(job.id);
+        ordinals.insert(job.ordinal);
+        EXPECT_EQ(job.options.width, 160);
+        EXPECT_EQ(job.options.height, 90);
+        EXPECT_EQ(job.options.repetitions, 2);
+        EXPECT_EQ(job.options.scene, "spheres");
+    }
+    EXPECT_EQ(ids.size(), expansion.jobs.size());
+    EXPECT_EQ(*ordinals.rbegin(), expansion.jobs.size() - 1);
+    // Ordinal order: cases outermost, then the axes in file order, last axis fastest.
+    std::vector<SweepJob> byOrdinal = expansion.jobs;
+    std::sort(byOrdinal.begin(), byOrdinal.end(), [](auto& a, auto& b) { return a.ordinal < b.ordinal; });
+    EXPECT_EQ(byOrdinal[0].options.stage, "brute");
+    EXPECT_EQ(byOrdinal[0].options.lights, 4);
+    EXPECT_EQ(byOrdinal[1].options.lights, 8);
+    EXPECT_EQ(byOrdinal[2].options.stage, "tiled:tile=8");
+    EXPECT_EQ(byOrdinal[0].options.sceneOptions.at("segments"), "16");
+    EXPECT_EQ(byOrdinal[6].options.sceneOptions.at("segments"), "32");
+
+    // The same file expands to the same ids; changing one setting changes only those jobs' ids.
+    const auto again = experiments::expandSweep(experiments::parseSweep(baseSweep(), "other-name.json"));
+    for (size_t i = 0; i < again.jobs.size(); ++i) EXPECT_EQ(again.jobs[i].id, expansion.jobs[i].id);
+    Json changed = baseSweep();
+    changed["fixed"]["seed"] = 4;
+    const auto moved = experiments::expandSweep(experiments::parseSweep(changed, "unit.json"));
+    for (size_t i = 0; i < moved.jobs.size(); ++i) EXPECT_NE(moved.jobs[i].id, expansion.jobs[i].id);
+}
+
+TEST(SweepFile, JobsSharingAReferenceAreAdjacent) {
+    const auto expansion = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
+    // Reference keys: (segments, lights) -> 4 groups of 3 stages each.
+    std::vector<std::string> groups;
+    for (const SweepJob& job : expansion.jobs)
+        if (groups.empty() || groups.back() != job.referenceKey) groups.push_back(job.referenceKey);
+    EXPECT_EQ(groups.size(), 4u);
+    EXPECT_EQ(std::set<std::string>(groups.begin(), groups.end()).size(), 4u) << "a key appears twice";
+    for (const SweepJob& job : expansion.jobs) {
+        EXPECT_EQ(job.referenceKey.find('/'), std::string::npos);
+        EXPECT_EQ(job.referenceKey.rfind("spheres-160x90-", 0), 0u) << job.referenceKey;
+    }
+}
+
+TEST(SweepFile, AxisColumnsInCanonicalOrder) {
+    const auto expansion = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
+    const std::vector<std::string> expected = {"scene",  "stage", "lights", "seed", "resolution", "width",
+                                               "height", "scene-option.segments", "repetitions", "warmup"};
+    EXPECT_EQ(expansion.axisColumns, expected);
+    const SweepJob& job = expansion.jobs.front();
+    EXPECT_EQ(experiments::axisValue(job, "width"), Json(160));
+    EXPECT_EQ(experiments::axisValue(job, "resolution"), Json("160x90"));
+    EXPECT_EQ(experiments::axisValue(job, "repetitions"), Json(2));
+}
+
+TEST(SweepFile, QuickBlockOverrides) {
+    const auto quick = experiments::applyQuick(experiments::parseSweep(baseSweep(), "unit.json"));
+    const auto expansion = experiments::expandSweep(quick);
+    ASSERT_EQ(expansion.jobs.size(), 2u * 1u * 2u);
+    for (const SweepJob& job : expansion.jobs) {
+        EXPECT_EQ(job.options.width, 80);
+        EXPECT_EQ(job.options.stage, "brute");
+        EXPECT_EQ(job.options.repetitions, 1);
+    }
+    // A key moved from the axes to quick.fixed leaves the axes.
+    Json file = baseSweep();
+    file["quick"] = Json::parse(R"({"fixed": {"lights": 2}})");
+    const auto moved = experiments::expandSweep(experiments::applyQuick(experiments::parseSweep(file, "u.json")));
+    EXPECT_EQ(moved.jobs.size(), 2u * 3u);
+    Json noQuick = baseSweep();
+    noQuick.erase("quick");
+    const std::string message = errorOf([&] { experiments::applyQuick(experiments::parseSweep(noQuick, "nq.json")); });
+    EXPECT_NE(message.find("nq.json"), std::string::npos) << message;
+    EXPECT_NE(message.find("quick"), std::string::npos) << message;
+}
+
+TEST(SweepFile, RejectsUnknownKeysNamingFileAndKey) {
+    Json file = baseSweep();
+    file["axis"] = Json::object();  // typo of "axes"
+    std::string message = errorOf([&] { experiments::parseSweep(file, "typo.json"); });
+    EXPECT_NE(message.find("typo.json"), std::string::npos) << message;
+    EXPECT_NE(message.find("'axis'"), std::string::npos) << message;
+
+    file = baseSweep();
+    file["quick"]["repetition"] = 1;
+    message = errorOf([&] { experiments::parseSweep(file, "typo.json"); });
+    EXPECT_NE(message.find("quick.repetition"), std::string::npos) << message;
+
+    file = baseSweep();
+    file["fixed"]["lights"] = 3;  // also an axis
+    message = errorOf([&] { experiments::parseSweep(file, "dup.json"); });
+    EXPECT_NE(message.find("'lights'"), std::string::npos) << message;
+
+    file = baseSweep();
+    file["cases"][1] = Json::parse(R"({"scene-option.behind": 1})");
+    message = errorOf([&] { experiments::parseSweep(file, "cases.json"); });
+    EXPECT_NE(message.find("cases[1]"), std::string::npos) << message;
+
+    file = baseSweep();
+    file["axes"]["lights"] = Json::array({true});
+    message = errorOf([&] { experiments::parseSweep(file, "type.json"); });
+    EXPECT_NE(message.find("axes.lights"), std::string::npos) << message;
+}
+
+TEST(SweepFile, ReportsEveryInvalidJobBeforeRunning) {
+    Json file = baseSweep();
+    file["axes"]["stage"] = Json::array({"brute", "no-such-stage", "tiled:tile=9999"});
+    const std::string message =
+        errorOf([&] { experiments::expandSweep(experiments::parseSweep(file, "bad.json")); });
+    EXPECT_NE(message.find("bad.json"), std::string::npos) << message;
+    EXPECT_NE(message.find("8 of 12 jobs are invalid"), std::string::npos) << message;
+    EXPECT_NE(message.find("stage=no-such-stage"), std::string::npos) << message;
+    EXPECT_NE(message.find("stage=tiled:tile=9999"), std::string::npos) << message;
+
+    file = baseSweep();
+    file["fixed"]["no-such-option"] = 1;
+    const std::string unknown =
+        errorOf([&] { experiments::expandSweep(experiments::parseSweep(file, "bad.json")); });
+    EXPECT_NE(unknown.find("no-such-option"), std::string::npos) << unknown;
+    EXPECT_NE(unknown.find("12 of 12"), std::string::npos) << unknown;
+}
+
+TEST(SweepFile, ChecksPublishedTables) {
+    Json file = baseSweep();
+    file["published"] = Json::parse(R"([{"title": "t", "metric": "time_total_median_ms",
+        "columns": [{"label": "brute", "select": {"stage": "brute"}}],
+        "rows": [{"label": "4 lights", "select": {"lights": 4}, "values": [1.5]}], "ratio_to": 0}])");
+    EXPECT_NO_THROW(experiments::parseSweep(file, "pub.json"));
+    file["published"][0]["rows"][0]["values"] = Json::array({1.0, 2.0});
+    EXPECT_NE(errorOf([&] { experiments::parseSweep(file, "pub.json"); }).find("values"), std::string::npos);
+    file["published"][0]["rows"][0]["values"] = Json::array({nullptr});
+    file["published"][0]["rows"][0]["select"] = Json::parse(R"({"colour": 4})");
+    EXPECT_NE(errorOf([&] { experiments::parseSweep(file, "pub.json"); }).find("colour"), std::string::npos);
+}
+
+TEST(SweepFile, TomlEqualsJson) {
+    const fs::path dir = testDir("toml");
+    std::ofstream(dir / "s.toml") << R"(name = "unit"
+warmup = 0
+repetitions = 2
+
+[fixed]
+scene = "spheres"
+resolution = "160x90"
+seed = 3
+
+[axes]
+stage = ["brute", "tiled:tile=8", "clustered"]
+lights = [4, 8]
+
+[[cases]]
+"scene-option.segments" = 16
+
+[[cases]]
+"scene-option.segments" = 32
+)";
+    std::ofstream(dir / "s.json") << baseSweep().dump();
+    const auto fromToml = experiments::expandSweep(experiments::readSweepFile(dir / "s.toml"));
+    const auto fromJson = experiments::expandSweep(experiments::readSweepFile(dir / "s.json"));
+    ASSERT_EQ(fromToml.jobs.size(), fromJson.jobs.size());
+    std::set<std::string> tomlIds, jsonIds;
+    for (const SweepJob& job : fromToml.jobs) tomlIds.insert(job.id);
+    for (const SweepJob& job : fromJson.jobs) jsonIds.insert(job.id);
+    EXPECT_EQ(tomlIds, jsonIds);
+
+    std::ofstream(dir / "broken.toml") << "name = \"x\"\n[axes\n";
+    const std::string message = errorOf([&] { experiments::readSweepFile(dir / "broken.toml"); });
+    EXPECT_NE(message.find("broken.toml:2"), std::string::npos) << message;
+}
+
+TEST(SweepFile, ShardsPartitionTheJobs) {
+    const auto jobs = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json")).jobs;
+    for (int count : {1, 2, 5, 12, 13}) {
+        std::multiset<std::string> seen;
+        size_t smallest = jobs.size(), largest = 0;
+        for (int index = 1; index <= count; ++index) {
+            const auto shard = experiments::shardJobs(jobs, index, count);
+            smallest = std::min(smallest, shard.size());
+            largest = std::max(largest, shard.size());
+            for (const SweepJob& job : shard) seen.insert(job.id);
+        }
+        EXPECT_EQ(seen.size(), jobs.size()) << count;
+        EXPECT_EQ(std::set<std::string>(seen.begin(), seen.end()).size(), jobs.size()) << count;
+        EXPECT_LE(largest - smallest, 1u) << count;
+    }
+    EXPECT_EQ(experiments::parseShard("2/4"), std::make_pair(2, 4));
+    for (const char* bad : {"0/4", "5/4", "2", "a/b", "2/4x", "-1/2"})
+        EXPECT_THROW(experiments::parseShard(bad), SweepError) << bad;
+}
+
+TEST(SweepFile, SettingTextOfNumbers) {
+    EXPECT_EQ(experiments::settingText(Json(1500), "k"), "1500");
+    EXPECT_EQ(experiments::settingText(Json(1500.0), "k"), "1500");
+    EXPECT_EQ(experiments::settingText(Json(0.25), "k"), "0.25");
+    EXPECT_EQ(experiments::settingText(Json("tiled:tile=32"), "k"), "tiled:tile=32");
+    EXPECT_THROW(experiments::settingText(Json(true), "k"), SweepError);
+}
+
+}  // namespace
