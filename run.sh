@@ -15,6 +15,7 @@ packages=(
     libtinygltf-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev
     fonts-dejavu-core
     libtomlplusplus-dev
+    python3-matplotlib chromium
 )
 missing=()
 for p in "${packages[@]}"; do

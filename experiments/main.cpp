@@ -1,6 +1,8 @@
 // testbed: the command-line front end. Subcommands:
 //   render  one scene, one stage -> render.exr, preview.png, heatmap.png, stats.json
 //   list    scenes, stages and normal encodings known to this build
+//   report  a sweep's results folder -> DIR/report.html (tables, plots, thumbnails)
+//   diff    two EXRs -> an image-diff report (metrics, side by side, |A-B|, per-channel stats)
 //   sweep   a sweep file -> one job folder per job, results.csv/json (resumable, shardable)
 //   merge   shard outputs of one sweep -> one results set
 //   normals normal-encoding precision study -> normals.csv, normals.json, plots
@@ -10,8 +12,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "experiments/DiffCommand.h"
 #include "experiments/NormalStudy.h"
 #include "experiments/RenderCommand.h"
+#include "experiments/ReportCommand.h"
 #include "experiments/SweepFile.h"
 #include "experiments/SweepRunner.h"
 #include "gbuffer/NormalCodec.h"
@@ -82,6 +86,25 @@ int main(int argc, char** argv) {
     CLI::App* render = app.add_subcommand("render", "render one scene with one shading stage");
     addRenderOptions(*render, renderOptions, sceneOptionTexts);
     CLI::App* list = app.add_subcommand("list", "list scenes and stages");
+    experiments::ReportCommandOptions reportOptions;
+    CLI::App* report = app.add_subcommand("report", "write DIR/report.html for a sweep's results folder DIR");
+    report->add_option("dir", reportOptions.dir, "results folder (holds results.json)")->required();
+    report->add_option("--plots-script", reportOptions.plotsScript, "matplotlib script")
+        ->default_str(experiments::defaultPlotsScript().string());
+    report->add_option("--python", reportOptions.python,
+                       "Python with matplotlib (default: /usr/bin/python3, else python3 on PATH)");
+    report->add_option("--thumbnail-width", reportOptions.thumbnailWidth, "thumbnail width in pixels")
+        ->capture_default_str();
+    experiments::DiffCommandOptions diffOptions;
+    CLI::App* diff = app.add_subcommand("diff", "image-diff report of two EXRs (B is the reference)");
+    diff->add_option("a", diffOptions.a, "first image (EXR with R, G, B)")->required();
+    diff->add_option("b", diffOptions.b, "second image, the reference")->required();
+    diff->add_option("--out", diffOptions.out, "output folder (index.html, diff.json, PNGs)")->capture_default_str();
+    diff->add_option("--exposure", diffOptions.exposure, "linear exposure of the previews")->capture_default_str();
+    diff->add_option("--plots-script", diffOptions.plotsScript, "matplotlib script")
+        ->default_str(experiments::defaultPlotsScript().string());
+    diff->add_option("--python", diffOptions.python,
+                     "Python with matplotlib (default: /usr/bin/python3, else python3 on PATH)");
     experiments::NormalStudyOptions normalsOptions;
     std::uint64_t normalsDirections = experiments::kNormalStudyDirections;
     std::string normalsModels = experiments::kNormalStudyModelsDir;
@@ -140,6 +163,8 @@ int main(int argc, char** argv) {
         return experiments::runRenderCommand(renderOptions);
     }
     if (list->parsed()) return listEverything();
+    if (report->parsed()) return experiments::runReportCommand(reportOptions);
+    if (diff->parsed()) return experiments::runDiffCommand(diffOptions);
     if (sweep->parsed()) {
         try {
             std::tie(sweepOptions.shardIndex, sweepOptions.shardCount) = experiments::parseShard(shardText);

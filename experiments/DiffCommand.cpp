@@ -1,0 +1,331 @@
+#include "experiments/DiffCommand.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+#include "experiments/AtomicFile.h"
+#include "experiments/ImageOutput.h"
+#include "experiments/RenderJob.h"
+#include "experiments/ReportCommand.h"
+
+namespace experiments {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kBeauty[3] = {"R", "G", "B"};
+constexpr double kPercentile = 0.99;
+
+OIIO::ImageBuf readImage(const fs::path& path) {
+    OIIO::ImageBuf image(path.string());
+    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+        throw std::runtime_error("cannot read " + path.string() + ": " + image.geterror());
+    return image;
+}
+
+int channelIndex(const OIIO::ImageBuf& image, const std::string& name) {
+    return image.spec().channelindex(name);
+}
+
+// The named channels of image, in the given order, as a new float image.
+OIIO::ImageBuf selectChannels(const OIIO::ImageBuf& image, const std::vector<int>& indices) {
+    OIIO::ImageBuf selected;
+    if (!OIIO::ImageBufAlgo::channels(selected, image, int(indices.size()), indices))
+        throw std::runtime_error("cannot select channels: " + selected.geterror());
+    return selected;
+}
+
+std::vector<float> channelPlane(const OIIO::ImageBuf& image, int channel) {
+    const OIIO::ImageSpec& spec = image.spec();
+    std::vector<float> plane(size_t(spec.width) * spec.height);
+    OIIO::ROI roi = image.roi();
+    roi.chbegin = channel;
+    roi.chend = channel + 1;
+    if (!image.get_pixels(roi, OIIO::TypeDesc::FLOAT, plane.data()))
+        throw std::runtime_error("cannot read channel " + std::to_string(channel) + ": " + image.geterror());
+    return plane;
+}
+
+lighting::StageResult beautyAsStageResult(const OIIO::ImageBuf& rgb) {
+    lighting::StageResult result;
+    result.width = rgb.spec().width;
+    result.height = rgb.spec().height;
+    for (int c = 0; c < 3; ++c) result.radiance[c] = channelPlane(rgb, c);
+    return result;
+}
+
+OIIO::ImageBufAlgo::PixelStats pixelStats(const OIIO::ImageBuf& image) {
+    OIIO::ImageBufAlgo::PixelStats stats = OIIO::ImageBufAlgo::computePixelStats(image);
+    if (image.has_error()) throw std::runtime_error("cannot compute statistics: " + image.geterror());
+    return stats;
+}
+
+json numberOrText(double value) {
+    if (std::isfinite(value)) return value;
+    return std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf";
+}
+
+std::string formatNumber(double value) {
+    if (std::isnan(value)) return "NaN";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.6g", value);
+    return buffer;
+}
+
+void writeDiffPlot(const DiffCommandOptions& options, const ImageDiff& diff, const fs::path& png) {
+    const fs::path script = options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
+    if (!fs::is_regular_file(script))
+        throw std::runtime_error("plot script " + script.string() + " not found (use --plots-script)");
+    const std::string python = findPythonWithMatplotlib(options.python);
+    // The plot script reads raw float32; the temporary file is removed whatever happens.
+    const fs::path raw = options.out / (".absdiff.tmp-" + std::to_string(getpid()) + ".f32");
+    struct RemoveOnExit {
+        fs::path path;
+        ~RemoveOnExit() {
+            std::error_code ignored;
+            fs::remove(path, ignored);
+        }
+    } cleanup{raw};
+    {
+        std::ofstream file(raw, std::ios::binary);
+        file.write(reinterpret_cast<const char*>(diff.maxAbsDifference.data()),
+                   std::streamsize(diff.maxAbsDifference.size() * sizeof(float)));
+        if (!file) throw std::runtime_error("cannot write " + raw.string());
+    }
+    const int status = runProcess({python, script.string(), "diff", "--raw", raw.string(), "--width",
+                                   std::to_string(diff.width), "--height", std::to_string(diff.height),
+                                   "--vmax", formatNumber(diff.metrics.maxAbs), "--out", png.string()});
+    if (status != 0)
+        throw std::runtime_error("plot script " + script.string() + " failed (exit status " +
+                                 std::to_string(status) + ")");
+}
+
+std::string statsCells(double min, double max, double mean) {
+    return "<td>" + formatNumber(min) + "</td><td>" + formatNumber(max) + "</td><td>" + formatNumber(mean) + "</td>";
+}
+
+std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
+    const DiffMetrics& m = diff.metrics;
+    std::ostringstream html;
+    const std::string a = options.a.string(), b = options.b.string();
+    html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>testbed diff: "
+         << htmlEscape(options.a.filename().string()) << " vs " << htmlEscape(options.b.filename().string())
+         << "</title>\n" << pageCheckScript()
+         << "<style>\nbody { font-family: DejaVu Sans, sans-serif; margin: 1.5em; color: #222; }\n"
+            "table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }\n"
+            "th, td { border: 1px solid #ccc; padding: 2px 8px; text-align: right; }\n"
+            "th { background: #eee; } td.text { text-align: left; }\n"
+            "figure { display: inline-block; margin: 0.5em; vertical-align: top; }\n"
+            "figure img { max-width: 640px; border: 1px solid #ddd; }\n"
+            "figure img.preview { width: 480px; image-rendering: pixelated; }\n"
+            "#page-check { font-size: 0.7em; color: #888; }\n</style>\n</head>\n<body>\n";
+    html << "<h1>Image diff</h1>\n<p>A = <code>" << htmlEscape(a) << "</code><br>B = <code>" << htmlEscape(b)
+         << "</code> (the reference)<br>" << diff.width << " &times; " << diff.height << " pixels</p>\n";
+    html << "<h2>Metrics on the beauty R, G, B</h2>\n<table>\n"
+         << "<tr><th>RMSE</th><th>relative RMSE</th><th>PSNR (dB)</th><th>max abs</th><th>mean abs</th>"
+            "<th>relative mean</th><th>99th percentile abs</th></tr>\n<tr><td>"
+         << formatNumber(m.rmse) << "</td><td>" << formatNumber(m.relativeRmse) << "</td><td>"
+         << formatNumber(m.psnr) << "</td><td>" << formatNumber(m.maxAbs) << "</td><td>"
+         << formatNumber(m.meanAbs) << "</td><td>" << formatNumber(m.relativeMean) << "</td><td>"
+         << formatNumber(m.p99Abs) << "</td></tr>\n</table>\n"
+         << "<p>relative RMSE = RMSE / RMS of B; relative mean = mean |A &minus; B| / mean |B|; PSNR peak = "
+            "the largest channel value of B.</p>\n";
+    html << "<h2>Images</h2>\n"
+         << "<figure><a href=\"a.png\"><img class=\"preview\" src=\"a.png\" alt=\"A\"></a><figcaption>A (tone-mapped, exposure "
+         << formatNumber(options.exposure) << ")</figcaption></figure>\n"
+         << "<figure><a href=\"b.png\"><img class=\"preview\" src=\"b.png\" alt=\"B\"></a><figcaption>B (tone-mapped, exposure "
+         << formatNumber(options.exposure) << ")</figcaption></figure>\n"
+         << "<figure><a href=\"absdiff.png\"><img class=\"plot\" src=\"absdiff.png\" alt=\"|A-B|\"></a>"
+            "<figcaption>|A &minus; B|, maximum over R, G, B, linear radiance; the full-precision "
+            "difference is in <a href=\"absdiff.exr\">absdiff.exr</a></figcaption></figure>\n";
+    html << "<h2>Per-channel statistics</h2>\n<p>Every channel present in both files; min, max and mean "
+            "over finite values.</p>\n<table>\n<tr><th rowspan=\"2\">channel</th><th colspan=\"3\">A</th>"
+            "<th colspan=\"3\">B</th><th colspan=\"3\">A &minus; B</th><th colspan=\"2\">|A &minus; B|</th>"
+            "<th rowspan=\"2\">NaN / inf in A, B</th></tr>\n<tr>";
+    for (int i = 0; i < 3; ++i) html << "<th>min</th><th>max</th><th>mean</th>";
+    html << "<th>max</th><th>mean</th></tr>\n";
+    for (const ChannelStatistics& c : diff.channels)
+        html << "<tr><td class=\"text\">" << htmlEscape(c.name) << "</td>" << statsCells(c.minA, c.maxA, c.meanA)
+             << statsCells(c.minB, c.maxB, c.meanB)
+             << statsCells(c.minDifference, c.maxDifference, c.meanDifference) << "<td>"
+             << formatNumber(c.maxAbsDifference) << "</td><td>" << formatNumber(c.meanAbsDifference) << "</td><td>"
+             << c.nanA << " / " << c.infA << ", " << c.nanB << " / " << c.infB << "</td></tr>\n";
+    html << "</table>\n";
+    auto list = [&](const char* what, const std::vector<std::string>& names) {
+        if (names.empty()) return;
+        html << "<p>Only in " << what << ":";
+        for (const std::string& name : names) html << " <code>" << htmlEscape(name) << "</code>";
+        html << "</p>\n";
+    };
+    list("A", diff.onlyInA);
+    list("B", diff.onlyInB);
+    html << "<pre id=\"page-check\" data-status=\"pending\">PAGE-CHECK: PENDING</pre>\n</body>\n</html>\n";
+    return html.str();
+}
+
+}  // namespace
+
+ImageDiff diffImageFiles(const fs::path& aPath, const fs::path& bPath) {
+    const OIIO::ImageBuf a = readImage(aPath), b = readImage(bPath);
+    const OIIO::ImageSpec &specA = a.spec(), &specB = b.spec();
+    if (specA.width != specB.width || specA.height != specB.height)
+        throw std::runtime_error("image sizes differ: " + aPath.string() + " is " + std::to_string(specA.width) +
+                                 "x" + std::to_string(specA.height) + ", " + bPath.string() + " is " +
+                                 std::to_string(specB.width) + "x" + std::to_string(specB.height));
+    std::vector<int> beautyA, beautyB;
+    for (const char* name : kBeauty) {
+        beautyA.push_back(channelIndex(a, name));
+        beautyB.push_back(channelIndex(b, name));
+        if (beautyA.back() < 0 || beautyB.back() < 0)
+            throw std::runtime_error("beauty channel " + std::string(name) + " missing in " +
+                                     (beautyA.back() < 0 ? aPath : bPath).string());
+    }
+    ImageDiff diff;
+    diff.width = specA.width;
+    diff.height = specA.height;
+
+    // Beauty metrics: the same comparison as the sweep's error against the reference.
+    const OIIO::ImageBuf rgbA = selectChannels(a, beautyA), rgbB = selectChannels(b, beautyB);
+    lighting::StageResult resultA = beautyAsStageResult(rgbA), resultB = beautyAsStageResult(rgbB);
+    const ErrorMetrics error = compareImages(resultA, resultB);
+    DiffMetrics& m = diff.metrics;
+    m.rmse = error.rmse;
+    m.relativeRmse = error.relativeRmse;
+    m.maxAbs = error.maxAbs;
+    m.psnr = error.psnr;
+    OIIO::ImageBuf absRgb, absB;
+    if (!OIIO::ImageBufAlgo::absdiff(absRgb, rgbA, rgbB) || !OIIO::ImageBufAlgo::abs(absB, rgbB))
+        throw std::runtime_error("cannot compute |A - B|: " + absRgb.geterror() + absB.geterror());
+    const auto absStats = pixelStats(absRgb), absBStats = pixelStats(absB);
+    double meanB = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        m.meanAbs += absStats.avg[size_t(c)] / 3.0;
+        meanB += absBStats.avg[size_t(c)] / 3.0;
+    }
+    m.relativeMean = meanB > 0.0 ? m.meanAbs / meanB : 0.0;
+    // ImageBufAlgo has no percentile: the nearest-rank 99th percentile of all R,G,B samples.
+    for (int c = 0; c < 3; ++c) {
+        diff.beautyA[c] = std::move(resultA.radiance[c]);
+        diff.beautyB[c] = std::move(resultB.radiance[c]);
+        diff.absDifference[c] = channelPlane(absRgb, c);
+    }
+    std::vector<float> samples;
+    samples.reserve(3 * diff.absDifference[0].size());
+    for (const std::vector<float>& plane : diff.absDifference) samples.insert(samples.end(), plane.begin(), plane.end());
+    if (!samples.empty()) {
+        const size_t rank = size_t(std::ceil(kPercentile * double(samples.size()))) - 1;
+        std::nth_element(samples.begin(), samples.begin() + std::ptrdiff_t(rank), samples.end());
+        m.p99Abs = samples[rank];
+    }
+    OIIO::ImageBuf maxAbs;
+    if (!OIIO::ImageBufAlgo::maxchan(maxAbs, absRgb))
+        throw std::runtime_error("cannot compute max over channels: " + maxAbs.geterror());
+    diff.maxAbsDifference = channelPlane(maxAbs, 0);
+
+    // Per-channel statistics over the channels both files have, in A's order.
+    std::vector<int> commonA, commonB;
+    for (int c = 0; c < specA.nchannels; ++c) {
+        const std::string& name = specA.channelnames[size_t(c)];
+        const int inB = channelIndex(b, name);
+        if (inB < 0) {
+            diff.onlyInA.push_back(name);
+            continue;
+        }
+        commonA.push_back(c);
+        commonB.push_back(inB);
+    }
+    for (int c = 0; c < specB.nchannels; ++c)
+        if (channelIndex(a, specB.channelnames[size_t(c)]) < 0) diff.onlyInB.push_back(specB.channelnames[size_t(c)]);
+    const OIIO::ImageBuf allA = selectChannels(a, commonA), allB = selectChannels(b, commonB);
+    OIIO::ImageBuf difference, absDifference;
+    if (!OIIO::ImageBufAlgo::sub(difference, allA, allB) || !OIIO::ImageBufAlgo::absdiff(absDifference, allA, allB))
+        throw std::runtime_error("cannot compute A - B: " + difference.geterror() + absDifference.geterror());
+    const auto statsA = pixelStats(allA), statsB = pixelStats(allB), statsDifference = pixelStats(difference),
+               statsAbs = pixelStats(absDifference);
+    for (size_t i = 0; i < commonA.size(); ++i) {
+        ChannelStatistics s;
+        s.name = specA.channelnames[size_t(commonA[i])];
+        s.minA = statsA.min[i], s.maxA = statsA.max[i], s.meanA = statsA.avg[i];
+        s.nanA = long(statsA.nancount[i]), s.infA = long(statsA.infcount[i]);
+        s.minB = statsB.min[i], s.maxB = statsB.max[i], s.meanB = statsB.avg[i];
+        s.nanB = long(statsB.nancount[i]), s.infB = long(statsB.infcount[i]);
+        s.minDifference = statsDifference.min[i], s.maxDifference = statsDifference.max[i];
+        s.meanDifference = statsDifference.avg[i];
+        s.maxAbsDifference = statsAbs.max[i], s.meanAbsDifference = statsAbs.avg[i];
+        diff.channels.push_back(s);
+    }
+    return diff;
+}
+
+json diffJson(const ImageDiff& diff, const fs::path& a, const fs::path& b) {
+    const DiffMetrics& m = diff.metrics;
+    json channels = json::array();
+    for (const ChannelStatistics& c : diff.channels)
+        channels.push_back({{"name", c.name},
+                            {"a", {{"min", c.minA}, {"max", c.maxA}, {"mean", c.meanA}, {"nan", c.nanA}, {"inf", c.infA}}},
+                            {"b", {{"min", c.minB}, {"max", c.maxB}, {"mean", c.meanB}, {"nan", c.nanB}, {"inf", c.infB}}},
+                            {"difference", {{"min", c.minDifference}, {"max", c.maxDifference}, {"mean", c.meanDifference}}},
+                            {"abs_difference", {{"max", c.maxAbsDifference}, {"mean", c.meanAbsDifference}}}});
+    return {{"a", a.string()},
+            {"b", b.string()},
+            {"width", diff.width},
+            {"height", diff.height},
+            {"metrics",
+             {{"rmse", m.rmse},
+              {"relative_rmse", m.relativeRmse},
+              {"psnr", numberOrText(m.psnr)},
+              {"max_abs", m.maxAbs},
+              {"mean_abs", m.meanAbs},
+              {"relative_mean", m.relativeMean},
+              {"p99_abs", m.p99Abs}}},
+            {"channels", channels},
+            {"only_in_a", diff.onlyInA},
+            {"only_in_b", diff.onlyInB}};
+}
+
+int runDiffCommand(const DiffCommandOptions& options) {
+    try {
+        if (!(options.exposure > 0.0f) || !std::isfinite(options.exposure))
+            throw std::runtime_error("--exposure must be a finite number > 0");
+        const ImageDiff diff = diffImageFiles(options.a, options.b);
+        ensureWritableDirectory(options.out);
+        const int w = diff.width, h = diff.height;
+        writePreviewPng(options.out / "a.png", w, h, diff.beautyA[0].data(), diff.beautyA[1].data(),
+                        diff.beautyA[2].data(), options.exposure);
+        writePreviewPng(options.out / "b.png", w, h, diff.beautyB[0].data(), diff.beautyB[1].data(),
+                        diff.beautyB[2].data(), options.exposure);
+        writeMultiLayerExr(options.out / "absdiff.exr", w, h,
+                           {{"R", diff.absDifference[0].data()},
+                            {"G", diff.absDifference[1].data()},
+                            {"B", diff.absDifference[2].data()}},
+                           {{"testbed:diff", "|A - B| of " + options.a.string() + " and " + options.b.string()}});
+        writeDiffPlot(options, diff, options.out / "absdiff.png");
+        writeTextAtomically(options.out / "diff.json", diffJson(diff, options.a, options.b).dump(2) + "\n");
+        writeTextAtomically(options.out / "index.html", diffPage(diff, options));
+        const DiffMetrics& m = diff.metrics;
+        std::cout << "testbed: diff of " << options.a.string() << " and " << options.b.string() << " (" << w << "x"
+                  << h << "): rmse " << formatNumber(m.rmse) << ", psnr " << formatNumber(m.psnr) << " dB, max_abs "
+                  << formatNumber(m.maxAbs) << ", relative_mean " << formatNumber(m.relativeMean) << ", p99_abs "
+                  << formatNumber(m.p99Abs) << "\n  report: " << (options.out / "index.html").string() << "\n";
+        return 0;
+    } catch (const std::exception& e) {
+        std::cerr << "testbed: error: " << e.what() << "\n";
+        return 1;
+    }
+}
+
+}  // namespace experiments

@@ -1,0 +1,86 @@
+// DiffCommand: `testbed diff A.exr B.exr --out DIR` compares two renders (any EXRs with beauty
+// channels R, G, B; typically two `testbed render` outputs) and writes an image-diff report:
+//   DIR/index.html     the page: metrics, A and B side by side, |A - B| in false colour with its
+//                      colour bar, per-channel statistics (no network, no external scripts)
+//   DIR/diff.json      the same figures: {"a", "b", "width", "height", "metrics": {...},
+//                      "channels": [{"name", "a": {min,max,mean,nan,inf}, "b": {...},
+//                      "difference": {min,max,mean}, "abs_difference": {max,mean}}],
+//                      "only_in_a", "only_in_b"}
+//   DIR/a.png, b.png   tone-mapped previews of the beauty (experiments/ImageOutput.h)
+//   DIR/absdiff.png    max over R,G,B of |A - B|, turbo colour map from 0 to max_abs with a colour
+//                      bar (matplotlib, experiments/plots/report.py diff)
+//   DIR/absdiff.exr    |A - B| per beauty channel as float32 R, G, B, for inspection in a viewer
+//
+// B is the reference of the metrics (as the reference render is in `testbed render`):
+//   rmse, max_abs, relative_rmse, psnr   experiments::compareImages on the beauty R, G, B
+//                                        (OpenImageIO ImageBufAlgo::compare; PSNR's peak is B's
+//                                        largest channel value; inf for identical images)
+//   mean_abs                             mean of |A - B| over the R, G, B samples
+//   relative_mean                        mean_abs / mean of |B| over the R, G, B samples
+//   p99_abs                              99th percentile of |A - B| over the R, G, B samples
+//                                        (nearest rank: the smallest value >= 99 % of samples)
+// Per-channel statistics cover every channel present in both files (N.X, Z, albedo.R,
+// lights.evaluated, ...), through ImageBufAlgo::computePixelStats on A, B, A - B and |A - B|;
+// min/max/mean are over the finite values, nan/inf count the others.
+//
+// Errors (one line "testbed: error: ...", exit code 1, nothing written): unreadable file, images
+// of different sizes, beauty channel missing, python3 with matplotlib missing.
+// Thread safety: the functions share no state.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace experiments {
+
+struct DiffCommandOptions {
+    std::filesystem::path a;
+    std::filesystem::path b;                   // the reference
+    std::filesystem::path out = "diff";
+    std::filesystem::path plotsScript;         // empty = experiments/plots/report.py
+    std::string python;                        // empty = found as for `testbed report`
+    float exposure = 1.0f;                     // linear factor applied before tone mapping
+};
+
+struct DiffMetrics {
+    double rmse = 0.0;
+    double relativeRmse = 0.0;
+    double maxAbs = 0.0;
+    double psnr = 0.0;
+    double meanAbs = 0.0;
+    double relativeMean = 0.0;
+    double p99Abs = 0.0;
+};
+
+struct ChannelStatistics {
+    std::string name;
+    double minA = 0, maxA = 0, meanA = 0, minB = 0, maxB = 0, meanB = 0;
+    long nanA = 0, infA = 0, nanB = 0, infB = 0;
+    double minDifference = 0, maxDifference = 0, meanDifference = 0;  // A - B
+    double maxAbsDifference = 0, meanAbsDifference = 0;                // |A - B|
+};
+
+struct ImageDiff {
+    int width = 0;
+    int height = 0;
+    DiffMetrics metrics;
+    std::vector<ChannelStatistics> channels;  // in A's channel order
+    std::vector<std::string> onlyInA, onlyInB;
+    // Images for the report: beauty planes of A and B, |A - B| per beauty channel, and the
+    // maximum over R, G, B of |A - B| (width * height each, row 0 at the top).
+    std::vector<float> beautyA[3], beautyB[3], absDifference[3], maxAbsDifference;
+};
+
+// Reads both files and compares them. Throws std::runtime_error naming the file and the problem
+// (unreadable, sizes differ, R/G/B missing).
+ImageDiff diffImageFiles(const std::filesystem::path& a, const std::filesystem::path& b);
+
+nlohmann::json diffJson(const ImageDiff& diff, const std::filesystem::path& a, const std::filesystem::path& b);
+
+// Writes DIR (see above); returns the exit code.
+int runDiffCommand(const DiffCommandOptions& options);
+
+}  // namespace experiments

@@ -1,0 +1,177 @@
+// Tests for experiments/DiffCommand: metrics of known differences (identical images, a constant
+// offset, an offset on part of the image), per-channel statistics of the layers both files
+// share, the written report, and refusal of mismatched sizes. Images are written with
+// writeMultiLayerExr into <build>/test-output/experiments/<test>/ and left there.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "experiments/DiffCommand.h"
+#include "experiments/ImageOutput.h"
+
+namespace experiments {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr int kWidth = 40, kHeight = 20;
+
+fs::path freshTestFolder() {
+    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" /
+                         (std::string(info->test_suite_name()) + "." + info->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string readText(const fs::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+// R, G, B = 0.5 (+ offset on the pixels where offsetWhere(x) holds), Z = depth, N.X = 0.25, and
+// an extra channel only this file has when extraName is set. Values are exact in binary.
+fs::path writeImage(const fs::path& path, float offset, bool (*offsetWhere)(int x), float depth,
+                    const std::string& extraName = "", int width = kWidth, int height = kHeight) {
+    const size_t n = size_t(width) * height;
+    std::vector<float> rgb(n), z(n, depth), normal(n, 0.25f), extra(n, 1.0f);
+    for (size_t i = 0; i < n; ++i) rgb[i] = 0.5f + (offsetWhere(int(i % width)) ? offset : 0.0f);
+    std::vector<ImagePlane> planes = {{"R", rgb.data()}, {"G", rgb.data()}, {"B", rgb.data()},
+                                      {"Z", z.data()},   {"N.X", normal.data()}};
+    if (!extraName.empty()) planes.push_back({extraName, extra.data()});
+    writeMultiLayerExr(path, width, height, planes, {});
+    return path;
+}
+
+bool everywhere(int) { return true; }
+bool leftHalf(int x) { return x < kWidth / 2; }
+bool nowhere(int) { return false; }
+
+const ChannelStatistics* channel(const ImageDiff& diff, const std::string& name) {
+    for (const ChannelStatistics& c : diff.channels)
+        if (c.name == name) return &c;
+    return nullptr;
+}
+
+TEST(ImageDiff, IdenticalImagesHaveZeroError) {
+    const fs::path dir = freshTestFolder();
+    const fs::path a = writeImage(dir / "a.exr", 0.0f, nowhere, 3.0f);
+    const ImageDiff diff = diffImageFiles(a, a);
+    EXPECT_EQ(diff.metrics.rmse, 0.0);
+    EXPECT_EQ(diff.metrics.maxAbs, 0.0);
+    EXPECT_EQ(diff.metrics.meanAbs, 0.0);
+    EXPECT_EQ(diff.metrics.relativeMean, 0.0);
+    EXPECT_EQ(diff.metrics.p99Abs, 0.0);
+    EXPECT_TRUE(std::isinf(diff.metrics.psnr));
+    ASSERT_EQ(diff.channels.size(), 5u);
+    for (const ChannelStatistics& c : diff.channels) {
+        EXPECT_EQ(c.maxAbsDifference, 0.0) << c.name;
+        EXPECT_EQ(c.meanA, c.meanB) << c.name;
+    }
+}
+
+TEST(ImageDiff, ConstantOffsetGivesThatOffsetAsEveryError) {
+    const fs::path dir = freshTestFolder();
+    const fs::path a = writeImage(dir / "a.exr", 0.125f, everywhere, 3.0f);
+    const fs::path b = writeImage(dir / "b.exr", 0.0f, nowhere, 2.0f);
+    const ImageDiff diff = diffImageFiles(a, b);
+    EXPECT_EQ(diff.width, kWidth);
+    EXPECT_EQ(diff.height, kHeight);
+    EXPECT_NEAR(diff.metrics.rmse, 0.125, 1e-12);
+    EXPECT_NEAR(diff.metrics.maxAbs, 0.125, 1e-12);
+    EXPECT_NEAR(diff.metrics.meanAbs, 0.125, 1e-12);
+    EXPECT_NEAR(diff.metrics.p99Abs, 0.125, 1e-12);
+    EXPECT_NEAR(diff.metrics.relativeMean, 0.125 / 0.5, 1e-12);
+    EXPECT_NEAR(diff.metrics.relativeRmse, 0.125 / 0.5, 1e-12);
+    EXPECT_NEAR(diff.metrics.psnr, 20.0 * std::log10(0.5 / 0.125), 1e-9);
+    const ChannelStatistics* z = channel(diff, "Z");
+    ASSERT_NE(z, nullptr);
+    EXPECT_EQ(z->meanA, 3.0);
+    EXPECT_EQ(z->meanB, 2.0);
+    EXPECT_EQ(z->minDifference, 1.0);
+    EXPECT_EQ(z->maxDifference, 1.0);
+    EXPECT_EQ(z->meanAbsDifference, 1.0);
+    const ChannelStatistics* normal = channel(diff, "N.X");
+    ASSERT_NE(normal, nullptr);
+    EXPECT_EQ(normal->maxAbsDifference, 0.0);
+}
+
+TEST(ImageDiff, OffsetOnHalfTheImage) {
+    const fs::path dir = freshTestFolder();
+    const fs::path a = writeImage(dir / "a.exr", -0.25f, leftHalf, 1.0f, "lights.evaluated");
+    const fs::path b = writeImage(dir / "b.exr", 0.0f, nowhere, 1.0f, "albedo.R");
+    const ImageDiff diff = diffImageFiles(a, b);
+    EXPECT_NEAR(diff.metrics.rmse, std::sqrt(0.5 * 0.25 * 0.25), 1e-12);
+    EXPECT_NEAR(diff.metrics.maxAbs, 0.25, 1e-12);
+    EXPECT_NEAR(diff.metrics.meanAbs, 0.125, 1e-12);
+    EXPECT_NEAR(diff.metrics.p99Abs, 0.25, 1e-12);
+    const ChannelStatistics* red = channel(diff, "R");
+    ASSERT_NE(red, nullptr);
+    EXPECT_EQ(red->minDifference, -0.25);
+    EXPECT_EQ(red->maxDifference, 0.0);
+    EXPECT_EQ(red->meanDifference, -0.125);
+    EXPECT_EQ(red->minA, 0.25);
+    EXPECT_EQ(diff.onlyInA, std::vector<std::string>{"lights.evaluated"});
+    EXPECT_EQ(diff.onlyInB, std::vector<std::string>{"albedo.R"});
+    EXPECT_EQ(channel(diff, "albedo.R"), nullptr);
+}
+
+TEST(DiffCommand, WritesPageJsonAndImages) {
+    const fs::path dir = freshTestFolder();
+    DiffCommandOptions options;
+    options.a = writeImage(dir / "a.exr", 0.125f, leftHalf, 3.0f);
+    options.b = writeImage(dir / "b.exr", 0.0f, nowhere, 3.0f);
+    options.out = dir / "diff";
+    ASSERT_EQ(runDiffCommand(options), 0);
+    for (const char* file : {"index.html", "diff.json", "a.png", "b.png", "absdiff.png", "absdiff.exr"})
+        EXPECT_TRUE(fs::is_regular_file(options.out / file)) << file;
+    const json result = json::parse(readText(options.out / "diff.json"));
+    EXPECT_NEAR(result["metrics"]["rmse"].get<double>(), std::sqrt(0.5) * 0.125, 1e-12);
+    EXPECT_NEAR(result["metrics"]["p99_abs"].get<double>(), 0.125, 1e-12);
+    EXPECT_EQ(result["channels"].size(), 5u);
+    const std::string html = readText(options.out / "index.html");
+    EXPECT_NE(html.find("src=\"absdiff.png\""), std::string::npos);
+    EXPECT_NE(html.find("<td class=\"text\">Z</td>"), std::string::npos);
+    EXPECT_EQ(html.find("http"), std::string::npos);
+    for (const fs::directory_entry& entry : fs::directory_iterator(options.out))
+        EXPECT_NE(entry.path().filename().string()[0], '.') << "temporary file left: " << entry.path();
+
+    options.out = dir / "identical";
+    options.a = options.b;
+    ASSERT_EQ(runDiffCommand(options), 0);
+    EXPECT_EQ(json::parse(readText(options.out / "diff.json"))["metrics"]["psnr"], "inf");
+}
+
+TEST(DiffCommand, RefusesImagesOfDifferentSizes) {
+    const fs::path dir = freshTestFolder();
+    DiffCommandOptions options;
+    options.a = writeImage(dir / "a.exr", 0.0f, nowhere, 1.0f);
+    options.b = writeImage(dir / "b.exr", 0.0f, nowhere, 1.0f, "", kWidth / 2, kHeight);
+    options.out = dir / "diff";
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(runDiffCommand(options), 1);
+    const std::string error = testing::internal::GetCapturedStderr();
+    EXPECT_NE(error.find("testbed: error: image sizes differ: " + options.a.string() + " is 40x20, " +
+                         options.b.string() + " is 20x20"),
+              std::string::npos)
+        << error;
+    EXPECT_FALSE(fs::exists(options.out)) << "nothing written";
+
+    options.b = dir / "missing.exr";
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(runDiffCommand(options), 1);
+    EXPECT_NE(testing::internal::GetCapturedStderr().find("cannot read"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace experiments

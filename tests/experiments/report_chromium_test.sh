@@ -1,0 +1,104 @@
+#!/usr/bin/env bash
+# Opens the report of a tiny sweep in headless Chromium and fails if the page logs an error, an
+# image fails to load, or a plot (or the page) is blank. Registered with ctest by
+# tests/CMakeLists.txt; by hand:
+#   tests/experiments/report_chromium_test.sh build/bin/testbed /tmp/report-chromium-test
+#
+# Input: made here by `testbed sweep tests/experiments/fixtures/report-smoke.json` (six tiny jobs,
+# three stages x two light counts, with a published-figures entry), then `testbed report`.
+# Failed jobs, null metrics and single-valued axes are covered by tests/experiments/report_test.cpp.
+#
+# The page's inline script (experiments/ReportCommand.h, pageCheckScript) writes
+# "PAGE-CHECK: OK (N images)" into #page-check after the load event, or "PAGE-CHECK: FAILED" and
+# the images that did not load / script errors; --dump-dom prints the DOM after loading. Any
+# console message or uncaught exception is caught from Chromium's log (--enable-logging=stderr). The plot PNGs
+# and the screenshot must have many distinct colours (a blank or one-colour image fails).
+#
+# Chromium missing is a failure, not a skip: ./run.sh installs Debian's chromium.
+set -euo pipefail
+
+testbed=${1:?usage: $0 TESTBED_BINARY WORK_DIR}
+work=${2:?usage: $0 TESTBED_BINARY WORK_DIR}
+here=$(cd "$(dirname "$0")" && pwd)
+sweep_file=$here/fixtures/report-smoke.json
+
+fail() { echo "report_chromium_test: FAIL: $*" >&2; exit 1; }
+
+chromium=$(command -v chromium || command -v chromium-browser || true)
+[ -n "$chromium" ] || fail "chromium not found on PATH (install Debian package chromium; ./run.sh does)"
+python=
+for candidate in /usr/bin/python3 python3; do
+    if "$candidate" -c "import matplotlib, numpy" 2>/dev/null; then python=$candidate; break; fi
+done
+[ -n "$python" ] || fail "no python3 with matplotlib (install Debian package python3-matplotlib)"
+
+rm -rf "$work"
+mkdir -p "$work"
+results=$work/results
+
+echo "report_chromium_test: testbed sweep $sweep_file --out $results"
+"$testbed" sweep "$sweep_file" --out "$results" >"$work/sweep.log" 2>&1 \
+    || { tail -30 "$work/sweep.log" >&2; fail "testbed sweep failed (log: $work/sweep.log)"; }
+[ -f "$results/results.json" ] || fail "the sweep wrote no results.json"
+
+"$testbed" report "$results" >"$work/report.log" 2>&1 || { cat "$work/report.log" >&2; fail "testbed report failed"; }
+page=$results/report.html
+[ -f "$page" ] || fail "no $page"
+
+# One run: --dump-dom prints the DOM once the page has loaded (after the load handlers ran),
+# --screenshot captures the window.
+flags=(--headless=new --no-sandbox --disable-gpu --hide-scrollbars --no-first-run
+       --disable-extensions --enable-logging=stderr --v=0 --window-size=1400,3000
+       --user-data-dir="$work/chromium-profile")
+timeout 120 "$chromium" "${flags[@]}" --dump-dom --screenshot="$work/screenshot.png" "file://$page" \
+    >"$work/dom.html" 2>"$work/chromium.log" \
+    || { tail -20 "$work/chromium.log" >&2; fail "chromium failed (log: $work/chromium.log)"; }
+[ -f "$work/screenshot.png" ] || fail "chromium wrote no screenshot"
+
+# The element itself, not the script's text that mentions the same words.
+status=$(grep -o '<pre id="page-check" data-status="[a-z]*">PAGE-CHECK: [A-Z]*' "$work/dom.html" | head -1 || true)
+echo "report_chromium_test: ${status#*>}"
+case "$status" in
+    *'data-status="ok">PAGE-CHECK: OK') ;;
+    "") fail "the page's check did not run (no #page-check in the DOM; see $work/dom.html)" ;;
+    *) sed -n '/<pre id="page-check"/,/<\/pre>/p' "$work/dom.html" >&2; fail "the page reported problems" ;;
+esac
+# Console messages of the page (Chromium logs every console message and uncaught exception as a
+# CONSOLE line; the report logs none); Chromium's own noise about D-Bus and the GPU in a
+# container is not the page's and is not matched.
+if grep -E 'CONSOLE|Uncaught|Failed to load resource|ERR_FILE_NOT_FOUND' "$work/chromium.log" >&2; then
+    fail "the page logged errors (above; logs in $work)"
+fi
+
+"$python" - "$results" "$work/screenshot.png" <<'EOF'
+import json, os, sys
+import matplotlib.image as mpimg
+import numpy as np
+results, screenshot = sys.argv[1], sys.argv[2]
+
+def distinct_colours(path):
+    pixels = mpimg.imread(path)
+    if pixels.dtype != np.uint8:
+        pixels = np.round(pixels * 255).astype(np.uint8)
+    rgb = pixels[..., :3].reshape(-1, 3)
+    background = np.all(rgb >= 250, axis=1)
+    return len(np.unique(rgb, axis=0)), 1.0 - background.mean()
+
+manifest = json.load(open(os.path.join(results, "report", "plots.json")))
+problems = []
+if len(manifest["plots"]) < 4:
+    problems.append("only %d plots drawn: %s" % (len(manifest["plots"]), manifest))
+for plot in manifest["plots"]:
+    colours, inked = distinct_colours(os.path.join(results, "report", plot["file"]))
+    print("  plot %-32s %5d colours, %4.1f %% non-white" % (plot["file"], colours, 100 * inked))
+    if colours < 32 or inked < 0.02:
+        problems.append("plot %s looks blank (%d colours, %.3f non-white)" % (plot["file"], colours, inked))
+colours, inked = distinct_colours(screenshot)
+print("  screenshot %d colours, %.1f %% non-white" % (colours, 100 * inked))
+if colours < 256 or inked < 0.05:
+    problems.append("screenshot looks blank (%d colours)" % colours)
+if problems:
+    print("\n".join(problems), file=sys.stderr)
+    sys.exit(1)
+EOF
+echo "report_chromium_test: PASS (page $page, screenshot $work/screenshot.png)"

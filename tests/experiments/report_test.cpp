@@ -1,0 +1,331 @@
+// Tests for experiments/ReportCommand: the matching of published figures (known numbers give known
+// medians and ratios), and `testbed report` on a hand-made results folder that follows the sweep
+// runner's format (failed job, null metrics, "inf" PSNR, a missing error image, single-valued
+// axes). Folders are left under <build>/test-output/experiments/ for inspection.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "experiments/ImageOutput.h"
+#include "experiments/ReportCommand.h"
+
+namespace experiments {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+fs::path freshTestFolder() {
+    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" /
+                         (std::string(info->test_suite_name()) + "." + info->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string readText(const fs::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+json okJob(const std::string& id, const std::string& stage, int lights, json time) {
+    return {{"job_id", id}, {"status", "ok"}, {"error", ""}, {"stage", stage}, {"lights", lights},
+            {"time_total_median_ms", time}, {"time_shading_median_ms", 1.0}};
+}
+
+TEST(ReportSelect, NumbersCompareByValueWhateverTheirSpelling) {
+    EXPECT_EQ(normalisedSelectValue(1500), "1500");
+    EXPECT_EQ(normalisedSelectValue("1500"), "1500");
+    EXPECT_EQ(normalisedSelectValue(1500.0), "1500");
+    EXPECT_EQ(normalisedSelectValue("1500.0"), "1500");
+    EXPECT_EQ(normalisedSelectValue(0.25), "0.25");
+    EXPECT_EQ(normalisedSelectValue("0.25"), "0.25");
+    EXPECT_EQ(normalisedSelectValue("deferred:vfc=1"), "deferred:vfc=1");
+    EXPECT_EQ(normalisedSelectValue("24x12x16"), "24x12x16");
+    EXPECT_EQ(normalisedSelectValue(true), "true");
+    const json job = {{"lights", 1500}, {"stage", "tiled"}, {"scene-option.behind", "0"}};
+    EXPECT_TRUE(jobMatchesSelect(job, {{"lights", "1500"}, {"scene-option.behind", 0}}));
+    EXPECT_FALSE(jobMatchesSelect(job, {{"lights", 1600}}));
+    EXPECT_FALSE(jobMatchesSelect(job, {{"threads", 2}})) << "a key the job lacks never matches";
+    EXPECT_TRUE(jobMatchesSelect(job, json::object()));
+}
+
+TEST(ReportSelect, MetricListsAreSummedAndMissingValuesGiveNothing) {
+    const json job = {{"a", 2.0}, {"b", 3.5}, {"c", nullptr}, {"d", "inf"}};
+    EXPECT_EQ(jobMetric(job, "a"), 2.0);
+    EXPECT_EQ(jobMetric(job, json::array({"a", "b"})), 5.5);
+    EXPECT_FALSE(jobMetric(job, "c").has_value());
+    EXPECT_FALSE(jobMetric(job, "d").has_value());
+    EXPECT_FALSE(jobMetric(job, json::array({"a", "missing"})).has_value());
+    EXPECT_EQ(median({3.0, 1.0, 2.0}), 2.0);
+    EXPECT_EQ(median({4.0, 1.0, 2.0, 3.0}), 2.5);
+    EXPECT_FALSE(median({}).has_value());
+}
+
+TEST(ReportPublished, KnownNumbersGiveKnownMediansAndRatios) {
+    const json jobs = json::array({
+        okJob("0", "deferred", 1500, 10.0),
+        okJob("1", "deferred", 1500, 14.0),  // two matches: median 12
+        okJob("2", "tiled", 1500, 3.0),
+        {{"job_id", "3"}, {"status", "failed"}, {"error", "boom"}, {"stage", "tiled"},
+         {"lights", 1500}, {"time_total_median_ms", 1000.0}},  // failed: never counted
+        okJob("4", "deferred", 2000, 40.0),
+        okJob("5", "tiled", 2000, nullptr),  // matches, but its metric is missing
+    });
+    const json published = {
+        {"title", "T"},
+        {"source", "S"},
+        {"metric", "time_total_median_ms"},
+        {"columns", {{{"label", "deferred"}, {"select", {{"stage", "deferred"}}}},
+                     {{"label", "tiled"}, {"select", {{"stage", "tiled"}}}}}},
+        {"rows", {{{"label", "Test 1"}, {"select", {{"lights", "1500"}}}, {"values", {30.0, 15.0}}},
+                  {{"label", "Test 2"}, {"select", {{"lights", 2000.0}}}, {"values", {60.0, nullptr}}},
+                  {{"label", "Test 3"}, {"select", {{"lights", 9999}}}, {"values", {1.0, 2.0}}}}},
+        {"ratio_to", 0},
+        {"finding", "F"}};
+    const json table = comparePublished(published, jobs);
+    EXPECT_EQ(table["columns"], json::array({"deferred", "tiled"}));
+    EXPECT_EQ(table["finding"], "F");
+    const json& test1 = table["rows"][0]["cells"];
+    EXPECT_DOUBLE_EQ(test1[0]["published"].get<double>(), 30.0);
+    EXPECT_DOUBLE_EQ(test1[0]["measured"].get<double>(), 12.0);
+    EXPECT_EQ(test1[0]["matched_jobs"], 2);
+    EXPECT_DOUBLE_EQ(test1[0]["published_ratio"].get<double>(), 1.0);
+    EXPECT_DOUBLE_EQ(test1[0]["measured_ratio"].get<double>(), 1.0);
+    EXPECT_DOUBLE_EQ(test1[1]["measured"].get<double>(), 3.0);
+    EXPECT_EQ(test1[1]["matched_jobs"], 1) << "the failed job does not count";
+    EXPECT_DOUBLE_EQ(test1[1]["published_ratio"].get<double>(), 0.5);
+    EXPECT_DOUBLE_EQ(test1[1]["measured_ratio"].get<double>(), 0.25);
+    const json& test2 = table["rows"][1]["cells"];
+    EXPECT_DOUBLE_EQ(test2[0]["measured"].get<double>(), 40.0);
+    EXPECT_TRUE(test2[1]["published"].is_null());
+    EXPECT_TRUE(test2[1]["published_ratio"].is_null());
+    EXPECT_TRUE(test2[1]["measured"].is_null()) << "matched, but no metric";
+    EXPECT_EQ(test2[1]["matched_jobs"], 1);
+    const json& test3 = table["rows"][2]["cells"];
+    EXPECT_TRUE(test3[0]["measured"].is_null());
+    EXPECT_TRUE(test3[1]["measured_ratio"].is_null());
+    EXPECT_DOUBLE_EQ(test3[1]["published_ratio"].get<double>(), 2.0);
+}
+
+TEST(ReportPublished, SummedMetricAndAnotherBaseline) {
+    json jobs = json::array({okJob("0", "a", 10, 4.0), okJob("1", "b", 10, 7.0)});
+    const json published = {
+        {"title", "sum"},
+        {"metric", {"time_total_median_ms", "time_shading_median_ms"}},
+        {"columns", {{{"label", "a"}, {"select", {{"stage", "a"}}}}, {{"label", "b"}, {"select", {{"stage", "b"}}}}}},
+        {"rows", {{{"label", "r"}, {"values", {2.0, 4.0}}}}},
+        {"ratio_to", 1}};
+    const json table = comparePublished(published, jobs);
+    EXPECT_EQ(table["metric_label"], "time_total_median_ms + time_shading_median_ms");
+    const json& cells = table["rows"][0]["cells"];
+    EXPECT_DOUBLE_EQ(cells[0]["measured"].get<double>(), 5.0);
+    EXPECT_DOUBLE_EQ(cells[1]["measured"].get<double>(), 8.0);
+    EXPECT_DOUBLE_EQ(cells[0]["measured_ratio"].get<double>(), 5.0 / 8.0);
+    EXPECT_DOUBLE_EQ(cells[0]["published_ratio"].get<double>(), 0.5);
+    EXPECT_DOUBLE_EQ(cells[1]["published_ratio"].get<double>(), 1.0);
+}
+
+TEST(ReportPublished, MalformedEntriesAreRefusedByName) {
+    const json columns = {{{"label", "a"}, {"select", json::object()}}};
+    auto messageOf = [](const json& entry) {
+        try {
+            comparePublished(entry, json::array());
+        } catch (const std::runtime_error& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(messageOf({{"title", "X"}, {"metric", "m"}, {"columns", columns},
+                         {"rows", {{{"label", "r"}, {"values", {1.0, 2.0}}}}}})
+                  .find("published entry 'X': rows[0].values must have one entry per column"),
+              std::string::npos);
+    EXPECT_NE(messageOf({{"title", "X"}, {"metric", "m"}, {"columns", columns}, {"rows", json::array()},
+                         {"ratio_to", 3}})
+                  .find("ratio_to"),
+              std::string::npos);
+    EXPECT_NE(messageOf({{"title", "X"}, {"columns", columns}, {"rows", json::array()}}).find("metric"),
+              std::string::npos);
+}
+
+// A results folder in the sweep runner's format: six ok jobs (two stages x three light counts)
+// with tiny images, one failed job without a folder; job 0005 lacks error.png.
+fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
+    const int w = 32, h = 18;
+    std::vector<float> red(w * h), green(w * h), blue(w * h);
+    std::vector<uint32_t> counts(w * h);
+    json jobs = json::array();
+    const std::vector<std::string> stages = {"brute", "tiled"};
+    const std::vector<int> lightCounts = singleJob ? std::vector<int>{64} : std::vector<int>{16, 64, 256};
+    int ordinal = 0;
+    for (const std::string& stage : singleJob ? std::vector<std::string>{"tiled"} : stages)
+        for (int lights : lightCounts) {
+            char id[32];
+            std::snprintf(id, sizeof id, "%04d-%s", ordinal, stage.c_str());
+            const fs::path jobDir = dir / "jobs" / id;
+            fs::create_directories(jobDir);
+            for (int i = 0; i < w * h; ++i) {
+                red[i] = float(i % w) / w;
+                green[i] = float(i / w) / h * float(ordinal + 1) / 6.0f;
+                blue[i] = 0.5f;
+                counts[i] = uint32_t((i + ordinal) % 9);
+            }
+            writePreviewPng(jobDir / "preview.png", w, h, red.data(), green.data(), blue.data());
+            writeHeatmapPng(jobDir / "heatmap.png", w, h, counts.data(), 0);
+            if (ordinal != 5) writePreviewPng(jobDir / "error.png", w, h, blue.data(), red.data(), green.data());
+            const bool brute = stage == "brute";
+            const double time = (brute ? 2.0 : 0.5) * lights + ordinal;
+            jobs.push_back({{"job_id", id}, {"status", "ok"}, {"error", ""}, {"scene", "atrium"},
+                            {"stage", stage}, {"lights", lights}, {"width", w}, {"height", h},
+                            {"time_total_median_ms", time}, {"time_total_min_ms", time},
+                            {"time_total_max_ms", time},
+                            {"light_evaluations", (brute ? 1.0 : 0.2) * lights * w * h},
+                            {"culling_efficiency", brute ? 0.05 : 0.4 + 0.001 * lights},
+                            {"bytes_per_pixel", 16},
+                            {"rmse", brute ? 1e-7 * (ordinal + 1) : 2e-6 * (ordinal + 1)},
+                            {"psnr", ordinal == 0 ? json("inf") : json(80.0 - ordinal)},
+                            {"max_abs", ordinal == 1 ? json() : json(1e-5)}});
+            ++ordinal;
+        }
+    jobs.push_back({{"job_id", "9999-failed"}, {"status", "failed"}, {"error", "stage 'nope' <unknown>"},
+                    {"scene", "atrium"}, {"stage", "nope"}, {"lights", 16}, {"width", w}, {"height", h},
+                    {"time_total_median_ms", nullptr}, {"time_total_min_ms", nullptr},
+                    {"time_total_max_ms", nullptr}, {"light_evaluations", nullptr},
+                    {"culling_efficiency", nullptr}, {"bytes_per_pixel", nullptr}, {"rmse", nullptr},
+                    {"psnr", nullptr}, {"max_abs", nullptr}});
+    const json columns = {"job_id", "status", "error", "scene", "stage", "lights", "width", "height",
+                          "time_total_median_ms", "time_total_min_ms", "time_total_max_ms",
+                          "light_evaluations", "culling_efficiency", "bytes_per_pixel", "rmse", "psnr",
+                          "max_abs"};
+    const json published = json::array(
+        {{{"title", "Thesis-like table"},
+          {"source", "made up"},
+          {"metric", "time_total_median_ms"},
+          {"columns", {{{"label", "brute"}, {"select", {{"stage", "brute"}}}},
+                       {{"label", "tiled"}, {"select", {{"stage", "tiled"}}}}}},
+          {"rows", {{{"label", "Test 64"}, {"select", {{"lights", 64}}}, {"values", {128.0, 32.0}}}}},
+          {"ratio_to", 0},
+          {"finding", "tiled wins <by far>"}}});
+    const json results = {{"sweep", {{"name", "fixture"}, {"published", published}}},
+                          {"sweep_file", "fixture.json"},
+                          {"quick", false},
+                          {"columns", columns},
+                          {"jobs", jobs}};
+    std::ofstream(dir / "results.json") << results.dump(1);
+    return dir;
+}
+
+// A plot is not blank: it has many distinct colours and a sizeable non-white part.
+void expectNotBlank(const fs::path& png) {
+    OIIO::ImageBuf image(png.string());
+    ASSERT_TRUE(image.read(0, 0, true, OIIO::TypeDesc::FLOAT)) << png;
+    const OIIO::ImageBufAlgo::PixelStats stats = OIIO::ImageBufAlgo::computePixelStats(image);
+    EXPECT_GT(stats.stddev[0] + stats.stddev[1] + stats.stddev[2], 0.05) << png;
+    OIIO::ImageBuf rgb = OIIO::ImageBufAlgo::channels(image, 3, {0, 1, 2});
+    // Distinct colours: hash the quantised pixels.
+    std::vector<float> pixels(size_t(rgb.spec().image_pixels()) * 3);
+    rgb.get_pixels(rgb.roi(), OIIO::TypeDesc::FLOAT, pixels.data());
+    std::set<uint32_t> colours;
+    for (size_t i = 0; i < pixels.size(); i += 3)
+        colours.insert(uint32_t(std::lround(pixels[i] * 255)) << 16 | uint32_t(std::lround(pixels[i + 1] * 255)) << 8 |
+                       uint32_t(std::lround(pixels[i + 2] * 255)));
+    EXPECT_GT(colours.size(), 32u) << png;
+}
+
+TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
+    const fs::path dir = writeResultsFolder(freshTestFolder(), false);
+    ReportCommandOptions options;
+    options.dir = dir;
+    ASSERT_EQ(runReportCommand(options), 0) << dir;
+    const std::string html = readText(dir / "report.html");
+    for (const char* id : {"0000-brute", "0001-brute", "0002-brute", "0003-tiled", "0004-tiled", "0005-tiled",
+                           "9999-failed"})
+        EXPECT_NE(html.find(std::string("<td class=\"text\">") + id + "</td>"), std::string::npos) << id;
+    EXPECT_NE(html.find("<tr class=\"failed\">"), std::string::npos);
+    EXPECT_NE(html.find("stage &#39;nope&#39; &lt;unknown&gt;"), std::string::npos) << "error shown, escaped";
+    EXPECT_NE(html.find("<td class=\"text\">inf</td>"), std::string::npos) << "psnr inf shown as text";
+    EXPECT_NE(html.find("tiled wins &lt;by far&gt;"), std::string::npos);
+    // Published table, row "Test 64": brute measured 129 (2*64 + ordinal 1), tiled 36 (0.5*64 +
+    // ordinal 4): published ratio 32/128 = 0.25, measured 36/129 = 0.2791.
+    EXPECT_NE(html.find("<td>128</td><td>129</td><td>1&times;</td><td>1&times;</td><td>1</td>"),
+              std::string::npos);
+    EXPECT_NE(html.find("<td>32</td><td>36</td><td>0.25&times;</td><td>0.2791&times;</td><td>1</td>"),
+              std::string::npos);
+    EXPECT_NE(html.find("no error.png"), std::string::npos) << "job 0005 has no error image";
+    EXPECT_NE(html.find("id=\"page-check\""), std::string::npos);
+    EXPECT_EQ(html.find("http://"), std::string::npos) << "nothing from the network";
+    EXPECT_EQ(html.find("https://"), std::string::npos);
+
+    const json manifest = json::parse(readText(dir / "report" / "plots.json"));
+    std::set<std::string> files;
+    for (const json& plot : manifest["plots"]) {
+        files.insert(plot["file"].get<std::string>());
+        expectNotBlank(dir / "report" / plot["file"].get<std::string>());
+        EXPECT_NE(html.find("src=\"report/" + plot["file"].get<std::string>() + "\""), std::string::npos);
+    }
+    for (const char* expected : {"time_vs_error_by_stage.png", "evaluations_vs_lights.png", "culling_vs_lights.png",
+                                 "time_vs_lights.png", "published_0.png"})
+        EXPECT_EQ(files.count(expected), 1u) << expected << " in " << manifest.dump();
+    EXPECT_EQ(files.count("bytes_vs_error.png"), 0u) << "one bytes-per-pixel value: not drawn";
+    EXPECT_NE(html.find("not enough data"), std::string::npos);
+    EXPECT_TRUE(fs::exists(dir / "report" / "thumbs" / "0000-brute-preview.png"));
+    EXPECT_TRUE(fs::exists(dir / "report" / "thumbs" / "0000-brute-heatmap.png"));
+    EXPECT_FALSE(fs::exists(dir / "report" / "thumbs" / "0005-tiled-error.png"));
+    const json published = json::parse(readText(dir / "report" / "published.json"));
+    EXPECT_NEAR(published[0]["rows"][0]["cells"][1]["measured_ratio"].get<double>(), 36.0 / 129.0, 1e-12);
+}
+
+TEST(ReportCommand, SingleValuedAxesSayNotEnoughDataInsteadOfEmptyPlots) {
+    const fs::path dir = writeResultsFolder(freshTestFolder(), true);
+    ReportCommandOptions options;
+    options.dir = dir;
+    ASSERT_EQ(runReportCommand(options), 0) << dir;
+    const json manifest = json::parse(readText(dir / "report" / "plots.json"));
+    EXPECT_TRUE(manifest["plots"].empty()) << "one ok job, no brute baseline: nothing to plot: " << manifest.dump();
+    EXPECT_GE(manifest["skipped"].size(), 4u);
+    const std::string html = readText(dir / "report.html");
+    EXPECT_NE(html.find("Time against error, per stage: not enough data"), std::string::npos);
+    EXPECT_NE(html.find("Culling efficiency against light count: not enough data"), std::string::npos);
+}
+
+TEST(ReportCommand, MissingResultsOrPythonIsOneClearError) {
+    const fs::path dir = freshTestFolder();
+    ReportCommandOptions options;
+    options.dir = dir;
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(runReportCommand(options), 1);
+    std::string error = testing::internal::GetCapturedStderr();
+    EXPECT_NE(error.find("testbed: error: cannot read " + (dir / "results.json").string()), std::string::npos)
+        << error;
+    EXPECT_FALSE(fs::exists(dir / "report.html"));
+
+    writeResultsFolder(dir, true);
+    options.python = "/nonexistent/python3";
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(runReportCommand(options), 1);
+    error = testing::internal::GetCapturedStderr();
+    EXPECT_NE(error.find("python3-matplotlib"), std::string::npos) << error;
+    EXPECT_FALSE(fs::exists(dir / "report.html"));
+
+    options.python.clear();
+    options.plotsScript = dir / "missing.py";
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(runReportCommand(options), 1);
+    error = testing::internal::GetCapturedStderr();
+    EXPECT_NE(error.find("missing.py not found"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace experiments
