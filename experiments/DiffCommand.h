@@ -11,14 +11,14 @@
 //                      bar (matplotlib, experiments/plots/report.py diff)
 //   DIR/absdiff.exr    |A - B| per beauty channel as float32 R, G, B, for inspection in a viewer
 //
-// B is the reference of the metrics (as the reference render is in `testbed render`):
-//   rmse, max_abs, relative_rmse, psnr   experiments::compareImages on the beauty R, G, B
-//                                        (OpenImageIO ImageBufAlgo::compare; PSNR's peak is B's
-//                                        largest channel value; inf for identical images)
-//   mean_abs                             mean of |A - B| over the R, G, B samples
-//   relative_mean                        mean_abs / mean of |B| over the R, G, B samples
+// B is the reference of the metrics, which are the sweep's error metrics (experiments::
+// compareImages on the beauty R, G, B, through OpenImageIO's ImageBufAlgo), so a diff of a job's
+// render.exr against the reference gives the figures of results.json:
+//   rmse, max_abs, relative_rmse, psnr   PSNR's peak is B's largest channel value; inf when equal
+//   relative_mean                        mean |A - B| / |mean B| over the R, G, B samples
 //   p99_abs                              99th percentile of |A - B| over the R, G, B samples
-//                                        (nearest rank: the smallest value >= 99 % of samples)
+//                                        (nearest rank)
+//   mean_abs                             mean of |A - B| over the R, G, B samples
 // Per-channel statistics cover every channel present in both files (N.X, Z, albedo.R,
 // lights.evaluated, ...), through ImageBufAlgo::computePixelStats on A, B, A - B and |A - B|;
 // min/max/mean are over the finite values, nan/inf count the others.
