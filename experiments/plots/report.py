@@ -194,7 +194,7 @@ def published_ratios(report, table, index):
     if not rows or all(c["measured_ratio"] is None for r in rows for c in r["cells"]):
         report.skip(title, "no measured ratio (no matching ok jobs)")
         return
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.1 * len(rows) * len(columns)), 4.4))
+    fig, ax = plt.subplots(figsize=(min(9.0, max(6.0, 1.1 * len(rows) * len(columns))), 4.8))
     width = 0.8 / (2 * len(columns))
     positions = np.arange(len(rows))
     for c, column in enumerate(columns):
