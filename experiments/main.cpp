@@ -6,12 +6,14 @@
 //   sweep   a sweep file -> one job folder per job, results.csv/json (resumable, shardable)
 //   merge   shard outputs of one sweep -> one results set
 //   normals normal-encoding precision study -> normals.csv, normals.json, plots
+//   depth   depth-format / position-reconstruction study -> depth.csv, depth.json, plots
 // Every option's default is stated by --help; unknown options are errors.
 #include <iostream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "experiments/DepthStudy.h"
 #include "experiments/DiffCommand.h"
 #include "experiments/NormalStudy.h"
 #include "experiments/RenderCommand.h"
@@ -105,6 +107,15 @@ int main(int argc, char** argv) {
         ->default_str(experiments::defaultPlotsScript().string());
     diff->add_option("--python", diffOptions.python,
                      "Python with matplotlib (default: /usr/bin/python3, else python3 on PATH)");
+    experiments::DepthCommandOptions depthOptions;
+    CLI::App* depth = app.add_subcommand(
+        "depth", "depth formats x position reconstruction: position error against distance");
+    depth->add_option("--out", depthOptions.out, "output folder")->capture_default_str();
+    depth->add_flag("--quick", depthOptions.quick, "40 distances and a 16x9 pixel grid (seconds)");
+    depth->add_option("--plots-script", depthOptions.plotsScript,
+                      "matplotlib script (default: experiments/plots/depth.py of the source tree)");
+    depth->add_option("--python", depthOptions.python,
+                      "Python with matplotlib (default: python3, else /usr/bin/python3)");
     experiments::NormalStudyOptions normalsOptions;
     std::uint64_t normalsDirections = experiments::kNormalStudyDirections;
     std::string normalsModels = experiments::kNormalStudyModelsDir;
@@ -165,6 +176,7 @@ int main(int argc, char** argv) {
     if (list->parsed()) return listEverything();
     if (report->parsed()) return experiments::runReportCommand(reportOptions);
     if (diff->parsed()) return experiments::runDiffCommand(diffOptions);
+    if (depth->parsed()) return experiments::runDepthCommand(depthOptions);
     if (sweep->parsed()) {
         try {
             std::tie(sweepOptions.shardIndex, sweepOptions.shardCount) = experiments::parseShard(shardText);

@@ -159,8 +159,9 @@ uint32_t encodeDepth(const DepthFormatSpec& format, const DepthProjection& proje
     }
     case DepthFormatKind::F16Linear: {
         if (depthNdc == projection.clearDepthNdc()) return clear;
-        // Clamped to [0, 65504]: NDC depth just past the near plane (rounding) must not give a
-        // negative half, whose sign bit would make the bit pattern compare as "farthest".
+        // Clamped to [0, 65504]: NDC depth outside [0, 1] (unclipped input; reversed z < 0 far
+        // enough gives a negative linear depth) must not give a negative half, whose bits the
+        // final min would turn into 65504 m, the far end.
         const double d = projection.viewDepthFromNdc(double(depthNdc));
         const Imath::half h(float(std::clamp(d, 0.0, 65504.0)));
         return std::min<uint32_t>(h.bits(), kHalfMaxFiniteBits);
