@@ -61,7 +61,9 @@ struct DepthProjection {
     static DepthProjection of(const FrameView& view);
     double ndcFromViewDepth(double viewDepthMetres) const;
     double viewDepthFromNdc(double depthNdc) const;
-    // The same inverse evaluated in float, as a shader reconstructing linear depth would.
+    // The same inverse evaluated in float, as a shader reconstructing linear depth would, in the
+    // cancellation-free form n f / (n + w (f - n)), w = distance of z from the far plane's value:
+    // within 8 float roundings of the double inverse for every z (tests/gbuffer/depth_format_test).
     float viewDepthFromNdcFloat(float depthNdc) const;
     float clearDepthNdc() const { return reversed ? 0.0f : 1.0f; }
 };
