@@ -11,7 +11,7 @@ case "$mode" in main|test) ;; *) echo "usage: $0 main|test" >&2; exit 2 ;; esac
 
 packages=(
     g++ cmake make git pkg-config
-    libglm-dev libtbb-dev libopenimageio-dev openimageio-tools libopenexr-dev
+    libglm-dev libtbb-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
     libtinygltf-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev
     fonts-dejavu-core
     libtomlplusplus-dev
