@@ -21,12 +21,19 @@ const std::string kTimePrefix = "time_";
 const std::string kMedianSuffix = "_median_ms";
 
 // Pipeline order of the passes stages report; anything else goes after them by name.
-const std::vector<std::string> kPassOrder = {"gbuffer", "exact_surface", "transform", "prepass",
-                                             "cull",    "assign",        "index",     "shading",
-                                             "lighting", "material", "stage"};
-const std::vector<std::string> kMetricColumns = {
-    "light_evaluations", "oracle_evaluations", "culling_efficiency", "bytes_per_pixel", "rmse",
-    "relative_rmse",     "psnr",               "max_abs",            "relative_mean",   "p99_abs"};
+const std::vector<std::string> kPassOrder = {"gbuffer",  "exact_surface", "transform", "prepass",
+                                             "cull",     "assign",        "index",     "shading",
+                                             "lighting", "material",      "stage"};
+const std::vector<std::string> kMetricColumns = {"light_evaluations",
+                                                 "oracle_evaluations",
+                                                 "culling_efficiency",
+                                                 "bytes_per_pixel",
+                                                 "rmse",
+                                                 "relative_rmse",
+                                                 "psnr",
+                                                 "max_abs",
+                                                 "relative_mean",
+                                                 "p99_abs"};
 
 bool endsWith(const std::string& text, const std::string& suffix) {
     return text.size() >= suffix.size() &&
@@ -34,19 +41,23 @@ bool endsWith(const std::string& text, const std::string& suffix) {
 }
 
 std::string csvField(const Json& value) {
-    if (value.is_null()) return "";
+    if (value.is_null())
+        return "";
     std::string text = value.is_string() ? value.get<std::string>() : value.dump();
     const bool quote = text.find_first_of(",\"\r\n") != std::string::npos ||
                        (!text.empty() && (text.front() == ' ' || text.back() == ' '));
-    if (!quote) return text;
+    if (!quote)
+        return text;
     std::string quoted = "\"";
-    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    for (char c : text)
+        quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
     return quoted + "\"";
 }
 
 std::string readText(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw SweepError(path.string() + ": cannot open");
+    if (!in)
+        throw SweepError(path.string() + ": cannot open");
     std::stringstream text;
     text << in.rdbuf();
     return text.str();
@@ -57,7 +68,8 @@ void linkOrCopy(const fs::path& from, const fs::path& to) {
     std::error_code error;
     fs::remove(to, error);
     fs::create_hard_link(from, to, error);
-    if (error) fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+    if (error)
+        fs::copy_file(from, to, fs::copy_options::overwrite_existing);
 }
 
 bool samePath(const fs::path& a, const fs::path& b) {
@@ -65,7 +77,7 @@ bool samePath(const fs::path& a, const fs::path& b) {
     return fs::exists(a) && fs::exists(b) && fs::equivalent(a, b, error);
 }
 
-}  // namespace
+} // namespace
 
 std::vector<std::string> metricColumns(const std::vector<Json>& rows) {
     std::set<std::string> passes;
@@ -76,11 +88,14 @@ std::vector<std::string> metricColumns(const std::vector<Json>& rows) {
                                          key.size() - kTimePrefix.size() - kMedianSuffix.size()));
     std::vector<std::string> ordered;
     for (const std::string& pass : kPassOrder)
-        if (passes.count(pass)) ordered.push_back(pass);
-    for (const std::string& pass : passes)  // std::set: by name
-        if (std::find(kPassOrder.begin(), kPassOrder.end(), pass) == kPassOrder.end() && pass != "total")
+        if (passes.count(pass))
             ordered.push_back(pass);
-    if (passes.count("total")) ordered.push_back("total");
+    for (const std::string& pass : passes) // std::set: by name
+        if (std::find(kPassOrder.begin(), kPassOrder.end(), pass) == kPassOrder.end() &&
+            pass != "total")
+            ordered.push_back(pass);
+    if (passes.count("total"))
+        ordered.push_back("total");
     std::vector<std::string> columns;
     for (const std::string& pass : ordered)
         for (const char* statistic : {"median", "min", "max"})
@@ -119,14 +134,16 @@ std::string resultsCsv(const Json& results) {
     std::string csv;
     const Json& columns = results.at("columns");
     for (size_t c = 0; c < columns.size(); ++c) {
-        if (c) csv += ',';
+        if (c)
+            csv += ',';
         csv += csvField(columns[c]);
     }
     csv += "\n";
     for (const Json& job : results.at("jobs")) {
         for (size_t c = 0; c < columns.size(); ++c) {
             const std::string name = columns[c].get<std::string>();
-            if (c) csv += ',';
+            if (c)
+                csv += ',';
             csv += csvField(job.contains(name) ? job[name] : Json(nullptr));
         }
         csv += "\n";
@@ -142,7 +159,8 @@ void writeResults(const fs::path& dir, const Json& results) {
 Json readResults(const fs::path& dir) {
     const fs::path file = dir / "results.json";
     if (!fs::is_regular_file(file))
-        throw SweepError(file.string() + ": not found (is " + dir.string() + " a sweep output folder?)");
+        throw SweepError(file.string() + ": not found (is " + dir.string() +
+                         " a sweep output folder?)");
     Json results;
     try {
         results = Json::parse(readText(file));
@@ -150,14 +168,17 @@ Json readResults(const fs::path& dir) {
         throw SweepError(file.string() + ": not valid JSON: " + e.what());
     }
     for (const char* key : {"sweep", "sweep_file", "quick", "columns", "axis_columns", "jobs"})
-        if (!results.contains(key)) throw SweepError(file.string() + ": lacks '" + key + "'");
+        if (!results.contains(key))
+            throw SweepError(file.string() + ": lacks '" + key + "'");
     return results;
 }
 
 size_t mergeSweepOutputs(const std::vector<fs::path>& inputs, const fs::path& out) {
-    if (inputs.empty()) throw SweepError("merge: no input folders");
+    if (inputs.empty())
+        throw SweepError("merge: no input folders");
     std::vector<Json> results;
-    for (const fs::path& input : inputs) results.push_back(readResults(input));
+    for (const fs::path& input : inputs)
+        results.push_back(readResults(input));
     const Json& first = results.front();
     for (size_t i = 1; i < results.size(); ++i)
         for (const char* key : {"sweep", "quick", "axis_columns"})
@@ -169,7 +190,7 @@ size_t mergeSweepOutputs(const std::vector<fs::path>& inputs, const fs::path& ou
         fs::path folder;
         Json row;
     };
-    std::map<std::string, Source> jobs;  // by job_id
+    std::map<std::string, Source> jobs; // by job_id
     for (size_t i = 0; i < results.size(); ++i)
         for (const Json& listed : results[i]["jobs"]) {
             const std::string id = listed.at("job_id").get<std::string>();
@@ -185,11 +206,13 @@ size_t mergeSweepOutputs(const std::vector<fs::path>& inputs, const fs::path& ou
                 throw SweepError("merge: " + (folder / kDoneMarker).string() + ": " + e.what());
             }
             if (!marker.contains("row") || marker["row"].value("job_id", "") != id)
-                throw SweepError("merge: " + (folder / kDoneMarker).string() + " is not job " + id + "'s marker");
+                throw SweepError("merge: " + (folder / kDoneMarker).string() + " is not job " + id +
+                                 "'s marker");
             const auto [it, inserted] = jobs.emplace(id, Source{folder, marker["row"]});
             if (!inserted && it->second.row != marker["row"])
-                throw SweepError("merge: job " + id + " differs between " + it->second.folder.string() +
-                                 " and " + folder.string() + "; refusing to pick one");
+                throw SweepError("merge: job " + id + " differs between " +
+                                 it->second.folder.string() + " and " + folder.string() +
+                                 "; refusing to pick one");
         }
 
     ensureWritableDirectory(out);
@@ -198,23 +221,26 @@ size_t mergeSweepOutputs(const std::vector<fs::path>& inputs, const fs::path& ou
         const fs::path target = out / "jobs" / id;
         if (!samePath(source.folder, target)) {
             fs::create_directories(target);
-            fs::remove(target / kDoneMarker);  // unfinished until its marker is copied, last
+            fs::remove(target / kDoneMarker); // unfinished until its marker is copied, last
             for (const fs::directory_entry& entry : fs::directory_iterator(source.folder)) {
                 const std::string name = entry.path().filename().string();
-                if (!entry.is_regular_file() || name == kDoneMarker || name.front() == '.') continue;
+                if (!entry.is_regular_file() || name == kDoneMarker || name.front() == '.')
+                    continue;
                 linkOrCopy(entry.path(), target / name);
             }
             writeFileAtomically(target / kDoneMarker, [&](const fs::path& temporary) {
-                fs::copy_file(source.folder / kDoneMarker, temporary, fs::copy_options::overwrite_existing);
+                fs::copy_file(source.folder / kDoneMarker, temporary,
+                              fs::copy_options::overwrite_existing);
             });
         }
         rows.push_back(source.row);
     }
     std::vector<std::string> axis;
-    for (const Json& column : first["axis_columns"]) axis.push_back(column.get<std::string>());
+    for (const Json& column : first["axis_columns"])
+        axis.push_back(column.get<std::string>());
     writeResults(out, resultsJson(first["sweep"], first["sweep_file"].get<std::string>(),
                                   first["quick"].get<bool>(), axis, std::move(rows)));
     return jobs.size();
 }
 
-}  // namespace experiments
+} // namespace experiments

@@ -36,8 +36,9 @@ inline constexpr const char* kDoneMarker = "done.json";
 std::vector<std::string> metricColumns(const std::vector<nlohmann::ordered_json>& rows);
 
 // The results object; rows are completed with null for missing columns and sorted by job_id.
-nlohmann::ordered_json resultsJson(const nlohmann::ordered_json& sweep, const std::string& sweepFile,
-                                   bool quick, const std::vector<std::string>& axisColumns,
+nlohmann::ordered_json resultsJson(const nlohmann::ordered_json& sweep,
+                                   const std::string& sweepFile, bool quick,
+                                   const std::vector<std::string>& axisColumns,
                                    std::vector<nlohmann::ordered_json> rows);
 
 // The CSV text of a results object (header line, one line per job, "\n" line ends).
@@ -59,4 +60,4 @@ nlohmann::ordered_json readResults(const std::filesystem::path& dir);
 size_t mergeSweepOutputs(const std::vector<std::filesystem::path>& inputs,
                          const std::filesystem::path& out);
 
-}  // namespace experiments
+} // namespace experiments

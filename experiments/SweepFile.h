@@ -7,11 +7,12 @@
 //   warmup, repetitions           untimed and timed runs of every job (may also be axes)
 //   reference: true|false         measure the error against the reference image (default true)
 //   quick: {fixed, axes, cases, warmup, repetitions, reference}   overrides for `--quick`
-//   published: [...]              published figures of a reproduction (contract.md's schema)
+//   published: [...]              published figures of a reproduction (schema in the README)
 // Keys are the names experiments::setRenderOption accepts (scene, stage, lights, seed, width,
-// height, resolution, threads, layout, normals, depth, position, scene-option.KEY) plus warmup
-// and repetitions. Values are strings or numbers and reach setRenderOption as text, so this file
-// knows no stage, encoding or scene: anything registered later works unchanged.
+// height, resolution, threads, layout, normals, normal-space, depth, position, scene-option.KEY:
+// whatever renderOptionKeys() lists) plus warmup and repetitions. Values are strings or numbers
+// and reach setRenderOption as text, so this file knows no stage, encoding or scene: anything
+// registered later works unchanged.
 //
 // Jobs: the full expansion (cases x axes) numbers jobs 0..n-1 in that order; a job's id is its
 // zero-padded ordinal and a hash of every setting that makes it ("0007-1a2b3c4d"), identical in
@@ -50,12 +51,12 @@ struct SweepSetting {
 };
 
 struct SweepSpec {
-    std::string origin;              // the file name, for messages
-    nlohmann::ordered_json source;   // the file's object verbatim (TOML converted to JSON)
+    std::string origin;            // the file name, for messages
+    nlohmann::ordered_json source; // the file's object verbatim (TOML converted to JSON)
     std::string name;
     std::string description;
     std::vector<SweepSetting> fixed;
-    std::vector<std::pair<std::string, std::vector<nlohmann::ordered_json>>> axes;  // file order
+    std::vector<std::pair<std::string, std::vector<nlohmann::ordered_json>>> axes; // file order
     std::vector<std::vector<SweepSetting>> cases;
     int warmup = 0;
     int repetitions = 1;
@@ -80,12 +81,12 @@ struct SweepJob {
     std::vector<SweepSetting> settings; // fixed, then the case's, then the axes' (file order)
     RenderOptions options;              // settings applied through setRenderOption
     bool compareReference = true;
-    std::string referenceKey;           // filesystem-safe, e.g. "wall-1280x720-1500l-s1-9f3a0c11"
+    std::string referenceKey; // filesystem-safe, e.g. "wall-1280x720-1500l-s1-9f3a0c11"
 };
 
 struct SweepExpansion {
-    std::vector<SweepJob> jobs;              // in run order: grouped by referenceKey
-    std::vector<std::string> axisColumns;    // result columns of the settings, see axisColumns()
+    std::vector<SweepJob> jobs;           // in run order: grouped by referenceKey
+    std::vector<std::string> axisColumns; // result columns of the settings, see axisColumns()
 };
 
 // Expands the spec (after applyQuick when wanted) into jobs and validates every one of them
@@ -95,7 +96,8 @@ struct SweepExpansion {
 SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads = std::nullopt);
 
 // The result columns for settings: every key the sweep sets, in the canonical order scene,
-// stage, lights, seed, resolution, width, height, threads, layout, normals, depth, position,
+// stage, lights, seed, resolution, width, height, threads, layout, normals, normal-space, depth,
+// position,
 // then scene-option.* and any other key in name order; width and height are always present
 // (the effective size), and repetitions and warmup close the list.
 std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys);
@@ -120,4 +122,4 @@ std::string settingText(const nlohmann::ordered_json& value, const std::string& 
 // "key=value key=value" for progress lines and messages.
 std::string describeSettings(const std::vector<SweepSetting>& settings);
 
-}  // namespace experiments
+} // namespace experiments

@@ -36,8 +36,11 @@ std::string formatDuration(double seconds) {
         std::snprintf(text, sizeof text, "%.1fs", seconds);
     } else {
         const long whole = std::lround(seconds);
-        if (whole < 3600) std::snprintf(text, sizeof text, "%ldm%02lds", whole / 60, whole % 60);
-        else std::snprintf(text, sizeof text, "%ldh%02ldm%02lds", whole / 3600, whole / 60 % 60, whole % 60);
+        if (whole < 3600)
+            std::snprintf(text, sizeof text, "%ldm%02lds", whole / 60, whole % 60);
+        else
+            std::snprintf(text, sizeof text, "%ldh%02ldm%02lds", whole / 3600, whole / 60 % 60,
+                          whole % 60);
     }
     return text;
 }
@@ -54,27 +57,32 @@ std::string utcNow() {
 // The marker's status, or "" when there is no readable marker (then the job is not finished).
 std::string markerStatus(const fs::path& marker) {
     std::ifstream in(marker, std::ios::binary);
-    if (!in) return "";
+    if (!in)
+        return "";
     try {
         const Json json = Json::parse(in);
         return json.value("status", "");
     } catch (const std::exception&) {
-        return "";  // cannot happen with atomic writes; treat as unfinished
+        return ""; // cannot happen with atomic writes; treat as unfinished
     }
 }
 
 std::optional<Json> markerRow(const fs::path& marker) {
     std::ifstream in(marker, std::ios::binary);
-    if (!in) return std::nullopt;
+    if (!in)
+        return std::nullopt;
     try {
         Json json = Json::parse(in);
-        if (json.contains("row") && json["row"].is_object()) return json["row"];
+        if (json.contains("row") && json["row"].is_object())
+            return json["row"];
     } catch (const std::exception&) {
     }
     return std::nullopt;
 }
 
-Json number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
+Json number(double value) {
+    return std::isfinite(value) ? Json(value) : Json(nullptr);
+}
 
 // The row's axis values and status; metrics are added by the caller.
 Json baseRow(const SweepJob& job, const std::vector<std::string>& axisColumns) {
@@ -82,7 +90,8 @@ Json baseRow(const SweepJob& job, const std::vector<std::string>& axisColumns) {
     row["job_id"] = job.id;
     row["status"] = "ok";
     row["error"] = "";
-    for (const std::string& column : axisColumns) row[column] = axisValue(job, column);
+    for (const std::string& column : axisColumns)
+        row[column] = axisValue(job, column);
     return row;
 }
 
@@ -92,16 +101,20 @@ PassTiming stageTiming(const std::vector<PassTiming>& passes) {
     PassTiming stage;
     stage.pass = "stage";
     for (const PassTiming& timing : passes) {
-        if (timing.pass == "gbuffer" || timing.pass == "exact_surface" || timing.pass == "total") continue;
-        if (stage.samplesMs.size() < timing.samplesMs.size()) stage.samplesMs.resize(timing.samplesMs.size(), 0.0);
-        for (size_t r = 0; r < timing.samplesMs.size(); ++r) stage.samplesMs[r] += timing.samplesMs[r];
+        if (timing.pass == "gbuffer" || timing.pass == "exact_surface" || timing.pass == "total")
+            continue;
+        if (stage.samplesMs.size() < timing.samplesMs.size())
+            stage.samplesMs.resize(timing.samplesMs.size(), 0.0);
+        for (size_t r = 0; r < timing.samplesMs.size(); ++r)
+            stage.samplesMs[r] += timing.samplesMs[r];
     }
     return stage;
 }
 
 void addMetrics(Json& row, const RenderRun& run) {
     std::vector<PassTiming> passes = run.passTimings;
-    if (const PassTiming stage = stageTiming(passes); !stage.samplesMs.empty()) passes.push_back(stage);
+    if (const PassTiming stage = stageTiming(passes); !stage.samplesMs.empty())
+        passes.push_back(stage);
     for (const PassTiming& timing : passes) {
         row["time_" + timing.pass + "_median_ms"] = number(timing.medianMs());
         row["time_" + timing.pass + "_min_ms"] = number(timing.minMs());
@@ -113,18 +126,20 @@ void addMetrics(Json& row, const RenderRun& run) {
     row["culling_efficiency"] = evaluations > 0 ? double(oracle) / double(evaluations) : 1.0;
     // Through statsJson, the one place that knows how the layout reports its size.
     const nlohmann::json stats = statsJson(run);
-    row["bytes_per_pixel"] = stats.contains("bytes_per_pixel") ? Json(stats["bytes_per_pixel"]) : Json(nullptr);
+    row["bytes_per_pixel"] =
+        stats.contains("bytes_per_pixel") ? Json(stats["bytes_per_pixel"]) : Json(nullptr);
     if (run.error) {
         row["rmse"] = number(run.error->rmse);
         row["relative_rmse"] = number(run.error->relativeRmse);
-        row["psnr"] = number(run.error->psnr);  // +inf (identical images) -> null
+        row["psnr"] = number(run.error->psnr); // +inf (identical images) -> null
         row["max_abs"] = number(run.error->maxAbs);
         row["relative_mean"] = number(run.error->relativeMean);
         row["p99_abs"] = number(run.error->p99Abs);
     }
 }
 
-void writeReferenceExr(const fs::path& path, const std::string& key, const lighting::StageResult& image) {
+void writeReferenceExr(const fs::path& path, const std::string& key,
+                       const lighting::StageResult& image) {
     writeMultiLayerExr(path, image.width, image.height,
                        {{"R", image.radiance[0].data()},
                         {"G", image.radiance[1].data()},
@@ -136,9 +151,11 @@ void writeReferenceExr(const fs::path& path, const std::string& key, const light
 // Reads a cached reference; nullopt when absent or not the expected image (then it is rendered).
 std::optional<lighting::StageResult> readReferenceExr(const fs::path& path, const std::string& key,
                                                       int width, int height) {
-    if (!fs::is_regular_file(path)) return std::nullopt;
+    if (!fs::is_regular_file(path))
+        return std::nullopt;
     OIIO::ImageBuf buffer(path.string());
-    if (!buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT)) return std::nullopt;
+    if (!buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+        return std::nullopt;
     const OIIO::ImageSpec& spec = buffer.spec();
     if (spec.width != width || spec.height != height ||
         spec.get_string_attribute("testbed:reference_key") != key)
@@ -150,12 +167,14 @@ std::optional<lighting::StageResult> readReferenceExr(const fs::path& path, cons
     const char* names[3] = {"R", "G", "B"};
     for (int c = 0; c < 3; ++c) {
         const int channel = spec.channelindex(names[c]);
-        if (channel < 0) return std::nullopt;
+        if (channel < 0)
+            return std::nullopt;
         image.radiance[c].resize(pixels);
         OIIO::ROI roi = buffer.roi();
         roi.chbegin = channel;
         roi.chend = channel + 1;
-        if (!buffer.get_pixels(roi, OIIO::TypeDesc::FLOAT, image.radiance[c].data())) return std::nullopt;
+        if (!buffer.get_pixels(roi, OIIO::TypeDesc::FLOAT, image.radiance[c].data()))
+            return std::nullopt;
     }
     return image;
 }
@@ -166,12 +185,14 @@ public:
 
     SweepSummary run() {
         SweepSpec spec = readSweepFile(mOptions.file);
-        if (mOptions.quick) spec = applyQuick(spec);
+        if (mOptions.quick)
+            spec = applyQuick(spec);
         mSpec = spec;
         const SweepExpansion expansion = expandSweep(spec, mOptions.threads);
         mAllJobs = expansion.jobs;
         mAxisColumns = expansion.axisColumns;
-        const std::vector<SweepJob> jobs = shardJobs(mAllJobs, mOptions.shardIndex, mOptions.shardCount);
+        const std::vector<SweepJob> jobs =
+            shardJobs(mAllJobs, mOptions.shardIndex, mOptions.shardCount);
         ensureWritableDirectory(mOptions.out);
         fs::create_directories(mOptions.out / "jobs");
         fs::create_directories(mOptions.out / "references");
@@ -179,7 +200,8 @@ public:
         mSummary.jobsInSweep = mAllJobs.size();
         mSummary.jobsInShard = jobs.size();
         const std::string name = spec.name.empty() ? mOptions.file.stem().string() : spec.name;
-        mLog << "sweep " << name << (mOptions.quick ? " (quick)" : "") << ": " << jobs.size() << " jobs";
+        mLog << "sweep " << name << (mOptions.quick ? " (quick)" : "") << ": " << jobs.size()
+             << " jobs";
         if (mOptions.shardCount > 1)
             mLog << " (shard " << mOptions.shardIndex << "/" << mOptions.shardCount << " of "
                  << mAllJobs.size() << ")";
@@ -193,7 +215,8 @@ public:
             finished[i] = markerStatus(jobDir(jobs[i]) / kDoneMarker) == "ok";
             if (!finished[i]) {
                 ++toRun;
-                if (jobs[i].compareReference) ++remainingUsers[jobs[i].referenceKey];
+                if (jobs[i].compareReference)
+                    ++remainingUsers[jobs[i].referenceKey];
             }
         }
 
@@ -201,7 +224,8 @@ public:
         double runSeconds = 0.0;
         for (size_t i = 0; i < jobs.size(); ++i) {
             const SweepJob& job = jobs[i];
-            const std::string position = "[" + std::to_string(i + 1) + "/" + std::to_string(jobs.size()) + "]";
+            const std::string position =
+                "[" + std::to_string(i + 1) + "/" + std::to_string(jobs.size()) + "]";
             if (finished[i]) {
                 ++mSummary.skipped;
                 mLog << position << " skipped " << job.id << " (finished before)\n";
@@ -209,21 +233,25 @@ public:
             }
             const size_t left = toRun - mSummary.ran;
             const std::string remaining =
-                mSummary.ran == 0 ? "?" : formatDuration(runSeconds / double(mSummary.ran) * double(left));
+                mSummary.ran == 0
+                    ? "?"
+                    : formatDuration(runSeconds / double(mSummary.ran) * double(left));
             mLog << position << " running " << job.id << ": " << describeSettings(job.settings)
-                 << " | done " << (mSummary.ran + mSummary.skipped) << "/" << jobs.size() << ", skipped "
-                 << mSummary.skipped << ", failed " << mSummary.failed << " | elapsed "
-                 << formatDuration(secondsSince(start)) << ", remaining ~" << remaining << "\n";
+                 << " | done " << (mSummary.ran + mSummary.skipped) << "/" << jobs.size()
+                 << ", skipped " << mSummary.skipped << ", failed " << mSummary.failed
+                 << " | elapsed " << formatDuration(secondsSince(start)) << ", remaining ~"
+                 << remaining << "\n";
             mLog.flush();
             const auto jobStart = Clock::now();
             const std::string error = runJob(job);
             const double seconds = secondsSince(jobStart);
             runSeconds += seconds;
             ++mSummary.ran;
-            if (!error.empty()) ++mSummary.failed;
+            if (!error.empty())
+                ++mSummary.failed;
             if (job.compareReference && --remainingUsers[job.referenceKey] == 0 &&
                 mReferenceKey == job.referenceKey) {
-                mReference.reset();  // no later job of this shard needs it
+                mReference.reset(); // no later job of this shard needs it
                 mReferenceKey.clear();
             }
             mLog << position << (error.empty() ? " ok " : " FAILED ") << job.id << " in "
@@ -233,9 +261,10 @@ public:
         rebuildTable();
         mLog << "sweep " << name << " finished in " << formatDuration(secondsSince(start)) << ": "
              << jobs.size() << " jobs, " << mSummary.ran << " ran, " << mSummary.skipped
-             << " skipped, " << mSummary.failed << " failed; references: " << mSummary.referencesRendered
-             << " rendered, " << mSummary.referencesLoaded << " read from disk; table of "
-             << mSummary.rowsInTable << " jobs in " << (mOptions.out / "results.csv").string() << " and "
+             << " skipped, " << mSummary.failed
+             << " failed; references: " << mSummary.referencesRendered << " rendered, "
+             << mSummary.referencesLoaded << " read from disk; table of " << mSummary.rowsInTable
+             << " jobs in " << (mOptions.out / "results.csv").string() << " and "
              << (mOptions.out / "results.json").string() << "\n";
         return mSummary;
     }
@@ -245,13 +274,16 @@ private:
 
     // The reference of the job's key: memory, then DIR/references, then rendered (and cached).
     const lighting::StageResult& reference(const SweepJob& job) {
-        if (mReferenceKey == job.referenceKey && mReference) return *mReference;
-        if (const auto failed = mReferenceErrors.find(job.referenceKey); failed != mReferenceErrors.end())
+        if (mReferenceKey == job.referenceKey && mReference)
+            return *mReference;
+        if (const auto failed = mReferenceErrors.find(job.referenceKey);
+            failed != mReferenceErrors.end())
             throw std::runtime_error(failed->second);
         mReference.reset();
         mReferenceKey = job.referenceKey;
         const fs::path path = mOptions.out / "references" / (job.referenceKey + ".exr");
-        if (auto loaded = readReferenceExr(path, job.referenceKey, job.options.width, job.options.height)) {
+        if (auto loaded =
+                readReferenceExr(path, job.referenceKey, job.options.width, job.options.height)) {
             mReference = std::move(*loaded);
             ++mSummary.referencesLoaded;
             return *mReference;
@@ -261,8 +293,9 @@ private:
         try {
             mReference = renderReference(job.options);
         } catch (const std::exception& e) {
-            const std::string message = std::string("reference ") + job.referenceKey + ": " + e.what();
-            mReferenceErrors[job.referenceKey] = message;  // the key's other jobs fail at once
+            const std::string message =
+                std::string("reference ") + job.referenceKey + ": " + e.what();
+            mReferenceErrors[job.referenceKey] = message; // the key's other jobs fail at once
             throw std::runtime_error(message);
         }
         ++mSummary.referencesRendered;
@@ -277,8 +310,9 @@ private:
         std::string error;
         try {
             fs::create_directories(dir);
-            fs::remove(dir / kDoneMarker);  // a failed job's old marker: the job is rerun now
-            const lighting::StageResult* referenceImage = job.compareReference ? &reference(job) : nullptr;
+            fs::remove(dir / kDoneMarker); // a failed job's old marker: the job is rerun now
+            const lighting::StageResult* referenceImage =
+                job.compareReference ? &reference(job) : nullptr;
             RenderOptions options = job.options;
             options.compareReference = job.compareReference;
             const RenderRun run = runRender(options, {}, referenceImage);
@@ -286,7 +320,8 @@ private:
             addMetrics(row, run);
         } catch (const std::exception& e) {
             error = e.what();
-            if (error.empty()) error = "unknown error";
+            if (error.empty())
+                error = "unknown error";
             row["status"] = "failed";
             row["error"] = error;
         }
@@ -297,7 +332,7 @@ private:
         marker["settings"] = describeSettings(job.settings);
         marker["finished_at"] = utcNow();
         marker["row"] = row;
-        writeTextAtomically(dir / kDoneMarker, marker.dump(2) + "\n");  // last: the job counts now
+        writeTextAtomically(dir / kDoneMarker, marker.dump(2) + "\n"); // last: the job counts now
         return error;
     }
 
@@ -305,7 +340,8 @@ private:
     void rebuildTable() {
         std::vector<Json> rows;
         for (const SweepJob& job : mAllJobs)
-            if (auto row = markerRow(jobDir(job) / kDoneMarker)) rows.push_back(std::move(*row));
+            if (auto row = markerRow(jobDir(job) / kDoneMarker))
+                rows.push_back(std::move(*row));
         mSummary.rowsInTable = rows.size();
         writeResults(mOptions.out, resultsJson(mSpec.source, mOptions.file.string(), mOptions.quick,
                                                mAxisColumns, std::move(rows)));
@@ -322,7 +358,7 @@ private:
     std::map<std::string, std::string> mReferenceErrors;
 };
 
-}  // namespace
+} // namespace
 
 SweepSummary runSweep(const SweepOptions& options, std::ostream& log) {
     return Runner(options, log).run();
@@ -332,8 +368,9 @@ int runSweepCommand(const SweepOptions& options) {
     try {
         const SweepSummary summary = runSweep(options, std::cerr);
         if (summary.failed > 0) {
-            std::cerr << "testbed: " << summary.failed << " of " << summary.jobsInShard
-                      << " jobs failed (status \"failed\" and the error in the results); exit code 1\n";
+            std::cerr
+                << "testbed: " << summary.failed << " of " << summary.jobsInShard
+                << " jobs failed (status \"failed\" and the error in the results); exit code 1\n";
             return 1;
         }
         return 0;
@@ -350,7 +387,8 @@ int runMergeCommand(const std::vector<fs::path>& inputs, const fs::path& out) {
     try {
         const size_t jobs = mergeSweepOutputs(inputs, out);
         std::cerr << "testbed: merged " << inputs.size() << " folders: " << jobs << " jobs in "
-                  << (out / "results.csv").string() << " and " << (out / "results.json").string() << "\n";
+                  << (out / "results.csv").string() << " and " << (out / "results.json").string()
+                  << "\n";
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "testbed: error: " << e.what() << "\n";
@@ -358,4 +396,4 @@ int runMergeCommand(const std::vector<fs::path>& inputs, const fs::path& out) {
     }
 }
 
-}  // namespace experiments
+} // namespace experiments

@@ -29,23 +29,23 @@
 namespace experiments {
 
 struct SweepOptions {
-    std::filesystem::path file;    // the sweep file (.json or .toml)
+    std::filesystem::path file; // the sweep file (.json or .toml)
     std::filesystem::path out = "sweep-out";
-    int shardIndex = 1;            // 1-based
+    int shardIndex = 1; // 1-based
     int shardCount = 1;
-    bool quick = false;            // apply the file's "quick" block
-    std::optional<int> threads;    // overrides every job's threads (0 = all hardware threads)
+    bool quick = false;         // apply the file's "quick" block
+    std::optional<int> threads; // overrides every job's threads (0 = all hardware threads)
 };
 
 struct SweepSummary {
-    size_t jobsInSweep = 0;     // full expansion
+    size_t jobsInSweep = 0; // full expansion
     size_t jobsInShard = 0;
-    size_t ran = 0;             // run in this invocation (ok or failed)
-    size_t skipped = 0;         // finished before (marker "ok")
-    size_t failed = 0;          // failed in this invocation
+    size_t ran = 0;     // run in this invocation (ok or failed)
+    size_t skipped = 0; // finished before (marker "ok")
+    size_t failed = 0;  // failed in this invocation
     size_t referencesRendered = 0;
-    size_t referencesLoaded = 0;  // read back from DIR/references
-    size_t rowsInTable = 0;       // jobs in DIR/results.json
+    size_t referencesLoaded = 0; // read back from DIR/references
+    size_t rowsInTable = 0;      // jobs in DIR/results.json
 };
 
 // Runs the sweep. Throws SweepError (file or jobs invalid: nothing was run) or
@@ -57,6 +57,7 @@ SweepSummary runSweep(const SweepOptions& options, std::ostream& log);
 int runSweepCommand(const SweepOptions& options);
 
 // `testbed merge DIR... --out DIR` (ResultsTable.h mergeSweepOutputs); exit code 0 or 1.
-int runMergeCommand(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out);
+int runMergeCommand(const std::vector<std::filesystem::path>& inputs,
+                    const std::filesystem::path& out);
 
-}  // namespace experiments
+} // namespace experiments

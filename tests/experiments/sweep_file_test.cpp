@@ -17,7 +17,8 @@ using experiments::SweepJob;
 using Json = nlohmann::ordered_json;
 
 fs::path testDir(const std::string& name) {
-    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / ("sweep-file-" + name);
+    const fs::path dir =
+        fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / ("sweep-file-" + name);
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
@@ -65,7 +66,8 @@ TEST(SweepFile, ExpandsCasesTimesAxesWithStableIds) {
     EXPECT_EQ(*ordinals.rbegin(), expansion.jobs.size() - 1);
     // Ordinal order: cases outermost, then the axes in file order, last axis fastest.
     std::vector<SweepJob> byOrdinal = expansion.jobs;
-    std::sort(byOrdinal.begin(), byOrdinal.end(), [](auto& a, auto& b) { return a.ordinal < b.ordinal; });
+    std::sort(byOrdinal.begin(), byOrdinal.end(),
+              [](auto& a, auto& b) { return a.ordinal < b.ordinal; });
     EXPECT_EQ(byOrdinal[0].options.stage, "brute");
     EXPECT_EQ(byOrdinal[0].options.lights, 4);
     EXPECT_EQ(byOrdinal[1].options.lights, 8);
@@ -74,22 +76,28 @@ TEST(SweepFile, ExpandsCasesTimesAxesWithStableIds) {
     EXPECT_EQ(byOrdinal[6].options.sceneOptions.at("segments"), "32");
 
     // The same file expands to the same ids; changing one setting changes only those jobs' ids.
-    const auto again = experiments::expandSweep(experiments::parseSweep(baseSweep(), "other-name.json"));
-    for (size_t i = 0; i < again.jobs.size(); ++i) EXPECT_EQ(again.jobs[i].id, expansion.jobs[i].id);
+    const auto again =
+        experiments::expandSweep(experiments::parseSweep(baseSweep(), "other-name.json"));
+    for (size_t i = 0; i < again.jobs.size(); ++i)
+        EXPECT_EQ(again.jobs[i].id, expansion.jobs[i].id);
     Json changed = baseSweep();
     changed["fixed"]["seed"] = 4;
     const auto moved = experiments::expandSweep(experiments::parseSweep(changed, "unit.json"));
-    for (size_t i = 0; i < moved.jobs.size(); ++i) EXPECT_NE(moved.jobs[i].id, expansion.jobs[i].id);
+    for (size_t i = 0; i < moved.jobs.size(); ++i)
+        EXPECT_NE(moved.jobs[i].id, expansion.jobs[i].id);
 }
 
 TEST(SweepFile, JobsSharingAReferenceAreAdjacent) {
-    const auto expansion = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
+    const auto expansion =
+        experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
     // Reference keys: (segments, lights) -> 4 groups of 3 stages each.
     std::vector<std::string> groups;
     for (const SweepJob& job : expansion.jobs)
-        if (groups.empty() || groups.back() != job.referenceKey) groups.push_back(job.referenceKey);
+        if (groups.empty() || groups.back() != job.referenceKey)
+            groups.push_back(job.referenceKey);
     EXPECT_EQ(groups.size(), 4u);
-    EXPECT_EQ(std::set<std::string>(groups.begin(), groups.end()).size(), 4u) << "a key appears twice";
+    EXPECT_EQ(std::set<std::string>(groups.begin(), groups.end()).size(), 4u)
+        << "a key appears twice";
     for (const SweepJob& job : expansion.jobs) {
         EXPECT_EQ(job.referenceKey.find('/'), std::string::npos);
         EXPECT_EQ(job.referenceKey.rfind("spheres-160x90-", 0), 0u) << job.referenceKey;
@@ -97,9 +105,12 @@ TEST(SweepFile, JobsSharingAReferenceAreAdjacent) {
 }
 
 TEST(SweepFile, AxisColumnsInCanonicalOrder) {
-    const auto expansion = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
-    const std::vector<std::string> expected = {"scene",  "stage", "lights", "seed", "resolution", "width",
-                                               "height", "scene-option.segments", "repetitions", "warmup"};
+    const auto expansion =
+        experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
+    const std::vector<std::string> expected = {
+        "scene",       "stage", "lights", "seed",
+        "resolution",  "width", "height", "scene-option.segments",
+        "repetitions", "warmup"};
     EXPECT_EQ(expansion.axisColumns, expected);
     const SweepJob& job = expansion.jobs.front();
     EXPECT_EQ(experiments::axisValue(job, "width"), Json(160));
@@ -119,18 +130,20 @@ TEST(SweepFile, QuickBlockOverrides) {
     // A key moved from the axes to quick.fixed leaves the axes.
     Json file = baseSweep();
     file["quick"] = Json::parse(R"({"fixed": {"lights": 2}})");
-    const auto moved = experiments::expandSweep(experiments::applyQuick(experiments::parseSweep(file, "u.json")));
+    const auto moved =
+        experiments::expandSweep(experiments::applyQuick(experiments::parseSweep(file, "u.json")));
     EXPECT_EQ(moved.jobs.size(), 2u * 3u);
     Json noQuick = baseSweep();
     noQuick.erase("quick");
-    const std::string message = errorOf([&] { experiments::applyQuick(experiments::parseSweep(noQuick, "nq.json")); });
+    const std::string message =
+        errorOf([&] { experiments::applyQuick(experiments::parseSweep(noQuick, "nq.json")); });
     EXPECT_NE(message.find("nq.json"), std::string::npos) << message;
     EXPECT_NE(message.find("quick"), std::string::npos) << message;
 }
 
 TEST(SweepFile, RejectsUnknownKeysNamingFileAndKey) {
     Json file = baseSweep();
-    file["axis"] = Json::object();  // typo of "axes"
+    file["axis"] = Json::object(); // typo of "axes"
     std::string message = errorOf([&] { experiments::parseSweep(file, "typo.json"); });
     EXPECT_NE(message.find("typo.json"), std::string::npos) << message;
     EXPECT_NE(message.find("'axis'"), std::string::npos) << message;
@@ -141,7 +154,7 @@ TEST(SweepFile, RejectsUnknownKeysNamingFileAndKey) {
     EXPECT_NE(message.find("quick.repetition"), std::string::npos) << message;
 
     file = baseSweep();
-    file["fixed"]["lights"] = 3;  // also an axis
+    file["fixed"]["lights"] = 3; // also an axis
     message = errorOf([&] { experiments::parseSweep(file, "dup.json"); });
     EXPECT_NE(message.find("'lights'"), std::string::npos) << message;
 
@@ -181,10 +194,12 @@ TEST(SweepFile, ChecksPublishedTables) {
         "rows": [{"label": "4 lights", "select": {"lights": 4}, "values": [1.5]}], "ratio_to": 0}])");
     EXPECT_NO_THROW(experiments::parseSweep(file, "pub.json"));
     file["published"][0]["rows"][0]["values"] = Json::array({1.0, 2.0});
-    EXPECT_NE(errorOf([&] { experiments::parseSweep(file, "pub.json"); }).find("values"), std::string::npos);
+    EXPECT_NE(errorOf([&] { experiments::parseSweep(file, "pub.json"); }).find("values"),
+              std::string::npos);
     file["published"][0]["rows"][0]["values"] = Json::array({nullptr});
     file["published"][0]["rows"][0]["select"] = Json::parse(R"({"colour": 4})");
-    EXPECT_NE(errorOf([&] { experiments::parseSweep(file, "pub.json"); }).find("colour"), std::string::npos);
+    EXPECT_NE(errorOf([&] { experiments::parseSweep(file, "pub.json"); }).find("colour"),
+              std::string::npos);
 }
 
 TEST(SweepFile, TomlEqualsJson) {
@@ -213,8 +228,10 @@ lights = [4, 8]
     const auto fromJson = experiments::expandSweep(experiments::readSweepFile(dir / "s.json"));
     ASSERT_EQ(fromToml.jobs.size(), fromJson.jobs.size());
     std::set<std::string> tomlIds, jsonIds;
-    for (const SweepJob& job : fromToml.jobs) tomlIds.insert(job.id);
-    for (const SweepJob& job : fromJson.jobs) jsonIds.insert(job.id);
+    for (const SweepJob& job : fromToml.jobs)
+        tomlIds.insert(job.id);
+    for (const SweepJob& job : fromJson.jobs)
+        jsonIds.insert(job.id);
     EXPECT_EQ(tomlIds, jsonIds);
 
     std::ofstream(dir / "broken.toml") << "name = \"x\"\n[axes\n";
@@ -223,7 +240,8 @@ lights = [4, 8]
 }
 
 TEST(SweepFile, ShardsPartitionTheJobs) {
-    const auto jobs = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json")).jobs;
+    const auto jobs =
+        experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json")).jobs;
     for (int count : {1, 2, 5, 12, 13}) {
         std::multiset<std::string> seen;
         size_t smallest = jobs.size(), largest = 0;
@@ -231,7 +249,8 @@ TEST(SweepFile, ShardsPartitionTheJobs) {
             const auto shard = experiments::shardJobs(jobs, index, count);
             smallest = std::min(smallest, shard.size());
             largest = std::max(largest, shard.size());
-            for (const SweepJob& job : shard) seen.insert(job.id);
+            for (const SweepJob& job : shard)
+                seen.insert(job.id);
         }
         EXPECT_EQ(seen.size(), jobs.size()) << count;
         EXPECT_EQ(std::set<std::string>(seen.begin(), seen.end()).size(), jobs.size()) << count;
@@ -242,6 +261,26 @@ TEST(SweepFile, ShardsPartitionTheJobs) {
         EXPECT_THROW(experiments::parseShard(bad), SweepError) << bad;
 }
 
+// The reproductions in experiments/sweeps (full and --quick) expand into valid jobs: a renamed
+// stage, encoding or option breaks this test, not a sweep after an hour.
+TEST(SweepFile, ReproductionSweepsAreValid) {
+    const fs::path folder =
+        fs::path(__FILE__).parent_path().parent_path().parent_path() / "experiments" / "sweeps";
+    ASSERT_TRUE(fs::is_directory(folder)) << folder;
+    size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(folder)) {
+        if (entry.path().extension() != ".json" && entry.path().extension() != ".toml")
+            continue;
+        ++files;
+        SCOPED_TRACE(entry.path().string());
+        const auto spec = experiments::readSweepFile(entry.path());
+        EXPECT_FALSE(spec.name.empty());
+        EXPECT_FALSE(experiments::expandSweep(spec).jobs.empty());
+        EXPECT_FALSE(experiments::expandSweep(experiments::applyQuick(spec)).jobs.empty());
+    }
+    EXPECT_GE(files, 4u);
+}
+
 TEST(SweepFile, SettingTextOfNumbers) {
     EXPECT_EQ(experiments::settingText(Json(1500), "k"), "1500");
     EXPECT_EQ(experiments::settingText(Json(1500.0), "k"), "1500");
@@ -250,4 +289,4 @@ TEST(SweepFile, SettingTextOfNumbers) {
     EXPECT_THROW(experiments::settingText(Json(true), "k"), SweepError);
 }
 
-}  // namespace
+} // namespace

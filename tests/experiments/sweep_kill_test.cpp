@@ -36,7 +36,8 @@ pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
             dup2(fd, STDERR_FILENO);
         }
         std::vector<char*> argv = {const_cast<char*>(kTestbed.c_str())};
-        for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+        for (const std::string& arg : args)
+            argv.push_back(const_cast<char*>(arg.c_str()));
         argv.push_back(nullptr);
         execv(kTestbed.c_str(), argv.data());
         _exit(127);
@@ -46,9 +47,11 @@ pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
 
 std::vector<fs::path> markers(const fs::path& out) {
     std::vector<fs::path> found;
-    if (!fs::exists(out / "jobs")) return found;
+    if (!fs::exists(out / "jobs"))
+        return found;
     for (const auto& job : fs::directory_iterator(out / "jobs"))
-        if (fs::is_regular_file(job.path() / "done.json")) found.push_back(job.path() / "done.json");
+        if (fs::is_regular_file(job.path() / "done.json"))
+            found.push_back(job.path() / "done.json");
     return found;
 }
 
@@ -73,7 +76,8 @@ Identity identity(const fs::path& path) {
 
 TEST(SweepKill, KilledSweepResumesWithoutRedoingFinishedJobs) {
     ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
-    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / "sweep-kill";
+    const fs::path dir =
+        fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / "sweep-kill";
     fs::remove_all(dir);
     fs::create_directories(dir);
     // 12 jobs of a few tens of milliseconds each, 2 references.
@@ -84,8 +88,8 @@ TEST(SweepKill, KilledSweepResumesWithoutRedoingFinishedJobs) {
         "repetitions": 2
     })";
     const fs::path out = dir / "out";
-    const std::vector<std::string> args = {"sweep", (dir / "sweep.json").string(), "--out", out.string(),
-                                           "--threads", "1"};
+    const std::vector<std::string> args = {
+        "sweep", (dir / "sweep.json").string(), "--out", out.string(), "--threads", "1"};
 
     const pid_t child = spawn(args, dir / "first.log");
     ASSERT_GT(child, 0);
@@ -95,7 +99,8 @@ TEST(SweepKill, KilledSweepResumesWithoutRedoingFinishedJobs) {
     kill(child, SIGKILL);
     int status = 0;
     waitpid(child, &status, 0);
-    ASSERT_FALSE(markers(out).empty()) << "no job finished in time; log:\n" << readText(dir / "first.log");
+    ASSERT_FALSE(markers(out).empty()) << "no job finished in time; log:\n"
+                                       << readText(dir / "first.log");
 
     std::map<std::string, Identity> before;
     for (const fs::path& marker : markers(out))
@@ -111,7 +116,8 @@ TEST(SweepKill, KilledSweepResumesWithoutRedoingFinishedJobs) {
     for (const auto& [id, was] : before) {
         EXPECT_NE(log.find("skipped " + id), std::string::npos) << id << "\n" << log;
         EXPECT_EQ(log.find("running " + id), std::string::npos) << id << " was run again\n" << log;
-        EXPECT_TRUE(identity(out / "jobs" / id / "done.json") == was) << id << "'s marker was rewritten";
+        EXPECT_TRUE(identity(out / "jobs" / id / "done.json") == was)
+            << id << "'s marker was rewritten";
     }
     const Json results = Json::parse(readText(out / "results.json"));
     ASSERT_EQ(results["jobs"].size(), 12u);
@@ -124,4 +130,4 @@ TEST(SweepKill, KilledSweepResumesWithoutRedoingFinishedJobs) {
     EXPECT_EQ(markers(out).size(), 12u);
 }
 
-}  // namespace
+} // namespace

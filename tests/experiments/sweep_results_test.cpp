@@ -16,12 +16,12 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 fs::path testDir(const std::string& name) {
-    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / ("sweep-results-" + name);
+    const fs::path dir =
+        fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / ("sweep-results-" + name);
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
 }
-
 
 Json row(const std::string& id, const std::string& stage, double shading) {
     Json r = Json::object();
@@ -46,7 +46,8 @@ void writeOutput(const fs::path& dir, const Json& sweep, const std::vector<Json>
     for (const Json& r : rows) {
         const fs::path job = dir / "jobs" / r["job_id"].get<std::string>();
         fs::create_directories(job);
-        experiments::writeTextAtomically(job / "stats.json", "{\"stage\": " + r["stage"].dump() + "}\n");
+        experiments::writeTextAtomically(job / "stats.json",
+                                         "{\"stage\": " + r["stage"].dump() + "}\n");
         Json marker = {{"job_id", r["job_id"]}, {"status", r["status"]}, {"row", r}};
         experiments::writeTextAtomically(job / experiments::kDoneMarker, marker.dump());
     }
@@ -76,7 +77,8 @@ TEST(ResultsTable, ColumnsInPipelineOrderAndNullForMissing) {
     ASSERT_EQ(results["jobs"].size(), 2u);
     EXPECT_EQ(results["jobs"][0]["job_id"], "0000-aaaaaaaa");
     EXPECT_TRUE(results["jobs"][0]["time_assign_median_ms"].is_null());
-    for (const Json& job : results["jobs"]) EXPECT_EQ(job.size(), columns.size());
+    for (const Json& job : results["jobs"])
+        EXPECT_EQ(job.size(), columns.size());
 }
 
 TEST(ResultsTable, CsvQuotesAndEmptiesNulls) {
@@ -87,9 +89,14 @@ TEST(ResultsTable, CsvQuotesAndEmptiesNulls) {
     const Json results = experiments::resultsJson(Json::object(), "s.json", false, kAxis, {failed});
     const std::string csv = experiments::resultsCsv(results);
     const std::string header = csv.substr(0, csv.find('\n'));
-    EXPECT_EQ(header.rfind("job_id,status,error,stage,repetitions,warmup,time_gbuffer_median_ms", 0), 0u) << header;
-    EXPECT_NE(csv.find("0000-aaaaaaaa,failed,\"said \"\"no\"\"\nthen stopped\",\"tiled:tile=8,vfc=0\",1,0,"),
-              std::string::npos) << csv;
+    EXPECT_EQ(
+        header.rfind("job_id,status,error,stage,repetitions,warmup,time_gbuffer_median_ms", 0), 0u)
+        << header;
+    EXPECT_NE(
+        csv.find(
+            "0000-aaaaaaaa,failed,\"said \"\"no\"\"\nthen stopped\",\"tiled:tile=8,vfc=0\",1,0,"),
+        std::string::npos)
+        << csv;
     // rmse column empty: the column before psnr (also empty), then max_abs... all empty here.
     EXPECT_NE(csv.find(",,,,,,,,,,\n"), std::string::npos) << csv;
 }
@@ -97,8 +104,10 @@ TEST(ResultsTable, CsvQuotesAndEmptiesNulls) {
 TEST(ResultsTable, MergeTakesTheUnionOfShards) {
     const fs::path dir = testDir("merge");
     const Json sweep = {{"name", "m"}};
-    writeOutput(dir / "a", sweep, {row("0000-aaaaaaaa", "brute", 3.0), row("0002-cccccccc", "tiled", 1.0)});
-    writeOutput(dir / "b", sweep, {row("0001-bbbbbbbb", "deferred", 2.0), row("0002-cccccccc", "tiled", 1.0)});
+    writeOutput(dir / "a", sweep,
+                {row("0000-aaaaaaaa", "brute", 3.0), row("0002-cccccccc", "tiled", 1.0)});
+    writeOutput(dir / "b", sweep,
+                {row("0001-bbbbbbbb", "deferred", 2.0), row("0002-cccccccc", "tiled", 1.0)});
     EXPECT_EQ(experiments::mergeSweepOutputs({dir / "a", dir / "b"}, dir / "out"), 3u);
     const Json merged = experiments::readResults(dir / "out");
     ASSERT_EQ(merged["jobs"].size(), 3u);
@@ -106,7 +115,8 @@ TEST(ResultsTable, MergeTakesTheUnionOfShards) {
     EXPECT_EQ(merged["sweep"], sweep);
     for (const char* id : {"0000-aaaaaaaa", "0001-bbbbbbbb", "0002-cccccccc"}) {
         EXPECT_TRUE(fs::is_regular_file(dir / "out" / "jobs" / id / "stats.json")) << id;
-        EXPECT_TRUE(fs::is_regular_file(dir / "out" / "jobs" / id / experiments::kDoneMarker)) << id;
+        EXPECT_TRUE(fs::is_regular_file(dir / "out" / "jobs" / id / experiments::kDoneMarker))
+            << id;
     }
     EXPECT_TRUE(fs::is_regular_file(dir / "out" / "results.csv"));
     // Merging into one of the inputs works too.
@@ -132,7 +142,8 @@ TEST(ResultsTable, MergeRefusesConflictsAndForeignSweeps) {
         EXPECT_NE(std::string(e.what()).find("sweep"), std::string::npos) << e.what();
     }
     EXPECT_FALSE(fs::exists(dir / "out" / "results.json"));
-    EXPECT_THROW(experiments::mergeSweepOutputs({dir / "missing"}, dir / "out"), experiments::SweepError);
+    EXPECT_THROW(experiments::mergeSweepOutputs({dir / "missing"}, dir / "out"),
+                 experiments::SweepError);
 }
 
-}  // namespace
+} // namespace

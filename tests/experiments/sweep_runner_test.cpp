@@ -19,7 +19,8 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 fs::path testDir(const std::string& name) {
-    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / ("sweep-runner-" + name);
+    const fs::path dir =
+        fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / ("sweep-runner-" + name);
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
@@ -41,7 +42,8 @@ fs::path writeSweep(const fs::path& dir, const Json& sweep) {
     return file;
 }
 
-experiments::SweepSummary run(const fs::path& file, const fs::path& out, int shard = 1, int shards = 1) {
+experiments::SweepSummary run(const fs::path& file, const fs::path& out, int shard = 1,
+                              int shards = 1) {
     experiments::SweepOptions options;
     options.file = file;
     options.out = out;
@@ -83,12 +85,14 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
         EXPECT_GE(job["light_evaluations"].get<double>(), job["oracle_evaluations"].get<double>());
         EXPECT_EQ(job["repetitions"], 2);
         const fs::path folder = dir / "out" / "jobs" / job["job_id"].get<std::string>();
-        for (const char* name : {"render.exr", "preview.png", "heatmap.png", "stats.json", "done.json"})
+        for (const char* name :
+             {"render.exr", "preview.png", "heatmap.png", "stats.json", "done.json"})
             EXPECT_TRUE(fs::is_regular_file(folder / name)) << folder / name;
     }
     std::ifstream csv(dir / "out" / "results.csv");
     size_t lines = 0;
-    for (std::string line; std::getline(csv, line);) ++lines;
+    for (std::string line; std::getline(csv, line);)
+        ++lines;
     EXPECT_EQ(lines, 7u);
 
     // Everything finished: a rerun runs and renders nothing.
@@ -106,7 +110,8 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
     EXPECT_EQ(resumed.referencesLoaded, 1u);
     const Json redone = experiments::readResults(dir / "out")["jobs"][3];
     EXPECT_EQ(redone["job_id"], victim["job_id"]);
-    for (const char* metric : {"rmse", "max_abs", "p99_abs", "light_evaluations", "oracle_evaluations"})
+    for (const char* metric :
+         {"rmse", "max_abs", "p99_abs", "light_evaluations", "oracle_evaluations"})
         EXPECT_EQ(redone[metric], victim[metric]) << metric;
 }
 
@@ -135,7 +140,7 @@ TEST(SweepRunner, FailingJobIsRecordedAndTheSweepGoesOn) {
     options.file = file;
     options.out = dir / "out";
     EXPECT_EQ(experiments::runSweepCommand(options), 1) << "a failed job must fail the command";
-    const auto retried = run(file, dir / "out");  // the failed job is retried, the ok one skipped
+    const auto retried = run(file, dir / "out"); // the failed job is retried, the ok one skipped
     EXPECT_EQ(retried.skipped, 1u);
     EXPECT_EQ(retried.ran, 1u);
 }
@@ -149,7 +154,8 @@ TEST(SweepRunner, InvalidSweepRunsNothing) {
         run(file, dir / "out");
         FAIL() << "an invalid sweep ran";
     } catch (const experiments::SweepError& e) {
-        EXPECT_NE(std::string(e.what()).find("2 of 4 jobs are invalid"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("2 of 4 jobs are invalid"), std::string::npos)
+            << e.what();
     }
     EXPECT_FALSE(fs::exists(dir / "out"));
     experiments::SweepOptions options;
@@ -176,11 +182,14 @@ TEST(SweepRunner, TwoShardsMergedEqualOneRun) {
     ASSERT_EQ(merged["jobs"].size(), one["jobs"].size());
     for (size_t i = 0; i < one["jobs"].size(); ++i)
         for (const auto& [column, value] : one["jobs"][i].items()) {
-            if (column.rfind("time_", 0) == 0) continue;  // timings differ from run to run
-            EXPECT_EQ(merged["jobs"][i][column], value) << one["jobs"][i]["job_id"] << " " << column;
+            if (column.rfind("time_", 0) == 0)
+                continue; // timings differ from run to run
+            EXPECT_EQ(merged["jobs"][i][column], value)
+                << one["jobs"][i]["job_id"] << " " << column;
         }
     for (const Json& job : merged["jobs"])
-        EXPECT_TRUE(fs::is_regular_file(dir / "merged" / "jobs" / job["job_id"].get<std::string>() / "render.exr"));
+        EXPECT_TRUE(fs::is_regular_file(dir / "merged" / "jobs" / job["job_id"].get<std::string>() /
+                                        "render.exr"));
 }
 
-}  // namespace
+} // namespace
