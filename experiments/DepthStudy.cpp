@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include "experiments/AtomicFile.h"
+#include "experiments/PlotScript.h"
 #include "scenes/Scene.h"
 
 #ifndef TESTBED_COMMIT
@@ -80,12 +81,6 @@ std::string number(double value) {
 
 nlohmann::json jsonNumber(double value) {
     return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
-
-std::string shellQuoted(const std::string& text) {
-    std::string quoted = "'";
-    for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return quoted + "'";
 }
 
 }  // namespace
@@ -402,19 +397,8 @@ std::string depthSummaryTable(const DepthStudyResult& result) {
 
 // ---- the command -----------------------------------------------------------------------------
 
-std::optional<std::string> findMatplotlibPython(const std::string& requested) {
-    std::vector<std::string> candidates;
-    if (!requested.empty()) candidates.push_back(requested);
-    else candidates = {"python3", "/usr/bin/python3"};
-    for (const std::string& python : candidates) {
-        const std::string probe = shellQuoted(python) + " -c 'import matplotlib' >/dev/null 2>&1";
-        if (std::system(probe.c_str()) == 0) return python;
-    }
-    return std::nullopt;
-}
-
 std::filesystem::path defaultDepthPlotsScript() {
-    return std::filesystem::path(TESTBED_SOURCE_DIR) / "experiments" / "plots" / "depth.py";
+    return plotScriptPath("depth.py");
 }
 
 int runDepthCommand(const DepthCommandOptions& options) {
@@ -435,17 +419,15 @@ int runDepthCommand(const DepthCommandOptions& options) {
         writeTextAtomically(options.out / "depth.json", depthStudyJson(result).dump(1) + "\n");
         std::cout << depthSummaryTable(result) << "\n";
 
-        const std::optional<std::string> python = findMatplotlibPython(options.python);
-        if (!python)
+        const std::string python = findPythonWithMatplotlib(options.python);
+        if (python.empty())
             return fail("plots need python3 with matplotlib (Debian: apt-get install "
                         "python3-matplotlib; or --python PATH); depth.csv and depth.json are in " +
                         options.out.string());
-        const std::string command = shellQuoted(*python) + " " + shellQuoted(script.string()) +
-                                    " " + shellQuoted((options.out / "depth.json").string()) + " " +
-                                    shellQuoted(options.out.string());
-        const int status = std::system(command.c_str());
+        const int status =
+            runProcess({python, script.string(), (options.out / "depth.json").string(), options.out.string()});
         if (status != 0)
-            return fail("plot script failed (" + command + "), exit status " +
+            return fail("plot script failed (" + python + " " + script.string() + "), exit status " +
                         std::to_string(status));
         std::cout << "study " << number(result.studySeconds) << " s; outputs in "
                   << options.out.string() << "\n";

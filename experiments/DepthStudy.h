@@ -165,13 +165,10 @@ struct DepthCommandOptions {
     bool quick = false;
     // Empty = experiments/plots/depth.py of the source tree this binary was built from.
     std::filesystem::path plotsScript;
-    // Empty = the first of python3 (PATH) and /usr/bin/python3 that imports matplotlib.
+    // Empty = found by findPythonWithMatplotlib (experiments/PlotScript.h).
     std::string python;
 };
 
-// A Python interpreter that imports matplotlib: `requested` only if given, else the default
-// candidates above. nullopt when none does.
-std::optional<std::string> findMatplotlibPython(const std::string& requested = "");
 std::filesystem::path defaultDepthPlotsScript();
 
 // Runs the study, writes the outputs, draws the plots, prints the summary and "outputs in DIR";

@@ -89,7 +89,7 @@ void writeDiffPlot(const DiffCommandOptions& options, const ImageDiff& diff, con
     const fs::path script = options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
     if (!fs::is_regular_file(script))
         throw std::runtime_error("plot script " + script.string() + " not found (use --plots-script)");
-    const std::string python = findPythonWithMatplotlib(options.python);
+    const std::string python = requirePythonWithMatplotlib(options.python);
     // The plot script reads raw float32; the temporary file is removed whatever happens.
     const fs::path raw = options.out / (".absdiff.tmp-" + std::to_string(getpid()) + ".f32");
     struct RemoveOnExit {

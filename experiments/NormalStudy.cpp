@@ -16,7 +16,6 @@
 #include <stdexcept>
 #include <thread>
 
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -25,6 +24,7 @@
 #include <tbb/task_arena.h>
 
 #include "experiments/AtomicFile.h"
+#include "experiments/PlotScript.h"
 #include "gbuffer/DepthFormat.h"
 #include "gbuffer/NormalCodec.h"
 #include "lighting/PreparedFrame.h"
@@ -38,7 +38,6 @@
 #define TESTBED_SOURCE_DIR "."
 #endif
 
-extern char** environ;
 
 namespace experiments {
 
@@ -657,35 +656,7 @@ void writeFloats(const std::filesystem::path& path, const std::vector<float>& va
     });
 }
 
-bool pythonHasMatplotlib(const std::string& python) {
-    const std::string command = "'" + python + "' -c 'import matplotlib' >/dev/null 2>&1";
-    return python.find('\'') == std::string::npos && std::system(command.c_str()) == 0;
-}
-
-int runProcess(const std::vector<std::string>& args) {
-    std::vector<char*> argv;
-    for (const std::string& arg : args)
-        argv.push_back(const_cast<char*>(arg.c_str()));
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0)
-        return -1;
-    int status = 0;
-    if (waitpid(pid, &status, 0) != pid)
-        return -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 } // namespace
-
-std::string findPlotPython(const std::string& requested) {
-    if (!requested.empty())
-        return pythonHasMatplotlib(requested) ? requested : "";
-    for (const char* candidate : {"python3", "/usr/bin/python3"})
-        if (pythonHasMatplotlib(candidate))
-            return candidate;
-    return "";
-}
 
 NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
                                  const std::function<void(const std::string&)>& progress) {
@@ -913,7 +884,7 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
 
     if (options.plots) {
         step("plots (matplotlib)");
-        const std::string python = findPlotPython(options.python);
+        const std::string python = findPythonWithMatplotlib(options.python);
         if (python.empty())
             throw std::runtime_error(
                 "plots: no python3 with matplotlib found (" +

@@ -54,7 +54,7 @@ struct NormalStudyOptions {
     bool quick = false;      // small sizes for tests, see above
     bool plots = true;       // run the matplotlib script
     std::string plotsScript; // "" = <source dir>/experiments/plots/normals.py
-    std::string python;      // "" = first of python3, /usr/bin/python3 with matplotlib
+    std::string python;      // "" = found by findPythonWithMatplotlib (experiments/PlotScript.h)
 };
 
 // One hard input: a normal, the view ray it is seen along (pixel-view reads it) and its group.
@@ -132,8 +132,5 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
 // the process exit code (errors printed to stderr).
 int runNormalStudyCommand(const NormalStudyOptions& options);
 
-// The python interpreter used for the plots: `requested` if non-empty, else the first of
-// python3 (PATH) and /usr/bin/python3 that imports matplotlib; "" if none.
-std::string findPlotPython(const std::string& requested);
 
 } // namespace experiments

@@ -445,46 +445,7 @@ json comparePublished(const json& published, const json& jobs) {
     return table;
 }
 
-fs::path defaultPlotsScript() { return fs::path(TESTBED_SOURCE_DIR) / "experiments" / "plots" / "report.py"; }
-
-int runProcess(const std::vector<std::string>& argv, bool quiet) {
-    if (argv.empty()) return 127;
-    std::fflush(nullptr);
-    const pid_t child = fork();
-    if (child < 0) return 127;
-    if (child == 0) {
-        if (quiet) {
-            const int null = open("/dev/null", O_WRONLY);
-            if (null >= 0) {
-                dup2(null, STDOUT_FILENO);
-                dup2(null, STDERR_FILENO);
-            }
-        }
-        std::vector<char*> args;
-        for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-        args.push_back(nullptr);
-        execvp(args[0], args.data());
-        _exit(127);
-    }
-    int status = 0;
-    while (waitpid(child, &status, 0) < 0)
-        if (errno != EINTR) return 127;
-    if (WIFEXITED(status)) return WEXITSTATUS(status);
-    if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-    return 127;
-}
-
-std::string findPythonWithMatplotlib(const std::string& requested) {
-    const std::vector<std::string> candidates =
-        requested.empty() ? std::vector<std::string>{"/usr/bin/python3", "python3"} : std::vector<std::string>{requested};
-    std::string tried;
-    for (const std::string& python : candidates) {
-        if (runProcess({python, "-c", "import matplotlib, numpy"}, true) == 0) return python;
-        tried += (tried.empty() ? "" : ", ") + python;
-    }
-    throw std::runtime_error("no Python 3 with matplotlib found (tried " + tried +
-                             "); install Debian packages python3 and python3-matplotlib");
-}
+fs::path defaultPlotsScript() { return plotScriptPath("report.py"); }
 
 int runReportCommand(const ReportCommandOptions& options) {
     try {
@@ -510,7 +471,7 @@ int runReportCommand(const ReportCommandOptions& options) {
         const fs::path script = options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
         if (!fs::is_regular_file(script))
             throw std::runtime_error("plot script " + script.string() + " not found (use --plots-script)");
-        const std::string python = findPythonWithMatplotlib(options.python);
+        const std::string python = requirePythonWithMatplotlib(options.python);
         const int status = runProcess({python, script.string(), "results", "--results", (dir / "results.json").string(),
                                        "--published", (reportDir / "published.json").string(), "--out",
                                        reportDir.string()});

@@ -35,6 +35,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/PlotScript.h"
+
 namespace experiments {
 
 struct ReportCommandOptions {
@@ -78,16 +80,6 @@ int runReportCommand(const ReportCommandOptions& options);
 // The default plot script (the source tree's experiments/plots/report.py, fixed at build time).
 std::filesystem::path defaultPlotsScript();
 
-// The Python interpreter to run the plot scripts with: `requested` if not empty (it must import
-// matplotlib), else the first of /usr/bin/python3 (Debian's, where python3-matplotlib installs)
-// and python3 on PATH that imports matplotlib. Throws std::runtime_error saying what to install
-// when none does.
-std::string findPythonWithMatplotlib(const std::string& requested);
-
-// Runs argv[0] (searched on PATH) with the arguments, waits, and returns its exit status (127
-// when it cannot be started, 128 + signal when killed). Its stdout and stderr are this process'.
-// With quiet, both go to /dev/null.
-int runProcess(const std::vector<std::string>& argv, bool quiet = false);
 
 // HTML pieces shared by the report and the diff pages.
 std::string htmlEscape(const std::string& text);

@@ -17,28 +17,17 @@
 #include <nlohmann/json.hpp>
 #include <tbb/task_arena.h>
 
+#include "TestFolders.h"
 #include "experiments/DepthStudy.h"
+#include "experiments/PlotScript.h"
 
 namespace experiments {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path freshTestFolder() {
-    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" /
-                         (std::string(info->test_suite_name()) + "." + info->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::string readText(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
+using experiments::test_files::freshTestFolder;
+using experiments::test_files::readText;
 
 // Quick study: 10 formats x 2 methods x 4 cameras x 40 distances.
 constexpr size_t kQuickRows = 10 * 2 * 4 * 40;
@@ -71,7 +60,7 @@ TEST(DepthStudy, QuickCommandWritesEveryRowAndThePlots) {
     EXPECT_TRUE(json.contains("commit"));
     EXPECT_TRUE(fs::exists(dir / "depth_steps.csv"));
 
-    if (!findMatplotlibPython()) {
+    if (findPythonWithMatplotlib("").empty()) {
         EXPECT_EQ(status, 1);  // the study's data is written, the plots are an error
         GTEST_SKIP() << "no python3 with matplotlib: plots not checked";
     }

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "TestFolders.h"
 #include "experiments/DiffCommand.h"
 #include "experiments/ImageOutput.h"
 
@@ -23,21 +24,8 @@ using nlohmann::json;
 
 constexpr int kWidth = 40, kHeight = 20;
 
-fs::path freshTestFolder() {
-    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" /
-                         (std::string(info->test_suite_name()) + "." + info->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::string readText(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
+using experiments::test_files::freshTestFolder;
+using experiments::test_files::readText;
 
 // R, G, B = 0.5 (+ offset on the pixels where offsetWhere(x) holds), Z = depth, N.X = 0.25, and
 // an extra channel only this file has when extraName is set. Values are exact in binary.

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "experiments/NormalStudy.h"
+#include "experiments/PlotScript.h"
 #include "gbuffer/NormalCodec.h"
 
 namespace {
@@ -68,7 +69,7 @@ std::vector<std::string> csvLines(const fs::path& path) {
 
 TEST(NormalStudy, QuickRunWritesEveryCodecBitsDatasetRowAndThePlots) {
     const fs::path out = outputDir("quick");
-    const std::string python = experiments::findPlotPython("");
+    const std::string python = experiments::findPythonWithMatplotlib("");
     NormalStudyOptions options = quickOptions(out, 2);
     options.plots = !python.empty();
     const NormalStudyResult result = experiments::runNormalStudy(options);

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "TestFolders.h"
 #include "experiments/ImageOutput.h"
 #include "experiments/ReportCommand.h"
 
@@ -24,21 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-fs::path freshTestFolder() {
-    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" /
-                         (std::string(info->test_suite_name()) + "." + info->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::string readText(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
+using experiments::test_files::freshTestFolder;
+using experiments::test_files::readText;
 
 json okJob(const std::string& id, const std::string& stage, int lights, json time) {
     return {{"job_id", id}, {"status", "ok"}, {"error", ""}, {"stage", stage}, {"lights", lights},
