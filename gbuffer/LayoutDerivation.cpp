@@ -131,7 +131,7 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
         layout.position = PositionMethod::ViewRay;
         layout.normals = {NormalCodecKind::Xyz, 48};
         layout.specular = SpecularEncoding::Unorm8Log8;
-        layout.unmodelled = {{"P.X,P.Y", "f16 x2", 32}, {"material-id", "f16", 16}, {"AO", "f16", 16}};
+        layout.unmodelled = {{"P.X,P.Y", "f16 x2", 32, "unmodelled"}, {"material-id", "f16", 16, "unmodelled"}, {"AO", "f16", 16, "unmodelled"}};
         layout.reasons = {{Channel::Depth, "RT0 position.z (f16); x and y follow from the view ray"},
                           {Channel::Normal, "RT1 normal xyz (RGB16F; 16-bit SNORM here)"},
                           {Channel::Specular, "RT2 alpha gloss (8 bits)"}};
@@ -142,7 +142,7 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
         layout.position = PositionMethod::ViewRay;
         layout.normals = {NormalCodecKind::XyReconstructZ, 32};
         layout.specular = SpecularEncoding::Unorm8Log8;
-        layout.unmodelled = {{"material-id+AO", "f16 bit-packed", 16}};
+        layout.unmodelled = {{"material-id+AO", "f16 bit-packed", 16, "unmodelled"}};
         layout.reasons = {{Channel::Depth, "RT0 linear depth in one f16"},
                           {Channel::Normal, "RT0 normal X,Y (2 x f16), Z reconstructed (16-bit SNORM here)"},
                           {Channel::Specular, "RT1 alpha gloss (8 bits)"}};
@@ -151,10 +151,10 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
         layout.depth = {DepthFormatKind::Unorm24, false};
         layout.normals = {NormalCodecKind::XyReconstructZ, 32};
         layout.specular = SpecularEncoding::Unorm8Log8;
-        layout.unmodelled = {{"stencil", "uint8", 8},
-                             {"light-accumulation", "RGBA8", 32},
-                             {"motion-vectors", "unorm8 x2", 16},
-                             {"sun-occlusion", "unorm8", 8}};
+        layout.unmodelled = {{"stencil", "uint8", 8, "unmodelled"},
+                             {"light-accumulation", "RGBA8", 32, "unmodelled"},
+                             {"motion-vectors", "unorm8 x2", 16, "unmodelled"},
+                             {"sun-occlusion", "unorm8", 8, "unmodelled"}};
         layout.reasons = {{Channel::Depth, "D24 hardware depth"},
                           {Channel::Normal, "normal X,Y as FP16 (16-bit SNORM here), Z reconstructed"},
                           {Channel::Specular, "spec-power and spec-intensity, 8 bits each"}};
@@ -163,9 +163,9 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
         layout.depth = {DepthFormatKind::Unorm24, false};
         layout.normals = {NormalCodecKind::Xyz, 24};
         layout.specular = SpecularEncoding::Unorm8Log8;
-        layout.unmodelled = {{"stencil", "uint8", 8},
-                             {"sky-visibility,envmap-id,material-param,material-id", "RGBA8", 32},
-                             {"irradiance", "RGBA8", 32}};
+        layout.unmodelled = {{"stencil", "uint8", 8, "unmodelled"},
+                             {"sky-visibility,envmap-id,material-param,material-id", "RGBA8", 32, "unmodelled"},
+                             {"irradiance", "RGBA8", 32, "unmodelled"}};
         layout.reasons = {{Channel::Depth, "D24 hardware depth"},
                           {Channel::Normal, "GB0 normal xyz in RGB8"},
                           {Channel::Specular, "GB0 alpha smoothness and GB1 alpha specular albedo"}};
@@ -174,7 +174,7 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
         layout.depth = {DepthFormatKind::Unorm24, false};
         layout.normals = {NormalCodecKind::Xyz, 48};
         layout.specular = SpecularEncoding::Unorm8Half;
-        layout.unmodelled = {{"stencil", "uint8", 8}};
+        layout.unmodelled = {{"stencil", "uint8", 8, "unmodelled"}};
         layout.reasons = {{Channel::Depth, "D24S8 hardware depth"},
                           {Channel::Normal, "RT1 normal xyz (RGB16F; 16-bit SNORM here)"},
                           {Channel::Specular, "RT0 alpha intensity (8 bits), RT1 alpha exponent (f16)"}};

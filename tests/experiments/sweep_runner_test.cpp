@@ -53,11 +53,6 @@ experiments::SweepSummary run(const fs::path& file, const fs::path& out, int sha
     return experiments::runSweep(options, log);
 }
 
-Json readJson(const fs::path& path) {
-    std::ifstream in(path);
-    return Json::parse(in);
-}
-
 TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
     const fs::path dir = testDir("basic");
     const fs::path file = writeSweep(dir, tinySweep());

@@ -114,8 +114,9 @@ TEST(Forward, PrepassShadesEachPixelOnceAndOverdrawIsCounted) {
     EXPECT_GT(total(single.lightsEvaluated), total(prepass.lightsEvaluated));
     for (size_t pixel = 0; pixel < single.lightsEvaluated.size(); ++pixel) {
         ASSERT_GE(single.lightsEvaluated[pixel], prepass.lightsEvaluated[pixel]) << pixel;
-        if (!f.gbuffer->covered(pixel))
+        if (!f.gbuffer->covered(pixel)) {
             ASSERT_EQ(prepass.lightsEvaluated[pixel], 0u) << pixel;
+        }
     }
     std::vector<std::string> passes;
     for (const auto& [name, ms] : prepass.timingsMs)
@@ -162,8 +163,9 @@ TEST(Forward, UnlitObjectsCostNothingAndALightBehindTheCameraStillLights) {
             // A and B each have exactly one light in reach; C none.
             EXPECT_EQ(result.lightsEvaluated[pixel] > 0, object != 2)
                 << stage << " pixel " << pixel;
-            if (object == 2)
+            if (object == 2) {
                 EXPECT_EQ(result.radiance[0][pixel], 0.0f) << stage;
+            }
         }
         for (int o = 0; o < 3; ++o)
             EXPECT_GT(pixelsOfObject[o], 100) << "object " << o << " not in view";
