@@ -21,20 +21,36 @@
 //   "material"  the second geometry pass: the scene is rasterized again into a visibility
 //               buffer (lighting/ForwardShading.h depthPrepass, the G-buffer pass's culling and
 //               depth test) and each fragment's albedo and specular intensity come from
-//               gbuffer::surfaceOfTriangle. DSF per full-res pixel: the 4 nearest low-res
-//               samples with bilinear weights, each weight zeroed when the sample is background,
+//               gbuffer::surfaceOfTriangle. Object IDs (ids=1): a pixel's ID is the scene
+//               instance of its visible triangle (SceneGeometry::triangleInstance); a sample's is
+//               the ID of the full-res pixel it read, taken from the same visibility buffer (what
+//               the technique writes into its DSF buffer in the geometry pass; ours are 32-bit,
+//               so they never wrap as its 8-bit IDs do). The instance is the finest "object" a
+//               scene has (a mesh has one material, so per-material-and-instance is the same;
+//               per-mesh IDs would merge the copies of a column or arch): on `atrium` the floor,
+//               the walls, the gallery slabs, every column, arch and banner are instances of their
+//               own; one instance's differently oriented faces (the four walls, a slab's sides) are
+//               told apart by the normal test, which stands in for the technique's normal-group
+//               IDs. DSF per full-res pixel: the 4 nearest low-res samples with bilinear weights,
+//               each weight zeroed when the sample is background, its ID differs from the pixel's,
 //               its view depth differs from the pixel's by more than depth * pixel depth, or the
-//               cosine between the normals is below `normal`; the weights are renormalised. When
-//               all four are rejected the nearest covered one of the four is used (zero light if
-//               none is covered). The technique's object/normal-group IDs are not in our
-//               G-buffer; depth and normal tests stand in for them.
+//               cosine between the normals is below `normal`; the weights are renormalised.
+//               Fallbacks, in order: when the ID test rejected every sample that depth and normal
+//               accept, those samples are used (counted in dsf_id_fallbacks: usually a thin object,
+//               or an object no sample lands on, bordered by a coplanar one; its own samples, which
+//               failed depth or normal, would light it worse -- measured on `atrium`); when all
+//               four fail depth or normal, the nearest covered one of the four is used (zero
+//               light if none is covered; counted in dsf_fallbacks). With ids=0 the ID test and
+//               its fallback are skipped: the filter without object IDs.
 // Options:
 //   scale=2      lighting resolution divisor per axis, 1..8
 //   depth=0.1    DSF relative view-depth threshold, > 0
 //   normal=0.9   DSF minimum normal cosine, -1..1
 //   tile=16      culling tile size in low-res samples, 4..128
+//   ids=1        DSF object-ID test, 1/0 (on/off)
 // G-buffer: depth, normal and specular (only the specular power is read from it; the layout has
-// no power-only channel). Parameters record the options, the L-buffer size and dsf_fallbacks.
+// no power-only channel). Parameters record the options, the L-buffer size, dsf_fallbacks and
+// dsf_id_fallbacks.
 // lightsEvaluated: the tile list size at the full-res pixel each low-res sample reads, zero
 // elsewhere, so its sum is the number of light evaluations actually done.
 // Cost note (CPU): a contributing light costs two evaluateLight calls (diffuse, then specular
@@ -66,7 +82,11 @@ struct InferredOptions {
     float depthThreshold = 0.1f;
     float normalThreshold = 0.9f;
     int tileSizeSamples = 16;
+    bool objectIds = true;
 };
+
+// Object ID of background (no triangle): never equal to a surface's ID.
+constexpr uint32_t kNoObject = UINT32_MAX;
 
 // One L-buffer sample: the full-res pixel it reads, its surface for DSF, and its light.
 struct LightSample {
@@ -90,11 +110,11 @@ float floatOption(const StageSpec& spec, const char* key, float defaultValue, fl
         used = 0;
     }
     const bool aboveMin = minExclusive ? value > minValue : value >= minValue;
-    if (used != found->second.size() || found->second.empty() || !std::isfinite(value) || !aboveMin ||
-        value > maxValue)
+    if (used != found->second.size() || found->second.empty() || !std::isfinite(value) ||
+        !aboveMin || value > maxValue)
         throw StageError("stage '" + spec.name + "': option " + key + "=" + found->second +
-                         " is not a number in " + (minExclusive ? "(" : "[") + std::to_string(minValue) +
-                         ", " + std::to_string(maxValue) + "]");
+                         " is not a number in " + (minExclusive ? "(" : "[") +
+                         std::to_string(minValue) + ", " + std::to_string(maxValue) + "]");
     return value;
 }
 
@@ -104,7 +124,8 @@ public:
 
     std::string name() const override { return "inferred"; }
     StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Specular}, false};
+        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Specular},
+                false};
     }
 
     void shade(const Frame& frame, StageResult& result) override {
@@ -125,7 +146,8 @@ public:
         const TileGrid grid = TileGrid::make(width, height, mOptions.tileSizeSamples * scale);
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
         std::vector<TileSurfaceBounds> bounds;
-        const std::vector<std::vector<uint32_t>> tileLights = basicTileLightLists(gb, grid, spheres, bounds);
+        const std::vector<std::vector<uint32_t>> tileLights =
+            basicTileLightLists(gb, grid, spheres, bounds);
         const double cullMs = forwardElapsedMs(cullStart);
 
         // L-buffer at low resolution.
@@ -162,14 +184,28 @@ public:
         mForward.prepare(frame);
         fitRasterizer(mRasterizer, view);
         depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
-        std::vector<uint32_t> rowFallbacks(size_t(height), 0);
+        // Object IDs: the scene instance of the visible triangle, for every pixel (looked up on
+        // the fly) and for every low-res sample (the pixel the sample read in "lighting").
+        const std::vector<uint32_t>& triangleInstance = frame.geometry->triangleInstance;
+        auto objectAt = [&](size_t pixel) {
+            const uint32_t code = mVisible[pixel];
+            return code == kNoVisibleTriangle ? kNoObject : triangleInstance[code & ~kBackFaceBit];
+        };
+        mSampleObjects.assign(size_t(lowWidth) * lowHeight, kNoObject);
+        if (mOptions.objectIds)
+            for (int j = 0; j < lowHeight; ++j)
+                for (int i = 0; i < lowWidth; ++i)
+                    mSampleObjects[size_t(j) * lowWidth + i] =
+                        objectAt(size_t(sampleY(j)) * width + sampleX(i));
+        std::vector<uint32_t> rowFallbacks(size_t(height), 0), rowIdFallbacks(size_t(height), 0);
         const float halfScale = float(scale / 2);
         tbb::parallel_for(0, height, [&](int y) {
             const float v = (float(y) - halfScale) / float(scale);
             const int j0 = int(std::floor(v));
             const float fy = v - float(j0);
-            const int ja = std::clamp(j0, 0, lowHeight - 1), jb = std::clamp(j0 + 1, 0, lowHeight - 1);
-            uint32_t fallbacks = 0;
+            const int ja = std::clamp(j0, 0, lowHeight - 1),
+                      jb = std::clamp(j0 + 1, 0, lowHeight - 1);
+            uint32_t fallbacks = 0, idFallbacks = 0;
             for (int x = 0; x < width; ++x) {
                 const size_t pixel = size_t(y) * width + x;
                 const uint32_t code = mVisible[pixel];
@@ -180,22 +216,26 @@ public:
                     code & ~kBackFaceBit, (code & kBackFaceBit) != 0, view.ndcOfPixel(x, y));
                 const gbuffer::Surface here = gb.decode(x, y);
                 const float depth = -here.positionView.z;
+                const uint32_t object = mOptions.objectIds ? objectAt(pixel) : kNoObject;
 
                 const float u = (float(x) - halfScale) / float(scale);
                 const int i0 = int(std::floor(u));
                 const float fx = u - float(i0);
-                const int ia = std::clamp(i0, 0, lowWidth - 1), ib = std::clamp(i0 + 1, 0, lowWidth - 1);
-                const LightSample* taps[4] = {&mSamples[size_t(ja) * lowWidth + ia],
-                                              &mSamples[size_t(ja) * lowWidth + ib],
-                                              &mSamples[size_t(jb) * lowWidth + ia],
-                                              &mSamples[size_t(jb) * lowWidth + ib]};
-                const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-                glm::vec3 diffuse(0.0f), specular(0.0f);
-                float weightSum = 0.0f;
+                const int ia = std::clamp(i0, 0, lowWidth - 1),
+                          ib = std::clamp(i0 + 1, 0, lowWidth - 1);
+                const size_t tapIndex[4] = {size_t(ja) * lowWidth + ia, size_t(ja) * lowWidth + ib,
+                                            size_t(jb) * lowWidth + ia, size_t(jb) * lowWidth + ib};
+                const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy,
+                                           fx * fy};
+                // Two filters at once: `same` applies the ID, depth and normal tests, `surface` the
+                // depth and normal tests only (with ids=0 they coincide).
+                glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f);
+                glm::vec3 surfaceDiffuse(0.0f), surfaceSpecular(0.0f);
+                float sameWeight = 0.0f, surfaceWeight = 0.0f;
                 int nearest = -1;
                 float nearestWeight = -1.0f;
                 for (int k = 0; k < 4; ++k) {
-                    const LightSample& t = *taps[k];
+                    const LightSample& t = mSamples[tapIndex[k]];
                     if (!t.covered)
                         continue;
                     if (bilinear[k] > nearestWeight) {
@@ -205,16 +245,26 @@ public:
                     if (std::abs(t.depthMetres - depth) > mOptions.depthThreshold * depth ||
                         glm::dot(t.normalView, here.normalView) < mOptions.normalThreshold)
                         continue;
-                    diffuse += bilinear[k] * t.diffuse;
-                    specular += bilinear[k] * t.specular;
-                    weightSum += bilinear[k];
+                    surfaceDiffuse += bilinear[k] * t.diffuse;
+                    surfaceSpecular += bilinear[k] * t.specular;
+                    surfaceWeight += bilinear[k];
+                    if (mSampleObjects[tapIndex[k]] != object)
+                        continue;
+                    sameDiffuse += bilinear[k] * t.diffuse;
+                    sameSpecular += bilinear[k] * t.specular;
+                    sameWeight += bilinear[k];
                 }
-                if (weightSum > 0.0f) {
-                    diffuse /= weightSum;
-                    specular /= weightSum;
+                glm::vec3 diffuse(0.0f), specular(0.0f);
+                if (sameWeight > 0.0f) {
+                    diffuse = sameDiffuse / sameWeight;
+                    specular = sameSpecular / sameWeight;
+                } else if (surfaceWeight > 0.0f) {
+                    diffuse = surfaceDiffuse / surfaceWeight;
+                    specular = surfaceSpecular / surfaceWeight;
+                    ++idFallbacks;
                 } else if (nearest >= 0) {
-                    diffuse = taps[nearest]->diffuse;
-                    specular = taps[nearest]->specular;
+                    diffuse = mSamples[tapIndex[nearest]].diffuse;
+                    specular = mSamples[tapIndex[nearest]].specular;
                     ++fallbacks;
                 } else {
                     ++fallbacks;
@@ -225,14 +275,17 @@ public:
                 result.radiance[2][pixel] = radiance.b;
             }
             rowFallbacks[size_t(y)] = fallbacks;
+            rowIdFallbacks[size_t(y)] = idFallbacks;
         });
         const double materialMs = forwardElapsedMs(materialStart);
 
-        uint64_t pairs = 0, fallbacks = 0;
+        uint64_t pairs = 0, fallbacks = 0, idFallbacks = 0;
         for (const auto& list : tileLights)
             pairs += list.size();
         for (uint32_t f : rowFallbacks)
             fallbacks += f;
+        for (uint32_t f : rowIdFallbacks)
+            idFallbacks += f;
         result.timingsMs.emplace_back("cull", cullMs);
         result.timingsMs.emplace_back("lighting", lightingMs);
         result.timingsMs.emplace_back("material", materialMs);
@@ -240,15 +293,18 @@ public:
         result.parameters["depth"] = std::to_string(mOptions.depthThreshold);
         result.parameters["normal"] = std::to_string(mOptions.normalThreshold);
         result.parameters["tile"] = std::to_string(mOptions.tileSizeSamples);
+        result.parameters["ids"] = mOptions.objectIds ? "1" : "0";
         result.parameters["lbuffer"] = std::to_string(lowWidth) + "x" + std::to_string(lowHeight);
         result.parameters["tile_light_pairs"] = std::to_string(pairs);
         result.parameters["dsf_fallbacks"] = std::to_string(fallbacks);
+        result.parameters["dsf_id_fallbacks"] = std::to_string(idFallbacks);
     }
 
 private:
     InferredOptions mOptions;
     // Per-frame scratch, kept to avoid reallocation between repetitions.
     std::vector<LightSample> mSamples;
+    std::vector<uint32_t> mSampleObjects; // object ID per low-res sample; all kNoObject with ids=0
     ForwardFrame mForward;
     std::unique_ptr<raster::Rasterizer> mRasterizer;
     std::vector<float> mDepth;
@@ -258,12 +314,13 @@ private:
 } // namespace
 
 std::unique_ptr<ShadingStage> makeInferredStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"scale", "depth", "normal", "tile"});
+    rejectUnknownOptions(spec, {"scale", "depth", "normal", "tile", "ids"});
     InferredOptions options;
     options.scale = intOption(spec, "scale", 2, 1, 8);
     options.depthThreshold = floatOption(spec, "depth", 0.1f, 0.0f, 1e30f, true);
     options.normalThreshold = floatOption(spec, "normal", 0.9f, -1.0f, 1.0f, false);
     options.tileSizeSamples = intOption(spec, "tile", 16, 4, 128);
+    options.objectIds = boolOption(spec, "ids", true);
     return std::make_unique<InferredStage>(options);
 }
 
