@@ -76,10 +76,12 @@ std::vector<uint32_t> buildConeProxyIndices() {
     std::vector<uint32_t> indices;
     for (uint32_t k = 0; k < n; ++k) {
         const uint32_t b = 1 + k, next = 1 + (k + 1) % n;
-        for (uint32_t i : {0u, next, b}) indices.push_back(i);  // side
+        for (uint32_t i : {0u, next, b})
+            indices.push_back(i);  // side
     }
     for (uint32_t k = 1; k + 1 < n; ++k)
-        for (uint32_t i : {1u, 1 + k, 2 + k}) indices.push_back(i);  // base fan
+        for (uint32_t i : {1u, 1 + k, 2 + k})
+            indices.push_back(i);  // base fan
     return indices;
 }
 
@@ -96,10 +98,12 @@ const std::vector<uint32_t>& coneProxyIndices() {
 }
 
 std::optional<ConeProxy> coneProxy(const LightSphere& light, float marginMetres) {
-    if (!light.spot || light.unbounded) return std::nullopt;
+    if (!light.spot || light.unbounded)
+        return std::nullopt;
     // The half-angle t, widened for the float cosine test and then by the relative slack.
     const double cosT = std::min(double(light.spotOuterCos), 1.0) - kConeCosSlack;
-    if (!(cosT > std::cos(glm::radians(kConeMaxHalfAngleDegrees)))) return std::nullopt;
+    if (!(cosT > std::cos(glm::radians(kConeMaxHalfAngleDegrees))))
+        return std::nullopt;
     const double tanT = std::sqrt(1.0 - cosT * cosT) / cosT * (1.0 + kCullingSlack);
     const double sinT = tanT / std::sqrt(1.0 + tanT * tanT);
     const double range = light.rangeMetres;
@@ -108,8 +112,8 @@ std::optional<ConeProxy> coneProxy(const LightSphere& light, float marginMetres)
     // rounding it allows for positions), plus the caller's margin. Moving the apex back along the
     // axis by s / sin t moves every side line out by s (the cone around the old apex's s-ball);
     // the base moves out by s.
-    const double dilation = range * kCullingSlack + kCullingSlackMetres + 4e-7 * (glm::length(apex) + range) +
-                            double(marginMetres);
+    const double dilation = range * kCullingSlack + kCullingSlackMetres +
+                            4e-7 * (glm::length(apex) + range) + double(marginMetres);
     const double back = dilation / sinT;
     const double height = back + range + dilation;
     // The base polygon circumscribes the circle of radius height * tan t.
@@ -131,18 +135,15 @@ std::optional<ConeProxy> coneProxy(const LightSphere& light, float marginMetres)
             glm::vec3(baseCentre + circumradius * (std::cos(angle) * u + std::sin(angle) * v));
     }
     // The base polygon's area is n r^2 tan(pi / n) for inradius r.
-    proxy.volume = height * kConeProxySides * inradius * inradius * std::tan(pi / kConeProxySides) / 3.0;
+    proxy.volume =
+        height * kConeProxySides * inradius * inradius * std::tan(pi / kConeProxySides) / 3.0;
     return proxy;
 }
 
-LightVolumeRasterizer::LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape, bool stencil,
-                                             SpotProxy spotProxy)
-    : mGBuffer(gbuffer),
-      mDepth(gbuffer.depth().data()),
-      mShape(shape),
-      mStencil(stencil),
-      mSpotProxy(spotProxy),
-      mRasterizer(gbuffer.width(), gbuffer.height()) {
+LightVolumeRasterizer::LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape,
+                                             bool stencil, SpotProxy spotProxy)
+    : mGBuffer(gbuffer), mDepth(gbuffer.depth().data()), mShape(shape), mStencil(stencil),
+      mSpotProxy(spotProxy), mRasterizer(gbuffer.width(), gbuffer.height()) {
     const gbuffer::FrameView& view = gbuffer.view();
     mReversedZ = view.reversedZ();
     mClearDepth = view.clearDepth();
@@ -214,8 +215,8 @@ LightVolumeRasterizer::DepthRange LightVolumeRasterizer::depthBounds(const Light
                               double(sphere.centreView.z) - sphere.radius);
 }
 
-LightVolumeRasterizer::DepthRange LightVolumeRasterizer::depthBoundsOfViewZ(double zNearest,
-                                                                            double zFarthest) const {
+LightVolumeRasterizer::DepthRange
+LightVolumeRasterizer::depthBoundsOfViewZ(double zNearest, double zFarthest) const {
     // Surfaces lie between the near and far planes; clamp so the mapping stays finite.
     const double nearZ = -double(mNearMetres), farZ = -double(mFarMetres);
     zNearest = std::clamp(zNearest, farZ, nearZ);
@@ -281,19 +282,24 @@ float LightVolumeRasterizer::marginMetres(float farthestMetres) const {
 
 bool LightVolumeRasterizer::tryConeProxy(const LightSphere& sphere, uint32_t slot) {
     // Lit points are at most range (plus slack) from the apex: grow by kProxyMarginPixels there.
-    const float farthest = glm::length(sphere.positionView) + sphere.rangeMetres * (1.0f + kCullingSlack);
+    const float farthest =
+        glm::length(sphere.positionView) + sphere.rangeMetres * (1.0f + kCullingSlack);
     const std::optional<ConeProxy> cone = coneProxy(sphere, marginMetres(farthest));
-    if (!cone) return false;
+    if (!cone)
+        return false;
     // The smaller proxy wins (file comment); the sphere proxy grown as in addProxy.
-    const double sphereRadius = double(sphere.radius) + marginMetres(glm::length(sphere.centreView) + sphere.radius);
-    if (!(cone->volume < unitProxySphere().volume * sphereRadius * sphereRadius * sphereRadius)) return false;
+    const double sphereRadius =
+        double(sphere.radius) + marginMetres(glm::length(sphere.centreView) + sphere.radius);
+    if (!(cone->volume < unitProxySphere().volume * sphereRadius * sphereRadius * sphereRadius))
+        return false;
     double zMin = cone->positionsView[0].z, zMax = zMin;
     for (const glm::vec3& p : cone->positionsView) {
         zMin = std::min(zMin, double(p.z));
         zMax = std::max(zMax, double(p.z));
     }
     // Back faces beyond the far plane would be clipped away: leave it to the sphere's checks.
-    if (!(zMin - 1e-5 * std::abs(zMin) > -double(mFarMetres))) return false;
+    if (!(zMin - 1e-5 * std::abs(zMin) > -double(mFarMetres)))
+        return false;
     Slot& s = mSlots[slot];
     s.backFaceTest = true;
     // Front faces are complete only when the proxy is wholly beyond the near plane.
@@ -307,23 +313,27 @@ bool LightVolumeRasterizer::tryConeProxy(const LightSphere& sphere, uint32_t slo
 
 void LightVolumeRasterizer::addProxy(const LightSphere& sphere, uint32_t slot) {
     // Grow the sphere by kProxyMarginPixels at its farthest distance from the eye.
-    const float radius = sphere.radius + marginMetres(glm::length(sphere.centreView) + sphere.radius);
+    const float radius =
+        sphere.radius + marginMetres(glm::length(sphere.centreView) + sphere.radius);
     const ProxyMesh& proxy = unitProxySphere();
     std::vector<glm::vec3> positionsView;
     positionsView.reserve(proxy.positions.size());
-    for (const glm::vec3& p : proxy.positions) positionsView.push_back(sphere.centreView + radius * p);
+    for (const glm::vec3& p : proxy.positions)
+        positionsView.push_back(sphere.centreView + radius * p);
     addMesh(positionsView.data(), positionsView.size(), proxy.indices, slot);
 }
 
 void LightVolumeRasterizer::addMesh(const glm::vec3* positionsView, size_t positionCount,
                                     const std::vector<uint32_t>& indices, uint32_t slot) {
     const uint32_t base = uint32_t(mClip.size());
-    for (size_t i = 0; i < positionCount; ++i) mClip.push_back(mClipFromView * glm::vec4(positionsView[i], 1.0f));
+    for (size_t i = 0; i < positionCount; ++i)
+        mClip.push_back(mClipFromView * glm::vec4(positionsView[i], 1.0f));
     // Stencil: a front-marking copy first, then the testing copy (see the header).
     const bool frontCopy = mSlots[slot].frontFaceTest;
     for (int copy = frontCopy ? 0 : 1; copy < 2; ++copy)
         for (size_t t = 0; t < indices.size(); t += 3) {
-            for (int k = 0; k < 3; ++k) mIndices.push_back(base + indices[t + k]);
+            for (int k = 0; k < 3; ++k)
+                mIndices.push_back(base + indices[t + k]);
             mTriangleSlot.push_back(copy == 0 ? (slot | kFrontCopy) : slot);
         }
 }

@@ -41,7 +41,7 @@
 // needs) while all tiles work in parallel and the set-up cost is paid once. Rectangles (volume=rect,
 // far-plane fallback) and unbounded lights (directional, ambient: full screen) are drawn as
 // screen-aligned quads in the same stream, at their place in the light order. With stencil=1
-// each sphere is submitted twice with no face culling: the first copy's front faces mark pixels,
+// each proxy is submitted twice with no face culling: the first copy's front faces mark pixels,
 // the second copy's back faces test; light i's copies precede light i+1's in every tile.
 //
 // Depth comparisons are done in the fragment function against the G-buffer's depth plane with a
@@ -123,7 +123,8 @@ struct LightVolumeStats {
 
 class LightVolumeRasterizer {
 public:
-    LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape, bool stencil, SpotProxy spotProxy);
+    LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape, bool stencil,
+                          SpotProxy spotProxy);
 
     // True when the sphere may touch the view frustum (conservative; six planes).
     bool inViewFrustum(const LightSphere& sphere) const;
@@ -133,7 +134,8 @@ public:
 
     // Draws the volumes of `lightIndices` (ascending; unbounded lights included) in one pass and
     // calls fn(light, x, y, pixel) as described in the file comment. Cost: set-up of 80 (160 with
-    // stencil) triangles per sphere, 22 (44) per cone, then O(covered bounding-box pixels) in parallel over tiles.
+    // stencil) triangles per sphere, 22 (44) per cone, then O(covered bounding-box pixels) in
+    // parallel over tiles.
     template <class Fn>
     void draw(const std::vector<LightSphere>& spheres, const std::vector<uint32_t>& lightIndices, Fn&& fn);
 
@@ -186,8 +188,8 @@ private:
     // plane); fills the slot's tests and depth bounds.
     bool tryConeProxy(const LightSphere& sphere, uint32_t slot);
     void addProxy(const LightSphere& sphere, uint32_t slot);
-    void addMesh(const glm::vec3* positionsView, size_t positionCount, const std::vector<uint32_t>& indices,
-                 uint32_t slot);
+    void addMesh(const glm::vec3* positionsView, size_t positionCount,
+                 const std::vector<uint32_t>& indices, uint32_t slot);
     void addQuad(const PixelRect& rect, uint32_t slot);
 
     const gbuffer::GBuffer& mGBuffer;

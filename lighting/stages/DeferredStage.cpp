@@ -81,7 +81,8 @@ public:
         result.timingsMs.emplace_back("shading", millisecondsSince(start));
 
         result.parameters["volume"] = mShape == VolumeShape::Sphere ? "sphere" : "rect";
-        if (mShape == VolumeShape::Sphere) result.parameters["spot"] = mSpotProxy == SpotProxy::Cone ? "cone" : "sphere";
+        if (mShape == VolumeShape::Sphere)
+            result.parameters["spot"] = mSpotProxy == SpotProxy::Cone ? "cone" : "sphere";
         result.parameters["stencil"] = mStencil ? "1" : "0";
         result.parameters["vfc"] = mFrustumCull ? "1" : "0";
         result.parameters["lights_culled"] = std::to_string(culled);
@@ -106,8 +107,9 @@ std::unique_ptr<ShadingStage> makeDeferredStage(const StageSpec& spec) {
         choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere" ? VolumeShape::Sphere : VolumeShape::Rect;
     if (shape == VolumeShape::Rect && spec.options.count("spot"))
         throw StageError("stage '" + spec.name + "': option spot applies to volume=sphere only");
-    const SpotProxy spotProxy =
-        choiceOption(spec, "spot", {"cone", "sphere"}) == "cone" ? SpotProxy::Cone : SpotProxy::Sphere;
+    const SpotProxy spotProxy = choiceOption(spec, "spot", {"cone", "sphere"}) == "cone"
+                                    ? SpotProxy::Cone
+                                    : SpotProxy::Sphere;
     return std::make_unique<DeferredStage>(shape, spotProxy, boolOption(spec, "stencil", false),
                                            boolOption(spec, "vfc", true));
 }

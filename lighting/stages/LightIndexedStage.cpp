@@ -42,8 +42,10 @@ constexpr uint16_t kOverflowed = 0xFFFF;
 
 class LightIndexedStage final : public ShadingStage {
 public:
-    LightIndexedStage(int maxLights, VolumeShape shape, SpotProxy spotProxy, bool stencil, bool frustumCull)
-        : mMaxLights(maxLights), mShape(shape), mSpotProxy(spotProxy), mStencil(stencil), mFrustumCull(frustumCull) {}
+    LightIndexedStage(int maxLights, VolumeShape shape, SpotProxy spotProxy, bool stencil,
+                      bool frustumCull)
+        : mMaxLights(maxLights), mShape(shape), mSpotProxy(spotProxy), mStencil(stencil),
+          mFrustumCull(frustumCull) {}
 
     std::string name() const override { return "light-indexed"; }
     StageRequirements requirements() const override {
@@ -107,7 +109,8 @@ public:
         for (uint32_t n : overflowPerRow) overflowPixels += n;
         result.parameters["max"] = std::to_string(mMaxLights);
         result.parameters["volume"] = mShape == VolumeShape::Sphere ? "sphere" : "rect";
-        if (mShape == VolumeShape::Sphere) result.parameters["spot"] = mSpotProxy == SpotProxy::Cone ? "cone" : "sphere";
+        if (mShape == VolumeShape::Sphere)
+            result.parameters["spot"] = mSpotProxy == SpotProxy::Cone ? "cone" : "sphere";
         result.parameters["stencil"] = mStencil ? "1" : "0";
         result.parameters["vfc"] = mFrustumCull ? "1" : "0";
         result.parameters["lights_culled"] = std::to_string(culled);
@@ -137,8 +140,9 @@ std::unique_ptr<ShadingStage> makeLightIndexedStage(const StageSpec& spec) {
         choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere" ? VolumeShape::Sphere : VolumeShape::Rect;
     if (shape == VolumeShape::Rect && spec.options.count("spot"))
         throw StageError("stage '" + spec.name + "': option spot applies to volume=sphere only");
-    const SpotProxy spotProxy =
-        choiceOption(spec, "spot", {"cone", "sphere"}) == "cone" ? SpotProxy::Cone : SpotProxy::Sphere;
+    const SpotProxy spotProxy = choiceOption(spec, "spot", {"cone", "sphere"}) == "cone"
+                                    ? SpotProxy::Cone
+                                    : SpotProxy::Sphere;
     return std::make_unique<LightIndexedStage>(intOption(spec, "max", 16, 1, 255), shape, spotProxy,
                                                boolOption(spec, "stencil", false),
                                                boolOption(spec, "vfc", true));

@@ -171,7 +171,8 @@ TEST(SpotBounds, DeferredConeProxiesEvaluateFewerLightsThanSpheres) {
         }
         EXPECT_EQ(dropped, 0) << stages[k];
     }
-    EXPECT_LT(double(evaluated[0]), 0.95 * double(evaluated[1])) << evaluated[0] << " vs " << evaluated[1];
+    EXPECT_LT(double(evaluated[0]), 0.95 * double(evaluated[1]))
+        << evaluated[0] << " vs " << evaluated[1];
 }
 
 TEST(StageRegistry, EveryStageRejectsUnknownOptions) {
