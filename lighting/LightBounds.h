@@ -10,7 +10,9 @@
 //   t >= 90 deg:            the range sphere
 // (each contains the apex, the rim and the whole cap; derivation in the function). The emitter's
 // own position stays in `positionView`: tests about where light comes from (back-face culling)
-// use it, tests about where light lands use the sphere.
+// use it, tests about where light lands use the sphere. Such spot lights also keep their raw cone
+// (apex positionView, axis, outer cosine, range; `spot` set) for bounds tighter than a sphere
+// (the cone proxies of LightVolumes.h), which must add their own slack.
 #pragma once
 
 #include <algorithm>
@@ -31,6 +33,11 @@ struct LightSphere {
     float radius = 0.0f;
     bool unbounded = false;        // directional / ambient
     glm::vec3 positionView{0.0f};  // the emitter (equal to centreView for point lights)
+    // Spot lights with a half-angle below 90 degrees: the raw cone, as the light is evaluated.
+    bool spot = false;
+    glm::vec3 axisView{0.0f, 0.0f, -1.0f};  // unit, the direction the light travels
+    float spotOuterCos = -1.0f;              // cosine of the outer half-angle
+    float rangeMetres = 0.0f;
 };
 
 inline std::vector<LightSphere> boundingSpheresView(const LightList& lights) {
@@ -58,6 +65,10 @@ inline std::vector<LightSphere> boundingSpheresView(const LightList& lights) {
             sphere.centreView = glm::vec3(glm::dvec3(light.positionView) + offset * axis);
             // The centre was rounded to float: grow by its rounding (relative to its magnitude).
             radius += 4e-7 * (glm::length(glm::dvec3(sphere.centreView)) + r);
+            sphere.spot = true;
+            sphere.axisView = light.directionView;
+            sphere.spotOuterCos = light.spotOuterCos;
+            sphere.rangeMetres = light.rangeMetres;
         }
         sphere.radius = float(radius) * (1.0f + kCullingSlack) + kCullingSlackMetres;
         spheres.push_back(sphere);

@@ -19,7 +19,7 @@ const std::vector<StageEntry>& registry() {
          makeReferenceStage},
         {{"brute", "every light at every pixel, float, from the G-buffer", StageKind::Exact}, makeBruteStage},
         {{"deferred", "traditional deferred: one light volume per light, shaded and added per fragment "
-                      "(volume=sphere|rect, stencil=0, vfc=1)", StageKind::Exact},
+                      "(volume=sphere|rect, spot=cone|sphere, stencil=0, vfc=1)", StageKind::Exact},
          makeDeferredStage},
         {{"light-indexed", "light-indexed deferred: volumes write per-pixel light lists (max=16), "
                            "overflow shades every light", StageKind::Exact},

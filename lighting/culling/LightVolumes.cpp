@@ -61,7 +61,28 @@ ProxyMesh buildUnitProxySphere() {
     }
     mesh.circumradius *= 1.0f + 1e-6f;
     mesh.positions = std::move(positions);
+    // Sum of the tetrahedra from the origin to each face.
+    for (size_t t = 0; t < mesh.indices.size(); t += 3) {
+        const glm::dvec3 a(mesh.positions[mesh.indices[t]]), b(mesh.positions[mesh.indices[t + 1]]),
+            c(mesh.positions[mesh.indices[t + 2]]);
+        mesh.volume += glm::dot(a, glm::cross(b, c)) / 6.0;
+    }
     return mesh;
+}
+
+std::vector<uint32_t> buildConeProxyIndices() {
+    // Vertex 0 the apex, 1..n the base polygon counter-clockwise seen from the base's side.
+    const uint32_t n = kConeProxySides;
+    std::vector<uint32_t> indices;
+    for (uint32_t k = 0; k < n; ++k) {
+        const uint32_t b = 1 + k, next = 1 + (k + 1) % n;
+        for (uint32_t i : {0u, next, b})
+            indices.push_back(i);  // side
+    }
+    for (uint32_t k = 1; k + 1 < n; ++k)
+        for (uint32_t i : {1u, 1 + k, 2 + k})
+            indices.push_back(i);  // base fan
+    return indices;
 }
 
 }  // namespace
@@ -71,12 +92,58 @@ const ProxyMesh& unitProxySphere() {
     return mesh;
 }
 
-LightVolumeRasterizer::LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape, bool stencil)
-    : mGBuffer(gbuffer),
-      mDepth(gbuffer.depth().data()),
-      mShape(shape),
-      mStencil(stencil),
-      mRasterizer(gbuffer.width(), gbuffer.height()) {
+const std::vector<uint32_t>& coneProxyIndices() {
+    static const std::vector<uint32_t> indices = buildConeProxyIndices();
+    return indices;
+}
+
+std::optional<ConeProxy> coneProxy(const LightSphere& light, float marginMetres) {
+    if (!light.spot || light.unbounded)
+        return std::nullopt;
+    // The half-angle t, widened for the float cosine test and then by the relative slack.
+    const double cosT = std::min(double(light.spotOuterCos), 1.0) - kConeCosSlack;
+    if (!(cosT > std::cos(glm::radians(kConeMaxHalfAngleDegrees))))
+        return std::nullopt;
+    const double tanT = std::sqrt(1.0 - cosT * cosT) / cosT * (1.0 + kCullingSlack);
+    const double sinT = tanT / std::sqrt(1.0 + tanT * tanT);
+    const double range = light.rangeMetres;
+    const glm::dvec3 apex(light.positionView);
+    // Dilate the truncated cone by s: LightBounds' slack (relative, absolute, and the float
+    // rounding it allows for positions), plus the caller's margin. Moving the apex back along the
+    // axis by s / sin t moves every side line out by s (the cone around the old apex's s-ball);
+    // the base moves out by s.
+    const double dilation = range * kCullingSlack + kCullingSlackMetres +
+                            4e-7 * (glm::length(apex) + range) + double(marginMetres);
+    const double back = dilation / sinT;
+    const double height = back + range + dilation;
+    // The base polygon circumscribes the circle of radius height * tan t.
+    const double pi = 3.14159265358979323846;
+    const double inradius = height * tanT;
+    const double circumradius = inradius / std::cos(pi / kConeProxySides) * (1.0 + 1e-6);
+    const glm::dvec3 axis = glm::normalize(glm::dvec3(light.axisView));
+    // A right-handed frame (u, v, axis): angles increase counter-clockwise seen from +axis.
+    const glm::dvec3 helper = std::abs(axis.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    const glm::dvec3 u = glm::normalize(glm::cross(helper, axis));
+    const glm::dvec3 v = glm::cross(axis, u);
+    const glm::dvec3 apexProxy = apex - back * axis;
+    const glm::dvec3 baseCentre = apex + (range + dilation) * axis;
+    ConeProxy proxy;
+    proxy.positionsView[0] = glm::vec3(apexProxy);
+    for (int k = 0; k < kConeProxySides; ++k) {
+        const double angle = 2.0 * pi * k / kConeProxySides;
+        proxy.positionsView[size_t(k) + 1] =
+            glm::vec3(baseCentre + circumradius * (std::cos(angle) * u + std::sin(angle) * v));
+    }
+    // The base polygon's area is n r^2 tan(pi / n) for inradius r.
+    proxy.volume =
+        height * kConeProxySides * inradius * inradius * std::tan(pi / kConeProxySides) / 3.0;
+    return proxy;
+}
+
+LightVolumeRasterizer::LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape,
+                                             bool stencil, SpotProxy spotProxy)
+    : mGBuffer(gbuffer), mDepth(gbuffer.depth().data()), mShape(shape), mStencil(stencil),
+      mSpotProxy(spotProxy), mRasterizer(gbuffer.width(), gbuffer.height()) {
     const gbuffer::FrameView& view = gbuffer.view();
     mReversedZ = view.reversedZ();
     mClearDepth = view.clearDepth();
@@ -144,10 +211,16 @@ LightVolumeRasterizer::PixelRect LightVolumeRasterizer::screenRect(const LightSp
 }
 
 LightVolumeRasterizer::DepthRange LightVolumeRasterizer::depthBounds(const LightSphere& sphere) const {
+    return depthBoundsOfViewZ(double(sphere.centreView.z) + sphere.radius,
+                              double(sphere.centreView.z) - sphere.radius);
+}
+
+LightVolumeRasterizer::DepthRange
+LightVolumeRasterizer::depthBoundsOfViewZ(double zNearest, double zFarthest) const {
     // Surfaces lie between the near and far planes; clamp so the mapping stays finite.
     const double nearZ = -double(mNearMetres), farZ = -double(mFarMetres);
-    const double zNearest = std::clamp(double(sphere.centreView.z) + sphere.radius, farZ, nearZ);
-    const double zFarthest = std::clamp(double(sphere.centreView.z) - sphere.radius, farZ, nearZ);
+    zNearest = std::clamp(zNearest, farZ, nearZ);
+    zFarthest = std::clamp(zFarthest, farZ, nearZ);
     // For a perspective projection clip z and w depend on view z only.
     const glm::dmat4& m = mClipFromViewExact;
     auto depthOf = [&](double z) { return (m[2][2] * z + m[3][2]) / (m[2][3] * z + m[3][3]); };
@@ -180,9 +253,12 @@ void LightVolumeRasterizer::buildGeometry(const std::vector<LightSphere>& sphere
         ++mStats.lightsDrawn;
         mSlots.push_back({light, depthBounds(sphere), false, false});
         if (mShape == VolumeShape::Sphere) {
+            if (mSpotProxy == SpotProxy::Cone && sphere.spot && tryConeProxy(sphere, slot)) {
+                ++mStats.coneProxies;
+                continue;
+            }
             // The proxy's extent: the grown radius times the proxy's circumradius.
-            const float farthest = glm::length(sphere.centreView) + sphere.radius;
-            const float margin = farthest * kProxyMarginPixels / std::min(mPixelsPerTanX, mPixelsPerTanY);
+            const float margin = marginMetres(glm::length(sphere.centreView) + sphere.radius);
             const float extent = (sphere.radius + margin) * unitProxySphere().circumradius * (1.0f + 1e-5f);
             // Back faces beyond the far plane would be clipped away: use the rectangle instead.
             if (sphere.centreView.z - extent > -mFarMetres) {
@@ -199,21 +275,65 @@ void LightVolumeRasterizer::buildGeometry(const std::vector<LightSphere>& sphere
     }
 }
 
+float LightVolumeRasterizer::marginMetres(float farthestMetres) const {
+    // A metric margin m at distance d projects to at least m / d * focal pixels.
+    return farthestMetres * kProxyMarginPixels / std::min(mPixelsPerTanX, mPixelsPerTanY);
+}
+
+bool LightVolumeRasterizer::tryConeProxy(const LightSphere& sphere, uint32_t slot) {
+    // Lit points are at most range (plus slack) from the apex: grow by kProxyMarginPixels there.
+    const float farthest =
+        glm::length(sphere.positionView) + sphere.rangeMetres * (1.0f + kCullingSlack);
+    const std::optional<ConeProxy> cone = coneProxy(sphere, marginMetres(farthest));
+    if (!cone)
+        return false;
+    // The smaller proxy wins (file comment); the sphere proxy grown as in addProxy.
+    const double sphereRadius =
+        double(sphere.radius) + marginMetres(glm::length(sphere.centreView) + sphere.radius);
+    if (!(cone->volume < unitProxySphere().volume * sphereRadius * sphereRadius * sphereRadius))
+        return false;
+    double zMin = cone->positionsView[0].z, zMax = zMin;
+    for (const glm::vec3& p : cone->positionsView) {
+        zMin = std::min(zMin, double(p.z));
+        zMax = std::max(zMax, double(p.z));
+    }
+    // Back faces beyond the far plane would be clipped away: leave it to the sphere's checks.
+    if (!(zMin - 1e-5 * std::abs(zMin) > -double(mFarMetres)))
+        return false;
+    Slot& s = mSlots[slot];
+    s.backFaceTest = true;
+    // Front faces are complete only when the proxy is wholly beyond the near plane.
+    s.frontFaceTest = mStencil && zMax + 1e-5 * std::abs(zMax) < -double(mNearMetres);
+    // Both depth ranges hold every lit surface: keep their intersection.
+    const DepthRange coneDepth = depthBoundsOfViewZ(zMax, zMin);
+    s.depth = {std::max(s.depth.lo, coneDepth.lo), std::min(s.depth.hi, coneDepth.hi)};
+    addMesh(cone->positionsView.data(), cone->positionsView.size(), coneProxyIndices(), slot);
+    return true;
+}
+
 void LightVolumeRasterizer::addProxy(const LightSphere& sphere, uint32_t slot) {
-    // Grow the sphere by kProxyMarginPixels at its farthest distance from the eye: a metric
-    // margin m at distance d projects to at least m / d * focal pixels.
-    const float farthest = glm::length(sphere.centreView) + sphere.radius;
-    const float margin = farthest * kProxyMarginPixels / std::min(mPixelsPerTanX, mPixelsPerTanY);
-    const float radius = sphere.radius + margin;
+    // Grow the sphere by kProxyMarginPixels at its farthest distance from the eye.
+    const float radius =
+        sphere.radius + marginMetres(glm::length(sphere.centreView) + sphere.radius);
     const ProxyMesh& proxy = unitProxySphere();
-    const uint32_t base = uint32_t(mClip.size());
+    std::vector<glm::vec3> positionsView;
+    positionsView.reserve(proxy.positions.size());
     for (const glm::vec3& p : proxy.positions)
-        mClip.push_back(mClipFromView * glm::vec4(sphere.centreView + radius * p, 1.0f));
+        positionsView.push_back(sphere.centreView + radius * p);
+    addMesh(positionsView.data(), positionsView.size(), proxy.indices, slot);
+}
+
+void LightVolumeRasterizer::addMesh(const glm::vec3* positionsView, size_t positionCount,
+                                    const std::vector<uint32_t>& indices, uint32_t slot) {
+    const uint32_t base = uint32_t(mClip.size());
+    for (size_t i = 0; i < positionCount; ++i)
+        mClip.push_back(mClipFromView * glm::vec4(positionsView[i], 1.0f));
     // Stencil: a front-marking copy first, then the testing copy (see the header).
     const bool frontCopy = mSlots[slot].frontFaceTest;
     for (int copy = frontCopy ? 0 : 1; copy < 2; ++copy)
-        for (size_t t = 0; t < proxy.indices.size(); t += 3) {
-            for (int k = 0; k < 3; ++k) mIndices.push_back(base + proxy.indices[t + k]);
+        for (size_t t = 0; t < indices.size(); t += 3) {
+            for (int k = 0; k < 3; ++k)
+                mIndices.push_back(base + indices[t + k]);
             mTriangleSlot.push_back(copy == 0 ? (slot | kFrontCopy) : slot);
         }
 }

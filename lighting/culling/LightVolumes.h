@@ -14,13 +14,26 @@
 //   faces in front of the near plane, where no surface lies, so a camera inside the volume or a
 //   volume crossing the near plane loses nothing. Far-plane clipping WOULD lose pixels, so a
 //   proxy reaching beyond the far plane falls back to the screen rectangle.
+// - Spot lights (half-angle below kConeMaxHalfAngleDegrees) may instead rasterize a CONE PROXY
+//   (coneProxy()): a pyramid with its apex behind the light and a kConeProxySides-gon base, whose
+//   faces circumscribe the lit cone truncated at axial distance = range (the lit region
+//   {distance < range, angle < outer} lies in it: axial distance <= distance), dilated by the
+//   same slack as the sphere (LightBounds.h) plus the same kProxyMarginPixels metric margin. The
+//   rule (spot=cone): draw whichever of the two proxies has the smaller volume, a view-independent
+//   stand-in for the surfaces each one encloses. Per unit range cubed the pyramid has
+//   4 tan^2(t) tan(pi/12) and the sphere proxy 4.49 R^3 (R of LightBounds.h): 0.36 vs 0.86 at
+//   30 degrees, 1.07 vs 1.59 at 45, 3.2 vs 2.9 at 60; the cone wins up to about 57 degrees. From
+//   kConeMaxHalfAngleDegrees on the cone is not even built (its volume blows up as tan^2). The
+//   pyramid is convex and closed, so everything said here of sphere proxies (back faces,
+//   near-plane clipping, far-plane fallback, stencil) holds for it as well; its depth bounds are
+//   the tighter of its vertices' view-depth range and the sphere's.
 // - stencil=1 adds the two-sided test: the FRONT faces mark pixels whose surface is not in
 //   front of the front face; the back faces then only accept marked pixels. When
 //   the proxy crosses the near plane its front faces are clipped, so the front test is skipped.
 // - Rect volumes cover the sphere's conservative screen rectangle (full screen when the sphere
 //   crosses the near plane), with no back-face test.
 // Every volume is followed by the depth-bounds test: the surface's view depth within
-// [centre - radius, centre + radius].
+// [centre - radius, centre + radius] (for cone proxies also within the pyramid's depth range).
 //
 // Batching: all lights of a frame are drawn in ONE rasterizer draw, light after light in ascending
 // index order. Inside a screen tile the rasterizer visits triangles in submission order, and a
@@ -28,7 +41,7 @@
 // needs) while all tiles work in parallel and the set-up cost is paid once. Rectangles (volume=rect,
 // far-plane fallback) and unbounded lights (directional, ambient: full screen) are drawn as
 // screen-aligned quads in the same stream, at their place in the light order. With stencil=1
-// each sphere is submitted twice with no face culling: the first copy's front faces mark pixels,
+// each proxy is submitted twice with no face culling: the first copy's front faces mark pixels,
 // the second copy's back faces test; light i's copies precede light i+1's in every tile.
 //
 // Depth comparisons are done in the fragment function against the G-buffer's depth plane with a
@@ -41,7 +54,9 @@
 // Deterministic: the pixels visited do not depend on the thread count.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -58,6 +73,7 @@ struct ProxyMesh {
     std::vector<glm::vec3> positions;
     std::vector<uint32_t> indices;
     float circumradius = 1.0f;  // largest vertex distance from the origin
+    double volume = 0.0;        // enclosed volume
 };
 // The icosahedron subdivided once (42 vertices, 80 faces), scaled so its inradius is 1.
 const ProxyMesh& unitProxySphere();
@@ -67,18 +83,48 @@ enum class VolumeShape { Sphere, Rect };
 // Screen growth of the proxy in pixels: covers fixed-point snapping (1/512 px) and the float
 // rounding of vertex transforms by a wide margin; costs a thin ring of extra fragments.
 inline constexpr float kProxyMarginPixels = 0.25f;
+// A spot light's cone proxy: 12 sides put the base polygon's vertices 3.5% beyond the cone's
+// circle (1 / cos(pi/12)) and its area 2.3% above the circle's, for 22 triangles (the sphere
+// proxy has 80); 8 sides would cost 8% and 5.5%, 16 sides 2% and 1.3% for 30 triangles.
+inline constexpr int kConeProxySides = 12;
+// From this outer half-angle on, spot lights use the sphere proxy: the pyramid's volume grows as
+// tan^2 and the sphere (radius range * sin) is smaller long before.
+inline constexpr double kConeMaxHalfAngleDegrees = 80.0;
+// Absolute widening of a spot's outer cosine: evaluateLight compares a float cosine (a few ulps
+// of error, and a float axis up to 1e-7 off unit length) with the outer cosine; widening the cone
+// by 1e-6 in cosine covers that even for cones narrower than a degree.
+inline constexpr double kConeCosSlack = 1e-6;
+
+// A spot light's cone proxy in view space: the apex (index 0) and the base polygon
+// (1..kConeProxySides). Faces are coneProxyIndices(), counter-clockwise seen from outside.
+struct ConeProxy {
+    std::array<glm::vec3, kConeProxySides + 1> positionsView;
+    double volume = 0.0;  // cubic metres
+};
+const std::vector<uint32_t>& coneProxyIndices();
+// The pyramid around `light`'s lit cone, its faces at least `marginMetres` (plus LightBounds'
+// slack) outside the truncated cone; empty for lights that are not spots or whose half-angle is
+// kConeMaxHalfAngleDegrees or more. Pure function, thread-safe.
+std::optional<ConeProxy> coneProxy(const LightSphere& light, float marginMetres);
+
+// Which proxy a bounded spot light gets (VolumeShape::Sphere only): Cone picks the smaller of the
+// cone and sphere proxies (file comment), Sphere always draws the sphere.
+enum class SpotProxy { Cone, Sphere };
+
 // Relative depth tolerance (of the depth value in reversed Z, of 1 in standard Z).
 inline constexpr float kDepthTolerance = 1e-5f;
 
 struct LightVolumeStats {
     uint64_t lightsDrawn = 0;    // bounded lights that reached a volume draw
     uint64_t rectFallbacks = 0;  // sphere volumes replaced by the rectangle (far plane)
+    uint64_t coneProxies = 0;    // spot lights drawn with their cone proxy
     uint64_t fragments = 0;      // samples covered by the volume draw (before any depth test)
 };
 
 class LightVolumeRasterizer {
 public:
-    LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape, bool stencil);
+    LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape, bool stencil,
+                          SpotProxy spotProxy);
 
     // True when the sphere may touch the view frustum (conservative; six planes).
     bool inViewFrustum(const LightSphere& sphere) const;
@@ -88,7 +134,8 @@ public:
 
     // Draws the volumes of `lightIndices` (ascending; unbounded lights included) in one pass and
     // calls fn(light, x, y, pixel) as described in the file comment. Cost: set-up of 80 (160 with
-    // stencil) triangles per sphere, then O(covered bounding-box pixels) in parallel over tiles.
+    // stencil) triangles per sphere, 22 (44) per cone, then O(covered bounding-box pixels) in
+    // parallel over tiles.
     template <class Fn>
     void draw(const std::vector<LightSphere>& spheres, const std::vector<uint32_t>& lightIndices, Fn&& fn);
 
@@ -106,13 +153,15 @@ public:
         float lo, hi;
     };
     DepthRange depthBounds(const LightSphere& sphere) const;
+    // The same for the view-depth range [zFarthest, zNearest] (metres, negative in front).
+    DepthRange depthBoundsOfViewZ(double zNearest, double zFarthest) const;
 
 private:
     // One drawn light: what the fragment function needs, looked up by triangle.
     struct Slot {
         uint32_t light;
         DepthRange depth;
-        bool backFaceTest;   // a sphere proxy (else a screen quad: no depth test)
+        bool backFaceTest;   // a proxy (else a screen quad: no depth test)
         bool frontFaceTest;  // stencil: the surface must not be in front of the front face
     };
     // Triangles of a stencil front-marking copy carry this bit in mTriangleSlot.
@@ -132,13 +181,22 @@ private:
     }
     // Fills mClip, mIndices, mTriangleSlot and mSlots for the lights to draw.
     void buildGeometry(const std::vector<LightSphere>& spheres, const std::vector<uint32_t>& lightIndices);
+    // The metric margin that grows a proxy by kProxyMarginPixels for surfaces up to
+    // `farthestMetres` from the eye.
+    float marginMetres(float farthestMetres) const;
+    // True when the cone proxy was added (it is smaller than the sphere proxy and fits the far
+    // plane); fills the slot's tests and depth bounds.
+    bool tryConeProxy(const LightSphere& sphere, uint32_t slot);
     void addProxy(const LightSphere& sphere, uint32_t slot);
+    void addMesh(const glm::vec3* positionsView, size_t positionCount,
+                 const std::vector<uint32_t>& indices, uint32_t slot);
     void addQuad(const PixelRect& rect, uint32_t slot);
 
     const gbuffer::GBuffer& mGBuffer;
     const float* mDepth;
     VolumeShape mShape;
     bool mStencil;
+    SpotProxy mSpotProxy;
     bool mReversedZ;
     float mClearDepth;
     float mNearMetres, mFarMetres;

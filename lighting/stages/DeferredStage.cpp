@@ -13,10 +13,13 @@
 // Options (defaults first):
 //   volume=sphere|rect  sphere: back faces of a circumscribing proxy (icosphere), depth test
 //                       "surface not behind the back face"; rect: the sphere's screen rectangle
+//   spot=cone|sphere    volume=sphere only: cone draws a spot light's pyramid proxy when it is
+//                       smaller than its sphere proxy (LightVolumes.h); sphere always the sphere
 //   stencil=0|1         1: also require the surface not in front of the volume's front face
 //                       (two draws per light, a per-pixel mark)
 //   vfc=1|0             CPU view-frustum culling of light spheres before any rasterizer set-up
-// Every volume ends with the depth-bounds test (surface view depth within centre +- radius).
+// Every volume ends with the depth-bounds test (surface view depth within centre +- radius, and
+// within the pyramid's depth range for cones).
 // Passes: "cull" (view-frustum culling), "shading" (volume rasterization and shading, interleaved).
 #include "lighting/stages/Stages.h"
 
@@ -36,8 +39,8 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
 
 class DeferredStage final : public ShadingStage {
 public:
-    DeferredStage(VolumeShape shape, bool stencil, bool frustumCull)
-        : mShape(shape), mStencil(stencil), mFrustumCull(frustumCull) {}
+    DeferredStage(VolumeShape shape, SpotProxy spotProxy, bool stencil, bool frustumCull)
+        : mShape(shape), mSpotProxy(spotProxy), mStencil(stencil), mFrustumCull(frustumCull) {}
 
     std::string name() const override { return "deferred"; }
     StageRequirements requirements() const override {
@@ -54,7 +57,7 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
-        LightVolumeRasterizer volumes(gb, mShape, mStencil);
+        LightVolumeRasterizer volumes(gb, mShape, mStencil, mSpotProxy);
         const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mFrustumCull);  // ascending
         const size_t culled = spheres.size() - drawn.size();
         result.timingsMs.emplace_back("cull", millisecondsSince(start));
@@ -78,16 +81,20 @@ public:
         result.timingsMs.emplace_back("shading", millisecondsSince(start));
 
         result.parameters["volume"] = mShape == VolumeShape::Sphere ? "sphere" : "rect";
+        if (mShape == VolumeShape::Sphere)
+            result.parameters["spot"] = mSpotProxy == SpotProxy::Cone ? "cone" : "sphere";
         result.parameters["stencil"] = mStencil ? "1" : "0";
         result.parameters["vfc"] = mFrustumCull ? "1" : "0";
         result.parameters["lights_culled"] = std::to_string(culled);
         result.parameters["lights_drawn"] = std::to_string(volumes.stats().lightsDrawn);
         result.parameters["rect_fallbacks"] = std::to_string(volumes.stats().rectFallbacks);
+        result.parameters["cone_proxies"] = std::to_string(volumes.stats().coneProxies);
         result.parameters["volume_fragments"] = std::to_string(volumes.stats().fragments);
     }
 
 private:
     VolumeShape mShape;
+    SpotProxy mSpotProxy;
     bool mStencil;
     bool mFrustumCull;
 };
@@ -95,10 +102,15 @@ private:
 }  // namespace
 
 std::unique_ptr<ShadingStage> makeDeferredStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"volume", "stencil", "vfc"});
+    rejectUnknownOptions(spec, {"volume", "spot", "stencil", "vfc"});
     const VolumeShape shape =
         choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere" ? VolumeShape::Sphere : VolumeShape::Rect;
-    return std::make_unique<DeferredStage>(shape, boolOption(spec, "stencil", false),
+    if (shape == VolumeShape::Rect && spec.options.count("spot"))
+        throw StageError("stage '" + spec.name + "': option spot applies to volume=sphere only");
+    const SpotProxy spotProxy = choiceOption(spec, "spot", {"cone", "sphere"}) == "cone"
+                                    ? SpotProxy::Cone
+                                    : SpotProxy::Sphere;
+    return std::make_unique<DeferredStage>(shape, spotProxy, boolOption(spec, "stencil", false),
                                            boolOption(spec, "vfc", true));
 }
 

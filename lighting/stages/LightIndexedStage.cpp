@@ -16,7 +16,7 @@
 //
 // Options (defaults first):
 //   max=16           list capacity per pixel, 1..255
-//   volume=sphere|rect, stencil=0|1, vfc=1|0   as for `deferred`
+//   volume=sphere|rect, spot=cone|sphere, stencil=0|1, vfc=1|0   as for `deferred`
 // Passes: "cull", "index", "shading".
 #include "lighting/stages/Stages.h"
 
@@ -42,8 +42,10 @@ constexpr uint16_t kOverflowed = 0xFFFF;
 
 class LightIndexedStage final : public ShadingStage {
 public:
-    LightIndexedStage(int maxLights, VolumeShape shape, bool stencil, bool frustumCull)
-        : mMaxLights(maxLights), mShape(shape), mStencil(stencil), mFrustumCull(frustumCull) {}
+    LightIndexedStage(int maxLights, VolumeShape shape, SpotProxy spotProxy, bool stencil,
+                      bool frustumCull)
+        : mMaxLights(maxLights), mShape(shape), mSpotProxy(spotProxy), mStencil(stencil),
+          mFrustumCull(frustumCull) {}
 
     std::string name() const override { return "light-indexed"; }
     StageRequirements requirements() const override {
@@ -61,7 +63,7 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
-        LightVolumeRasterizer volumes(gb, mShape, mStencil);
+        LightVolumeRasterizer volumes(gb, mShape, mStencil, mSpotProxy);
         const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mFrustumCull);  // ascending
         const size_t culled = spheres.size() - drawn.size();
         result.timingsMs.emplace_back("cull", millisecondsSince(start));
@@ -107,11 +109,14 @@ public:
         for (uint32_t n : overflowPerRow) overflowPixels += n;
         result.parameters["max"] = std::to_string(mMaxLights);
         result.parameters["volume"] = mShape == VolumeShape::Sphere ? "sphere" : "rect";
+        if (mShape == VolumeShape::Sphere)
+            result.parameters["spot"] = mSpotProxy == SpotProxy::Cone ? "cone" : "sphere";
         result.parameters["stencil"] = mStencil ? "1" : "0";
         result.parameters["vfc"] = mFrustumCull ? "1" : "0";
         result.parameters["lights_culled"] = std::to_string(culled);
         result.parameters["lights_drawn"] = std::to_string(volumes.stats().lightsDrawn);
         result.parameters["rect_fallbacks"] = std::to_string(volumes.stats().rectFallbacks);
+        result.parameters["cone_proxies"] = std::to_string(volumes.stats().coneProxies);
         result.parameters["volume_fragments"] = std::to_string(volumes.stats().fragments);
         result.parameters["overflow_pixels"] = std::to_string(overflowPixels);
     }
@@ -119,6 +124,7 @@ public:
 private:
     int mMaxLights;
     VolumeShape mShape;
+    SpotProxy mSpotProxy;
     bool mStencil;
     bool mFrustumCull;
     // Kept between frames so steady-state frames do not allocate.
@@ -129,10 +135,15 @@ private:
 }  // namespace
 
 std::unique_ptr<ShadingStage> makeLightIndexedStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"max", "volume", "stencil", "vfc"});
+    rejectUnknownOptions(spec, {"max", "volume", "spot", "stencil", "vfc"});
     const VolumeShape shape =
         choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere" ? VolumeShape::Sphere : VolumeShape::Rect;
-    return std::make_unique<LightIndexedStage>(intOption(spec, "max", 16, 1, 255), shape,
+    if (shape == VolumeShape::Rect && spec.options.count("spot"))
+        throw StageError("stage '" + spec.name + "': option spot applies to volume=sphere only");
+    const SpotProxy spotProxy = choiceOption(spec, "spot", {"cone", "sphere"}) == "cone"
+                                    ? SpotProxy::Cone
+                                    : SpotProxy::Sphere;
+    return std::make_unique<LightIndexedStage>(intOption(spec, "max", 16, 1, 255), shape, spotProxy,
                                                boolOption(spec, "stencil", false),
                                                boolOption(spec, "vfc", true));
 }

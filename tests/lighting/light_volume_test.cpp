@@ -1,12 +1,14 @@
 // Light volumes (`deferred`, `light-indexed`): option variants and hard cases against `brute`
-// (image within 1e-5 of peak, evaluated >= oracle at every pixel), the proxy's conservativeness,
-// thread-count independence, and that volumes actually cull.
+// (image within 1e-5 of peak, evaluated >= oracle at every pixel), the proxies' conservativeness
+// (sphere and spot cone), thread-count independence, and that volumes (and cones) actually cull.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 
 #include <tbb/task_arena.h>
@@ -82,6 +84,7 @@ const std::vector<std::string> kVariants = {
     "deferred",
     "deferred:volume=rect",
     "deferred:stencil=1",
+    "deferred:spot=sphere",
     "deferred:vfc=0",
     "deferred:volume=rect,vfc=0",
     "light-indexed",
@@ -234,9 +237,227 @@ TEST(LightVolumes, DeferredCullsOnAtrium) {
     }
 }
 
+// The cone proxy: closed, wound counter-clockwise outside, and every point of the lit region
+// (distance < range, angle < outer) is at least the margin inside every face plane; lights the
+// pyramid does not suit get none.
+TEST(LightVolumes, ConeProxyCircumscribesTheLitRegionAndIsClosed) {
+    const std::vector<uint32_t>& indices = lighting::coneProxyIndices();
+    ASSERT_EQ(indices.size(), size_t(2 * lighting::kConeProxySides - 2) * 3);
+    std::map<std::pair<uint32_t, uint32_t>, int> directedEdges;
+    for (size_t t = 0; t < indices.size(); t += 3)
+        for (int e = 0; e < 3; ++e)
+            ++directedEdges[{indices[t + e], indices[t + (e + 1) % 3]}];
+    for (const auto& [edge, count] : directedEdges) {
+        EXPECT_EQ(count, 1);
+        EXPECT_EQ(directedEdges.count({edge.second, edge.first}), 1u);
+    }
+    std::mt19937 random(3);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::normal_distribution<float> gaussian;
+    const float halfAnglesDegrees[] = {0.05f, 0.5f, 5.0f, 30.0f, 45.0f, 60.0f, 75.0f, 79.0f};
+    for (int s = 0; s < 64; ++s) {
+        lighting::LightSphere light;
+        light.spot = true;
+        light.positionView = {gaussian(random) * 10.0f, gaussian(random) * 10.0f,
+                              gaussian(random) * 10.0f};
+        light.axisView =
+            glm::normalize(glm::vec3(gaussian(random), gaussian(random), gaussian(random)));
+        const float halfAngle = glm::radians(halfAnglesDegrees[s % std::size(halfAnglesDegrees)]);
+        light.spotOuterCos = std::cos(halfAngle);
+        light.rangeMetres = 0.01f + 20.0f * unit(random);
+        const float margin = s % 2 ? 0.0f : 0.01f * light.rangeMetres;
+        const std::optional<lighting::ConeProxy> cone = lighting::coneProxy(light, margin);
+        ASSERT_TRUE(cone.has_value()) << "cone " << s;
+        const glm::dvec3 interior =
+            (glm::dvec3(cone->positionsView[0]) + glm::dvec3(cone->positionsView[1]) +
+             glm::dvec3(cone->positionsView[1 + lighting::kConeProxySides / 2])) /
+            3.0;
+        std::vector<glm::dvec4> planes;  // outward unit normal, offset
+        for (size_t t = 0; t < indices.size(); t += 3) {
+            const glm::dvec3 a(cone->positionsView[indices[t]]),
+                b(cone->positionsView[indices[t + 1]]), c(cone->positionsView[indices[t + 2]]);
+            const glm::dvec3 normal = glm::normalize(glm::cross(b - a, c - a));
+            ASSERT_GT(glm::dot(normal, a - interior), 0.0)
+                << "cone " << s << " face " << t / 3 << " inward";
+            planes.emplace_back(normal, glm::dot(normal, a));
+        }
+        // Lit points, biased to the rim, the tip and the cap where the proxy is tightest.
+        for (int p = 0; p < 4000; ++p) {
+            const glm::dvec3 axis = glm::normalize(glm::dvec3(light.axisView));
+            const glm::dvec3 side = glm::normalize(
+                glm::cross(axis, glm::dvec3(gaussian(random), gaussian(random), gaussian(random))));
+            const double angle = halfAngle * (p % 3 ? 0.99999 : double(unit(random)));
+            const double distance =
+                light.rangeMetres * (p % 5 ? 0.99999 : std::pow(double(unit(random)), 3.0));
+            const glm::dvec3 point = glm::dvec3(light.positionView) +
+                                     distance * (std::cos(angle) * axis + std::sin(angle) * side);
+            for (const glm::dvec4& plane : planes)
+                ASSERT_LE(glm::dot(glm::dvec3(plane), point), plane.w - margin * 0.999)
+                    << "cone " << s << ": lit point outside a face (half-angle "
+                    << glm::degrees(halfAngle) << ")";
+        }
+        // The pyramid is tight: its volume within 25% of the grown cone's for non-tiny cones.
+        if (halfAngle > glm::radians(1.0f) && margin == 0.0f && light.rangeMetres > 1.0f) {
+            const double r = light.rangeMetres, tanT = std::tan(double(halfAngle));
+            EXPECT_LT(cone->volume, 1.25 * 3.14159265 * r * r * r * tanT * tanT / 3.0)
+                << "cone " << s;
+        }
+    }
+    lighting::LightSphere wide;
+    wide.spot = true;
+    wide.rangeMetres = 1.0f;
+    wide.spotOuterCos = std::cos(glm::radians(80.5f));
+    EXPECT_FALSE(lighting::coneProxy(wide, 0.0f).has_value());
+    wide.spot = false;
+    wide.spotOuterCos = 0.9f;
+    EXPECT_FALSE(lighting::coneProxy(wide, 0.0f).has_value());
+}
+
+// Hard spot lights in view space: the camera inside a cone, apexes just in front of, on and just
+// behind the near plane, a spot pointing at the camera, narrow (0.5 to 5 degrees) and wide
+// (75 degrees) cones into the scene, and surfaces grazed by the cone's edge just inside and just
+// outside, or touched by the rim at the range.
+std::vector<scenes::Light> hardSpots(const TestFrame& f) {
+    std::vector<scenes::Light> lights = f.scene.lights;
+    auto spot = [&](glm::vec3 positionView, glm::vec3 axisView, float range, float outerDegrees) {
+        scenes::Light light;
+        light.type = scenes::LightType::Spot;
+        light.positionWorld = f.worldFromView(positionView);
+        light.directionWorld = f.worldDirectionFromView(glm::normalize(axisView));
+        light.rangeMetres = range;
+        light.spotOuterCos = std::cos(glm::radians(outerDegrees));
+        light.spotInnerCos = std::cos(glm::radians(0.7f * outerDegrees));
+        light.intensity = 2.0f;
+        lights.push_back(light);
+    };
+    const float nearZ = -f.view.nearMetres;
+    // Camera inside: apex behind the eye (30 degrees), and a wide cone (75) around the eye.
+    spot({0.0f, 0.0f, 2.0f}, {0.0f, 0.0f, -1.0f}, 40.0f, 30.0f);
+    spot({0.2f, -0.1f, 0.5f}, {0.1f, 0.0f, -1.0f}, 25.0f, 75.0f);
+    // Apex just in front of the near plane (forward and aside), just behind it, and on it.
+    spot({0.1f, 0.05f, nearZ - 1e-3f}, {0.0f, 0.0f, -1.0f}, 30.0f, 40.0f);
+    spot({0.3f, 0.0f, nearZ - 1e-3f}, {1.0f, 0.0f, -0.2f}, 20.0f, 20.0f);
+    spot({-0.1f, 0.0f, nearZ + 1e-3f}, {0.1f, -0.2f, -1.0f}, 30.0f, 20.0f);
+    spot({0.0f, 0.1f, nearZ}, {-0.2f, -0.1f, -1.0f}, 30.0f, 10.0f);
+    // Pointing at the camera: reaching past it, and stopping just short of the near plane.
+    spot({0.0f, 0.0f, -8.0f}, {0.0f, 0.0f, 1.0f}, 12.0f, 20.0f);
+    spot({0.5f, 0.0f, -3.0f}, {-0.1f, 0.0f, 1.0f}, 3.0f + nearZ - 1e-3f, 45.0f);
+    // Narrow (5 and 0.5 degrees) and wide (75) cones into the scene, one past the far plane.
+    spot({0.0f, 1.0f, -2.0f}, {0.0f, -0.3f, -1.0f}, 60.0f, 5.0f);
+    spot({-1.0f, 0.5f, -2.0f}, {0.1f, -0.2f, -1.0f}, 60.0f, 0.5f);
+    spot({1.0f, 1.5f, -4.0f}, {-0.1f, -0.5f, -1.0f}, 40.0f, 75.0f);
+    spot({0.0f, 0.0f, -20.0f}, {0.0f, 0.0f, -1.0f}, 2.0f * f.view.farMetres, 15.0f);
+    int placed = 0;
+    const float angles[] = {5.0f, 30.0f, 55.0f, 75.0f, 45.0f};
+    for (int y = 9; y < kHeight; y += 19)
+        for (int x = 11; x < kWidth; x += 27) {
+            const size_t pixel = size_t(y) * kWidth + x;
+            if (!f.gbuffer->covered(pixel))
+                continue;
+            const gbuffer::Surface s = f.gbuffer->decode(x, y);
+            const float range = 0.05f * glm::length(s.positionView) + 0.2f;
+            const glm::vec3 n = s.normalView;
+            const glm::vec3 t = glm::normalize(glm::cross(n, glm::vec3(0.3f, 1.0f, 0.2f)));
+            const float theta = glm::radians(angles[placed % std::size(angles)]);
+            const int kind = placed++ % 4;
+            if (kind < 3) {
+                // Grazing: the cone's lower edge runs along the surface, dipping into it by
+                // 0.01 rad (kind 0), parallel (1), or rising away (2), from just above it.
+                const float dip = 0.01f * float(kind - 1);
+                const glm::vec3 axis = std::cos(theta + dip) * t + std::sin(theta + dip) * n;
+                spot(s.positionView - t * (0.5f * range) + n * (0.002f * range), axis, range,
+                     glm::degrees(theta));
+            } else {
+                // The rim: the surface point at 0.999 of the range and of the half-angle.
+                const float angle = 0.999f * theta;
+                spot(s.positionView + n * (0.999f * range),
+                     -n * std::cos(angle) + t * std::sin(angle), range, glm::degrees(theta));
+            }
+        }
+    return lights;
+}
+
+const std::vector<std::string> kSpotVariants = {
+    "deferred",
+    "deferred:stencil=1",
+    "deferred:spot=sphere",
+    "deferred:stencil=1,vfc=0",
+    "light-indexed",
+    "light-indexed:stencil=1,max=4",
+};
+
+TEST(LightVolumes, HardSpotsMatchBrute) {
+    for (const gbuffer::DepthConvention depth :
+         {gbuffer::DepthConvention::Reversed, gbuffer::DepthConvention::Standard})
+        for (const char* sceneName : {"atrium", "spheres", "wall"}) {
+            TestFrame f(proceduralScene(sceneName, 20), depth);
+            f.setLights(hardSpots(f));
+            const std::string where =
+                std::string("hard spots ") + sceneName +
+                (depth == gbuffer::DepthConvention::Standard ? " standard" : " reversed");
+            for (const std::string& stage : kSpotVariants)
+                expectMatchesBrute(f, stage, where);
+            // The cone path is the one under test.
+            lighting::StageResult result;
+            lighting::makeStage("deferred:stencil=1")->shade(f.frame, result);
+            EXPECT_GT(std::stoull(result.parameters.at("cone_proxies")), 20u) << where;
+        }
+}
+
+// Narrow spots on atrium: the cone proxy evaluates markedly fewer lights than the sphere proxy,
+// and the images agree (both are checked against brute above).
+TEST(LightVolumes, ConeProxiesCullMoreThanSpheresForNarrowSpots) {
+    scenes::Scene scene = proceduralScene("atrium", 300);
+    int index = 0;
+    for (scenes::Light& light : scene.lights) {
+        if (light.type != scenes::LightType::Point)
+            continue;
+        const float a = 2.399963f * float(index);
+        light.type = scenes::LightType::Spot;
+        light.directionWorld = glm::normalize(glm::vec3(std::cos(a), -0.5f, std::sin(a)));
+        const float outer = glm::radians(5.0f + 25.0f * float(index % 6) / 5.0f);  // 5..30 degrees
+        light.spotOuterCos = std::cos(outer);
+        light.spotInnerCos = std::cos(0.8f * outer);
+        light.rangeMetres *= 2.0f;
+        ++index;
+    }
+    const TestFrame f(std::move(scene));
+    for (const char* stencil : {"0", "1"}) {
+        uint64_t evaluated[2] = {0, 0};
+        const char* proxies[2] = {"cone", "sphere"};
+        for (int k = 0; k < 2; ++k) {
+            lighting::StageResult result;
+            lighting::makeStage(std::string("deferred:stencil=") + stencil + ",spot=" + proxies[k])
+                ->shade(f.frame, result);
+            EXPECT_EQ(result.parameters.at("spot"), proxies[k]);
+            for (uint32_t n : result.lightsEvaluated)
+                evaluated[k] += n;
+            if (k == 0)
+                EXPECT_GT(std::stoull(result.parameters.at("cone_proxies")), 200u);
+            else
+                EXPECT_EQ(result.parameters.at("cone_proxies"), "0");
+        }
+        uint64_t oracle = 0;
+        for (uint32_t n : f.oracle)
+            oracle += n;
+        std::printf("narrow spots, stencil=%s: evaluated cone %llu, sphere %llu, oracle %llu\n",
+                    stencil, (unsigned long long)evaluated[0], (unsigned long long)evaluated[1],
+                    (unsigned long long)oracle);
+        EXPECT_LT(double(evaluated[0]), 0.7 * double(evaluated[1])) << "stencil=" << stencil;
+    }
+}
+
+TEST(LightVolumes, SpotOptionIsForSphereVolumesOnly) {
+    EXPECT_THROW(lighting::makeStage("deferred:volume=rect,spot=cone"), lighting::StageError);
+    EXPECT_THROW(lighting::makeStage("deferred:spot=pyramid"), lighting::StageError);
+    EXPECT_THROW(lighting::makeStage("light-indexed:volume=rect,spot=sphere"),
+                 lighting::StageError);
+}
+
 TEST(LightVolumes, FrustumCullingAndScreenRectAreConservative) {
     const TestFrame f(proceduralScene("atrium", 8));
-    lighting::LightVolumeRasterizer volumes(*f.gbuffer, lighting::VolumeShape::Rect, false);
+    lighting::LightVolumeRasterizer volumes(*f.gbuffer, lighting::VolumeShape::Rect, false,
+                                            lighting::SpotProxy::Cone);
     std::mt19937 random(5);
     std::uniform_real_distribution<float> coordinate(-30.0f, 30.0f), radius(0.01f, 10.0f);
     int visibleCount = 0;

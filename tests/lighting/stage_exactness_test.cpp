@@ -155,6 +155,26 @@ TEST(SpotBounds, ConeBoundsCullMoreThanRangeSpheres) {
     EXPECT_LT(double(cones), 0.8 * double(rangeSpheres)) << cones << " vs " << rangeSpheres;
 }
 
+// `deferred`'s cone proxies (the default, spot=cone) must cut work against its sphere proxies on
+// the same spots, and neither may drop a light (the image is checked for the default above).
+TEST(SpotBounds, DeferredConeProxiesEvaluateFewerLightsThanSpheres) {
+    const PreparedCase& spots = prepared(kScenes[3]);
+    uint64_t evaluated[2] = {0, 0};
+    const char* stages[2] = {"deferred:spot=cone", "deferred:spot=sphere"};
+    for (int k = 0; k < 2; ++k) {
+        lighting::StageResult result;
+        lighting::makeStage(stages[k])->shade(spots.prepared->frame, result);
+        int dropped = 0;
+        for (size_t pixel = 0; pixel < result.lightsEvaluated.size(); ++pixel) {
+            evaluated[k] += result.lightsEvaluated[pixel];
+            dropped += result.lightsEvaluated[pixel] < spots.oracle[pixel];
+        }
+        EXPECT_EQ(dropped, 0) << stages[k];
+    }
+    EXPECT_LT(double(evaluated[0]), 0.95 * double(evaluated[1]))
+        << evaluated[0] << " vs " << evaluated[1];
+}
+
 TEST(StageRegistry, EveryStageRejectsUnknownOptions) {
     for (const lighting::StageInfo& info : lighting::stageInfos())
         EXPECT_THROW(lighting::makeStage(info.name + ":no_such_option=1"), lighting::StageError) << info.name;
