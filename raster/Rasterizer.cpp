@@ -33,6 +33,17 @@ float planeDistance(int plane, const glm::vec4& c, float guardX, float guardY) {
     }
 }
 
+// Which frustum planes (x, y within +-w, 0 <= z <= w) a clip position is outside of, one bit
+// each; no pixel centre can be covered when all three vertices share a bit.
+uint8_t frustumOutcode(const glm::vec4& c) {
+    return uint8_t((c.x > c.w) | (c.x < -c.w) << 1 | (c.y > c.w) << 2 | (c.y < -c.w) << 3 |
+                   (c.z < 0.0f) << 4 | (c.z > c.w) << 5);
+}
+
+bool isFinite(const glm::vec4& c) {
+    return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w);
+}
+
 // Sutherland-Hodgman against one plane. A triangle clipped by 6 planes has at most 9 vertices.
 constexpr int kMaxPolygon = 3 + kClipPlaneCount;
 
@@ -102,12 +113,12 @@ void setUpAttributePlanes(SetupTriangle& s, double x[3], double y[3], const doub
 Rasterizer::ProjectedVertex Rasterizer::project(const glm::vec4& clip) const {
     // After clipping, w = 0 is only possible at the clip-space origin (the eye of a zero-near
     // projection): a piece touching it is seen edge-on and covers nothing (invW = 0 marks it).
-    if (!(clip.w > 0.0f)) return {0, 0, 0.0f};
+    if (!(clip.w > 0.0f)) return {0, 0, 0.0f, 0};
     const float invW = 1.0f / clip.w;
     const float screenX = (clip.x * invW + 1.0f) * (0.5f * float(mWidth));
     const float screenY = (1.0f - clip.y * invW) * (0.5f * float(mHeight));
     return {int32_t(std::lrint(screenX * float(kSubpixelScale))),
-            int32_t(std::lrint(screenY * float(kSubpixelScale))), invW};
+            int32_t(std::lrint(screenY * float(kSubpixelScale))), invW, 0};
 }
 
 Rasterizer::Rasterizer(int width, int height) : mWidth(width), mHeight(height) {
@@ -131,7 +142,9 @@ void Rasterizer::setUpAndBin(const TriangleList& triangles, CullMode cullMode) {
             const glm::vec4& c = triangles.clipPositions[v];
             const bool insideGuardBand = std::abs(c.x) <= kGuardBandPixels / (0.5f * float(mWidth)) * c.w &&
                                          std::abs(c.y) <= kGuardBandPixels / (0.5f * float(mHeight)) * c.w;
-            mProjected[v] = insideGuardBand ? project(c) : ProjectedVertex{0, 0, 0.0f};
+            ProjectedVertex projected = insideGuardBand ? project(c) : ProjectedVertex{0, 0, 0.0f, 0};
+            projected.outcode = isFinite(c) ? frustumOutcode(c) : kNonFinite;
+            mProjected[v] = projected;
         }
     });
     mBatches.resize(batchCount);
@@ -163,49 +176,39 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
     const float guardY = kGuardBandPixels / (0.5f * float(mHeight));
 
     for (uint32_t t = first; t < last; ++t) {
-        glm::vec4 clip[3];
         uint32_t index[3];
+        ProjectedVertex projected[3];
         for (int i = 0; i < 3; ++i) {
             index[i] = triangles.indices[size_t(t) * 3 + i];
-            clip[i] = triangles.clipPositions[index[i]];
+            projected[i] = mProjected[index[i]];
         }
-        // Trivial reject against the view frustum (x, y within +-w, 0 <= z <= w): no pixel
-        // centre of the viewport can be covered when all three vertices are outside one plane.
-        auto outcode = [](const glm::vec4& c) {
-            return (c.x > c.w) | (c.x < -c.w) << 1 | (c.y > c.w) << 2 | (c.y < -c.w) << 3 |
-                   (c.z < 0.0f) << 4 | (c.z > c.w) << 5;
-        };
         // Non-finite input has no meaningful coverage; reject it rather than draw garbage.
-        auto finite = [](const glm::vec4& c) {
-            return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w);
-        };
-        if (!finite(clip[0]) || !finite(clip[1]) || !finite(clip[2])) {
+        // Trivial reject against the view frustum: all three vertices outside one plane.
+        const uint8_t code0 = projected[0].outcode, code1 = projected[1].outcode,
+                      code2 = projected[2].outcode;
+        if (((code0 | code1 | code2) & kNonFinite) || (code0 & code1 & code2)) {
             ++batch.stats.trianglesCulled;
             continue;
         }
-        const int code0 = outcode(clip[0]), code1 = outcode(clip[1]), code2 = outcode(clip[2]);
-        if (code0 & code1 & code2) {
-            ++batch.stats.trianglesCulled;
-            continue;
-        }
+        const glm::vec4* const clipOfVertex[3] = {&triangles.clipPositions[index[0]],
+                                                  &triangles.clipPositions[index[1]],
+                                                  &triangles.clipPositions[index[2]]};
         // The clip volume contains the frustum: only a vertex outside the frustum can need
         // clipping, so the common case (all inside) skips the plane tests.
         bool needsClip = false;
         if (code0 | code1 | code2)
             for (int plane = 0; plane < kClipPlaneCount && !needsClip; ++plane)
                 for (int i = 0; i < 3; ++i)
-                    if (planeDistance(plane, clip[i], guardX, guardY) < 0.0f) needsClip = true;
+                    if (planeDistance(plane, *clipOfVertex[i], guardX, guardY) < 0.0f) needsClip = true;
 
         if (!needsClip) {
-            const ProjectedVertex projected[3] = {mProjected[index[0]], mProjected[index[1]],
-                                                  mProjected[index[2]]};
-            emitTriangle(clip, projected, nullptr, t, cullMode, batch);
+            emitTriangle(clipOfVertex, projected, nullptr, t, cullMode, batch);
             continue;
         }
         ++batch.stats.trianglesClipped;
         ClipVertex polygon[2][kMaxPolygon];
         int count = 3;
-        for (int i = 0; i < 3; ++i) polygon[0][i] = {clip[i], glm::vec3(i == 0, i == 1, i == 2)};
+        for (int i = 0; i < 3; ++i) polygon[0][i] = {*clipOfVertex[i], glm::vec3(i == 0, i == 1, i == 2)};
         int current = 0;
         for (int plane = 0; plane < kClipPlaneCount && count >= 3; ++plane) {
             count = clipPolygon(polygon[current], count, polygon[1 - current], plane, guardX, guardY);
@@ -216,10 +219,10 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
             const ClipVertex& a = polygon[current][0];
             const ClipVertex& b = polygon[current][i];
             const ClipVertex& c = polygon[current][i + 1];
-            const glm::vec4 pieceClip[3] = {a.clip, b.clip, c.clip};
+            const glm::vec4* const pieceClip[3] = {&a.clip, &b.clip, &c.clip};
             const glm::vec3 pieceBarycentric[3] = {a.barycentric, b.barycentric, c.barycentric};
-            const ProjectedVertex projected[3] = {project(a.clip), project(b.clip), project(c.clip)};
-            emitTriangle(pieceClip, projected, pieceBarycentric, t, cullMode, batch);
+            const ProjectedVertex pieceProjected[3] = {project(a.clip), project(b.clip), project(c.clip)};
+            emitTriangle(pieceClip, pieceProjected, pieceBarycentric, t, cullMode, batch);
         }
     }
     // Counting sort of the (tile, triangle) pairs; stable, so each bin keeps submission order.
@@ -237,7 +240,7 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
     batch.binOffsets[0] = 0;
 }
 
-void Rasterizer::emitTriangle(const glm::vec4 clip[3], const ProjectedVertex projected[3],
+void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVertex projected[3],
                               const glm::vec3 barycentric[3], uint32_t triangle, CullMode cullMode,
                               Batch& batch) const {
     SetupTriangle s;
@@ -300,7 +303,7 @@ void Rasterizer::emitTriangle(const glm::vec4 clip[3], const ProjectedVertex pro
     // triangles are back faces, and these divisions showed in profiles).
     double screenXs[3], screenYs[3], depth[3];
     for (int i = 0; i < 3; ++i) {
-        const glm::vec4& c = clip[order[i]];
+        const glm::vec4& c = *clip[order[i]];
         screenXs[i] = (double(c.x) / c.w + 1.0) * (0.5 * mWidth);
         screenYs[i] = (1.0 - double(c.y) / c.w) * (0.5 * mHeight);
         depth[i] = double(c.z) / c.w;

@@ -165,13 +165,19 @@ private:
     void setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last, CullMode cullMode,
                     Batch& batch) const;
     // A vertex snapped to fixed point; invW == 0 marks one that must not be set up (w <= 0).
+    // `outcode` (computed once per vertex, read by each of its ~6 triangles) has one bit per
+    // frustum plane the clip position lies outside of, and kNonFinite for NaN/Inf input.
     struct ProjectedVertex {
         int32_t x, y;
         float invW;
+        uint8_t outcode;
     };
+    static constexpr uint8_t kNonFinite = 1u << 6;
     ProjectedVertex project(const glm::vec4& clip) const;
     // `barycentric` (weights of the original vertices) is null for an unclipped triangle.
-    void emitTriangle(const glm::vec4 clip[3], const ProjectedVertex projected[3],
+    // `clip` points at the three clip positions; they are read only for triangles that survive
+    // culling (most culled ones are back faces, decided from `projected` alone).
+    void emitTriangle(const glm::vec4* const clip[3], const ProjectedVertex projected[3],
                       const glm::vec3 barycentric[3], uint32_t triangle, CullMode cullMode,
                       Batch& batch) const;
 

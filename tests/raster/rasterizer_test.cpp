@@ -1651,6 +1651,33 @@ TEST(RasterCulling, WindingDecidesFacingAndCulling) {
     }
 }
 
+TEST(RasterCulling, NonFiniteVerticesCullTheirTrianglesOnly) {
+    // A NaN or infinite coordinate in any component makes its triangles cover nothing (they are
+    // counted as culled); a valid triangle sharing nothing with them still draws. Set-up reads
+    // a per-vertex flag for this, so every component and every vertex slot is tried.
+    const int width = 64, height = 48;
+    const float bad[] = {std::numeric_limits<float>::quiet_NaN(),
+                         std::numeric_limits<float>::infinity(),
+                         -std::numeric_limits<float>::infinity()};
+    for (float value : bad)
+        for (int component = 0; component < 4; ++component)
+            for (int slot = 0; slot < 3; ++slot) {
+                ClipMesh mesh;
+                mesh.positions = {{-0.9f, -0.9f, 0.5f, 1}, {0.9f, -0.9f, 0.5f, 1},
+                                  {0.0f, 0.9f, 0.5f, 1},   {-0.5f, -0.5f, 0.5f, 1},
+                                  {0.5f, -0.5f, 0.5f, 1},  {0.0f, 0.5f, 0.5f, 1}};
+                mesh.positions[size_t(3 + slot)][component] = value;
+                mesh.indices = {3, 4, 5, 0, 1, 2};
+                std::atomic<uint64_t> fromBad{0}, fromGood{0};
+                Rasterizer rasterizer(width, height);
+                rasterizer.draw(mesh.list(), {CullMode::None, DepthTest::Always, false}, nullptr,
+                                [&](const Fragment& f) { ++(f.triangle == 0 ? fromBad : fromGood); });
+                EXPECT_EQ(fromBad.load(), 0u) << value << " in component " << component;
+                EXPECT_GT(fromGood.load(), 0u);
+                EXPECT_EQ(rasterizer.lastStats().trianglesCulled, 1u);
+            }
+}
+
 TEST(RasterCulling, RandomTrianglesFacingMatchesSignedNdcArea) {
     // Random triangles with random positive w: facing is the sign of the NDC area (y up), which
     // the test computes from the projected float inputs in double.
