@@ -1,4 +1,5 @@
 #include "experiments/DepthStudy.h"
+#include "experiments/BuildCommit.h"
 
 #include <algorithm>
 #include <bit>
@@ -19,9 +20,6 @@
 #include "experiments/PlotScript.h"
 #include "scenes/Scene.h"
 
-#ifndef TESTBED_COMMIT
-#define TESTBED_COMMIT "unknown"
-#endif
 #ifndef TESTBED_SOURCE_DIR
 #define TESTBED_SOURCE_DIR "."
 #endif
@@ -306,7 +304,7 @@ nlohmann::json depthStudyJson(const DepthStudyResult& result) {
     const DepthStudyOptions& o = result.options;
     nlohmann::json json;
     json["command"] = "depth";
-    json["commit"] = TESTBED_COMMIT;
+    json["commit"] = kBuildCommit;
     json["hardware_threads"] = std::thread::hardware_concurrency();
     json["study_seconds"] = result.studySeconds;
     nlohmann::json& options = json["options"];

@@ -2,6 +2,7 @@
 // the definitions. Parallel work is always "fixed chunks, per-chunk results, merged in chunk
 // order" (no atomics, no order-dependent float sums), so results do not depend on threads.
 #include "experiments/NormalStudy.h"
+#include "experiments/BuildCommit.h"
 
 #include <algorithm>
 #include <chrono>
@@ -31,9 +32,6 @@
 #include "scenes/ProceduralScenes.h"
 #include "scenes/SceneLoader.h"
 
-#ifndef TESTBED_COMMIT
-#define TESTBED_COMMIT "unknown"
-#endif
 #ifndef TESTBED_SOURCE_DIR
 #define TESTBED_SOURCE_DIR "."
 #endif
@@ -824,7 +822,7 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
 
     nlohmann::json& json = result.json;
     json["study"] = "normals";
-    json["commit"] = TESTBED_COMMIT;
+    json["commit"] = kBuildCommit;
     json["hardware_threads"] = std::thread::hardware_concurrency();
     json["config"] = {
         {"directions", directions},

@@ -1,4 +1,5 @@
 #include "experiments/RenderCommand.h"
+#include "experiments/BuildCommit.h"
 
 #include <algorithm>
 #include <array>
@@ -20,9 +21,6 @@
 #include "lighting/StageRegistry.h"
 #include "scenes/Scene.h"
 
-#ifndef TESTBED_COMMIT
-#define TESTBED_COMMIT "unknown"
-#endif
 
 namespace experiments {
 
@@ -138,7 +136,7 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir, 
         {"testbed:scene", run.options.scene},
         {"testbed:stage", run.options.stage},
         {"testbed:layout", gb.layout().name},
-        {"testbed:commit", TESTBED_COMMIT},
+        {"testbed:commit", kBuildCommit},
         {"testbed:stats", stats.dump()},
         {"testbed:Z", "view-space depth in metres decoded from the G-buffer, 0 = background"},
         {"testbed:error", "error.R,G,B = |R,G,B - reference| (double-precision reference)"},
@@ -162,7 +160,7 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["height"] = run.options.height;
     stats["threads"] = run.threads;
     stats["hardware_threads"] = std::thread::hardware_concurrency();
-    stats["commit"] = TESTBED_COMMIT;
+    stats["commit"] = kBuildCommit;
     stats["triangles"] = run.scene().triangleCount();
     stats["lights"] = run.scene().lights.size();
     stats["generated_lights"] = run.options.lights;
