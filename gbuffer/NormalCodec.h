@@ -18,10 +18,11 @@
 //   zero vector encodes kFallbackNormalView (+Z). Non-unit lengths (huge, subnormal, 1+-1e-3) are
 //   normalised in double first. decode accepts ANY code (also codes no encoder writes) and returns
 //   a finite unit vector (to float rounding, |n| = 1 +- 1e-6), never NaN/Inf.
-// - All functions are pure, allocation-free (except the name/registry helpers and parse) and
-//   thread-safe. Encode/decode cost tens of nanoseconds; `best-fit` encode searches 128
-//   candidates (several times a plain encode, sub-microsecond) and `octahedral-precise` decodes
-//   up to 4 candidates.
+// - All functions are pure, allocation-free (except the name/registry helpers, parse and
+//   best-fit's one-time table) and thread-safe. Encode/decode cost tens of nanoseconds;
+//   `best-fit` encode looks up a 512 KiB table of best lengths, built once by the first best-fit
+//   encode (TBB-parallel; that call blocks ~0.5 s, concurrent first callers wait for the same
+//   build), and `octahedral-precise` decodes up to 4 candidates.
 // - `pixel-view` (the thesis' "per-pixel view space", Ishmukhametov 2013, section "Compact normal
 //   storage") expresses the normal in a frame built from the pixel's view ray r: z =
 //   -normalize(r), x = normalize(z.z, 0, -z.x), y = cross(z, x) (at the image centre this is the
@@ -100,6 +101,12 @@ NormalCode encodeNormal(const NormalCodecSpec& spec, glm::vec3 unitNormalView,
 // ray given to encodeNormal (only `pixel-view` reads it).
 glm::vec3 decodeNormal(const NormalCodecSpec& spec, NormalCode code,
                        glm::vec3 viewRayView = kCentralViewRay);
+
+// The oracle for `best-fit:24`'s table encoder (tests and studies only): the exact per-direction
+// search over all 127 major-axis lengths plus naive rounding, a superset of the table encoder's
+// two candidates, so never farther from the input (in double). Same robustness contract and code
+// layout as encodeNormal({BestFit, 24}, ...); costs 128 candidates, ~7x the table encoder.
+NormalCode encodeBestFitBySearch(glm::vec3 unitNormalView);
 
 // Angle between two directions in radians, computed in double as atan2(|a x b|, a . b), which
 // stays accurate for tiny angles (acos of a dot product loses ~1e-4 rad near 0). Lengths do not
