@@ -16,14 +16,22 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
 // Perspective-correct barycentrics of the pixel centre at `ndc` in the triangle with clip-space
 // vertices c0, c1, c2. The point sum(b_i c_i) projects onto ndc when
 // sum b_i (x_i - ndc.x w_i) = 0 and sum b_i (y_i - ndc.y w_i) = 0, so b is the cross product of
-// those two rows, normalised to sum 1. Homogeneous: valid for triangles crossing the near plane.
-glm::vec3 perspectiveBarycentrics(const glm::vec4& c0, const glm::vec4& c1, const glm::vec4& c2,
-                                  glm::vec2 ndc) {
+// those two rows, up to scale (the barycentrics are b / sum b). Homogeneous: valid for triangles
+// crossing the near plane.
+// Returned unnormalised (b, not b / sum): the normal is renormalised anyway, so only the sign of
+// the scale matters there, and the division stays off the per-pixel critical path unless a
+// texture needs the true weights. sum = 0 (pixel ray parallel to the plane) gives equal weights.
+struct UnnormalisedWeights {
+    glm::vec3 b;
+    float sum;
+};
+UnnormalisedWeights perspectiveBarycentrics(const glm::vec4& c0, const glm::vec4& c1,
+                                            const glm::vec4& c2, glm::vec2 ndc) {
     const glm::vec3 rowX(c0.x - ndc.x * c0.w, c1.x - ndc.x * c1.w, c2.x - ndc.x * c2.w);
     const glm::vec3 rowY(c0.y - ndc.y * c0.w, c1.y - ndc.y * c1.w, c2.y - ndc.y * c2.w);
     const glm::vec3 b = glm::cross(rowX, rowY);
     const float sum = b.x + b.y + b.z;
-    return sum != 0.0f ? b * (1.0f / sum) : glm::vec3(1.0f / 3.0f);
+    return sum != 0.0f ? UnnormalisedWeights{b, sum} : UnnormalisedWeights{glm::vec3(1.0f), 3.0f};
 }
 
 }  // namespace
@@ -34,18 +42,21 @@ Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& sc
                           glm::vec2 ndc) {
     const uint32_t* corners = geometry.indices.data() + 3 * size_t(triangle);
     const uint32_t i0 = corners[0], i1 = corners[1], i2 = corners[2];
-    const glm::vec3 weights =
+    const UnnormalisedWeights weights =
         perspectiveBarycentrics(clipPositions[i0], clipPositions[i1], clipPositions[i2], ndc);
     Surface surface;
-    glm::vec3 normal = raster::interpolate(normalsView[i0], normalsView[i1], normalsView[i2], weights);
+    glm::vec3 normal = raster::interpolate(normalsView[i0], normalsView[i1], normalsView[i2], weights.b);
     const float length2 = glm::dot(normal, normal);
-    normal = length2 > 0.0f ? normal * (1.0f / std::sqrt(length2)) : glm::vec3(0.0f, 0.0f, 1.0f);
-    surface.normalView = backFace ? -normal : normal;  // two-sided draws light the visible side
+    // Two-sided draws light the visible side; a negative weight sum flips the interpolated sum.
+    const float sign = (weights.sum < 0.0f) != backFace ? -1.0f : 1.0f;
+    surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2))
+                                        : glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
     surface.material = geometry.triangleMaterial[triangle];
     const scenes::Material& material = scene.materials[surface.material];
     glm::vec3 albedo(material.baseColorFactor);
     if (material.baseColorTexture >= 0) {
-        const glm::vec2 uv = raster::interpolate(geometry.uv[i0], geometry.uv[i1], geometry.uv[i2], weights);
+        const glm::vec2 uv = raster::interpolate(geometry.uv[i0], geometry.uv[i1], geometry.uv[i2],
+                                                 weights.b * (1.0f / weights.sum));
         albedo *= glm::vec3(scene.textures[size_t(material.baseColorTexture)].sample(uv));
     }
     surface.albedo = albedo;

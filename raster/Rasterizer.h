@@ -181,7 +181,9 @@ private:
                       const glm::vec3 barycentric[3], uint32_t triangle, CullMode cullMode,
                       Batch& batch) const;
 
-    template <class FragmentFn>
+    // The depth test is a template parameter so that the per-sample comparison is one
+    // instruction, not a switch (draw() dispatches once per tile).
+    template <DepthTest kDepthTest, class FragmentFn>
     void rasterizeTile(int tileIndex, const RasterState& state, float* depth,
                        FragmentFn& fragmentFn, RasterStats& tileStats) const;
 
@@ -202,7 +204,8 @@ private:
 // Template implementation: the per-tile traversal is inlined with the fragment function.
 
 namespace detail {
-inline bool depthPasses(DepthTest test, float fragmentDepth, float storedDepth) {
+template <DepthTest test>
+inline bool depthPasses(float fragmentDepth, float storedDepth) {
     switch (test) {
     case DepthTest::Always: return true;
     case DepthTest::Less: return fragmentDepth < storedDepth;
@@ -230,7 +233,22 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
     const int tileCount = mTilesX * mTilesY;
     mTileStats.assign(size_t(tileCount), TileStats{});
     tbb::parallel_for(0, tileCount, [&](int tile) {
-        rasterizeTile(tile, state, depth, fragmentFn, mTileStats[size_t(tile)].stats);
+        RasterStats& stats = mTileStats[size_t(tile)].stats;
+        switch (state.depthTest) {
+        case DepthTest::Always:
+            rasterizeTile<DepthTest::Always>(tile, state, depth, fragmentFn, stats);
+            break;
+        case DepthTest::Less: rasterizeTile<DepthTest::Less>(tile, state, depth, fragmentFn, stats); break;
+        case DepthTest::LessEqual:
+            rasterizeTile<DepthTest::LessEqual>(tile, state, depth, fragmentFn, stats);
+            break;
+        case DepthTest::Greater:
+            rasterizeTile<DepthTest::Greater>(tile, state, depth, fragmentFn, stats);
+            break;
+        case DepthTest::GreaterEqual:
+            rasterizeTile<DepthTest::GreaterEqual>(tile, state, depth, fragmentFn, stats);
+            break;
+        }
     });
     // Sum in a fixed order so the statistics are as deterministic as the pixels.
     for (const TileStats& tile : mTileStats) {
@@ -239,7 +257,7 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
     }
 }
 
-template <class FragmentFn>
+template <DepthTest kDepthTest, class FragmentFn>
 void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* depth,
                                FragmentFn& fragmentFn, RasterStats& tileStats) const {
     const int tileMinX = (tileIndex % mTilesX) * kTileSize;
@@ -279,15 +297,25 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
             int64_t row1 = edge(x[2], y[2], x[0], y[0], px0, py0);
             int64_t row2 = edge(x[0], y[0], x[1], y[1], px0, py0);
 
+            const AttributePlanes& p = t.planes;
             for (int py = minY; py <= maxY; ++py) {
                 int64_t w0 = row0, w1 = row1, w2 = row2;
                 float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;
-                for (int px = minX; px <= maxX; ++px) {
-                    if (((w0 + bias0) | (w1 + bias1) | (w2 + bias2)) >= 0) {
+                // Depth plane at (px, py) = (z0 + z2 py) + z1 px; px counts in double (exact).
+                const double zRow = p.z[0] + p.z[2] * py;
+                double pxDouble = minX;
+                // A triangle's samples in one row are contiguous (the intersection of three
+                // half-planes is convex, biases included), so the row ends at its first
+                // uncovered sample after a covered one.
+                bool spanStarted = false;
+                for (int px = minX; px <= maxX; ++px, pxDouble += 1.0) {
+                    if (((w0 + bias0) | (w1 + bias1) | (w2 + bias2)) < 0) {
+                        if (spanStarted) break;
+                    } else {
+                        spanStarted = true;
                         ++samplesCovered;
-                        const AttributePlanes& p = t.planes;
-                        const float z = float(std::clamp(p.z[0] + p.z[1] * px + p.z[2] * py, 0.0, 1.0));
-                        bool pass = !depthRow || detail::depthPasses(state.depthTest, z, depthRow[px]);
+                        const float z = float(std::clamp(zRow + p.z[1] * pxDouble, 0.0, 1.0));
+                        bool pass = !depthRow || detail::depthPasses<kDepthTest>(z, depthRow[px]);
                         if (pass) {
                             ++samplesPassed;
                             if (depthRow && state.depthWrite) depthRow[px] = z;
