@@ -36,33 +36,71 @@ UnnormalisedWeights perspectiveBarycentrics(const glm::vec4& c0, const glm::vec4
 
 }  // namespace
 
-Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& scene,
-                          std::span<const glm::vec4> clipPositions,
-                          std::span<const glm::vec3> normalsView, uint32_t triangle, bool backFace,
-                          glm::vec2 ndc) {
-    const uint32_t* corners = geometry.indices.data() + 3 * size_t(triangle);
-    const uint32_t i0 = corners[0], i1 = corners[1], i2 = corners[2];
+namespace {
+
+// What surfaceOfTriangle reads per triangle, loaded once: resolve() reuses it while consecutive
+// pixels show the same triangle (about 2.5 pixels in a row on atrium), which takes the dependent
+// index -> vertex loads off most pixels. uv is loaded only for textured materials.
+struct TriangleCorners {
+    glm::vec4 clip[3];
+    glm::vec3 normalView[3];
+    glm::vec2 uv[3];
+    uint32_t materialIndex;
+    const scenes::Material* material;
+    const scenes::Texture* baseColorTexture;  // null when untextured
+};
+
+TriangleCorners loadTriangleCorners(const SceneGeometry& geometry, const scenes::Scene& scene,
+                                    std::span<const glm::vec4> clipPositions,
+                                    std::span<const glm::vec3> normalsView, uint32_t triangle) {
+    const uint32_t* index = geometry.indices.data() + 3 * size_t(triangle);
+    TriangleCorners corners;
+    corners.materialIndex = geometry.triangleMaterial[triangle];
+    corners.material = &scene.materials[corners.materialIndex];
+    corners.baseColorTexture = corners.material->baseColorTexture >= 0
+                                   ? &scene.textures[size_t(corners.material->baseColorTexture)]
+                                   : nullptr;
+    for (int i = 0; i < 3; ++i) {
+        corners.clip[i] = clipPositions[index[i]];
+        corners.normalView[i] = normalsView[index[i]];
+        corners.uv[i] = corners.baseColorTexture ? geometry.uv[index[i]] : glm::vec2(0.0f);
+    }
+    return corners;
+}
+
+Surface surfaceAt(const TriangleCorners& corners, bool backFace, glm::vec2 ndc) {
     const UnnormalisedWeights weights =
-        perspectiveBarycentrics(clipPositions[i0], clipPositions[i1], clipPositions[i2], ndc);
+        perspectiveBarycentrics(corners.clip[0], corners.clip[1], corners.clip[2], ndc);
     Surface surface;
-    glm::vec3 normal = raster::interpolate(normalsView[i0], normalsView[i1], normalsView[i2], weights.b);
+    glm::vec3 normal = raster::interpolate(corners.normalView[0], corners.normalView[1],
+                                           corners.normalView[2], weights.b);
     const float length2 = glm::dot(normal, normal);
     // Two-sided draws light the visible side; a negative weight sum flips the interpolated sum.
     const float sign = (weights.sum < 0.0f) != backFace ? -1.0f : 1.0f;
     surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2))
                                         : glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
-    surface.material = geometry.triangleMaterial[triangle];
-    const scenes::Material& material = scene.materials[surface.material];
+    surface.material = corners.materialIndex;
+    const scenes::Material& material = *corners.material;
     glm::vec3 albedo(material.baseColorFactor);
-    if (material.baseColorTexture >= 0) {
-        const glm::vec2 uv = raster::interpolate(geometry.uv[i0], geometry.uv[i1], geometry.uv[i2],
+    if (corners.baseColorTexture) {
+        const glm::vec2 uv = raster::interpolate(corners.uv[0], corners.uv[1], corners.uv[2],
                                                  weights.b * (1.0f / weights.sum));
-        albedo *= glm::vec3(scene.textures[size_t(material.baseColorTexture)].sample(uv));
+        albedo *= glm::vec3(corners.baseColorTexture->sample(uv));
     }
     surface.albedo = albedo;
     surface.specularIntensity = material.specularIntensity;
     surface.specularPower = material.specularPower;
     return surface;
+}
+
+}  // namespace
+
+Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& scene,
+                          std::span<const glm::vec4> clipPositions,
+                          std::span<const glm::vec3> normalsView, uint32_t triangle, bool backFace,
+                          glm::vec2 ndc) {
+    return surfaceAt(loadTriangleCorners(geometry, scene, clipPositions, normalsView, triangle),
+                     backFace, ndc);
 }
 
 glm::vec3 positionViewOfPixel(const FrameView& view, int x, int y, float depth) {
@@ -94,6 +132,8 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
     const int width = target.width();
     const FrameView& view = target.view();
     tbb::parallel_for(0, target.height(), [&](int y) {
+        uint32_t cornersOf = kNoTriangle;  // the triangle `corners` holds
+        TriangleCorners corners;
         for (int x = 0; x < width; ++x) {
             const size_t pixel = size_t(y) * width + x;
             const uint32_t visible = mVisibleTriangle[pixel];
@@ -103,8 +143,11 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
             }
             const uint32_t t = visible & ~kBackFaceBit;
             const bool backFace = (visible & kBackFaceBit) != 0;
-            const Surface surface = surfaceOfTriangle(mGeometry, mScene, mClipPositions, mNormalView, t,
-                                                      backFace, view.ndcOfPixel(x, y));
+            if (t != cornersOf) {
+                corners = loadTriangleCorners(mGeometry, mScene, mClipPositions, mNormalView, t);
+                cornersOf = t;
+            }
+            const Surface surface = surfaceAt(corners, backFace, view.ndcOfPixel(x, y));
             target.writeSurface(pixel, surface);
             if (exact) {
                 exact->triangle[pixel] = t;

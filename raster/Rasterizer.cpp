@@ -88,12 +88,13 @@ void setUpAttributePlanes(SetupTriangle& s, double x[3], double y[3], const doub
         area = snappedArea;
     }
     double l1[3], l2[3];
+    const double inverseArea = 1.0 / area;  // one division per triangle, not six
     auto plane = [&](int a, int b, double out[3]) {
         // E_ab at pixel (px, py), sampled at its centre (px + 0.5, py + 0.5), over the area.
         const double dx = x[b] - x[a], dy = y[b] - y[a];
-        out[1] = -dy / area;
-        out[2] = dx / area;
-        out[0] = (dx * (0.5 - y[a]) - dy * (0.5 - x[a])) / area;
+        out[1] = -dy * inverseArea;
+        out[2] = dx * inverseArea;
+        out[0] = (dx * (0.5 - y[a]) - dy * (0.5 - x[a])) * inverseArea;
     };
     plane(2, 0, l1);
     plane(0, 1, l2);
@@ -300,13 +301,14 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
         batch.clippedWeights.push_back({barycentric[order[0]], barycentric[order[1]], barycentric[order[2]]});
     }
     // Unsnapped positions in double, only for triangles that survived culling (most culled
-    // triangles are back faces, and these divisions showed in profiles).
+    // triangles are back faces, and these divisions showed in profiles): one per vertex.
     double screenXs[3], screenYs[3], depth[3];
     for (int i = 0; i < 3; ++i) {
         const glm::vec4& c = *clip[order[i]];
-        screenXs[i] = (double(c.x) / c.w + 1.0) * (0.5 * mWidth);
-        screenYs[i] = (1.0 - double(c.y) / c.w) * (0.5 * mHeight);
-        depth[i] = double(c.z) / c.w;
+        const double inverseW = 1.0 / double(c.w);
+        screenXs[i] = (double(c.x) * inverseW + 1.0) * (0.5 * mWidth);
+        screenYs[i] = (1.0 - double(c.y) * inverseW) * (0.5 * mHeight);
+        depth[i] = double(c.z) * inverseW;
     }
     setUpAttributePlanes(s, screenXs, screenYs, depth);
     s.triangle = triangle;
