@@ -131,7 +131,11 @@ void GBufferPass::transformVertices(const FrameView& view) {
 void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
     const int width = target.width();
     const FrameView& view = target.view();
+    // ndcOfPixel's x per column, computed once: the same floats, without a division per pixel.
+    std::vector<float> ndcXOfColumn(static_cast<size_t>(width));
+    for (int x = 0; x < width; ++x) ndcXOfColumn[size_t(x)] = view.ndcOfPixel(x, 0).x;
     tbb::parallel_for(0, target.height(), [&](int y) {
+        const float ndcY = view.ndcOfPixel(0, y).y;
         uint32_t cornersOf = kNoTriangle;  // the triangle `corners` holds
         TriangleCorners corners;
         for (int x = 0; x < width; ++x) {
@@ -147,7 +151,7 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
                 corners = loadTriangleCorners(mGeometry, mScene, mClipPositions, mNormalView, t);
                 cornersOf = t;
             }
-            const Surface surface = surfaceAt(corners, backFace, view.ndcOfPixel(x, y));
+            const Surface surface = surfaceAt(corners, backFace, {ndcXOfColumn[size_t(x)], ndcY});
             target.writeSurface(pixel, surface);
             if (exact) {
                 exact->triangle[pixel] = t;

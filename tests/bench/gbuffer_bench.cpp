@@ -7,6 +7,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "gbuffer/LayoutDerivation.h"
 #include "lighting/StageRegistry.h"
 #include "tests/bench/BenchScenes.h"
 
@@ -17,10 +18,17 @@ const bench::BenchFrame& atrium() {
     return frame;
 }
 
+// range(0): threads; range(1): 0 = the reference layout (float planes, 40 bytes per pixel),
+// 1 = the layout `testbed render` derives for `brute` on atrium (gbuffer/LayoutDerivation.h:
+// float normals, material index, 17 bytes per pixel; the same image bit for bit).
 void gbufferPass(benchmark::State& state) {
     const bench::BenchFrame& f = atrium();
     tbb::task_arena arena(int(state.range(0)));
-    gbuffer::GBuffer target(gbuffer::GBufferLayout::reference(), f.view);
+    const gbuffer::GBufferLayout layout =
+        state.range(1) == 0 ? gbuffer::GBufferLayout::reference()
+                            : gbuffer::deriveLayout(f.scene, lighting::makeStage("brute")->requirements().channels);
+    state.SetLabel(state.range(1) == 0 ? "reference layout" : "derived layout");
+    gbuffer::GBuffer target(layout, f.view);
     raster::Rasterizer rasterizer(bench::kWidth, bench::kHeight);
     gbuffer::GBufferPass pass(f.scene, f.geometry);
     for (auto _ : state) {
@@ -33,7 +41,11 @@ void gbufferPass(benchmark::State& state) {
                                                        benchmark::Counter::kIsIterationInvariantRate);
     state.counters["fragments"] = double(rasterizer.lastStats().samplesCovered);
 }
-BENCHMARK(gbufferPass)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(gbufferPass)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 void bruteShading(benchmark::State& state) {
     const bench::BenchFrame& f = atrium();
