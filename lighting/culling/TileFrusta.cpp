@@ -272,6 +272,35 @@ std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, cons
     return candidates;
 }
 
+uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, int ty,
+                          const TileSurfaceBounds& b, const TileBox& box, TileLightTests tests,
+                          std::vector<uint32_t>& list) {
+    uint64_t backfaceRejected = 0;
+    for (const CandidateLight& c : candidates) {
+        if (c.unbounded) {
+            list.push_back(c.index);
+            continue;
+        }
+        if (tx < c.columnMin || tx > c.columnMax || ty < c.rowMin || ty > c.rowMax)
+            continue;
+        const float centreDepth = -c.centreView.z;
+        const float low = centreDepth - c.radius, high = centreDepth + c.radius;
+        if (high < b.minDepthMetres || low > b.maxDepthMetres)
+            continue;
+        if (distanceSquaredToBox(c.centreView, box.boxMin, box.boxMax) > c.radius * c.radius)
+            continue;
+        if (tests.depthMask &&
+            (depthRangeMask(low, high, b.minDepthMetres, b.maxDepthMetres) & b.depthMask) == 0)
+            continue;
+        if (tests.backface && lightBackFacesTile(box, b, c.positionView)) {
+            ++backfaceRejected;
+            continue;
+        }
+        list.push_back(c.index);
+    }
+    return backfaceRejected;
+}
+
 std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb, const TileGrid& grid,
                                                      const std::vector<LightSphere>& spheres,
                                                      std::vector<TileSurfaceBounds>& bounds) {

@@ -172,6 +172,20 @@ inline constexpr float kBackfaceSlackRadians = 1e-3f; // >> float error of the a
 bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
                         const glm::vec3& lightCentreView);
 
+// The per-tile light test of `tiled`, `tiled-backface` and `tiled-forward`: appends to `list`,
+// in the candidates' (ascending) order, every candidate that may touch covered tile (tx, ty)
+// with bounds `b` and frustum `box`: unbounded lights always; bounded ones when inside the tile's
+// column/row range, the depth range, and the box (sphere distance); with `depthMask` also
+// Harada's 2.5D test, with `backface` the thesis' normal-cone test (lightBackFacesTile; needs
+// bounds computed with normalCone). Returns how many the back-face test rejected.
+struct TileLightTests {
+    bool depthMask = false;
+    bool backface = false;
+};
+uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, int ty,
+                          const TileSurfaceBounds& b, const TileBox& box, TileLightTests tests,
+                          std::vector<uint32_t>& list);
+
 // Per-tile light lists (ascending indices) for the covered tiles of `grid` over `gb`, with the
 // conservative tests of `tiled` and none of its optional extras (vfc, masks, cones); `bounds`
 // receives the tiles' surface bounds. Used by the stages that only need plain tile culling.

@@ -15,6 +15,8 @@
 // Options:
 //   tile=16   tile size in pixels, 4..128
 //   vfc=1     first cull lights against the camera frustum (lightsInViewFrustum); only speed
+//   mask=0    Harada's 2.5D culling (his proposal was for Forward+): a 32-bin depth mask per
+//             tile from the pre-pass depths against each light's depth range, as in `tiled`
 // Parameters record the options and lights_after_vfc, vfc_culled and tile_light_pairs.
 //
 // Exactness: the visible fragment's surface and position are computed by the G-buffer's own
@@ -45,6 +47,7 @@ namespace {
 struct TiledForwardOptions {
     int tileSizePixels = 16;
     bool viewFrustumCulling = true;
+    bool depthMask = false;
 };
 
 class TiledForwardStage final : public ShadingStage {
@@ -105,6 +108,7 @@ public:
             pairs += list.size();
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
+        result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
         result.parameters["lights_after_vfc"] = std::to_string(lightsAfterVfc);
         result.parameters["vfc_culled"] =
             std::to_string(frame.lights->lights.size() - lightsAfterVfc);
@@ -113,7 +117,7 @@ public:
 
 private:
     // Fills mTileLights from the pre-pass depth (mDepth); returns the number of lights kept by
-    // view-frustum culling. The same tests, in the same order, as `tiled` without its mask.
+    // view-frustum culling. The same tests (appendTileLights) as `tiled` with the same options.
     size_t buildTileLightLists(const gbuffer::FrameView& view, const TileGrid& grid,
                                const LightList& lightList) {
         const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
@@ -122,7 +126,7 @@ private:
             candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
 
         const std::vector<TileSurfaceBounds> bounds =
-            computeTileDepthBounds(view, std::span<const float>(mDepth), grid, false);
+            computeTileDepthBounds(view, std::span<const float>(mDepth), grid, mOptions.depthMask);
 
         mTileLights.resize(size_t(grid.tileCount()));
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
@@ -133,22 +137,7 @@ private:
                 return; // no visible fragment will ask for this list
             const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
             const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-            for (const CandidateLight& c : candidates) {
-                if (c.unbounded) {
-                    list.push_back(c.index);
-                    continue;
-                }
-                if (tx < c.columnMin || tx > c.columnMax || ty < c.rowMin || ty > c.rowMax)
-                    continue;
-                const float centreDepth = -c.centreView.z;
-                if (centreDepth + c.radius < b.minDepthMetres ||
-                    centreDepth - c.radius > b.maxDepthMetres)
-                    continue;
-                if (distanceSquaredToBox(c.centreView, box.boxMin, box.boxMax) >
-                    c.radius * c.radius)
-                    continue;
-                list.push_back(c.index);
-            }
+            appendTileLights(candidates, tx, ty, b, box, {mOptions.depthMask, false}, list);
         });
         return candidates.size();
     }
@@ -164,10 +153,11 @@ private:
 } // namespace
 
 std::unique_ptr<ShadingStage> makeTiledForwardStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"tile", "vfc"});
+    rejectUnknownOptions(spec, {"tile", "vfc", "mask"});
     TiledForwardOptions options;
     options.tileSizePixels = intOption(spec, "tile", 16, 4, 128);
     options.viewFrustumCulling = boolOption(spec, "vfc", true);
+    options.depthMask = boolOption(spec, "mask", false);
     return std::make_unique<TiledForwardStage>(options);
 }
 

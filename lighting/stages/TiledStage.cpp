@@ -82,33 +82,9 @@ public:
                 return;
             const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
             const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-            std::vector<uint32_t>& list = tileLights[size_t(tile)];
-            uint64_t rejected = 0;
-            for (const CandidateLight& c : candidates) {
-                if (c.unbounded) {
-                    list.push_back(c.index);
-                    continue;
-                }
-                if (tx < c.columnMin || tx > c.columnMax || ty < c.rowMin || ty > c.rowMax)
-                    continue;
-                const float centreDepth = -c.centreView.z;
-                const float low = centreDepth - c.radius, high = centreDepth + c.radius;
-                if (high < b.minDepthMetres || low > b.maxDepthMetres)
-                    continue;
-                if (distanceSquaredToBox(c.centreView, box.boxMin, box.boxMax) >
-                    c.radius * c.radius)
-                    continue;
-                if (mOptions.depthMask &&
-                    (depthRangeMask(low, high, b.minDepthMetres, b.maxDepthMetres) & b.depthMask) ==
-                        0)
-                    continue;
-                if (mOptions.backface && lightBackFacesTile(box, b, c.positionView)) {
-                    ++rejected;
-                    continue;
-                }
-                list.push_back(c.index);
-            }
-            tileBackfaceRejected[size_t(tile)] = rejected;
+            tileBackfaceRejected[size_t(tile)] =
+                appendTileLights(candidates, tx, ty, b, box, {mOptions.depthMask, mOptions.backface},
+                                 tileLights[size_t(tile)]);
         });
         const double cullMs =
             std::chrono::duration<double, std::milli>(Clock::now() - cullStart).count();

@@ -1,6 +1,6 @@
-// `tiled-forward` (Forward+) beyond the shared exactness suite: tile=32 and vfc=0 variants are
-// bitwise `brute` on atrium with evaluated >= oracle; it evaluates exactly as many lights per
-// pixel as `tiled` at the same tile size (its pre-pass depth is the G-buffer's depth, so the tile
+// `tiled-forward` (Forward+) beyond the shared exactness suite: tile=32, vfc=0 and mask=1 variants
+// are bitwise `brute` on atrium with evaluated >= oracle; it evaluates exactly as many lights per
+// pixel as `tiled` at the same tile size and options (mask=1 included) (its pre-pass depth is the G-buffer's depth, so the tile
 // bounds and hence the tile lists are the same, and the visible surface is the same); the
 // pre-pass tile bounds equal the G-buffer's bitwise; 1 thread and N threads give the same bits;
 // options are parsed, checked and recorded.
@@ -90,7 +90,8 @@ lighting::StageResult expectExact(const TestFrame& f, const std::string& spec) {
 
 TEST(TiledForward, VariantsAreBitwiseBruteOnAtrium) {
     for (const char* spec : {"tiled-forward", "tiled-forward:tile=32", "tiled-forward:vfc=0",
-                             "tiled-forward:tile=32,vfc=0", "tiled-forward:tile=4"})
+                             "tiled-forward:tile=32,vfc=0", "tiled-forward:tile=4",
+                             "tiled-forward:mask=1", "tiled-forward:tile=8,mask=1,vfc=0"})
         expectExact(atrium(), spec);
 }
 
@@ -100,7 +101,10 @@ TEST(TiledForward, BitwiseBruteWithStandardDepth) {
         makeFrame("atrium", 200, 320, 180, gbuffer::DepthConvention::Standard);
     expectExact(*f, "tiled-forward");
     expectExact(*f, "tiled-forward:tile=32,vfc=0");
+    expectExact(*f, "tiled-forward:mask=1");
     EXPECT_EQ(run("tiled-forward", *f).lightsEvaluated, run("tiled", *f).lightsEvaluated);
+    EXPECT_EQ(run("tiled-forward:mask=1", *f).lightsEvaluated,
+              run("tiled:mask=1", *f).lightsEvaluated);
 }
 
 // Same tile size, same lists, same visible surface: the pre-pass draws the same triangles with
@@ -110,7 +114,8 @@ TEST(TiledForward, BitwiseBruteWithStandardDepth) {
 TEST(TiledForward, EvaluatesExactlyAsManyLightsAsTiled) {
     const std::unique_ptr<TestFrame> wall = makeFrame("wall", 300, 320, 180);
     for (const TestFrame* f : {&atrium(), static_cast<const TestFrame*>(wall.get())}) {
-        for (const std::string options : {"tile=16", "tile=32", "tile=8,vfc=0", "tile=32,vfc=0"}) {
+        for (const std::string options :
+             {"tile=16", "tile=32", "tile=8,vfc=0", "tile=32,vfc=0", "mask=1", "tile=32,mask=1,vfc=0"}) {
             const lighting::StageResult tiled = run("tiled:" + options, *f);
             const lighting::StageResult forward = run("tiled-forward:" + options, *f);
             EXPECT_EQ(forward.lightsEvaluated, tiled.lightsEvaluated) << options;
@@ -181,12 +186,14 @@ TEST(TiledForward, OptionsParseAndAreRecorded) {
     EXPECT_THROW(lighting::makeStage("tiled-forward:tile=3"), lighting::StageError);
     EXPECT_THROW(lighting::makeStage("tiled-forward:tile=129"), lighting::StageError);
     EXPECT_THROW(lighting::makeStage("tiled-forward:vfc=2"), lighting::StageError);
-    EXPECT_THROW(lighting::makeStage("tiled-forward:mask=1"), lighting::StageError);
+    EXPECT_THROW(lighting::makeStage("tiled-forward:mask=2"), lighting::StageError);
 
     const lighting::StageResult r = run("tiled-forward:tile=32,vfc=0", atrium());
     EXPECT_EQ(r.parameters.at("tile"), "32");
     EXPECT_EQ(r.parameters.at("vfc"), "0");
     EXPECT_EQ(r.parameters.at("vfc_culled"), "0");
+    EXPECT_EQ(r.parameters.at("mask"), "0");
+    EXPECT_EQ(run("tiled-forward:mask=1", atrium()).parameters.at("mask"), "1");
     ASSERT_EQ(r.timingsMs.size(), 4u);
     EXPECT_EQ(r.timingsMs[0].first, "transform");
     EXPECT_EQ(r.timingsMs[1].first, "prepass");
