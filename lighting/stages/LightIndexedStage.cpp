@@ -6,8 +6,10 @@
 // pixel, not once per light as in `deferred`).
 //
 // Overflow never drops a light: a pixel whose list would exceed `max` is marked and shaded with
-// EVERY light (conservative, like Filament's froxel overflow); the count of such pixels is
-// reported as parameters["overflow_pixels"].
+// the light list of its 16x16 screen tile (basicTileLightLists in culling/TileFrusta.h: the
+// conservative tests of `tiled`, ascending), built only when some pixel overflowed. Like
+// Filament's froxel overflow it is conservative, but it costs a tile's lights, not every light.
+// parameters["overflow_pixels"] counts such pixels.
 //
 // Memory: max x 4 bytes per pixel for the lists plus 2 bytes of count and overflow flag (16 lights
 // at 1280x720: 59 MB). Lists are ascending because lights are drawn in ascending order and each
@@ -20,14 +22,15 @@
 // Passes: "cull", "index", "shading".
 #include "lighting/stages/Stages.h"
 
+#include <algorithm>
 #include <chrono>
-#include <numeric>
 
 #include <tbb/parallel_for.h>
 
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/culling/LightVolumes.h"
+#include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
 
@@ -39,6 +42,8 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
 
 // Marks an overflowed pixel in the count plane (counts never exceed 255).
 constexpr uint16_t kOverflowed = 0xFFFF;
+// Tile size of the overflow fallback's lists: `tiled`'s default.
+constexpr int kOverflowTileSize = 16;
 
 class LightIndexedStage final : public ShadingStage {
 public:
@@ -86,8 +91,14 @@ public:
         result.timingsMs.emplace_back("index", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
-        std::vector<uint32_t> everyLight(lights.size());
-        std::iota(everyLight.begin(), everyLight.end(), 0u);
+        const bool anyOverflow =
+            std::find(mCounts.begin(), mCounts.end(), kOverflowed) != mCounts.end();
+        const TileGrid overflowGrid = TileGrid::make(width, height, kOverflowTileSize);
+        std::vector<std::vector<uint32_t>> overflowLists;
+        if (anyOverflow) {
+            std::vector<TileSurfaceBounds> bounds;
+            overflowLists = basicTileLightLists(gb, overflowGrid, spheres, bounds);
+        }
         std::vector<uint32_t> overflowPerRow(size_t(height), 0);
         tbb::parallel_for(0, height, [&](int y) {
             uint32_t overflowed = 0;
@@ -95,7 +106,9 @@ public:
                 const size_t pixel = size_t(y) * width + x;
                 if (counts[pixel] == kOverflowed) {
                     ++overflowed;
-                    shadeWithLightList(gb, x, y, lights, everyLight, result);
+                    const size_t tile = size_t(y / kOverflowTileSize) * overflowGrid.tileCountX +
+                                        size_t(x / kOverflowTileSize);
+                    shadeWithLightList(gb, x, y, lights, overflowLists[tile], result);
                 } else {
                     shadeWithLightList(gb, x, y, lights,
                                        std::span<const uint32_t>(lists + pixel * capacity, counts[pixel]), result);

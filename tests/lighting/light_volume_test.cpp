@@ -112,9 +112,11 @@ TEST(LightVolumes, LightIndexedOverflowIsReportedAndConservative) {
     lighting::makeStage("light-indexed:max=1")->shade(f.frame, result);
     ASSERT_TRUE(result.parameters.count("overflow_pixels"));
     EXPECT_GT(std::stoull(result.parameters.at("overflow_pixels")), 0u);
-    // Overflowed pixels are shaded with every light.
-    EXPECT_NE(std::find(result.lightsEvaluated.begin(), result.lightsEvaluated.end(), uint32_t(f.lights.size())),
-              result.lightsEvaluated.end());
+    // Overflowed pixels are shaded with their 16x16 tile's conservative list: more than the
+    // one-entry capacity, far fewer than every light (exactness: OptionVariantsMatchBrute).
+    const uint32_t most = *std::max_element(result.lightsEvaluated.begin(), result.lightsEvaluated.end());
+    EXPECT_GT(most, 1u);
+    EXPECT_LT(most, uint32_t(f.lights.size()) / 2);
 }
 
 TEST(LightVolumes, ProxyCircumscribesTheUnitSphereAndIsClosed) {
