@@ -44,6 +44,11 @@ namespace {
 struct TriangleCorners {
     glm::vec4 clip[3];
     glm::vec3 normalView[3];
+    // Flat triangles (the three normals bitwise equal: floors, walls) have one normal direction;
+    // it is normalised here once, and per pixel only the sign of the weight sum is needed.
+    bool flat;
+    bool flatNormalIsZero;     // flat with zero-length normals: the (0, 0, +-1) fallback
+    glm::vec3 flatNormalView;  // unit, valid when flat and not zero
     glm::vec2 uv[3];
     uint32_t materialIndex;
     const scenes::Material* material;
@@ -65,6 +70,13 @@ TriangleCorners loadTriangleCorners(const SceneGeometry& geometry, const scenes:
         corners.normalView[i] = normalsView[index[i]];
         corners.uv[i] = corners.baseColorTexture ? geometry.uv[index[i]] : glm::vec2(0.0f);
     }
+    corners.flat = corners.normalView[0] == corners.normalView[1] &&
+                   corners.normalView[0] == corners.normalView[2];
+    const float length2 = glm::dot(corners.normalView[0], corners.normalView[0]);
+    corners.flatNormalIsZero = !(length2 > 0.0f);
+    corners.flatNormalView = corners.flatNormalIsZero
+                                 ? glm::vec3(0.0f)
+                                 : corners.normalView[0] * (1.0f / std::sqrt(length2));
     return corners;
 }
 
@@ -72,13 +84,19 @@ Surface surfaceAt(const TriangleCorners& corners, bool backFace, glm::vec2 ndc) 
     const UnnormalisedWeights weights =
         perspectiveBarycentrics(corners.clip[0], corners.clip[1], corners.clip[2], ndc);
     Surface surface;
-    glm::vec3 normal = raster::interpolate(corners.normalView[0], corners.normalView[1],
-                                           corners.normalView[2], weights.b);
-    const float length2 = glm::dot(normal, normal);
     // Two-sided draws light the visible side; a negative weight sum flips the interpolated sum.
     const float sign = (weights.sum < 0.0f) != backFace ? -1.0f : 1.0f;
-    surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2))
-                                        : glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
+    if (corners.flat) {
+        surface.normalView = corners.flatNormalIsZero
+                                 ? glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f)
+                                 : corners.flatNormalView * sign;
+    } else {
+        const glm::vec3 normal = raster::interpolate(corners.normalView[0], corners.normalView[1],
+                                                     corners.normalView[2], weights.b);
+        const float length2 = glm::dot(normal, normal);
+        surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2))
+                                            : glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
+    }
     surface.material = corners.materialIndex;
     const scenes::Material& material = *corners.material;
     glm::vec3 albedo(material.baseColorFactor);
