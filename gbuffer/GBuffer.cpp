@@ -91,37 +91,35 @@ glm::vec3 GBuffer::viewRayOfPixel(size_t pixel) const {
     return viewRayOfNdc(mView, mView.ndcOfPixel(x, y));
 }
 
-void GBuffer::writeBackground(size_t pixel) {
-    Surface background;
-    background.normalView = glm::vec3(0.0f, 0.0f, 1.0f);
-    background.specularPower = 1.0f;
-    writeSurface(pixel, background);
+GBuffer::Writer::Writer(GBuffer& target) {
+    auto pointer = [](auto& plane) { return plane.empty() ? nullptr : plane.data(); };
+    for (int c = 0; c < 3; ++c) {
+        mNormal[c] = pointer(target.mNormal[c]);
+        mAlbedo[c] = pointer(target.mAlbedo[c]);
+    }
+    for (int c = 0; c < 2; ++c) mSpecular[c] = pointer(target.mSpecular[c]);
+    mMaterial = pointer(target.mMaterial);
+    mEncoded = target.hasEncodedPlanes() ? &target : nullptr;
 }
 
-void GBuffer::writeSurface(size_t pixel, const Surface& s) {
-    if (!mNormal[0].empty()) {
-        mNormal[0][pixel] = s.normalView.x;
-        mNormal[1][pixel] = s.normalView.y;
-        mNormal[2][pixel] = s.normalView.z;
-    } else if (!mNormalCode32.empty() || !mNormalCode64.empty()) {
+bool GBuffer::hasEncodedPlanes() const {
+    return !mNormalCode32.empty() || !mNormalCode64.empty() || !mAlbedoPacked.empty() ||
+           !mSpecularPacked.empty();
+}
+
+void GBuffer::writeEncoded(size_t pixel, const Surface& s) {
+    if (!mNormalCode32.empty() || !mNormalCode64.empty()) {
         const glm::vec3 normal =
             mLayout.normalSpace == NormalSpace::World ? mWorldFromView * s.normalView : s.normalView;
         const NormalCode code = encodeNormal(mLayout.normals, normal, viewRayOfPixel(pixel));
         if (!mNormalCode32.empty()) mNormalCode32[pixel] = uint32_t(code.low);
         else mNormalCode64[pixel] = code.low;
     }
-    if (!mAlbedo[0].empty()) {
-        mAlbedo[0][pixel] = s.albedo.r;
-        mAlbedo[1][pixel] = s.albedo.g;
-        mAlbedo[2][pixel] = s.albedo.b;
-    } else if (!mAlbedoPacked.empty()) {
+    if (!mAlbedoPacked.empty()) {
         mAlbedoPacked[pixel] = unorm8(srgbFromLinear(s.albedo.r)) | unorm8(srgbFromLinear(s.albedo.g)) << 8 |
                                unorm8(srgbFromLinear(s.albedo.b)) << 16;
     }
-    if (!mSpecular[0].empty()) {
-        mSpecular[0][pixel] = s.specularIntensity;
-        mSpecular[1][pixel] = s.specularPower;
-    } else if (!mSpecularPacked.empty()) {
+    if (!mSpecularPacked.empty()) {
         uint32_t power = 0;
         if (mLayout.specular == SpecularEncoding::Unorm8Half) {
             power = Imath::half(std::clamp(s.specularPower, 0.0f, 65504.0f)).bits();
@@ -130,7 +128,6 @@ void GBuffer::writeSurface(size_t pixel, const Surface& s) {
         }
         mSpecularPacked[pixel] = unorm8(s.specularIntensity) | power << 8;
     }
-    if (!mMaterial.empty()) mMaterial[pixel] = uint16_t(s.material);
 }
 
 glm::vec3 GBuffer::reconstructPositionView(int x, int y, float depthNdc) const {

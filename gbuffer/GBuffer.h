@@ -19,13 +19,14 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
+#include <span>
 
 #include <glm/glm.hpp>
 
 #include "gbuffer/DepthFormat.h"
 #include "gbuffer/FrameView.h"
 #include "gbuffer/GBufferLayout.h"
+#include "gbuffer/Plane.h"
 
 namespace gbuffer {
 
@@ -57,10 +58,45 @@ public:
     // Rounds every covered pixel's depth through the layout's format (no-op for the float format
     // of the view's own convention). Parallel (TBB). A covered pixel stays covered.
     void quantiseDepth();
-    // Writes the background value (zero codes) to every plane but depth at one pixel.
-    void writeBackground(size_t pixel);
-    // Encodes one pixel's surface attributes (depth is written by the rasterizer directly).
-    void writeSurface(size_t pixel, const Surface& surface);
+    // Writes pixels' attributes into the planes (depth is written by the rasterizer directly).
+    // It holds the planes' raw pointers, so the G-buffer pass' stores per pixel are inline and
+    // branch only on which planes exist (the same at every pixel); planes that need encoding
+    // (normal codes, packed albedo or specular) go through GBuffer::writeEncoded. Safe
+    // concurrently for different pixels; valid while the GBuffer lives and is not moved.
+    class Writer {
+    public:
+        explicit Writer(GBuffer& target);
+        void write(size_t pixel, const Surface& s) const {
+            if (mNormal[0]) {
+                mNormal[0][pixel] = s.normalView.x;
+                mNormal[1][pixel] = s.normalView.y;
+                mNormal[2][pixel] = s.normalView.z;
+            }
+            if (mAlbedo[0]) {
+                mAlbedo[0][pixel] = s.albedo.r;
+                mAlbedo[1][pixel] = s.albedo.g;
+                mAlbedo[2][pixel] = s.albedo.b;
+            }
+            if (mSpecular[0]) {
+                mSpecular[0][pixel] = s.specularIntensity;
+                mSpecular[1][pixel] = s.specularPower;
+            }
+            if (mMaterial) mMaterial[pixel] = uint16_t(s.material);
+            if (mEncoded) mEncoded->writeEncoded(pixel, s);
+        }
+        // The background value (zero codes) in every plane but depth.
+        void writeBackground(size_t pixel) const { write(pixel, kBackground); }
+
+    private:
+        static constexpr Surface kBackground{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, {0.0f, 0.0f, 0.0f},
+                                             0.0f, 1.0f, 0};
+        float* mNormal[3] = {};
+        float* mAlbedo[3] = {};
+        float* mSpecular[2] = {};
+        uint16_t* mMaterial = nullptr;
+        GBuffer* mEncoded = nullptr;  // the target when it has encoded planes
+    };
+    Writer writer() { return Writer(*this); }
 
     bool covered(size_t pixel) const { return mDepth[pixel] != mClearDepth; }
     // Reconstructs view-space position from depth and decodes the other channels; channels the
@@ -69,25 +105,28 @@ public:
     glm::vec3 reconstructPositionView(int x, int y, float depthNdc) const;
 
     float* depthPlane() { return mDepth.data(); }
-    const std::vector<float>& depth() const { return mDepth; }
+    std::span<const float> depth() const { return mDepth; }
 
 private:
     glm::vec3 viewRayOfPixel(size_t pixel) const;
+    bool hasEncodedPlanes() const;
+    // The planes Writer cannot store directly: normal codes, packed albedo, packed specular.
+    void writeEncoded(size_t pixel, const Surface& surface);
 
     GBufferLayout mLayout;
     FrameView mView;
     DepthProjection mProjection;
     glm::mat3 mWorldFromView{1.0f};  // for world-space normal codes (viewFromWorldNormal is a rotation)
     float mClearDepth;
-    std::vector<float> mDepth;
-    std::vector<float> mNormal[3];          // float32 normals
-    std::vector<uint32_t> mNormalCode32;    // codes of up to 32 bits
-    std::vector<uint64_t> mNormalCode64;    // longer codes (xyz:48)
-    std::vector<float> mAlbedo[3];          // f32
-    std::vector<uint32_t> mAlbedoPacked;    // rgb8-srgb
-    std::vector<float> mSpecular[2];        // f32
-    std::vector<uint32_t> mSpecularPacked;  // unorm8+f16, unorm8+log8
-    std::vector<uint16_t> mMaterial;        // material index
+    Plane<float> mDepth;
+    Plane<float> mNormal[3];          // float32 normals
+    Plane<uint32_t> mNormalCode32;    // codes of up to 32 bits
+    Plane<uint64_t> mNormalCode64;    // longer codes (xyz:48)
+    Plane<float> mAlbedo[3];          // f32
+    Plane<uint32_t> mAlbedoPacked;    // rgb8-srgb
+    Plane<float> mSpecular[2];        // f32
+    Plane<uint32_t> mSpecularPacked;  // unorm8+f16, unorm8+log8
+    Plane<uint16_t> mMaterial;        // material index
 };
 
 }  // namespace gbuffer

@@ -13,36 +13,14 @@ namespace {
 double millisecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
-// Perspective-correct barycentrics of the pixel centre at `ndc` in the triangle with clip-space
-// vertices c0, c1, c2. The point sum(b_i c_i) projects onto ndc when
-// sum b_i (x_i - ndc.x w_i) = 0 and sum b_i (y_i - ndc.y w_i) = 0, so b is the cross product of
-// those two rows, up to scale (the barycentrics are b / sum b). Homogeneous: valid for triangles
-// crossing the near plane.
-// Returned unnormalised (b, not b / sum): the normal is renormalised anyway, so only the sign of
-// the scale matters there, and the division stays off the per-pixel critical path unless a
-// texture needs the true weights. sum = 0 (pixel ray parallel to the plane) gives equal weights.
-struct UnnormalisedWeights {
-    glm::vec3 b;
-    float sum;
-};
-UnnormalisedWeights perspectiveBarycentrics(const glm::vec4& c0, const glm::vec4& c1,
-                                            const glm::vec4& c2, glm::vec2 ndc) {
-    const glm::vec3 rowX(c0.x - ndc.x * c0.w, c1.x - ndc.x * c1.w, c2.x - ndc.x * c2.w);
-    const glm::vec3 rowY(c0.y - ndc.y * c0.w, c1.y - ndc.y * c1.w, c2.y - ndc.y * c2.w);
-    const glm::vec3 b = glm::cross(rowX, rowY);
-    const float sum = b.x + b.y + b.z;
-    return sum != 0.0f ? UnnormalisedWeights{b, sum} : UnnormalisedWeights{glm::vec3(1.0f), 3.0f};
-}
-
-}  // namespace
-
-namespace {
 
 // What surfaceOfTriangle reads per triangle, loaded once: resolve() reuses it while consecutive
-// pixels show the same triangle (about 2.5 pixels in a row on atrium), which takes the dependent
+// pixels show the same triangle (about 3.4 pixels in a row on atrium), which takes the dependent
 // index -> vertex loads off most pixels. uv is loaded only for textured materials.
 struct TriangleCorners {
-    glm::vec4 clip[3];
+    // Clip-space x, y and w of the three vertices (z is not needed: depth comes from the
+    // rasterizer).
+    glm::vec3 clipX, clipY, clipW;
     glm::vec3 normalView[3];
     // Flat triangles (the three normals bitwise equal: floors, walls) have one normal direction;
     // it is normalised here once, and per pixel only the sign of the weight sum is needed.
@@ -66,7 +44,10 @@ TriangleCorners loadTriangleCorners(const SceneGeometry& geometry, const scenes:
                                    ? &scene.textures[size_t(corners.material->baseColorTexture)]
                                    : nullptr;
     for (int i = 0; i < 3; ++i) {
-        corners.clip[i] = clipPositions[index[i]];
+        const glm::vec4& clip = clipPositions[index[i]];
+        corners.clipX[i] = clip.x;
+        corners.clipY[i] = clip.y;
+        corners.clipW[i] = clip.w;
         corners.normalView[i] = normalsView[index[i]];
         corners.uv[i] = corners.baseColorTexture ? geometry.uv[index[i]] : glm::vec2(0.0f);
     }
@@ -80,19 +61,43 @@ TriangleCorners loadTriangleCorners(const SceneGeometry& geometry, const scenes:
     return corners;
 }
 
-Surface surfaceAt(const TriangleCorners& corners, bool backFace, glm::vec2 ndc) {
-    const UnnormalisedWeights weights =
-        perspectiveBarycentrics(corners.clip[0], corners.clip[1], corners.clip[2], ndc);
+// Perspective-correct barycentrics along one pixel row. The point sum(b_i c_i) of the triangle
+// with clip-space vertices c_i projects onto the pixel centre (ndcX, ndcY) when
+// sum b_i (x_i - ndcX w_i) = 0 and sum b_i (y_i - ndcY w_i) = 0, so b is the cross product of
+// those two rows, up to scale (the barycentrics are b / sum b). The second row is fixed along a
+// pixel row, so b = cross(x, rowY) - ndcX cross(w, rowY) is affine in ndcX: two cross products per
+// run of pixels, then three multiply-adds per pixel. Homogeneous: valid for triangles crossing
+// the near plane.
+struct RowWeights {
+    glm::vec3 constant;
+    glm::vec3 slope;
+};
+RowWeights rowWeights(const TriangleCorners& corners, float ndcY) {
+    const glm::vec3 rowY = corners.clipY - ndcY * corners.clipW;
+    return {glm::cross(corners.clipX, rowY), glm::cross(corners.clipW, rowY)};
+}
+
+[[gnu::always_inline]] inline Surface surfaceAt(const TriangleCorners& corners, const RowWeights& row, bool backFace,
+                                                float ndcX) {
+    // Unnormalised weights: the normal is renormalised anyway, so only the sign of the scale
+    // matters there, and the division stays off the per-pixel path unless a texture needs the
+    // true weights. sum = 0 (pixel ray parallel to the plane) gives equal weights.
+    glm::vec3 b = row.constant - ndcX * row.slope;
+    float sum = b.x + b.y + b.z;
+    if (sum == 0.0f) {
+        b = glm::vec3(1.0f);
+        sum = 3.0f;
+    }
     Surface surface;
     // Two-sided draws light the visible side; a negative weight sum flips the interpolated sum.
-    const float sign = (weights.sum < 0.0f) != backFace ? -1.0f : 1.0f;
+    const float sign = (sum < 0.0f) != backFace ? -1.0f : 1.0f;
     if (corners.flat) {
         surface.normalView = corners.flatNormalIsZero
                                  ? glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f)
                                  : corners.flatNormalView * sign;
     } else {
         const glm::vec3 normal = raster::interpolate(corners.normalView[0], corners.normalView[1],
-                                                     corners.normalView[2], weights.b);
+                                                     corners.normalView[2], b);
         const float length2 = glm::dot(normal, normal);
         surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2))
                                             : glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
@@ -101,8 +106,8 @@ Surface surfaceAt(const TriangleCorners& corners, bool backFace, glm::vec2 ndc) 
     const scenes::Material& material = *corners.material;
     glm::vec3 albedo(material.baseColorFactor);
     if (corners.baseColorTexture) {
-        const glm::vec2 uv = raster::interpolate(corners.uv[0], corners.uv[1], corners.uv[2],
-                                                 weights.b * (1.0f / weights.sum));
+        const glm::vec2 uv =
+            raster::interpolate(corners.uv[0], corners.uv[1], corners.uv[2], b * (1.0f / sum));
         albedo *= glm::vec3(corners.baseColorTexture->sample(uv));
     }
     surface.albedo = albedo;
@@ -117,8 +122,8 @@ Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& sc
                           std::span<const glm::vec4> clipPositions,
                           std::span<const glm::vec3> normalsView, uint32_t triangle, bool backFace,
                           glm::vec2 ndc) {
-    return surfaceAt(loadTriangleCorners(geometry, scene, clipPositions, normalsView, triangle),
-                     backFace, ndc);
+    const TriangleCorners corners = loadTriangleCorners(geometry, scene, clipPositions, normalsView, triangle);
+    return surfaceAt(corners, rowWeights(corners, ndc.y), backFace, ndc.x);
 }
 
 glm::vec3 positionViewOfPixel(const FrameView& view, int x, int y, float depth) {
@@ -149,28 +154,31 @@ void GBufferPass::transformVertices(const FrameView& view) {
 void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
     const int width = target.width();
     const FrameView& view = target.view();
+    const GBuffer::Writer writer = target.writer();
     // ndcOfPixel's x per column, computed once: the same floats, without a division per pixel.
     std::vector<float> ndcXOfColumn(static_cast<size_t>(width));
     for (int x = 0; x < width; ++x) ndcXOfColumn[size_t(x)] = view.ndcOfPixel(x, 0).x;
     tbb::parallel_for(0, target.height(), [&](int y) {
         const float ndcY = view.ndcOfPixel(0, y).y;
-        uint32_t cornersOf = kNoTriangle;  // the triangle `corners` holds
+        uint32_t cornersOf = kNoTriangle;  // the triangle `corners` and `row` describe
         TriangleCorners corners;
+        RowWeights row;
         for (int x = 0; x < width; ++x) {
             const size_t pixel = size_t(y) * width + x;
             const uint32_t visible = mVisibleTriangle[pixel];
             if (visible == kNoTriangle) {
-                target.writeBackground(pixel);
+                writer.writeBackground(pixel);
                 continue;
             }
             const uint32_t t = visible & ~kBackFaceBit;
             const bool backFace = (visible & kBackFaceBit) != 0;
             if (t != cornersOf) {
                 corners = loadTriangleCorners(mGeometry, mScene, mClipPositions, mNormalView, t);
+                row = rowWeights(corners, ndcY);
                 cornersOf = t;
             }
-            const Surface surface = surfaceAt(corners, backFace, {ndcXOfColumn[size_t(x)], ndcY});
-            target.writeSurface(pixel, surface);
+            const Surface surface = surfaceAt(corners, row, backFace, ndcXOfColumn[size_t(x)]);
+            writer.write(pixel, surface);
             if (exact) {
                 exact->triangle[pixel] = t;
                 exact->backFacing[pixel] = backFace ? 1 : 0;

@@ -11,6 +11,7 @@
 #include "gbuffer/ExactSurface.h"
 #include "gbuffer/FrameView.h"
 #include "gbuffer/GBuffer.h"
+#include "gbuffer/Plane.h"
 #include "gbuffer/SceneGeometry.h"
 #include "raster/Rasterizer.h"
 #include "scenes/Scene.h"
@@ -70,7 +71,7 @@ private:
     const SceneGeometry& mGeometry;
     std::vector<glm::vec4> mClipPositions;
     std::vector<glm::vec3> mNormalView;
-    std::vector<uint32_t> mVisibleTriangle;
+    Plane<uint32_t> mVisibleTriangle;
 };
 
 }  // namespace gbuffer

@@ -55,7 +55,7 @@ public:
         const auto assignStart = std::chrono::steady_clock::now();
 
         // Nearest and farthest covered NDC depth (min/max: order-independent, so deterministic).
-        const std::vector<float>& depth = gb.depth();
+        const std::span<const float> depth = gb.depth();
         const float clear = gb.view().clearDepth();
         using MinMax = std::pair<float, float>;
         const MinMax ndcRange = tbb::parallel_reduce(

@@ -32,9 +32,9 @@ RenderOptions smallAtrium(int threads) {
     return options;
 }
 
-template <class T>
-bool bitwiseEqual(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+template <class A, class B>
+bool bitwiseEqual(const A& a, const B& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
 }
 
 // Every decoded G-buffer value of two runs, compared bit for bit.
