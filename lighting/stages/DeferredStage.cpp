@@ -28,6 +28,7 @@
 #include "lighting/EveryLight.h"
 #include "lighting/LightBounds.h"
 #include "lighting/culling/LightVolumes.h"
+#include "lighting/stages/VolumeStageOptions.h"
 
 namespace lighting {
 
@@ -39,8 +40,7 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
 
 class DeferredStage final : public ShadingStage {
 public:
-    DeferredStage(VolumeShape shape, SpotProxy spotProxy, bool stencil, bool frustumCull)
-        : mShape(shape), mSpotProxy(spotProxy), mStencil(stencil), mFrustumCull(frustumCull) {}
+    explicit DeferredStage(const VolumeStageOptions& volume) : mVolume(volume) {}
 
     std::string name() const override { return "deferred"; }
     StageRequirements requirements() const override {
@@ -57,8 +57,8 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
-        LightVolumeRasterizer volumes(gb, mShape, mStencil, mSpotProxy);
-        const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mFrustumCull);  // ascending
+        LightVolumeRasterizer volumes(gb, mVolume.shape, mVolume.stencil, mVolume.spotProxy);
+        const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mVolume.frustumCull);  // ascending
         const size_t culled = spheres.size() - drawn.size();
         result.timingsMs.emplace_back("cull", millisecondsSince(start));
 
@@ -80,38 +80,18 @@ public:
         });
         result.timingsMs.emplace_back("shading", millisecondsSince(start));
 
-        result.parameters["volume"] = mShape == VolumeShape::Sphere ? "sphere" : "rect";
-        if (mShape == VolumeShape::Sphere)
-            result.parameters["spot"] = mSpotProxy == SpotProxy::Cone ? "cone" : "sphere";
-        result.parameters["stencil"] = mStencil ? "1" : "0";
-        result.parameters["vfc"] = mFrustumCull ? "1" : "0";
-        result.parameters["lights_culled"] = std::to_string(culled);
-        result.parameters["lights_drawn"] = std::to_string(volumes.stats().lightsDrawn);
-        result.parameters["rect_fallbacks"] = std::to_string(volumes.stats().rectFallbacks);
-        result.parameters["cone_proxies"] = std::to_string(volumes.stats().coneProxies);
-        result.parameters["volume_fragments"] = std::to_string(volumes.stats().fragments);
+        recordVolumeParameters(mVolume, culled, volumes.stats(), result.parameters);
     }
 
 private:
-    VolumeShape mShape;
-    SpotProxy mSpotProxy;
-    bool mStencil;
-    bool mFrustumCull;
+    VolumeStageOptions mVolume;
 };
 
 }  // namespace
 
 std::unique_ptr<ShadingStage> makeDeferredStage(const StageSpec& spec) {
     rejectUnknownOptions(spec, {"volume", "spot", "stencil", "vfc"});
-    const VolumeShape shape =
-        choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere" ? VolumeShape::Sphere : VolumeShape::Rect;
-    if (shape == VolumeShape::Rect && spec.options.count("spot"))
-        throw StageError("stage '" + spec.name + "': option spot applies to volume=sphere only");
-    const SpotProxy spotProxy = choiceOption(spec, "spot", {"cone", "sphere"}) == "cone"
-                                    ? SpotProxy::Cone
-                                    : SpotProxy::Sphere;
-    return std::make_unique<DeferredStage>(shape, spotProxy, boolOption(spec, "stencil", false),
-                                           boolOption(spec, "vfc", true));
+    return std::make_unique<DeferredStage>(parseVolumeStageOptions(spec));
 }
 
 }  // namespace lighting

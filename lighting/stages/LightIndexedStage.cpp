@@ -30,6 +30,7 @@
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/culling/LightVolumes.h"
+#include "lighting/stages/VolumeStageOptions.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
@@ -47,10 +48,8 @@ constexpr int kOverflowTileSize = 16;
 
 class LightIndexedStage final : public ShadingStage {
 public:
-    LightIndexedStage(int maxLights, VolumeShape shape, SpotProxy spotProxy, bool stencil,
-                      bool frustumCull)
-        : mMaxLights(maxLights), mShape(shape), mSpotProxy(spotProxy), mStencil(stencil),
-          mFrustumCull(frustumCull) {}
+    LightIndexedStage(int maxLights, const VolumeStageOptions& volume)
+        : mMaxLights(maxLights), mVolume(volume) {}
 
     std::string name() const override { return "light-indexed"; }
     StageRequirements requirements() const override {
@@ -68,8 +67,8 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
-        LightVolumeRasterizer volumes(gb, mShape, mStencil, mSpotProxy);
-        const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mFrustumCull);  // ascending
+        LightVolumeRasterizer volumes(gb, mVolume.shape, mVolume.stencil, mVolume.spotProxy);
+        const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mVolume.frustumCull);  // ascending
         const size_t culled = spheres.size() - drawn.size();
         result.timingsMs.emplace_back("cull", millisecondsSince(start));
 
@@ -121,25 +120,13 @@ public:
         uint64_t overflowPixels = 0;
         for (uint32_t n : overflowPerRow) overflowPixels += n;
         result.parameters["max"] = std::to_string(mMaxLights);
-        result.parameters["volume"] = mShape == VolumeShape::Sphere ? "sphere" : "rect";
-        if (mShape == VolumeShape::Sphere)
-            result.parameters["spot"] = mSpotProxy == SpotProxy::Cone ? "cone" : "sphere";
-        result.parameters["stencil"] = mStencil ? "1" : "0";
-        result.parameters["vfc"] = mFrustumCull ? "1" : "0";
-        result.parameters["lights_culled"] = std::to_string(culled);
-        result.parameters["lights_drawn"] = std::to_string(volumes.stats().lightsDrawn);
-        result.parameters["rect_fallbacks"] = std::to_string(volumes.stats().rectFallbacks);
-        result.parameters["cone_proxies"] = std::to_string(volumes.stats().coneProxies);
-        result.parameters["volume_fragments"] = std::to_string(volumes.stats().fragments);
+        recordVolumeParameters(mVolume, culled, volumes.stats(), result.parameters);
         result.parameters["overflow_pixels"] = std::to_string(overflowPixels);
     }
 
 private:
     int mMaxLights;
-    VolumeShape mShape;
-    SpotProxy mSpotProxy;
-    bool mStencil;
-    bool mFrustumCull;
+    VolumeStageOptions mVolume;
     // Kept between frames so steady-state frames do not allocate.
     std::vector<uint16_t> mCounts;  // entries used, or kOverflowed
     std::vector<uint32_t> mLists;  // capacity entries per pixel
@@ -149,16 +136,8 @@ private:
 
 std::unique_ptr<ShadingStage> makeLightIndexedStage(const StageSpec& spec) {
     rejectUnknownOptions(spec, {"max", "volume", "spot", "stencil", "vfc"});
-    const VolumeShape shape =
-        choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere" ? VolumeShape::Sphere : VolumeShape::Rect;
-    if (shape == VolumeShape::Rect && spec.options.count("spot"))
-        throw StageError("stage '" + spec.name + "': option spot applies to volume=sphere only");
-    const SpotProxy spotProxy = choiceOption(spec, "spot", {"cone", "sphere"}) == "cone"
-                                    ? SpotProxy::Cone
-                                    : SpotProxy::Sphere;
-    return std::make_unique<LightIndexedStage>(intOption(spec, "max", 16, 1, 255), shape, spotProxy,
-                                               boolOption(spec, "stencil", false),
-                                               boolOption(spec, "vfc", true));
+    const VolumeStageOptions volume = parseVolumeStageOptions(spec);
+    return std::make_unique<LightIndexedStage>(intOption(spec, "max", 16, 1, 255), volume);
 }
 
 }  // namespace lighting

@@ -1,0 +1,31 @@
+// The light-volume options `deferred` and `light-indexed` share, parsed and recorded in one place:
+//   volume=sphere|rect  spot=cone|sphere (volume=sphere only)  stencil=0|1  vfc=1|0
+// (their meaning: DeferredStage.cpp's header and culling/LightVolumes.h).
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <string>
+
+#include "lighting/StageRegistry.h"
+#include "lighting/culling/LightVolumes.h"
+
+namespace lighting {
+
+struct VolumeStageOptions {
+    VolumeShape shape = VolumeShape::Sphere;
+    SpotProxy spotProxy = SpotProxy::Cone;
+    bool stencil = false;
+    bool frustumCull = true;
+};
+
+// Reads the four options (the caller rejects unknown keys); a StageError when malformed or when
+// `spot` is given with volume=rect.
+VolumeStageOptions parseVolumeStageOptions(const StageSpec& spec);
+
+// Records the options and the volume draw's statistics (`culled`: lights removed by view-frustum
+// culling) in a stage's parameters.
+void recordVolumeParameters(const VolumeStageOptions& options, size_t culled,
+                            const LightVolumeStats& stats, std::map<std::string, std::string>& parameters);
+
+}  // namespace lighting
