@@ -84,12 +84,10 @@ public:
             if (mMaterial) mMaterial[pixel] = uint16_t(s.material);
             if (mEncoded) mEncoded->writeEncoded(pixel, s);
         }
-        // The background value (zero codes) in every plane but depth.
-        void writeBackground(size_t pixel) const { write(pixel, kBackground); }
+        // The background value in every plane but depth: Surface's defaults.
+        void writeBackground(size_t pixel) const { write(pixel, Surface{}); }
 
     private:
-        static constexpr Surface kBackground{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, {0.0f, 0.0f, 0.0f},
-                                             0.0f, 1.0f, 0};
         float* mNormal[3] = {};
         float* mAlbedo[3] = {};
         float* mSpecular[2] = {};
