@@ -210,6 +210,7 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     };
     raster::RasterState state;
     state.cullMode = raster::CullMode::Back;
+    state.barycentrics = false;
     state.depthTest = view.reversedZ() ? raster::DepthTest::Greater : raster::DepthTest::Less;
     rasterizer.draw(raster::TriangleList{mClipPositions, mGeometry.indices}, state,
                     target.depthPlane(), recordVisible);

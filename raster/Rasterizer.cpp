@@ -71,11 +71,12 @@ int clipPolygon(const ClipVertex* in, int count, ClipVertex* out, int plane, flo
     return outCount;
 }
 
-// Attribute planes from the unsnapped screen positions (see AttributePlanes). With the edge
-// function E_ab(p) = (bx-ax)(py-ay) - (by-ay)(px-ax): l1 = E_20 / area, l2 = E_01 / area.
-// A triangle that is degenerate before snapping but not after falls back to the snapped
-// positions, which are then the only consistent description of it.
-void setUpAttributePlanes(SetupTriangle& s, double x[3], double y[3], const double depth[3]) {
+// Depth (and, when asked, barycentric) planes from the unsnapped screen positions (see
+// SetupTriangle). With the edge function E_ab(p) = (bx-ax)(py-ay) - (by-ay)(px-ax):
+// l1 = E_20 / area, l2 = E_01 / area. A triangle that is degenerate before snapping but not
+// after falls back to the snapped positions, which are then the only consistent description.
+void setUpPlanes(SetupTriangle& s, SetupBarycentrics* barycentrics, double x[3], double y[3],
+                 const double depth[3]) {
     double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
     const double snappedArea = (double(s.x[1] - s.x[0]) * (s.y[2] - s.y[0]) -
                                 double(s.y[1] - s.y[0]) * (s.x[2] - s.x[0])) /
@@ -99,13 +100,14 @@ void setUpAttributePlanes(SetupTriangle& s, double x[3], double y[3], const doub
     plane(2, 0, l1);
     plane(0, 1, l2);
     for (int k = 0; k < 3; ++k)
-        s.planes.z[k] = (k == 0 ? depth[0] : 0.0) + l1[k] * (depth[1] - depth[0]) + l2[k] * (depth[2] - depth[0]);
+        s.z[k] = (k == 0 ? depth[0] : 0.0) + l1[k] * (depth[1] - depth[0]) + l2[k] * (depth[2] - depth[0]);
+    if (!barycentrics) return;
     // Barycentrics relative to the bounding-box corner, rounded to float.
-    s.planes.l1[0] = float(l1[0] + l1[1] * s.minX + l1[2] * s.minY);
-    s.planes.l2[0] = float(l2[0] + l2[1] * s.minX + l2[2] * s.minY);
+    barycentrics->l1[0] = float(l1[0] + l1[1] * s.minX + l1[2] * s.minY);
+    barycentrics->l2[0] = float(l2[0] + l2[1] * s.minX + l2[2] * s.minY);
     for (int k = 1; k < 3; ++k) {
-        s.planes.l1[k] = float(l1[k]);
-        s.planes.l2[k] = float(l2[k]);
+        barycentrics->l1[k] = float(l1[k]);
+        barycentrics->l2[k] = float(l2[k]);
     }
 }
 
@@ -131,7 +133,7 @@ Rasterizer::Rasterizer(int width, int height) : mWidth(width), mHeight(height) {
     mTilesY = (height + kTileSize - 1) / kTileSize;
 }
 
-void Rasterizer::setUpAndBin(const TriangleList& triangles, CullMode cullMode) {
+void Rasterizer::setUpAndBin(const TriangleList& triangles, const RasterState& state) {
     const uint32_t triangleCount = triangles.triangleCount();
     const uint32_t batchCount = (triangleCount + kTrianglesPerBatch - 1) / kTrianglesPerBatch;
     // Project and snap every vertex once: a vertex is shared by about six triangles. Vertices
@@ -152,7 +154,7 @@ void Rasterizer::setUpAndBin(const TriangleList& triangles, CullMode cullMode) {
     tbb::parallel_for(uint32_t(0), batchCount, [&](uint32_t b) {
         const uint32_t first = b * kTrianglesPerBatch;
         const uint32_t last = std::min(first + kTrianglesPerBatch, triangleCount);
-        setUpBatch(triangles, first, last, cullMode, mBatches[b]);
+        setUpBatch(triangles, first, last, state, mBatches[b]);
     });
     mStats = RasterStats{};
     for (const Batch& batch : mBatches) {
@@ -164,9 +166,11 @@ void Rasterizer::setUpAndBin(const TriangleList& triangles, CullMode cullMode) {
 }
 
 void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last,
-                            CullMode cullMode, Batch& batch) const {
+                            const RasterState& state, Batch& batch) const {
     batch.triangles.clear();
     batch.triangles.reserve(last - first);  // address space only; pages are touched on use
+    batch.barycentrics.clear();
+    if (state.barycentrics) batch.barycentrics.reserve(last - first);
     batch.clippedWeights.clear();
     batch.pairTile.clear();
     batch.pairTriangle.clear();
@@ -203,7 +207,7 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
                     if (planeDistance(plane, *clipOfVertex[i], guardX, guardY) < 0.0f) needsClip = true;
 
         if (!needsClip) {
-            emitTriangle(clipOfVertex, projected, nullptr, t, cullMode, batch);
+            emitTriangle(clipOfVertex, projected, nullptr, t, state, batch);
             continue;
         }
         ++batch.stats.trianglesClipped;
@@ -223,7 +227,7 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
             const glm::vec4* const pieceClip[3] = {&a.clip, &b.clip, &c.clip};
             const glm::vec3 pieceBarycentric[3] = {a.barycentric, b.barycentric, c.barycentric};
             const ProjectedVertex pieceProjected[3] = {project(a.clip), project(b.clip), project(c.clip)};
-            emitTriangle(pieceClip, pieceProjected, pieceBarycentric, t, cullMode, batch);
+            emitTriangle(pieceClip, pieceProjected, pieceBarycentric, t, state, batch);
         }
     }
     // Counting sort of the (tile, triangle) pairs; stable, so each bin keeps submission order.
@@ -242,9 +246,10 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
 }
 
 void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVertex projected[3],
-                              const glm::vec3 barycentric[3], uint32_t triangle, CullMode cullMode,
-                              Batch& batch) const {
+                              const glm::vec3 barycentric[3], uint32_t triangle,
+                              const RasterState& state, Batch& batch) const {
     SetupTriangle s;
+    float invW[3];
     for (int i = 0; i < 3; ++i) {
         if (projected[i].invW == 0.0f) {
             ++batch.stats.trianglesCulled;
@@ -252,7 +257,7 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
         }
         s.x[i] = projected[i].x;
         s.y[i] = projected[i].y;
-        s.invW[i] = projected[i].invW;
+        invW[i] = projected[i].invW;
     }
     // Signed doubled area in fixed point; with y down, counter-clockwise in NDC is negative.
     const int64_t area = int64_t(s.x[1] - s.x[0]) * (s.y[2] - s.y[0]) -
@@ -262,8 +267,8 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
         return;
     }
     s.frontFacing = area < 0;
-    if ((cullMode == CullMode::Back && !s.frontFacing) ||
-        (cullMode == CullMode::Front && s.frontFacing)) {
+    if ((state.cullMode == CullMode::Back && !s.frontFacing) ||
+        (state.cullMode == CullMode::Front && s.frontFacing)) {
         ++batch.stats.trianglesCulled;
         return;
     }
@@ -271,10 +276,9 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
     if (area < 0) {  // traversal wants positive area: swap vertices 1 and 2
         std::swap(s.x[1], s.x[2]);
         std::swap(s.y[1], s.y[2]);
-        std::swap(s.invW[1], s.invW[2]);
+        std::swap(invW[1], invW[2]);
         std::swap(order[1], order[2]);
     }
-    s.swapped = order[1] == 2;
     // Pixel bounds: pixel p is sampled at p + 0.5, so the first candidate column is
     // ceil(minX - 0.5) and the last floor(maxX - 0.5), in fixed point.
     const int32_t minXf = std::min({s.x[0], s.x[1], s.x[2]});
@@ -295,11 +299,6 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
     s.minY = int16_t(minY);
     s.maxX = int16_t(maxX);
     s.maxY = int16_t(maxY);
-    s.clippedWeights = SetupTriangle::kNotClipped;
-    if (barycentric) {
-        s.clippedWeights = uint32_t(batch.clippedWeights.size());
-        batch.clippedWeights.push_back({barycentric[order[0]], barycentric[order[1]], barycentric[order[2]]});
-    }
     // Unsnapped positions in double, only for triangles that survived culling (most culled
     // triangles are back faces, and these divisions showed in profiles): one per vertex.
     double screenXs[3], screenYs[3], depth[3];
@@ -310,7 +309,18 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
         screenYs[i] = (1.0 - double(c.y) * inverseW) * (0.5 * mHeight);
         depth[i] = double(c.z) * inverseW;
     }
-    setUpAttributePlanes(s, screenXs, screenYs, depth);
+    SetupBarycentrics* barycentrics = nullptr;
+    if (state.barycentrics) {
+        barycentrics = &batch.barycentrics.emplace_back();
+        for (int i = 0; i < 3; ++i) barycentrics->invW[i] = invW[i];
+        barycentrics->swapped = order[1] == 2;
+        barycentrics->clippedWeights = SetupBarycentrics::kNotClipped;
+        if (barycentric) {
+            barycentrics->clippedWeights = uint32_t(batch.clippedWeights.size());
+            batch.clippedWeights.push_back({barycentric[order[0]], barycentric[order[1]], barycentric[order[2]]});
+        }
+    }
+    setUpPlanes(s, barycentrics, screenXs, screenYs, depth);
     s.triangle = triangle;
     const uint32_t index = uint32_t(batch.triangles.size());
     batch.triangles.push_back(s);

@@ -60,6 +60,9 @@ struct RasterState {
     CullMode cullMode = CullMode::Back;
     DepthTest depthTest = DepthTest::Less;
     bool depthWrite = true;
+    // Compute Fragment::barycentric. Passes that find their attributes another way (from the
+    // triangle id and the pixel centre) turn it off and save its set-up; it is then zero.
+    bool barycentrics = true;
 };
 
 // Triangles as indexed clip-space vertices; triangle t uses indices[3t .. 3t+2].
@@ -94,34 +97,41 @@ struct RasterStats {
     uint64_t samplesPassed = 0;  // passed the depth test
 };
 
-// Depth and screen-space barycentrics l1, l2 as affine functions of the pixel index. They are
-// set up in double from the UNSNAPPED vertex positions: snapping may shift a triangle by up to
-// 1/512 pixel, which on a grazing surface moves the reconstructed position by ~1e-4 relative
-// (measured on a tilted plane); coverage uses the snapped edges, attributes do not inherit their
-// error. Depth stays double: z(px, py) = z[0] + z[1] px + z[2] py (pixel centres folded in).
-// The barycentrics are float, relative to the triangle's bounding-box corner to keep their
-// magnitudes small: l(px, py) = l[0] + l[1] (px - minX) + l[2] (py - minY).
-struct AttributePlanes {
+// A triangle after clipping, snapping and orientation fix-up, as the traversal reads it for
+// every tile it is binned into: one cache line. Set-up writes these for every surviving
+// triangle and the traversal reads them back in tile order, so on a dense scene the stream does
+// not fit in cache and its size is what both phases pay for: with the barycentric set-up inline
+// (104 bytes, two or three lines) the G-buffer pass of atrium rasterized ~1 ms slower on one core.
+//
+// Depth is an affine function of the pixel index, set up in double from the UNSNAPPED vertex
+// positions: snapping may shift a triangle by up to 1/512 pixel, which on a grazing surface
+// moves the reconstructed position by ~1e-4 relative (measured on a tilted plane); coverage uses
+// the snapped edges, attributes do not inherit their error.
+// z(px, py) = z[0] + z[1] px + z[2] py (pixel centres folded in). Positive area in the
+// edge-function convention used by the traversal.
+struct alignas(64) SetupTriangle {
     double z[3];
-    float l1[3];
-    float l2[3];
+    int32_t x[3], y[3];  // fixed point, kSubpixelBits fraction bits
+    int16_t minX, minY, maxX, maxY;  // inclusive pixel bounds, clamped to the viewport
+    uint32_t triangle;
+    bool frontFacing;
 };
+static_assert(sizeof(SetupTriangle) == 64, "the traversal reads one cache line per triangle");
 
-// A triangle after clipping, snapping and orientation fix-up; positive area in the
-// edge-function convention used by the traversal. Kept small (it streams through memory
-// between set-up and traversal): clipped pieces keep their weights in a side table.
-struct SetupTriangle {
+// The set-up of Fragment::barycentric, beside SetupTriangle (same index), written only when
+// RasterState::barycentrics is set. Screen-space barycentrics l1, l2 are float, relative to the
+// triangle's bounding-box corner to keep their magnitudes small:
+// l(px, py) = l[0] + l[1] (px - minX) + l[2] (py - minY), from the same unsnapped positions as
+// depth; with invW they give the perspective-correct weights.
+struct SetupBarycentrics {
     static constexpr uint32_t kNotClipped = UINT32_MAX;
 
-    AttributePlanes planes;
-    int32_t x[3], y[3];  // fixed point, kSubpixelBits fraction bits
+    float l1[3];
+    float l2[3];
     float invW[3];
-    uint32_t triangle;
     // Index into Batch::clippedWeights (vertex i as weights of the original triangle's
     // vertices), or kNotClipped: vertex i is original vertex i (1 and 2 swapped if `swapped`).
     uint32_t clippedWeights;
-    int16_t minX, minY, maxX, maxY;  // inclusive pixel bounds, clamped to the viewport
-    bool frontFacing;
     bool swapped;
 };
 static_assert(kMaxViewportSize <= INT16_MAX, "pixel bounds are stored as int16_t");
@@ -149,6 +159,7 @@ private:
     // slowdown).
     struct alignas(64) Batch {
         std::vector<SetupTriangle> triangles;
+        std::vector<SetupBarycentrics> barycentrics;  // empty unless RasterState::barycentrics
         std::vector<std::array<glm::vec3, 3>> clippedWeights;
         // Bins as one compressed table: the triangles (indices into `triangles`, in submission
         // order) of tile t are binItems[binOffsets[t] .. binOffsets[t+1]). Built by a counting
@@ -161,9 +172,9 @@ private:
     };
 
     // Clip, cull, snap and bin all triangles into mBatches (parallel, deterministic).
-    void setUpAndBin(const TriangleList& triangles, CullMode cullMode);
-    void setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last, CullMode cullMode,
-                    Batch& batch) const;
+    void setUpAndBin(const TriangleList& triangles, const RasterState& state);
+    void setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last,
+                    const RasterState& state, Batch& batch) const;
     // A vertex snapped to fixed point; invW == 0 marks one that must not be set up (w <= 0).
     // `outcode` (computed once per vertex, read by each of its ~6 triangles) has one bit per
     // frustum plane the clip position lies outside of, and kNonFinite for NaN/Inf input.
@@ -178,11 +189,16 @@ private:
     // `clip` points at the three clip positions; they are read only for triangles that survive
     // culling (most culled ones are back faces, decided from `projected` alone).
     void emitTriangle(const glm::vec4* const clip[3], const ProjectedVertex projected[3],
-                      const glm::vec3 barycentric[3], uint32_t triangle, CullMode cullMode,
+                      const glm::vec3 barycentric[3], uint32_t triangle, const RasterState& state,
                       Batch& batch) const;
 
     // The depth test is a template parameter so that the per-sample comparison is one
     // instruction, not a switch (draw() dispatches once per tile).
+    // Perspective-correct weights of the original vertices at pixel (px, py) of set-up triangle
+    // `index` (`t`) of `batch`.
+    static glm::vec3 barycentricAt(const Batch& batch, uint32_t index, const SetupTriangle& t,
+                                   int px, int py);
+
     template <DepthTest kDepthTest, class FragmentFn>
     void rasterizeTile(int tileIndex, const RasterState& state, float* depth,
                        FragmentFn& fragmentFn, RasterStats& tileStats) const;
@@ -229,7 +245,7 @@ inline int64_t fillBias(int32_t ax, int32_t ay, int32_t bx, int32_t by) {
 template <class FragmentFn>
 void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, float* depth,
                       FragmentFn&& fragmentFn) {
-    setUpAndBin(triangles, state.cullMode);
+    setUpAndBin(triangles, state);
     const int tileCount = mTilesX * mTilesY;
     mTileStats.assign(size_t(tileCount), TileStats{});
     tbb::parallel_for(0, tileCount, [&](int tile) {
@@ -257,6 +273,22 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
     }
 }
 
+inline glm::vec3 Rasterizer::barycentricAt(const Batch& batch, uint32_t index, const SetupTriangle& t,
+                                           int px, int py) {
+    const SetupBarycentrics& s = batch.barycentrics[index];
+    const float dx = float(px - t.minX), dy = float(py - t.minY);
+    const float l1 = s.l1[0] + s.l1[1] * dx + s.l1[2] * dy;
+    const float l2 = s.l2[0] + s.l2[1] * dx + s.l2[2] * dy;
+    const float q0 = (1.0f - l1 - l2) * s.invW[0], q1 = l1 * s.invW[1], q2 = l2 * s.invW[2];
+    const float invSum = 1.0f / (q0 + q1 + q2);
+    const glm::vec3 b(q0 * invSum, q1 * invSum, q2 * invSum);
+    // Map back to the original vertices (set-up may have clipped the triangle or swapped two
+    // vertices to fix the orientation).
+    if (s.clippedWeights == SetupBarycentrics::kNotClipped) return s.swapped ? glm::vec3(b.x, b.z, b.y) : b;
+    const auto& w = batch.clippedWeights[s.clippedWeights];
+    return w[0] * b.x + w[1] * b.y + w[2] * b.z;
+}
+
 template <DepthTest kDepthTest, class FragmentFn>
 void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* depth,
                                FragmentFn& fragmentFn, RasterStats& tileStats) const {
@@ -271,7 +303,8 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     for (const Batch& batch : mBatches) {
         const uint32_t binEnd = batch.binOffsets[size_t(tileIndex) + 1];
         for (uint32_t item = batch.binOffsets[size_t(tileIndex)]; item < binEnd; ++item) {
-            const SetupTriangle& t = batch.triangles[batch.binItems[item]];
+            const uint32_t index = batch.binItems[item];
+            const SetupTriangle& t = batch.triangles[index];
             const int minX = std::max(int(t.minX), tileMinX), maxX = std::min(int(t.maxX), tileMaxX);
             const int minY = std::max(int(t.minY), tileMinY), maxY = std::min(int(t.maxY), tileMaxY);
             if (minX > maxX || minY > maxY) continue;
@@ -297,12 +330,11 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
             int64_t row1 = edge(x[2], y[2], x[0], y[0], px0, py0);
             int64_t row2 = edge(x[0], y[0], x[1], y[1], px0, py0);
 
-            const AttributePlanes& p = t.planes;
             for (int py = minY; py <= maxY; ++py) {
                 int64_t w0 = row0, w1 = row1, w2 = row2;
                 float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;
                 // Depth plane at (px, py) = (z0 + z2 py) + z1 px; px counts in double (exact).
-                const double zRow = p.z[0] + p.z[2] * py;
+                const double zRow = t.z[0] + t.z[2] * py;
                 double pxDouble = minX;
                 // A triangle's samples in one row are contiguous (the intersection of three
                 // half-planes is convex, biases included), so the row ends at its first
@@ -314,30 +346,17 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                     } else {
                         spanStarted = true;
                         ++samplesCovered;
-                        const float z = float(std::clamp(zRow + p.z[1] * pxDouble, 0.0, 1.0));
+                        const float z = float(std::clamp(zRow + t.z[1] * pxDouble, 0.0, 1.0));
                         bool pass = !depthRow || detail::depthPasses<kDepthTest>(z, depthRow[px]);
                         if (pass) {
                             ++samplesPassed;
                             if (depthRow && state.depthWrite) depthRow[px] = z;
-                            const float dx = float(px - t.minX), dy = float(py - t.minY);
-                            const float l1 = p.l1[0] + p.l1[1] * dx + p.l1[2] * dy;
-                            const float l2 = p.l2[0] + p.l2[1] * dx + p.l2[2] * dy;
-                            const float q0 = (1.0f - l1 - l2) * t.invW[0], q1 = l1 * t.invW[1],
-                                        q2 = l2 * t.invW[2];
-                            const float invSum = 1.0f / (q0 + q1 + q2);
-                            const glm::vec3 b(q0 * invSum, q1 * invSum, q2 * invSum);
                             Fragment fragment;
                             fragment.x = px;
                             fragment.y = py;
                             fragment.depth = z;
-                            // Map back to the original vertices (set-up may have clipped
-                            // the triangle or swapped two vertices to fix the orientation).
-                            if (t.clippedWeights == SetupTriangle::kNotClipped) {
-                                fragment.barycentric = t.swapped ? glm::vec3(b.x, b.z, b.y) : b;
-                            } else {
-                                const auto& w = batch.clippedWeights[t.clippedWeights];
-                                fragment.barycentric = w[0] * b.x + w[1] * b.y + w[2] * b.z;
-                            }
+                            if (state.barycentrics)
+                                fragment.barycentric = barycentricAt(batch, index, t, px, py);
                             fragment.triangle = t.triangle;
                             fragment.frontFacing = t.frontFacing;
                             fragmentFn(fragment);

@@ -225,6 +225,7 @@ void LightVolumeRasterizer::draw(const std::vector<LightSphere>& spheres,
     const raster::TriangleList triangles{mClip, mIndices};
     raster::RasterState state;
     state.depthWrite = false;
+    state.barycentrics = false;  // a volume has no varyings
     // Without stencil only back faces are drawn; quads are wound clockwise (back-facing).
     state.cullMode = mStencil ? raster::CullMode::None : raster::CullMode::Front;
     const bool stencil = mStencil;
