@@ -563,9 +563,9 @@ TEST(RasterizerConstruction, RejectsViewportsOutsideTheSupportedRange) {
     EXPECT_THROW(Rasterizer(kMaxViewportSize + 1, 1), std::invalid_argument);
     const Rasterizer largest(kMaxViewportSize, 1);
     EXPECT_EQ(largest.tileCountX(), kMaxViewportSize / kTileSize);
-    const Rasterizer odd(133, 77);
-    EXPECT_EQ(odd.tileCountX(), 3); // ceil(133 / 64)
-    EXPECT_EQ(odd.tileCountY(), 2); // ceil(77 / 64)
+    const Rasterizer odd(2 * kTileSize + 5, kTileSize + 13);
+    EXPECT_EQ(odd.tileCountX(), 3);
+    EXPECT_EQ(odd.tileCountY(), 2);
 }
 
 // =============================================================================================
@@ -864,10 +864,11 @@ TEST(RasterTopLeft, HorizontalAndVerticalEdgesThroughCentres) {
 // many centres: the union is the square ring's interior with the half-open closed form, the
 // shared centre pixel is covered exactly once.
 TEST(RasterTopLeft, FanVertexOnPixelCentreCoveredOnce) {
-    const int width = 96, height = 72;
+    const int width = kTileSize + 32, height = kTileSize + 8;
     Random random(17);
     const int radius = 12;
-    const glm::ivec2 centres[] = {{40, 30}, {63, 63}, {64, 20}}; // the last two on tile borders
+    // The last two on tile borders.
+    const glm::ivec2 centres[] = {{40, 30}, {kTileSize - 1, kTileSize - 1}, {kTileSize, 20}};
     for (const glm::ivec2 centre : centres) {
         ScreenMesh fan;
         const uint32_t c = fan.addVertex({centre.x + 0.5, centre.y + 0.5});
@@ -1800,7 +1801,8 @@ void expectIdentical(const SoupOutput& a, const SoupOutput& b, const std::string
 TEST(RasterDeterminism, SameOutputForAnyThreadCount) {
     // Let TBB really run 7 threads even on a smaller machine.
     tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, 8);
-    const int width = 211, height = 143; // 4 x 3 tiles, partial at the right and bottom
+    // 4 x 3 tiles, partial at the right and bottom.
+    const int width = 3 * kTileSize + 19, height = 2 * kTileSize + 15;
     const ClipMesh mesh = randomSoup(width, height, 5000, 53); // three set-up batches
     const RasterState states[] = {{CullMode::None, DepthTest::LessEqual, true},
                                   {CullMode::Back, DepthTest::Greater, true},
@@ -1827,7 +1829,7 @@ TEST(RasterDeterminism, SameOutputForAnyThreadCount) {
 TEST(RasterDeterminism, BarycentricsOffChangesNothingButTheBarycentrics) {
     // Passes that resolve attributes themselves skip the barycentric set-up; coverage, depth and
     // statistics must not notice, on a soup with clipped pieces and several set-up batches.
-    const int width = 211, height = 143;
+    const int width = 3 * kTileSize + 19, height = 2 * kTileSize + 15;
     const ClipMesh mesh = randomSoup(width, height, 5000, 67);
     RasterState with{CullMode::None, DepthTest::LessEqual, true};
     RasterState without = with;
@@ -1926,7 +1928,9 @@ TEST_P(RasterViewport, PartlyOffscreenTrianglesMatchOracle) {
 INSTANTIATE_TEST_SUITE_P(
     Sizes, RasterViewport,
     ::testing::Values(glm::ivec2(133, 77), glm::ivec2(1, 1), glm::ivec2(64, 64), glm::ivec2(65, 65),
-                      glm::ivec2(127, 1), glm::ivec2(1, 130), glm::ivec2(200, 129)),
+                      glm::ivec2(127, 1), glm::ivec2(1, 130), glm::ivec2(200, 129),
+                      glm::ivec2(kTileSize, kTileSize), glm::ivec2(kTileSize + 1, 2 * kTileSize + 1),
+                      glm::ivec2(3 * kTileSize - 1, 1)),
     [](const ::testing::TestParamInfo<glm::ivec2>& info) {
         return std::to_string(info.param.x) + "x" + std::to_string(info.param.y);
     });
