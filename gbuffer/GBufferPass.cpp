@@ -154,11 +154,14 @@ void GBufferPass::transformVertices(const FrameView& view) {
 void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
     const int width = target.width();
     const FrameView& view = target.view();
-    const GBuffer::Writer writer = target.writer();
+    const GBuffer::Writer sharedWriter = target.writer();
     // ndcOfPixel's x per column, computed once: the same floats, without a division per pixel.
     std::vector<float> ndcXOfColumn(static_cast<size_t>(width));
     for (int x = 0; x < width; ++x) ndcXOfColumn[size_t(x)] = view.ndcOfPixel(x, 0).x;
     tbb::parallel_for(0, target.height(), [&](int y) {
+        // A copy whose address does not escape, so the plane pointers stay in registers (the
+        // encoded planes' out-of-line call could otherwise change the shared one).
+        const GBuffer::Writer writer = sharedWriter;
         const float ndcY = view.ndcOfPixel(0, y).y;
         uint32_t cornersOf = kNoTriangle;  // the triangle `corners` and `row` describe
         TriangleCorners corners;
