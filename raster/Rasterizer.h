@@ -38,7 +38,9 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 namespace raster {
 
@@ -250,7 +252,7 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
     setUpAndBin(triangles, state);
     const int tileCount = mTilesX * mTilesY;
     mTileStats.assign(size_t(tileCount), TileStats{});
-    tbb::parallel_for(0, tileCount, [&](int tile) {
+    auto rasterize = [&](int tile) {
         RasterStats& stats = mTileStats[size_t(tile)].stats;
         switch (state.depthTest) {
         case DepthTest::Always:
@@ -267,7 +269,15 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
             rasterizeTile<DepthTest::GreaterEqual>(tile, state, depth, fragmentFn, stats);
             break;
         }
-    });
+    };
+    // One task per tile: tiles differ in cost by orders of magnitude (sky against the nave), and
+    // with only tens of them the default partitioner's ranges left one thread waiting.
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tileCount, 1),
+        [&](const tbb::blocked_range<int>& tiles) {
+            for (int tile = tiles.begin(); tile != tiles.end(); ++tile) rasterize(tile);
+        },
+        tbb::simple_partitioner());
     // Sum in a fixed order so the statistics are as deterministic as the pixels.
     for (const TileStats& tile : mTileStats) {
         mStats.samplesCovered += tile.stats.samplesCovered;
