@@ -270,8 +270,9 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
             break;
         }
     };
-    // One task per tile: tiles differ in cost by orders of magnitude (sky against the nave), and
-    // with only tens of them the default partitioner's ranges left one thread waiting.
+    // One task per tile: tiles differ in cost by orders of magnitude (sky against the nave) and
+    // there are only tens of them, so ranges of tiles could leave a thread waiting behind the
+    // other's expensive range (atrium, 2 threads: 1.9-2.0x faster than 1 with this).
     tbb::parallel_for(
         tbb::blocked_range<int>(0, tileCount, 1),
         [&](const tbb::blocked_range<int>& tiles) {
