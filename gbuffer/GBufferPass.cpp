@@ -77,8 +77,23 @@ RowWeights rowWeights(const TriangleCorners& corners, float ndcY) {
     return {glm::cross(corners.clipX, rowY), glm::cross(corners.clipW, rowY)};
 }
 
-[[gnu::always_inline]] inline Surface surfaceAt(const TriangleCorners& corners, const RowWeights& row, bool backFace,
-                                                float ndcX) {
+// The parts of a triangle's surface that do not vary over it: material index, albedo factor
+// (the whole albedo when untextured) and specular. Normal and textured albedo come per pixel from
+// updateSurfaceAt; the G-buffer pass fills this once per run of pixels showing the triangle.
+Surface triangleSurface(const TriangleCorners& corners) {
+    const scenes::Material& material = *corners.material;
+    Surface surface;
+    surface.material = corners.materialIndex;
+    surface.albedo = glm::vec3(material.baseColorFactor);
+    surface.specularIntensity = material.specularIntensity;
+    surface.specularPower = material.specularPower;
+    return surface;
+}
+
+// Sets the pixel-varying parts of `surface` (from triangleSurface of the same corners) at the
+// pixel centre ndcX of the row `row` describes.
+[[gnu::always_inline]] inline void updateSurfaceAt(Surface& surface, const TriangleCorners& corners,
+                                                   const RowWeights& row, bool backFace, float ndcX) {
     // Unnormalised weights: the normal is renormalised anyway, so only the sign of the scale
     // matters there, and the division stays off the per-pixel path unless a texture needs the
     // true weights. sum = 0 (pixel ray parallel to the plane) gives equal weights.
@@ -88,7 +103,6 @@ RowWeights rowWeights(const TriangleCorners& corners, float ndcY) {
         b = glm::vec3(1.0f);
         sum = 3.0f;
     }
-    Surface surface;
     // Two-sided draws light the visible side; a negative weight sum flips the interpolated sum.
     const float sign = (sum < 0.0f) != backFace ? -1.0f : 1.0f;
     if (corners.flat) {
@@ -102,18 +116,12 @@ RowWeights rowWeights(const TriangleCorners& corners, float ndcY) {
         surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2))
                                             : glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
     }
-    surface.material = corners.materialIndex;
-    const scenes::Material& material = *corners.material;
-    glm::vec3 albedo(material.baseColorFactor);
     if (corners.baseColorTexture) {
         const glm::vec2 uv =
             raster::interpolate(corners.uv[0], corners.uv[1], corners.uv[2], b * (1.0f / sum));
-        albedo *= glm::vec3(corners.baseColorTexture->sample(uv));
+        surface.albedo = glm::vec3(corners.material->baseColorFactor) *
+                         glm::vec3(corners.baseColorTexture->sample(uv));
     }
-    surface.albedo = albedo;
-    surface.specularIntensity = material.specularIntensity;
-    surface.specularPower = material.specularPower;
-    return surface;
 }
 
 }  // namespace
@@ -123,7 +131,9 @@ Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& sc
                           std::span<const glm::vec3> normalsView, uint32_t triangle, bool backFace,
                           glm::vec2 ndc) {
     const TriangleCorners corners = loadTriangleCorners(geometry, scene, clipPositions, normalsView, triangle);
-    return surfaceAt(corners, rowWeights(corners, ndc.y), backFace, ndc.x);
+    Surface surface = triangleSurface(corners);
+    updateSurfaceAt(surface, corners, rowWeights(corners, ndc.y), backFace, ndc.x);
+    return surface;
 }
 
 glm::vec3 positionViewOfPixel(const FrameView& view, int x, int y, float depth) {
@@ -166,6 +176,7 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
         uint32_t cornersOf = kNoTriangle;  // the triangle `corners` and `row` describe
         TriangleCorners corners;
         RowWeights row;
+        Surface surface;
         for (int x = 0; x < width; ++x) {
             const size_t pixel = size_t(y) * width + x;
             const uint32_t visible = mVisibleTriangle[pixel];
@@ -178,9 +189,10 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
             if (t != cornersOf) {
                 corners = loadTriangleCorners(mGeometry, mScene, mClipPositions, mNormalView, t);
                 row = rowWeights(corners, ndcY);
+                surface = triangleSurface(corners);
                 cornersOf = t;
             }
-            const Surface surface = surfaceAt(corners, row, backFace, ndcXOfColumn[size_t(x)]);
+            updateSurfaceAt(surface, corners, row, backFace, ndcXOfColumn[size_t(x)]);
             writer.write(pixel, surface);
             if (exact) {
                 exact->triangle[pixel] = t;
