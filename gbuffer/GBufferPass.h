@@ -1,8 +1,9 @@
 // GBufferPass: rasterizes a scene's geometry into a GBuffer (and, on request, the ExactSurface
 // for the reference). Per frame: vertices to clip space and normals to view space (parallel),
-// then one draw with back-face culling and a closer-than depth test; the fragment function
-// interpolates normals and uvs perspective-correctly, samples the base colour texture and writes
-// the G-buffer planes. Deterministic for any thread count (see raster/Rasterizer.h).
+// then one draw with back-face culling and a closer-than depth test that records only the visible
+// triangle per pixel (a visibility buffer); a resolve pass then interpolates normals and uvs
+// perspective-correctly once per pixel, samples the base colour texture and writes the G-buffer
+// planes. Deterministic for any thread count (see raster/Rasterizer.h).
 #pragma once
 
 #include <span>
