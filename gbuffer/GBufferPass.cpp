@@ -105,16 +105,15 @@ Surface triangleSurface(const TriangleCorners& corners) {
     }
     // Two-sided draws light the visible side; a negative weight sum flips the interpolated sum.
     const float sign = (sum < 0.0f) != backFace ? -1.0f : 1.0f;
+    // Zero-length normals (degenerate input) face the viewer.
+    const glm::vec3 zeroNormalFallback(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
     if (corners.flat) {
-        surface.normalView = corners.flatNormalIsZero
-                                 ? glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f)
-                                 : corners.flatNormalView * sign;
+        surface.normalView = corners.flatNormalIsZero ? zeroNormalFallback : corners.flatNormalView * sign;
     } else {
         const glm::vec3 normal = raster::interpolate(corners.normalView[0], corners.normalView[1],
                                                      corners.normalView[2], b);
         const float length2 = glm::dot(normal, normal);
-        surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2))
-                                            : glm::vec3(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
+        surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2)) : zeroNormalFallback;
     }
     if (corners.baseColorTexture) {
         const glm::vec2 uv =
