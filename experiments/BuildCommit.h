@@ -6,4 +6,4 @@
 
 namespace experiments {
 extern const char* const kBuildCommit;
-}  // namespace experiments
+} // namespace experiments

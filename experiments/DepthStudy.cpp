@@ -41,17 +41,20 @@ constexpr double kPlaneInsetRelative = 1e-6;
 constexpr PositionMethod kMethods[] = {PositionMethod::InverseProjection, PositionMethod::ViewRay};
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Largest finite half's bits; the bit patterns of non-negative halves are ordered like their values.
+// Largest finite half's bits; the bit patterns of non-negative halves are ordered like their
+// values.
 constexpr uint64_t kHalfMaxFiniteBits = 0x7BFF;
-constexpr uint64_t kFloatOneBits = 0x3F800000;  // NDC depth never exceeds 1
+constexpr uint64_t kFloatOneBits = 0x3F800000; // NDC depth never exceeds 1
 
 void validate(const DepthStudyOptions& o) {
     if (o.cameras.empty() || o.formats.empty())
         throw std::invalid_argument("depth study: no cameras or no formats");
     if (o.distanceCount < 2 || o.pixelColumns < 2 || o.pixelRows < 2)
-        throw std::invalid_argument("depth study: distanceCount, pixelColumns and pixelRows must be >= 2");
+        throw std::invalid_argument(
+            "depth study: distanceCount, pixelColumns and pixelRows must be >= 2");
     if (o.width < 2 || o.height < 2 || o.pixelColumns > o.width || o.pixelRows > o.height)
-        throw std::invalid_argument("depth study: the pixel grid must fit a screen of at least 2x2");
+        throw std::invalid_argument(
+            "depth study: the pixel grid must fit a screen of at least 2x2");
     if (!(o.verticalFovDegrees > 0.0 && o.verticalFovDegrees < 180.0))
         throw std::invalid_argument("depth study: verticalFovDegrees must be in (0, 180)");
     for (const DepthStudyCamera& c : o.cameras)
@@ -71,7 +74,8 @@ std::string cameraText(DepthStudyCamera c) {
 }
 
 std::string number(double value) {
-    if (std::isnan(value)) return "nan";
+    if (std::isnan(value))
+        return "nan";
     char text[32];
     std::snprintf(text, sizeof text, "%.9g", value);
     return text;
@@ -81,7 +85,7 @@ nlohmann::json jsonNumber(double value) {
     return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
 }
 
-}  // namespace
+} // namespace
 
 DepthStudyOptions DepthStudyOptions::quick() {
     DepthStudyOptions options;
@@ -96,7 +100,7 @@ DepthStudyOptions DepthStudyOptions::quick() {
 DepthSampler::DepthSampler(const DepthStudyOptions& options, DepthStudyCamera camera,
                            DepthFormatSpec format)
     : mFormat(format) {
-    scenes::Camera c;  // at the origin, looking down -Z, +Y up: view space is world space
+    scenes::Camera c; // at the origin, looking down -Z, +Y up: view space is world space
     c.verticalFovRadians = float(options.verticalFovDegrees * kPi / 180.0);
     c.nearMetres = float(camera.nearMetres);
     c.farMetres = float(camera.farMetres);
@@ -137,13 +141,17 @@ glm::vec3 DepthSampler::reconstruct(PositionMethod method, int x, int y, float d
 }
 
 bool DepthSampler::validCode(uint64_t code) const {
-    if (code == gbuffer::clearDepthCode(mFormat, mProjection)) return false;
+    if (code == gbuffer::clearDepthCode(mFormat, mProjection))
+        return false;
     switch (mFormat.kind) {
     case DepthFormatKind::F32:
-    case DepthFormatKind::F32Reversed: return code <= kFloatOneBits;
+    case DepthFormatKind::F32Reversed:
+        return code <= kFloatOneBits;
     case DepthFormatKind::Unorm24:
-    case DepthFormatKind::Unorm16: return code < (uint64_t(1) << mFormat.bits());
-    case DepthFormatKind::F16Linear: return code <= kHalfMaxFiniteBits;
+    case DepthFormatKind::Unorm16:
+        return code < (uint64_t(1) << mFormat.bits());
+    case DepthFormatKind::F16Linear:
+        return code <= kHalfMaxFiniteBits;
     }
     return false;
 }
@@ -155,7 +163,8 @@ double DepthSampler::codeViewDepthExact(uint32_t code) const {
         return mProjection.viewDepthFromNdc(double(std::bit_cast<float>(code)));
     case DepthFormatKind::Unorm24:
     case DepthFormatKind::Unorm16:
-        return mProjection.viewDepthFromNdc(double(code) / double((uint64_t(1) << mFormat.bits()) - 1));
+        return mProjection.viewDepthFromNdc(double(code) /
+                                            double((uint64_t(1) << mFormat.bits()) - 1));
     case DepthFormatKind::F16Linear: {
         Imath::half h;
         h.setBits(uint16_t(code));
@@ -167,15 +176,18 @@ double DepthSampler::codeViewDepthExact(uint32_t code) const {
 
 double DepthSampler::depthStepMetres(double viewDepthMetres) const {
     const float depthNdc = rasterDepthNdc({0.0, 0.0, -viewDepthMetres});
-    if (lost(depthNdc)) return kNaN;
+    if (lost(depthNdc))
+        return kNaN;
     const uint32_t code = gbuffer::encodeDepth(mFormat, mProjection, depthNdc);
     const double here = codeViewDepthExact(code);
     double farther = kNaN, nearer = kNaN;
     for (int64_t delta : {-1, 1}) {
         const int64_t neighbour = int64_t(code) + delta;
-        if (neighbour < 0 || !validCode(uint64_t(neighbour))) continue;
+        if (neighbour < 0 || !validCode(uint64_t(neighbour)))
+            continue;
         const double d = codeViewDepthExact(uint32_t(neighbour));
-        if (!(std::isfinite(d) && d > 0.0)) continue;
+        if (!(std::isfinite(d) && d > 0.0))
+            continue;
         (d > here ? farther : nearer) = d;
     }
     return !std::isnan(farther) ? farther - here : here - nearer;
@@ -190,7 +202,7 @@ std::vector<double> depthStudyDistances(const DepthStudyOptions& options, DepthS
     for (int i = 0; i < options.distanceCount; ++i)
         distances[size_t(i)] =
             first * std::pow(last / first, double(i) / double(options.distanceCount - 1));
-    distances.back() = last;  // exactly, not pow's rounding of it
+    distances.back() = last; // exactly, not pow's rounding of it
     return distances;
 }
 
@@ -232,7 +244,8 @@ DepthStudyResult runDepthStudy(const DepthStudyOptions& options) {
                         ++row.lostCount;
                         continue;
                     }
-                    const glm::dvec3 got(sampler.reconstruct(kMethods[m], pixel.x, pixel.y, depthNdc));
+                    const glm::dvec3 got(
+                        sampler.reconstruct(kMethods[m], pixel.x, pixel.y, depthNdc));
                     const double error = glm::length(got - exact);
                     relativeSum += error / d;
                     row.maxRelativeError = std::max(row.maxRelativeError, error / d);
@@ -240,7 +253,8 @@ DepthStudyResult runDepthStudy(const DepthStudyOptions& options) {
                 }
                 const int measured = row.sampleCount - row.lostCount;
                 row.meanRelativeError = measured > 0 ? relativeSum / measured : kNaN;
-                if (measured == 0) row.maxRelativeError = row.maxAbsoluteErrorMetres = kNaN;
+                if (measured == 0)
+                    row.maxRelativeError = row.maxAbsoluteErrorMetres = kNaN;
             }
         }
     });
@@ -310,7 +324,8 @@ nlohmann::json depthStudyJson(const DepthStudyResult& result) {
     nlohmann::json& options = json["options"];
     for (const DepthStudyCamera& c : o.cameras)
         options["cameras"].push_back({{"near", c.nearMetres}, {"far", c.farMetres}});
-    for (const DepthFormatSpec& f : o.formats) options["formats"].push_back(f.text());
+    for (const DepthFormatSpec& f : o.formats)
+        options["formats"].push_back(f.text());
     options["distance_count"] = o.distanceCount;
     options["pixel_grid"] = {o.pixelColumns, o.pixelRows};
     options["width"] = o.width;
@@ -362,9 +377,10 @@ nlohmann::json depthStudyJson(const DepthStudyResult& result) {
 
 std::string depthSummaryTable(const DepthStudyResult& result) {
     std::ostringstream table;
-    table << "max relative position error |p' - p| / d over d in [far/2, far]; lost = fraction of "
-             "those samples read as background;\nfirst > 1e-3 = first distance (m) with error > 1e-3 "
-             "or a lost sample\n";
+    table
+        << "max relative position error |p' - p| / d over d in [far/2, far]; lost = fraction of "
+           "those samples read as background;\nfirst > 1e-3 = first distance (m) with error > 1e-3 "
+           "or a lost sample\n";
     const size_t methodCount = std::size(kMethods);
     std::string lastCamera;
     char line[200];
@@ -422,11 +438,11 @@ int runDepthCommand(const DepthCommandOptions& options) {
             return fail("plots need python3 with matplotlib (Debian: apt-get install "
                         "python3-matplotlib; or --python PATH); depth.csv and depth.json are in " +
                         options.out.string());
-        const int status =
-            runProcess({python, script.string(), (options.out / "depth.json").string(), options.out.string()});
+        const int status = runProcess(
+            {python, script.string(), (options.out / "depth.json").string(), options.out.string()});
         if (status != 0)
-            return fail("plot script failed (" + python + " " + script.string() + "), exit status " +
-                        std::to_string(status));
+            return fail("plot script failed (" + python + " " + script.string() +
+                        "), exit status " + std::to_string(status));
         std::cout << "study " << number(result.studySeconds) << " s; outputs in "
                   << options.out.string() << "\n";
         return 0;
@@ -435,4 +451,4 @@ int runDepthCommand(const DepthCommandOptions& options) {
     }
 }
 
-}  // namespace experiments
+} // namespace experiments

@@ -59,11 +59,11 @@ struct DepthStudyCamera {
 
 struct DepthStudyOptions {
     // The range "0.01/100 to 0.1/10000", plus a near plane pushed out to 1 m.
-    std::vector<DepthStudyCamera> cameras{{0.01, 100.0}, {0.1, 1000.0}, {0.1, 10000.0},
-                                          {1.0, 10000.0}};
+    std::vector<DepthStudyCamera> cameras{
+        {0.01, 100.0}, {0.1, 1000.0}, {0.1, 10000.0}, {1.0, 10000.0}};
     std::vector<gbuffer::DepthFormatSpec> formats = gbuffer::allDepthFormatSpecs();
-    int distanceCount = 200;  // log-spaced, near..far (just inside both)
-    int pixelColumns = 64;    // pixel grid over the screen, corners included
+    int distanceCount = 200; // log-spaced, near..far (just inside both)
+    int pixelColumns = 64;   // pixel grid over the screen, corners included
     int pixelRows = 36;
     int width = 1280;
     int height = 720;
@@ -79,11 +79,11 @@ struct DepthErrorRow {
     gbuffer::PositionMethod method = gbuffer::PositionMethod::InverseProjection;
     DepthStudyCamera camera;
     double distanceMetres = 0.0;
-    double meanRelativeError = 0.0;  // over measured (not lost) samples; NaN when all are lost
+    double meanRelativeError = 0.0; // over measured (not lost) samples; NaN when all are lost
     double maxRelativeError = 0.0;
     double maxAbsoluteErrorMetres = 0.0;
-    int sampleCount = 0;  // pixels in the grid
-    int lostCount = 0;    // samples read as background (see the model above)
+    int sampleCount = 0; // pixels in the grid
+    int lostCount = 0;   // samples read as background (see the model above)
 };
 
 // Metres between the code a surface at `distanceMetres` encodes to and its farther neighbour
@@ -92,7 +92,7 @@ struct DepthStepRow {
     gbuffer::DepthFormatSpec format;
     DepthStudyCamera camera;
     double distanceMetres = 0.0;
-    double stepMetres = 0.0;  // NaN when the surface is lost (its NDC depth is the clear value)
+    double stepMetres = 0.0; // NaN when the surface is lost (its NDC depth is the clear value)
 };
 
 // Per (format, method, camera): the figures of the printed table.
@@ -142,8 +142,8 @@ private:
     gbuffer::DepthFormatSpec mFormat;
     gbuffer::FrameView mView;
     gbuffer::DepthProjection mProjection;
-    glm::dmat4 mRasterClipFromView;  // the float matrix, widened: what the rasterizer applies
-    double mViewXPerNdc = 1.0;       // exact: x_view = ndc.x * d * mViewXPerNdc
+    glm::dmat4 mRasterClipFromView; // the float matrix, widened: what the rasterizer applies
+    double mViewXPerNdc = 1.0;      // exact: x_view = ndc.x * d * mViewXPerNdc
     double mViewYPerNdc = 1.0;
 };
 
@@ -177,4 +177,4 @@ std::filesystem::path defaultDepthPlotsScript();
 // are written before the plots are attempted.
 int runDepthCommand(const DepthCommandOptions& options);
 
-}  // namespace experiments
+} // namespace experiments

@@ -54,7 +54,8 @@ std::vector<float> channelPlane(const OIIO::ImageBuf& image, int channel) {
     roi.chbegin = channel;
     roi.chend = channel + 1;
     if (!image.get_pixels(roi, OIIO::TypeDesc::FLOAT, plane.data()))
-        throw std::runtime_error("cannot read channel " + std::to_string(channel) + ": " + image.geterror());
+        throw std::runtime_error("cannot read channel " + std::to_string(channel) + ": " +
+                                 image.geterror());
     return plane;
 }
 
@@ -62,33 +63,40 @@ lighting::StageResult beautyAsStageResult(const OIIO::ImageBuf& rgb) {
     lighting::StageResult result;
     result.width = rgb.spec().width;
     result.height = rgb.spec().height;
-    for (int c = 0; c < 3; ++c) result.radiance[c] = channelPlane(rgb, c);
+    for (int c = 0; c < 3; ++c)
+        result.radiance[c] = channelPlane(rgb, c);
     return result;
 }
 
 OIIO::ImageBufAlgo::PixelStats pixelStats(const OIIO::ImageBuf& image) {
     OIIO::ImageBufAlgo::PixelStats stats = OIIO::ImageBufAlgo::computePixelStats(image);
-    if (image.has_error()) throw std::runtime_error("cannot compute statistics: " + image.geterror());
+    if (image.has_error())
+        throw std::runtime_error("cannot compute statistics: " + image.geterror());
     return stats;
 }
 
 json numberOrText(double value) {
-    if (std::isfinite(value)) return value;
+    if (std::isfinite(value))
+        return value;
     return std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf";
 }
 
 std::string formatNumber(double value) {
-    if (std::isnan(value)) return "NaN";
-    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    if (std::isnan(value))
+        return "NaN";
+    if (std::isinf(value))
+        return value > 0 ? "inf" : "-inf";
     char buffer[64];
     std::snprintf(buffer, sizeof buffer, "%.6g", value);
     return buffer;
 }
 
 void writeDiffPlot(const DiffCommandOptions& options, const ImageDiff& diff, const fs::path& png) {
-    const fs::path script = options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
+    const fs::path script =
+        options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
     if (!fs::is_regular_file(script))
-        throw std::runtime_error("plot script " + script.string() + " not found (use --plots-script)");
+        throw std::runtime_error("plot script " + script.string() +
+                                 " not found (use --plots-script)");
     const std::string python = requirePythonWithMatplotlib(options.python);
     // The plot script reads raw float32; the temporary file is removed whatever happens.
     const fs::path raw = options.out / (".absdiff.tmp-" + std::to_string(getpid()) + ".f32");
@@ -103,27 +111,32 @@ void writeDiffPlot(const DiffCommandOptions& options, const ImageDiff& diff, con
         std::ofstream file(raw, std::ios::binary);
         file.write(reinterpret_cast<const char*>(diff.maxAbsDifference.data()),
                    std::streamsize(diff.maxAbsDifference.size() * sizeof(float)));
-        if (!file) throw std::runtime_error("cannot write " + raw.string());
+        if (!file)
+            throw std::runtime_error("cannot write " + raw.string());
     }
-    const int status = runProcess({python, script.string(), "diff", "--raw", raw.string(), "--width",
-                                   std::to_string(diff.width), "--height", std::to_string(diff.height),
-                                   "--vmax", formatNumber(diff.metrics.maxAbs), "--out", png.string()});
+    const int status =
+        runProcess({python, script.string(), "diff", "--raw", raw.string(), "--width",
+                    std::to_string(diff.width), "--height", std::to_string(diff.height), "--vmax",
+                    formatNumber(diff.metrics.maxAbs), "--out", png.string()});
     if (status != 0)
         throw std::runtime_error("plot script " + script.string() + " failed (exit status " +
                                  std::to_string(status) + ")");
 }
 
 std::string statsCells(double min, double max, double mean) {
-    return "<td>" + formatNumber(min) + "</td><td>" + formatNumber(max) + "</td><td>" + formatNumber(mean) + "</td>";
+    return "<td>" + formatNumber(min) + "</td><td>" + formatNumber(max) + "</td><td>" +
+           formatNumber(mean) + "</td>";
 }
 
 std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
     const DiffMetrics& m = diff.metrics;
     std::ostringstream html;
     const std::string a = options.a.string(), b = options.b.string();
-    html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>testbed diff: "
-         << htmlEscape(options.a.filename().string()) << " vs " << htmlEscape(options.b.filename().string())
-         << "</title>\n" << pageCheckScript()
+    html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>testbed "
+            "diff: "
+         << htmlEscape(options.a.filename().string()) << " vs "
+         << htmlEscape(options.b.filename().string()) << "</title>\n"
+         << pageCheckScript()
          << "<style>\nbody { font-family: DejaVu Sans, sans-serif; margin: 1.5em; color: #222; }\n"
             "table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }\n"
             "th, td { border: 1px solid #ccc; padding: 2px 8px; text-align: right; }\n"
@@ -132,59 +145,74 @@ std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
             "figure img { max-width: 640px; border: 1px solid #ddd; }\n"
             "figure img.preview { width: 480px; image-rendering: pixelated; }\n"
             "#page-check { font-size: 0.7em; color: #888; }\n</style>\n</head>\n<body>\n";
-    html << "<h1>Image diff</h1>\n<p>A = <code>" << htmlEscape(a) << "</code><br>B = <code>" << htmlEscape(b)
-         << "</code> (the reference)<br>" << diff.width << " &times; " << diff.height << " pixels</p>\n";
+    html << "<h1>Image diff</h1>\n<p>A = <code>" << htmlEscape(a) << "</code><br>B = <code>"
+         << htmlEscape(b) << "</code> (the reference)<br>" << diff.width << " &times; "
+         << diff.height << " pixels</p>\n";
     html << "<h2>Metrics on the beauty R, G, B</h2>\n<table>\n"
-         << "<tr><th>RMSE</th><th>relative RMSE</th><th>PSNR (dB)</th><th>max abs</th><th>mean abs</th>"
+         << "<tr><th>RMSE</th><th>relative RMSE</th><th>PSNR (dB)</th><th>max abs</th><th>mean "
+            "abs</th>"
             "<th>relative mean</th><th>99th percentile abs</th></tr>\n<tr><td>"
          << formatNumber(m.rmse) << "</td><td>" << formatNumber(m.relativeRmse) << "</td><td>"
          << formatNumber(m.psnr) << "</td><td>" << formatNumber(m.maxAbs) << "</td><td>"
          << formatNumber(m.meanAbs) << "</td><td>" << formatNumber(m.relativeMean) << "</td><td>"
          << formatNumber(m.p99Abs) << "</td></tr>\n</table>\n"
-         << "<p>relative RMSE = RMSE / RMS of B; relative mean = mean |A &minus; B| / |mean of B|; PSNR peak = "
+         << "<p>relative RMSE = RMSE / RMS of B; relative mean = mean |A &minus; B| / |mean of B|; "
+            "PSNR peak = "
             "the largest channel value of B.</p>\n";
     html << "<h2>Images</h2>\n"
-         << "<figure><a href=\"a.png\"><img class=\"preview\" src=\"a.png\" alt=\"A\"></a><figcaption>A (tone-mapped, exposure "
+         << "<figure><a href=\"a.png\"><img class=\"preview\" src=\"a.png\" "
+            "alt=\"A\"></a><figcaption>A (tone-mapped, exposure "
          << formatNumber(options.exposure) << ")</figcaption></figure>\n"
-         << "<figure><a href=\"b.png\"><img class=\"preview\" src=\"b.png\" alt=\"B\"></a><figcaption>B (tone-mapped, exposure "
+         << "<figure><a href=\"b.png\"><img class=\"preview\" src=\"b.png\" "
+            "alt=\"B\"></a><figcaption>B (tone-mapped, exposure "
          << formatNumber(options.exposure) << ")</figcaption></figure>\n"
-         << "<figure><a href=\"absdiff.png\"><img class=\"plot\" src=\"absdiff.png\" alt=\"|A-B|\"></a>"
+         << "<figure><a href=\"absdiff.png\"><img class=\"plot\" src=\"absdiff.png\" "
+            "alt=\"|A-B|\"></a>"
             "<figcaption>|A &minus; B|, maximum over R, G, B, linear radiance; the full-precision "
             "difference is in <a href=\"absdiff.exr\">absdiff.exr</a></figcaption></figure>\n";
-    html << "<h2>Per-channel statistics</h2>\n<p>Every channel present in both files; min, max and mean "
-            "over finite values.</p>\n<table>\n<tr><th rowspan=\"2\">channel</th><th colspan=\"3\">A</th>"
-            "<th colspan=\"3\">B</th><th colspan=\"3\">A &minus; B</th><th colspan=\"2\">|A &minus; B|</th>"
+    html << "<h2>Per-channel statistics</h2>\n<p>Every channel present in both files; min, max and "
+            "mean "
+            "over finite values.</p>\n<table>\n<tr><th rowspan=\"2\">channel</th><th "
+            "colspan=\"3\">A</th>"
+            "<th colspan=\"3\">B</th><th colspan=\"3\">A &minus; B</th><th colspan=\"2\">|A "
+            "&minus; B|</th>"
             "<th rowspan=\"2\">NaN / inf in A, B</th></tr>\n<tr>";
-    for (int i = 0; i < 3; ++i) html << "<th>min</th><th>max</th><th>mean</th>";
+    for (int i = 0; i < 3; ++i)
+        html << "<th>min</th><th>max</th><th>mean</th>";
     html << "<th>max</th><th>mean</th></tr>\n";
     for (const ChannelStatistics& c : diff.channels)
-        html << "<tr><td class=\"text\">" << htmlEscape(c.name) << "</td>" << statsCells(c.minA, c.maxA, c.meanA)
-             << statsCells(c.minB, c.maxB, c.meanB)
+        html << "<tr><td class=\"text\">" << htmlEscape(c.name) << "</td>"
+             << statsCells(c.minA, c.maxA, c.meanA) << statsCells(c.minB, c.maxB, c.meanB)
              << statsCells(c.minDifference, c.maxDifference, c.meanDifference) << "<td>"
-             << formatNumber(c.maxAbsDifference) << "</td><td>" << formatNumber(c.meanAbsDifference) << "</td><td>"
-             << c.nanA << " / " << c.infA << ", " << c.nanB << " / " << c.infB << "</td></tr>\n";
+             << formatNumber(c.maxAbsDifference) << "</td><td>" << formatNumber(c.meanAbsDifference)
+             << "</td><td>" << c.nanA << " / " << c.infA << ", " << c.nanB << " / " << c.infB
+             << "</td></tr>\n";
     html << "</table>\n";
     auto list = [&](const char* what, const std::vector<std::string>& names) {
-        if (names.empty()) return;
+        if (names.empty())
+            return;
         html << "<p>Only in " << what << ":";
-        for (const std::string& name : names) html << " <code>" << htmlEscape(name) << "</code>";
+        for (const std::string& name : names)
+            html << " <code>" << htmlEscape(name) << "</code>";
         html << "</p>\n";
     };
     list("A", diff.onlyInA);
     list("B", diff.onlyInB);
-    html << "<pre id=\"page-check\" data-status=\"pending\">PAGE-CHECK: PENDING</pre>\n</body>\n</html>\n";
+    html << "<pre id=\"page-check\" data-status=\"pending\">PAGE-CHECK: "
+            "PENDING</pre>\n</body>\n</html>\n";
     return html.str();
 }
 
-}  // namespace
+} // namespace
 
 ImageDiff diffImageFiles(const fs::path& aPath, const fs::path& bPath) {
     const OIIO::ImageBuf a = readImage(aPath), b = readImage(bPath);
     const OIIO::ImageSpec &specA = a.spec(), &specB = b.spec();
     if (specA.width != specB.width || specA.height != specB.height)
-        throw std::runtime_error("image sizes differ: " + aPath.string() + " is " + std::to_string(specA.width) +
-                                 "x" + std::to_string(specA.height) + ", " + bPath.string() + " is " +
-                                 std::to_string(specB.width) + "x" + std::to_string(specB.height));
+        throw std::runtime_error("image sizes differ: " + aPath.string() + " is " +
+                                 std::to_string(specA.width) + "x" + std::to_string(specA.height) +
+                                 ", " + bPath.string() + " is " + std::to_string(specB.width) +
+                                 "x" + std::to_string(specB.height));
     std::vector<int> beautyA, beautyB;
     for (const char* name : kBeauty) {
         beautyA.push_back(channelIndex(a, name));
@@ -236,13 +264,16 @@ ImageDiff diffImageFiles(const fs::path& aPath, const fs::path& bPath) {
         commonB.push_back(inB);
     }
     for (int c = 0; c < specB.nchannels; ++c)
-        if (channelIndex(a, specB.channelnames[size_t(c)]) < 0) diff.onlyInB.push_back(specB.channelnames[size_t(c)]);
+        if (channelIndex(a, specB.channelnames[size_t(c)]) < 0)
+            diff.onlyInB.push_back(specB.channelnames[size_t(c)]);
     const OIIO::ImageBuf allA = selectChannels(a, commonA), allB = selectChannels(b, commonB);
     OIIO::ImageBuf difference, absDifference;
-    if (!OIIO::ImageBufAlgo::sub(difference, allA, allB) || !OIIO::ImageBufAlgo::absdiff(absDifference, allA, allB))
-        throw std::runtime_error("cannot compute A - B: " + difference.geterror() + absDifference.geterror());
-    const auto statsA = pixelStats(allA), statsB = pixelStats(allB), statsDifference = pixelStats(difference),
-               statsAbs = pixelStats(absDifference);
+    if (!OIIO::ImageBufAlgo::sub(difference, allA, allB) ||
+        !OIIO::ImageBufAlgo::absdiff(absDifference, allA, allB))
+        throw std::runtime_error("cannot compute A - B: " + difference.geterror() +
+                                 absDifference.geterror());
+    const auto statsA = pixelStats(allA), statsB = pixelStats(allB),
+               statsDifference = pixelStats(difference), statsAbs = pixelStats(absDifference);
     for (size_t i = 0; i < commonA.size(); ++i) {
         ChannelStatistics s;
         s.name = specA.channelnames[size_t(commonA[i])];
@@ -262,11 +293,23 @@ json diffJson(const ImageDiff& diff, const fs::path& a, const fs::path& b) {
     const DiffMetrics& m = diff.metrics;
     json channels = json::array();
     for (const ChannelStatistics& c : diff.channels)
-        channels.push_back({{"name", c.name},
-                            {"a", {{"min", c.minA}, {"max", c.maxA}, {"mean", c.meanA}, {"nan", c.nanA}, {"inf", c.infA}}},
-                            {"b", {{"min", c.minB}, {"max", c.maxB}, {"mean", c.meanB}, {"nan", c.nanB}, {"inf", c.infB}}},
-                            {"difference", {{"min", c.minDifference}, {"max", c.maxDifference}, {"mean", c.meanDifference}}},
-                            {"abs_difference", {{"max", c.maxAbsDifference}, {"mean", c.meanAbsDifference}}}});
+        channels.push_back(
+            {{"name", c.name},
+             {"a",
+              {{"min", c.minA},
+               {"max", c.maxA},
+               {"mean", c.meanA},
+               {"nan", c.nanA},
+               {"inf", c.infA}}},
+             {"b",
+              {{"min", c.minB},
+               {"max", c.maxB},
+               {"mean", c.meanB},
+               {"nan", c.nanB},
+               {"inf", c.infB}}},
+             {"difference",
+              {{"min", c.minDifference}, {"max", c.maxDifference}, {"mean", c.meanDifference}}},
+             {"abs_difference", {{"max", c.maxAbsDifference}, {"mean", c.meanAbsDifference}}}});
     return {{"a", a.string()},
             {"b", b.string()},
             {"width", diff.width},
@@ -295,19 +338,23 @@ int runDiffCommand(const DiffCommandOptions& options) {
                         diff.beautyA[2].data(), options.exposure);
         writePreviewPng(options.out / "b.png", w, h, diff.beautyB[0].data(), diff.beautyB[1].data(),
                         diff.beautyB[2].data(), options.exposure);
-        writeMultiLayerExr(options.out / "absdiff.exr", w, h,
-                           {{"R", diff.absDifference[0].data()},
-                            {"G", diff.absDifference[1].data()},
-                            {"B", diff.absDifference[2].data()}},
-                           {{"testbed:diff", "|A - B| of " + options.a.string() + " and " + options.b.string()}});
+        writeMultiLayerExr(
+            options.out / "absdiff.exr", w, h,
+            {{"R", diff.absDifference[0].data()},
+             {"G", diff.absDifference[1].data()},
+             {"B", diff.absDifference[2].data()}},
+            {{"testbed:diff", "|A - B| of " + options.a.string() + " and " + options.b.string()}});
         writeDiffPlot(options, diff, options.out / "absdiff.png");
-        writeTextAtomically(options.out / "diff.json", diffJson(diff, options.a, options.b).dump(2) + "\n");
+        writeTextAtomically(options.out / "diff.json",
+                            diffJson(diff, options.a, options.b).dump(2) + "\n");
         writeTextAtomically(options.out / "index.html", diffPage(diff, options));
         const DiffMetrics& m = diff.metrics;
-        std::cout << "testbed: diff of " << options.a.string() << " and " << options.b.string() << " (" << w << "x"
-                  << h << "): rmse " << formatNumber(m.rmse) << ", psnr " << formatNumber(m.psnr) << " dB, max_abs "
-                  << formatNumber(m.maxAbs) << ", relative_mean " << formatNumber(m.relativeMean) << ", p99_abs "
-                  << formatNumber(m.p99Abs) << "\n  report: " << (options.out / "index.html").string() << "\n";
+        std::cout << "testbed: diff of " << options.a.string() << " and " << options.b.string()
+                  << " (" << w << "x" << h << "): rmse " << formatNumber(m.rmse) << ", psnr "
+                  << formatNumber(m.psnr) << " dB, max_abs " << formatNumber(m.maxAbs)
+                  << ", relative_mean " << formatNumber(m.relativeMean) << ", p99_abs "
+                  << formatNumber(m.p99Abs)
+                  << "\n  report: " << (options.out / "index.html").string() << "\n";
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "testbed: error: " << e.what() << "\n";
@@ -315,4 +362,4 @@ int runDiffCommand(const DiffCommandOptions& options) {
     }
 }
 
-}  // namespace experiments
+} // namespace experiments

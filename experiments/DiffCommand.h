@@ -38,11 +38,11 @@ namespace experiments {
 
 struct DiffCommandOptions {
     std::filesystem::path a;
-    std::filesystem::path b;                   // the reference
+    std::filesystem::path b; // the reference
     std::filesystem::path out = "diff";
-    std::filesystem::path plotsScript;         // empty = experiments/plots/report.py
-    std::string python;                        // empty = found as for `testbed report`
-    float exposure = 1.0f;                     // linear factor applied before tone mapping
+    std::filesystem::path plotsScript; // empty = experiments/plots/report.py
+    std::string python;                // empty = found as for `testbed report`
+    float exposure = 1.0f;             // linear factor applied before tone mapping
 };
 
 struct DiffMetrics {
@@ -59,15 +59,15 @@ struct ChannelStatistics {
     std::string name;
     double minA = 0, maxA = 0, meanA = 0, minB = 0, maxB = 0, meanB = 0;
     long nanA = 0, infA = 0, nanB = 0, infB = 0;
-    double minDifference = 0, maxDifference = 0, meanDifference = 0;  // A - B
-    double maxAbsDifference = 0, meanAbsDifference = 0;                // |A - B|
+    double minDifference = 0, maxDifference = 0, meanDifference = 0; // A - B
+    double maxAbsDifference = 0, meanAbsDifference = 0;              // |A - B|
 };
 
 struct ImageDiff {
     int width = 0;
     int height = 0;
     DiffMetrics metrics;
-    std::vector<ChannelStatistics> channels;  // in A's channel order
+    std::vector<ChannelStatistics> channels; // in A's channel order
     std::vector<std::string> onlyInA, onlyInB;
     // Images for the report: beauty planes of A and B, |A - B| per beauty channel, and the
     // maximum over R, G, B of |A - B| (width * height each, row 0 at the top).
@@ -78,9 +78,10 @@ struct ImageDiff {
 // (unreadable, sizes differ, R/G/B missing).
 ImageDiff diffImageFiles(const std::filesystem::path& a, const std::filesystem::path& b);
 
-nlohmann::json diffJson(const ImageDiff& diff, const std::filesystem::path& a, const std::filesystem::path& b);
+nlohmann::json diffJson(const ImageDiff& diff, const std::filesystem::path& a,
+                        const std::filesystem::path& b);
 
 // Writes DIR (see above); returns the exit code.
 int runDiffCommand(const DiffCommandOptions& options);
 
-}  // namespace experiments
+} // namespace experiments

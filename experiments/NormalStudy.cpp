@@ -36,7 +36,6 @@
 #define TESTBED_SOURCE_DIR "."
 #endif
 
-
 namespace experiments {
 
 namespace {

@@ -132,5 +132,4 @@ NormalStudyResult runNormalStudy(const NormalStudyOptions& options,
 // the process exit code (errors printed to stderr).
 int runNormalStudyCommand(const NormalStudyOptions& options);
 
-
 } // namespace experiments

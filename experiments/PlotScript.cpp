@@ -17,21 +17,24 @@ namespace experiments {
 namespace {
 
 std::vector<std::string> pythonCandidates(const std::string& requested) {
-    if (!requested.empty()) return {requested};
+    if (!requested.empty())
+        return {requested};
     return {"/usr/bin/python3", "python3"};
 }
 
-}  // namespace
+} // namespace
 
 std::filesystem::path plotScriptPath(const std::string& fileName) {
     return std::filesystem::path(TESTBED_SOURCE_DIR) / "experiments" / "plots" / fileName;
 }
 
 int runProcess(const std::vector<std::string>& argv, bool quiet) {
-    if (argv.empty()) return 127;
-    std::fflush(nullptr);  // nothing buffered may be written twice by the child
+    if (argv.empty())
+        return 127;
+    std::fflush(nullptr); // nothing buffered may be written twice by the child
     const pid_t child = fork();
-    if (child < 0) return 127;
+    if (child < 0)
+        return 127;
     if (child == 0) {
         if (quiet) {
             const int null = open("/dev/null", O_WRONLY);
@@ -41,28 +44,34 @@ int runProcess(const std::vector<std::string>& argv, bool quiet) {
             }
         }
         std::vector<char*> args;
-        for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+        for (const std::string& arg : argv)
+            args.push_back(const_cast<char*>(arg.c_str()));
         args.push_back(nullptr);
         execvp(args[0], args.data());
         _exit(127);
     }
     int status = 0;
     while (waitpid(child, &status, 0) < 0)
-        if (errno != EINTR) return 127;
-    if (WIFEXITED(status)) return WEXITSTATUS(status);
-    if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+        if (errno != EINTR)
+            return 127;
+    if (WIFEXITED(status))
+        return WEXITSTATUS(status);
+    if (WIFSIGNALED(status))
+        return 128 + WTERMSIG(status);
     return 127;
 }
 
 std::string findPythonWithMatplotlib(const std::string& requested) {
     for (const std::string& python : pythonCandidates(requested))
-        if (runProcess({python, "-c", "import matplotlib, numpy"}, true) == 0) return python;
+        if (runProcess({python, "-c", "import matplotlib, numpy"}, true) == 0)
+            return python;
     return "";
 }
 
 std::string requirePythonWithMatplotlib(const std::string& requested) {
     const std::string python = findPythonWithMatplotlib(requested);
-    if (!python.empty()) return python;
+    if (!python.empty())
+        return python;
     std::string tried;
     for (const std::string& candidate : pythonCandidates(requested))
         tried += (tried.empty() ? "" : ", ") + candidate;
@@ -70,4 +79,4 @@ std::string requirePythonWithMatplotlib(const std::string& requested) {
                              "); install Debian's python3-matplotlib, or pass --python PATH");
 }
 
-}  // namespace experiments
+} // namespace experiments

@@ -26,4 +26,4 @@ std::string findPythonWithMatplotlib(const std::string& requested);
 // The same, but throws std::runtime_error naming what was tried and what to install.
 std::string requirePythonWithMatplotlib(const std::string& requested);
 
-}  // namespace experiments
+} // namespace experiments

@@ -21,7 +21,6 @@
 #include "lighting/StageRegistry.h"
 #include "scenes/Scene.h"
 
-
 namespace experiments {
 
 namespace {
@@ -43,18 +42,23 @@ DecodedLayers decodeLayers(const gbuffer::GBuffer& gb) {
     const bool normals = layout.provides(gbuffer::Channel::Normal);
     const bool albedo = layout.provides(gbuffer::Channel::Albedo);
     for (int c = 0; c < 3; ++c) {
-        if (normals) layers.normal[c].assign(n, 0.0f);
-        if (albedo) layers.albedo[c].assign(n, 0.0f);
+        if (normals)
+            layers.normal[c].assign(n, 0.0f);
+        if (albedo)
+            layers.albedo[c].assign(n, 0.0f);
     }
     tbb::parallel_for(0, gb.height(), [&](int y) {
         for (int x = 0; x < gb.width(); ++x) {
             const size_t pixel = size_t(y) * gb.width() + x;
-            if (!gb.covered(pixel)) continue;
+            if (!gb.covered(pixel))
+                continue;
             const gbuffer::Surface s = gb.decode(x, y);
             layers.z[pixel] = -s.positionView.z;
             for (int c = 0; c < 3; ++c) {
-                if (normals) layers.normal[c][pixel] = s.normalView[c];
-                if (albedo) layers.albedo[c][pixel] = s.albedo[c];
+                if (normals)
+                    layers.normal[c][pixel] = s.normalView[c];
+                if (albedo)
+                    layers.albedo[c][pixel] = s.albedo[c];
             }
         }
     });
@@ -68,33 +72,41 @@ std::vector<float> toFloat(const std::vector<uint32_t>& counts) {
 // |image - reference| per channel, through ImageBufAlgo; empty planes without a reference.
 std::array<std::vector<float>, 3> errorPlanes(const RenderRun& run) {
     std::array<std::vector<float>, 3> planes;
-    if (!run.error) return planes;
+    if (!run.error)
+        return planes;
     const int w = run.result.width, h = run.result.height;
     auto toBuffer = [&](const lighting::StageResult& image) {
         OIIO::ImageBuf buffer(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::FLOAT));
         for (int c = 0; c < 3; ++c)
-            buffer.set_pixels(OIIO::ROI(0, w, 0, h, 0, 1, c, c + 1), OIIO::TypeDesc::FLOAT, image.radiance[c].data());
+            buffer.set_pixels(OIIO::ROI(0, w, 0, h, 0, 1, c, c + 1), OIIO::TypeDesc::FLOAT,
+                              image.radiance[c].data());
         return buffer;
     };
-    const OIIO::ImageBuf difference = OIIO::ImageBufAlgo::absdiff(toBuffer(run.result), toBuffer(run.reference));
+    const OIIO::ImageBuf difference =
+        OIIO::ImageBufAlgo::absdiff(toBuffer(run.result), toBuffer(run.reference));
     for (int c = 0; c < 3; ++c) {
         planes[size_t(c)].resize(size_t(w) * h);
-        difference.get_pixels(OIIO::ROI(0, w, 0, h, 0, 1, c, c + 1), OIIO::TypeDesc::FLOAT, planes[size_t(c)].data());
+        difference.get_pixels(OIIO::ROI(0, w, 0, h, 0, 1, c, c + 1), OIIO::TypeDesc::FLOAT,
+                              planes[size_t(c)].data());
     }
     return planes;
 }
 
 // False-colour PNG of the largest channel error per pixel, Turbo from 0 to the image's maximum
 // (ImageBufAlgo::color_map), for thumbnails; the exact values are the EXR's error layers.
-void writeErrorPng(const std::filesystem::path& path, int w, int h, const std::array<std::vector<float>, 3>& error) {
+void writeErrorPng(const std::filesystem::path& path, int w, int h,
+                   const std::array<std::vector<float>, 3>& error) {
     OIIO::ImageBuf largest(OIIO::ImageSpec(w, h, 1, OIIO::TypeDesc::FLOAT));
     std::vector<float> values(size_t(w) * h);
     float peak = 0.0f;
     for (size_t i = 0; i < values.size(); ++i) {
         values[i] = std::max({error[0][i], error[1][i], error[2][i]});
-        if (std::isfinite(values[i])) peak = std::max(peak, values[i]);
+        if (std::isfinite(values[i]))
+            peak = std::max(peak, values[i]);
     }
-    for (float& v : values) v = peak > 0.0f && std::isfinite(v) ? std::min(v / peak, 1.0f) : (std::isfinite(v) ? 0.0f : 1.0f);
+    for (float& v : values)
+        v = peak > 0.0f && std::isfinite(v) ? std::min(v / peak, 1.0f)
+                                            : (std::isfinite(v) ? 0.0f : 1.0f);
     largest.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values.data());
     const OIIO::ImageBuf coloured = OIIO::ImageBufAlgo::color_map(largest, 0, "turbo");
     writeFileAtomically(path, [&](const std::filesystem::path& temp) {
@@ -103,9 +115,10 @@ void writeErrorPng(const std::filesystem::path& path, int w, int h, const std::a
     });
 }
 
-}  // namespace
+} // namespace
 
-void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir, uint32_t heatmapMax) {
+void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
+                        uint32_t heatmapMax) {
     const gbuffer::GBuffer& gb = run.gbuffer();
     const int w = gb.width(), h = gb.height();
     const nlohmann::json stats = statsJson(run);
@@ -114,23 +127,24 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir, 
     const std::vector<float> oracle = toFloat(run.oracle);
     // Evaluations that added nothing: the culling stage's waste at each pixel.
     std::vector<float> wasted(evaluated.size());
-    for (size_t pixel = 0; pixel < wasted.size(); ++pixel) wasted[pixel] = evaluated[pixel] - oracle[pixel];
+    for (size_t pixel = 0; pixel < wasted.size(); ++pixel)
+        wasted[pixel] = evaluated[pixel] - oracle[pixel];
     const std::array<std::vector<float>, 3> error = errorPlanes(run);
     std::vector<ImagePlane> planes = {
-        {"R", run.result.radiance[0].data()},
-        {"G", run.result.radiance[1].data()},
-        {"B", run.result.radiance[2].data()},
-        {"Z", layers.z.data()},
-        {"lights.evaluated", evaluated.data()},
-        {"lights.oracle", oracle.data()},
+        {"R", run.result.radiance[0].data()},   {"G", run.result.radiance[1].data()},
+        {"B", run.result.radiance[2].data()},   {"Z", layers.z.data()},
+        {"lights.evaluated", evaluated.data()}, {"lights.oracle", oracle.data()},
         {"lights.wasted", wasted.data()},
     };
     const char* xyz[] = {"X", "Y", "Z"};
     const char* rgb[] = {"R", "G", "B"};
     for (int c = 0; c < 3; ++c) {
-        if (!layers.normal[c].empty()) planes.push_back({std::string("N.") + xyz[c], layers.normal[c].data()});
-        if (!layers.albedo[c].empty()) planes.push_back({std::string("albedo.") + rgb[c], layers.albedo[c].data()});
-        if (!error[size_t(c)].empty()) planes.push_back({std::string("error.") + rgb[c], error[size_t(c)].data()});
+        if (!layers.normal[c].empty())
+            planes.push_back({std::string("N.") + xyz[c], layers.normal[c].data()});
+        if (!layers.albedo[c].empty())
+            planes.push_back({std::string("albedo.") + rgb[c], layers.albedo[c].data()});
+        if (!error[size_t(c)].empty())
+            planes.push_back({std::string("error.") + rgb[c], error[size_t(c)].data()});
     }
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"testbed:scene", run.options.scene},
@@ -142,10 +156,11 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir, 
         {"testbed:error", "error.R,G,B = |R,G,B - reference| (double-precision reference)"},
     };
     writeMultiLayerExr(dir / "render.exr", w, h, planes, metadata);
-    writePreviewPng(dir / "preview.png", w, h, run.result.radiance[0].data(), run.result.radiance[1].data(),
-                    run.result.radiance[2].data());
+    writePreviewPng(dir / "preview.png", w, h, run.result.radiance[0].data(),
+                    run.result.radiance[1].data(), run.result.radiance[2].data());
     writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(), heatmapMax);
-    if (run.error) writeErrorPng(dir / "error.png", w, h, error);
+    if (run.error)
+        writeErrorPng(dir / "error.png", w, h, error);
     writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
 }
 
@@ -174,7 +189,8 @@ nlohmann::json statsJson(const RenderRun& run) {
                           {"bits", plane.bits},
                           {"allocated", !plane.unmodelled}});
     nlohmann::json reasons = nlohmann::json::object();
-    for (const auto& [channel, reason] : layout.reasons) reasons[gbuffer::channelName(channel)] = reason;
+    for (const auto& [channel, reason] : layout.reasons)
+        reasons[gbuffer::channelName(channel)] = reason;
     stats["layout"] = {{"name", layout.name},
                        {"depth", layout.depth.text()},
                        {"position", gbuffer::positionMethodName(layout.position)},
@@ -189,15 +205,21 @@ nlohmann::json statsJson(const RenderRun& run) {
                        {"allocated_bytes_per_pixel", layout.allocatedBytesPerPixel()}};
     stats["bytes_per_pixel"] = layout.bytesPerPixel();
     nlohmann::json timings = nlohmann::json::object();
-    for (const auto& [pass, ms] : run.timingsMs) timings[pass] = ms;
-    stats["timings_ms"] = timings;  // medians over the repetitions
+    for (const auto& [pass, ms] : run.timingsMs)
+        timings[pass] = ms;
+    stats["timings_ms"] = timings; // medians over the repetitions
     nlohmann::json spread = nlohmann::json::object();
     for (const PassTiming& timing : run.passTimings)
-        spread[timing.pass] = {{"median", timing.medianMs()}, {"min", timing.minMs()}, {"max", timing.maxMs()},
+        spread[timing.pass] = {{"median", timing.medianMs()},
+                               {"min", timing.minMs()},
+                               {"max", timing.maxMs()},
                                {"samples", timing.samplesMs}};
-    stats["timings"] = {{"warmup", run.options.warmup}, {"repetitions", run.options.repetitions}, {"passes_ms", spread}};
-    stats["oracle_surface"] = run.oracleFromLosslessGBuffer ? "lossless G-buffer (the layout lacks BRDF channels)"
-                                                            : "the stage's G-buffer";
+    stats["timings"] = {{"warmup", run.options.warmup},
+                        {"repetitions", run.options.repetitions},
+                        {"passes_ms", spread}};
+    stats["oracle_surface"] = run.oracleFromLosslessGBuffer
+                                  ? "lossless G-buffer (the layout lacks BRDF channels)"
+                                  : "the stage's G-buffer";
     stats["gbuffer_steps_ms"] = {{"transform", run.prepared->gbufferTimings.transformMs},
                                  {"raster", run.prepared->gbufferTimings.rasterMs},
                                  {"resolve", run.prepared->gbufferTimings.resolveMs},
@@ -239,9 +261,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
         const bool terminal = isatty(STDERR_FILENO);
         const auto start = std::chrono::steady_clock::now();
         auto progress = [&](const std::string& step) {
-            if (!terminal) return;
-            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            std::cerr << "[" << std::fixed << std::setprecision(1) << seconds << " s] " << step << "\n";
+            if (!terminal)
+                return;
+            const double seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            std::cerr << "[" << std::fixed << std::setprecision(1) << seconds << " s] " << step
+                      << "\n";
         };
         const RenderRun run = runRender(options.render, progress);
         progress("writing outputs");
@@ -251,14 +276,17 @@ int runRenderCommand(const RenderCommandOptions& options) {
                   << " lights) at " << run.options.width << "x" << run.options.height << ", "
                   << run.threads << " threads\n";
         for (const auto& [pass, ms] : run.timingsMs)
-            std::cout << "  " << pass << ": " << std::fixed << std::setprecision(2) << ms << " ms\n";
+            std::cout << "  " << pass << ": " << std::fixed << std::setprecision(2) << ms
+                      << " ms\n";
         if (run.error)
             std::cout << "  error vs reference: rmse " << std::scientific << run.error->rmse
                       << ", max_abs " << run.error->maxAbs << ", relative rmse "
                       << run.error->relativeRmse << "\n";
         std::cout << "outputs in " << std::filesystem::absolute(options.out).string() << ":\n";
-        for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
-            if (std::filesystem::exists(options.out / file)) std::cout << "  " << (options.out / file).string() << "\n";
+        for (const char* file :
+             {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
+            if (std::filesystem::exists(options.out / file))
+                std::cout << "  " << (options.out / file).string() << "\n";
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "testbed: error: " << e.what() << "\n";
@@ -266,4 +294,4 @@ int runRenderCommand(const RenderCommandOptions& options) {
     }
 }
 
-}  // namespace experiments
+} // namespace experiments

@@ -21,8 +21,8 @@ namespace experiments {
 struct RenderCommandOptions {
     RenderOptions render;
     std::filesystem::path out = "out";
-    uint32_t heatmapMax = 0;  // 0 = the image's own maximum
-    bool explainLayout = false;  // print the derived layout and its reasons instead of rendering
+    uint32_t heatmapMax = 0;    // 0 = the image's own maximum
+    bool explainLayout = false; // print the derived layout and its reasons instead of rendering
 };
 
 nlohmann::json statsJson(const RenderRun& run);
@@ -30,10 +30,11 @@ nlohmann::json statsJson(const RenderRun& run);
 // Writes render.exr (with error.R,G,B when the run was compared with a reference), preview.png,
 // heatmap.png, error.png (false colour |image - reference|, only with a reference) and stats.json
 // into `dir` (which must exist), each atomically. heatmapMax 0 = the image's own maximum.
-void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir, uint32_t heatmapMax);
+void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
+                        uint32_t heatmapMax);
 
 // Validates, renders, writes; returns the process exit code (0 on success). Errors are
 // reported on stderr as one line starting with "testbed: error:".
 int runRenderCommand(const RenderCommandOptions& options);
 
-}  // namespace experiments
+} // namespace experiments

@@ -37,12 +37,13 @@ OIIO::ImageBuf toImageBuf(const lighting::StageResult& image) {
     OIIO::ImageBuf buffer(spec);
     std::vector<float> interleaved(size_t(image.width) * image.height * 3);
     for (size_t i = 0; i < interleaved.size() / 3; ++i)
-        for (int c = 0; c < 3; ++c) interleaved[3 * i + c] = image.radiance[c][i];
+        for (int c = 0; c < 3; ++c)
+            interleaved[3 * i + c] = image.radiance[c][i];
     buffer.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, interleaved.data());
     return buffer;
 }
 
-}  // namespace
+} // namespace
 
 void validate(const RenderOptions& options) {
     if (options.width <= 0 || options.height <= 0 || options.width > kMaxImageSide ||
@@ -58,7 +59,7 @@ void validate(const RenderOptions& options) {
     if (options.threads < 0 || options.threads > kMaxThreads)
         throw UsageError("--threads " + std::to_string(options.threads) +
                          " refused: must be 0 (all) .. " + std::to_string(kMaxThreads));
-    lighting::makeStage(options.stage);  // throws StageError listing the valid names
+    lighting::makeStage(options.stage); // throws StageError listing the valid names
     if (!scenes::isProceduralScene(options.scene)) {
         const std::filesystem::path path(options.scene);
         const std::string extension = path.extension().string();
@@ -76,8 +77,9 @@ void validate(const RenderOptions& options) {
         options.repetitions > kMaxRepetitions)
         throw UsageError("--warmup " + std::to_string(options.warmup) + " / --repetitions " +
                          std::to_string(options.repetitions) + " refused: warmup 0.." +
-                         std::to_string(kMaxRepetitions) + ", repetitions 1.." + std::to_string(kMaxRepetitions));
-    layoutRequest(options);  // throws UsageError for bad encodings, formats or presets
+                         std::to_string(kMaxRepetitions) + ", repetitions 1.." +
+                         std::to_string(kMaxRepetitions));
+    layoutRequest(options); // throws UsageError for bad encodings, formats or presets
 }
 
 gbuffer::LayoutRequest layoutRequest(const RenderOptions& options) {
@@ -87,15 +89,21 @@ gbuffer::LayoutRequest layoutRequest(const RenderOptions& options) {
             const std::vector<std::string> presets = gbuffer::layoutPresetNames();
             if (std::find(presets.begin(), presets.end(), options.layout) == presets.end()) {
                 std::string valid;
-                for (const std::string& preset : presets) valid += (valid.empty() ? "" : ", ") + preset;
-                throw std::invalid_argument("unknown G-buffer layout '" + options.layout + "'; valid: " + valid);
+                for (const std::string& preset : presets)
+                    valid += (valid.empty() ? "" : ", ") + preset;
+                throw std::invalid_argument("unknown G-buffer layout '" + options.layout +
+                                            "'; valid: " + valid);
             }
             request.preset = options.layout;
         }
-        if (!options.normals.empty()) request.normals = gbuffer::NormalCodecSpec::parse(options.normals);
-        if (!options.depth.empty()) request.depth = gbuffer::DepthFormatSpec::parse(options.depth);
-        if (!options.position.empty()) request.position = gbuffer::parsePositionMethod(options.position);
-        if (!options.normalSpace.empty()) request.normalSpace = gbuffer::parseNormalSpace(options.normalSpace);
+        if (!options.normals.empty())
+            request.normals = gbuffer::NormalCodecSpec::parse(options.normals);
+        if (!options.depth.empty())
+            request.depth = gbuffer::DepthFormatSpec::parse(options.depth);
+        if (!options.position.empty())
+            request.position = gbuffer::parsePositionMethod(options.position);
+        if (!options.normalSpace.empty())
+            request.normalSpace = gbuffer::parseNormalSpace(options.normalSpace);
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
     }
@@ -103,7 +111,8 @@ gbuffer::LayoutRequest layoutRequest(const RenderOptions& options) {
 }
 
 double PassTiming::medianMs() const {
-    if (samplesMs.empty()) return 0.0;
+    if (samplesMs.empty())
+        return 0.0;
     std::vector<double> sorted = samplesMs;
     std::sort(sorted.begin(), sorted.end());
     const size_t n = sorted.size();
@@ -118,8 +127,7 @@ double PassTiming::maxMs() const {
 
 namespace {
 
-template <typename Number>
-Number parseNumber(const std::string& key, const std::string& value) {
+template <typename Number> Number parseNumber(const std::string& key, const std::string& value) {
     Number number{};
     const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
     if (error != std::errc() || end != value.data() + value.size())
@@ -127,55 +135,72 @@ Number parseNumber(const std::string& key, const std::string& value) {
     return number;
 }
 
-}  // namespace
+} // namespace
 
 std::vector<std::string> renderOptionKeys() {
-    return {"scene", "stage",  "lights", "seed",   "width",    "height",
-            "resolution", "threads", "layout", "normals", "normal-space", "depth", "position",
-            "scene-option.<key>"};
+    return {
+        "scene",   "stage",  "lights",  "seed",         "width", "height",   "resolution",
+        "threads", "layout", "normals", "normal-space", "depth", "position", "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
     static const std::string kSceneOption = "scene-option.";
-    if (key == "scene") options.scene = value;
-    else if (key == "stage") options.stage = value;
-    else if (key == "lights") options.lights = parseNumber<int>(key, value);
-    else if (key == "seed") options.seed = parseNumber<uint64_t>(key, value);
-    else if (key == "width") options.width = parseNumber<int>(key, value);
-    else if (key == "height") options.height = parseNumber<int>(key, value);
-    else if (key == "threads") options.threads = parseNumber<int>(key, value);
-    else if (key == "layout") options.layout = value;
-    else if (key == "normals") options.normals = value;
-    else if (key == "normal-space") options.normalSpace = value;
-    else if (key == "depth") options.depth = value;
-    else if (key == "position") options.position = value;
+    if (key == "scene")
+        options.scene = value;
+    else if (key == "stage")
+        options.stage = value;
+    else if (key == "lights")
+        options.lights = parseNumber<int>(key, value);
+    else if (key == "seed")
+        options.seed = parseNumber<uint64_t>(key, value);
+    else if (key == "width")
+        options.width = parseNumber<int>(key, value);
+    else if (key == "height")
+        options.height = parseNumber<int>(key, value);
+    else if (key == "threads")
+        options.threads = parseNumber<int>(key, value);
+    else if (key == "layout")
+        options.layout = value;
+    else if (key == "normals")
+        options.normals = value;
+    else if (key == "normal-space")
+        options.normalSpace = value;
+    else if (key == "depth")
+        options.depth = value;
+    else if (key == "position")
+        options.position = value;
     else if (key == "resolution") {
         const size_t x = value.find('x');
-        if (x == std::string::npos) throw UsageError("option 'resolution': '" + value + "' is not WIDTHxHEIGHT");
+        if (x == std::string::npos)
+            throw UsageError("option 'resolution': '" + value + "' is not WIDTHxHEIGHT");
         options.width = parseNumber<int>(key, value.substr(0, x));
         options.height = parseNumber<int>(key, value.substr(x + 1));
     } else if (key.rfind(kSceneOption, 0) == 0 && key.size() > kSceneOption.size()) {
         options.sceneOptions[key.substr(kSceneOption.size())] = value;
     } else {
         std::string keys;
-        for (const std::string& k : renderOptionKeys()) keys += (keys.empty() ? "" : ", ") + k;
+        for (const std::string& k : renderOptionKeys())
+            keys += (keys.empty() ? "" : ", ") + k;
         throw UsageError("unknown render option '" + key + "'; valid: " + keys);
     }
 }
 
 uint64_t RenderRun::lightEvaluations() const {
     uint64_t sum = 0;
-    for (uint32_t count : result.lightsEvaluated) sum += count;
+    for (uint32_t count : result.lightsEvaluated)
+        sum += count;
     return sum;
 }
 
 uint64_t RenderRun::oracleLightEvaluations() const {
     uint64_t sum = 0;
-    for (uint32_t count : oracle) sum += count;
+    for (uint32_t count : oracle)
+        sum += count;
     return sum;
 }
 
-ErrorMetrics compareImages(const lighting::StageResult& image, const lighting::StageResult& reference) {
+ErrorMetrics compareImages(const lighting::StageResult& image,
+                           const lighting::StageResult& reference) {
     const OIIO::ImageBuf a = toImageBuf(image), b = toImageBuf(reference);
     const auto comparison = OIIO::ImageBufAlgo::compare(a, b, 0.0f, 0.0f);
     const auto referenceStats = OIIO::ImageBufAlgo::computePixelStats(b);
@@ -205,7 +230,8 @@ ErrorMetrics compareImages(const lighting::StageResult& image, const lighting::S
     std::vector<float> values(size_t(image.width) * image.height * 3);
     difference.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values.data());
     if (!values.empty()) {
-        const size_t rank = std::min(values.size() - 1, size_t(std::ceil(0.99 * double(values.size()))) - 1);
+        const size_t rank =
+            std::min(values.size() - 1, size_t(std::ceil(0.99 * double(values.size()))) - 1);
         std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(rank), values.end());
         metrics.p99Abs = values[rank];
     }
@@ -224,15 +250,20 @@ scenes::Scene loadRequestedScene(const RenderOptions& options) {
 
 // Adds one repetition's pass times to `timings`, keeping the passes' first-seen order and
 // summing a pass that a stage reports twice.
-void addRepetition(std::vector<PassTiming>& timings, const std::vector<std::pair<std::string, double>>& passes) {
+void addRepetition(std::vector<PassTiming>& timings,
+                   const std::vector<std::pair<std::string, double>>& passes) {
     std::vector<std::pair<std::string, double>> merged;
     for (const auto& [pass, ms] : passes) {
-        auto it = std::find_if(merged.begin(), merged.end(), [&](const auto& m) { return m.first == pass; });
-        if (it == merged.end()) merged.emplace_back(pass, ms);
-        else it->second += ms;
+        auto it = std::find_if(merged.begin(), merged.end(),
+                               [&](const auto& m) { return m.first == pass; });
+        if (it == merged.end())
+            merged.emplace_back(pass, ms);
+        else
+            it->second += ms;
     }
     for (const auto& [pass, ms] : merged) {
-        auto it = std::find_if(timings.begin(), timings.end(), [&](const PassTiming& t) { return t.pass == pass; });
+        auto it = std::find_if(timings.begin(), timings.end(),
+                               [&](const PassTiming& t) { return t.pass == pass; });
         if (it == timings.end()) {
             timings.push_back({pass, {}});
             it = timings.end() - 1;
@@ -241,14 +272,15 @@ void addRepetition(std::vector<PassTiming>& timings, const std::vector<std::pair
     }
 }
 
-}  // namespace
+} // namespace
 
 gbuffer::GBufferLayout renderLayout(const RenderOptions& options) {
     validate(options);
     const scenes::Scene scene = loadRequestedScene(options);
     const std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage(options.stage);
     try {
-        return gbuffer::makeLayout(scene, stage->requirements().channels, stage->name(), layoutRequest(options));
+        return gbuffer::makeLayout(scene, stage->requirements().channels, stage->name(),
+                                   layoutRequest(options));
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
     }
@@ -259,21 +291,25 @@ lighting::StageResult renderReference(const RenderOptions& options) {
     lighting::StageResult reference;
     tbb::task_arena arena(effectiveThreads(options.threads));
     arena.execute([&] {
-        lighting::PreparedFrame frame(loadRequestedScene(options), options.width, options.height, true);
+        lighting::PreparedFrame frame(loadRequestedScene(options), options.width, options.height,
+                                      true);
         lighting::makeStage("reference")->shade(frame.frame, reference);
     });
     return reference;
 }
 
-RenderRun runRender(const RenderOptions& options, const std::function<void(const std::string&)>& progress,
+RenderRun runRender(const RenderOptions& options,
+                    const std::function<void(const std::string&)>& progress,
                     const lighting::StageResult* givenReference) {
     auto step = [&](const std::string& what) {
-        if (progress) progress(what);
+        if (progress)
+            progress(what);
     };
     validate(options);
-    if (givenReference && (givenReference->width != options.width || givenReference->height != options.height))
-        throw UsageError("the given reference image is " + std::to_string(givenReference->width) + "x" +
-                         std::to_string(givenReference->height) + ", the render " +
+    if (givenReference &&
+        (givenReference->width != options.width || givenReference->height != options.height))
+        throw UsageError("the given reference image is " + std::to_string(givenReference->width) +
+                         "x" + std::to_string(givenReference->height) + ", the render " +
                          std::to_string(options.width) + "x" + std::to_string(options.height));
     const bool compare = options.compareReference || givenReference;
     RenderRun run;
@@ -287,36 +323,44 @@ RenderRun runRender(const RenderOptions& options, const std::function<void(const
         const lighting::StageRequirements needs = stage->requirements();
         gbuffer::GBufferLayout layout;
         try {
-            layout = gbuffer::makeLayout(scene, needs.channels, stage->name(), layoutRequest(options));
+            layout =
+                gbuffer::makeLayout(scene, needs.channels, stage->name(), layoutRequest(options));
         } catch (const std::invalid_argument& e) {
             throw UsageError(e.what());
         }
 
         step("G-buffer pass");
         const bool needExact = needs.exactSurface || (compare && !givenReference);
-        run.prepared = std::make_unique<lighting::PreparedFrame>(std::move(scene), options.width, options.height,
-                                                                 needExact, layout);
+        run.prepared = std::make_unique<lighting::PreparedFrame>(std::move(scene), options.width,
+                                                                 options.height, needExact, layout);
         const lighting::Frame& frame = run.prepared->frame;
         const int runs = options.warmup + options.repetitions;
         for (int i = 0; i < runs; ++i) {
             const bool timed = i >= options.warmup;
             step(std::string(timed ? "" : "warm-up ") + "shading: " + options.stage +
                  (runs > 1 ? " (" + std::to_string(i + 1) + "/" + std::to_string(runs) + ")" : ""));
-            if (i > 0) run.prepared->renderGBuffer();
+            if (i > 0)
+                run.prepared->renderGBuffer();
             const gbuffer::GBufferPassTimings& passTimings = run.prepared->gbufferTimings;
             std::vector<std::pair<std::string, double>> passes;
-            passes.emplace_back("gbuffer", passTimings.transformMs + passTimings.rasterMs + passTimings.resolveMs);
-            if (needs.exactSurface) passes.emplace_back("exact_surface", passTimings.exactMs);
+            passes.emplace_back("gbuffer", passTimings.transformMs + passTimings.rasterMs +
+                                               passTimings.resolveMs);
+            if (needs.exactSurface)
+                passes.emplace_back("exact_surface", passTimings.exactMs);
             lighting::StageResult result;
             stage->shade(frame, result);
-            for (const auto& timing : result.timingsMs) passes.push_back(timing);
+            for (const auto& timing : result.timingsMs)
+                passes.push_back(timing);
             double total = 0.0;
-            for (const auto& [pass, ms] : passes) total += ms;
+            for (const auto& [pass, ms] : passes)
+                total += ms;
             passes.emplace_back("total", total);
-            if (timed) addRepetition(run.passTimings, passes);
+            if (timed)
+                addRepetition(run.passTimings, passes);
             run.result = std::move(result);
         }
-        for (const PassTiming& timing : run.passTimings) run.timingsMs.emplace_back(timing.pass, timing.medianMs());
+        for (const PassTiming& timing : run.passTimings)
+            run.timingsMs.emplace_back(timing.pass, timing.medianMs());
 
         // The oracle and the reference are measurement, not part of the stage: timed apart. The
         // oracle counts lights on the surface the stage shades: its G-buffer when that holds every
@@ -334,7 +378,8 @@ RenderRun runRender(const RenderOptions& options, const std::function<void(const
                 run.oracle = lighting::countContributingLights(frame);
             } else {
                 run.oracleFromLosslessGBuffer = true;
-                const std::unique_ptr<gbuffer::GBuffer> lossless = run.prepared->renderLosslessGBuffer();
+                const std::unique_ptr<gbuffer::GBuffer> lossless =
+                    run.prepared->renderLosslessGBuffer();
                 lighting::Frame losslessFrame = frame;
                 losslessFrame.gbuffer = lossless.get();
                 run.oracle = lighting::countContributingLights(losslessFrame);
@@ -358,4 +403,4 @@ RenderRun runRender(const RenderOptions& options, const std::function<void(const
     return run;
 }
 
-}  // namespace experiments
+} // namespace experiments

@@ -22,28 +22,29 @@ namespace experiments {
 // Every option of a render, with its default in one place (the CLI's --help shows these).
 struct RenderOptions {
     std::string scene = "atrium";
-    std::map<std::string, std::string> sceneOptions;  // --scene-option key=value
+    std::map<std::string, std::string> sceneOptions; // --scene-option key=value
     std::string stage = "brute";
     int lights = 256;
     uint64_t seed = 1;
     int width = 1280;
     int height = 720;
-    int threads = 0;  // 0 = every hardware thread
+    int threads = 0; // 0 = every hardware thread
     bool compareReference = false;
-    // G-buffer: a preset name ("" = derived from the scene and the stage, gbuffer/LayoutDerivation.h),
-    // then overrides of its normal encoding ("NAME:BITS"), depth format and position method.
+    // G-buffer: a preset name ("" = derived from the scene and the stage,
+    // gbuffer/LayoutDerivation.h), then overrides of its normal encoding ("NAME:BITS"), depth
+    // format and position method.
     std::string layout;
     std::string normals;
     std::string depth;
     std::string position;
-    std::string normalSpace;  // "view" (default) or "world"
-    int warmup = 0;       // untimed runs of the G-buffer pass and the stage before the timed ones
-    int repetitions = 1;  // timed runs; timings are reported as median, min and max over them
+    std::string normalSpace; // "view" (default) or "world"
+    int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
+    int repetitions = 1; // timed runs; timings are reported as median, min and max over them
 };
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
-// seed, width, height, resolution (WxH), threads, layout, normals, normal-space, depth, position, and
-// scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown
+// seed, width, height, resolution (WxH), threads, layout, normals, normal-space, depth, position,
+// and scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown
 // key throws UsageError naming it. The sweep runner goes through this, so every stage, encoding
 // or scene added later is reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
@@ -68,11 +69,11 @@ void validate(const RenderOptions& options);
 // Over all pixels and the three colour channels.
 struct ErrorMetrics {
     double rmse = 0.0;
-    double relativeRmse = 0.0;  // rmse / rms of the reference
+    double relativeRmse = 0.0; // rmse / rms of the reference
     double maxAbs = 0.0;
-    double psnr = 0.0;          // dB, peak = the reference's maximum channel value
-    double relativeMean = 0.0;  // mean |image - reference| / mean |reference|
-    double p99Abs = 0.0;        // 99th percentile of |image - reference|
+    double psnr = 0.0;         // dB, peak = the reference's maximum channel value
+    double relativeMean = 0.0; // mean |image - reference| / mean |reference|
+    double p99Abs = 0.0;       // 99th percentile of |image - reference|
 };
 
 // One pass's times over the timed repetitions, in execution order of the passes.
@@ -86,17 +87,18 @@ struct PassTiming {
 
 struct RenderRun {
     RenderOptions options;
-    int threads = 0;  // effective
-    std::unique_ptr<lighting::PreparedFrame> prepared;  // scene, G-buffer, exact surface, lights
+    int threads = 0;                                   // effective
+    std::unique_ptr<lighting::PreparedFrame> prepared; // scene, G-buffer, exact surface, lights
     lighting::StageResult result;
-    std::vector<uint32_t> oracle;  // per pixel, from the stage or counted by brute force
-    std::vector<PassTiming> passTimings;  // gbuffer, exact_surface (reference only), stage passes, total
-    std::vector<std::pair<std::string, double>> timingsMs;  // the medians of passTimings
-    bool oracleFromLosslessGBuffer = false;  // the layout lacked channels the oracle needs
+    std::vector<uint32_t> oracle; // per pixel, from the stage or counted by brute force
+    std::vector<PassTiming>
+        passTimings; // gbuffer, exact_surface (reference only), stage passes, total
+    std::vector<std::pair<std::string, double>> timingsMs; // the medians of passTimings
+    bool oracleFromLosslessGBuffer = false; // the layout lacked channels the oracle needs
     double oracleMs = 0.0;
     double referenceMs = 0.0;
     std::optional<ErrorMetrics> error;
-    lighting::StageResult reference;  // filled when compared with the reference
+    lighting::StageResult reference; // filled when compared with the reference
 
     const scenes::Scene& scene() const { return prepared->scene; }
     const gbuffer::GBuffer& gbuffer() const { return *prepared->gbuffer; }
@@ -123,6 +125,7 @@ gbuffer::LayoutRequest layoutRequest(const RenderOptions& options);
 // UsageError when the layout lacks a channel the stage reads.
 gbuffer::GBufferLayout renderLayout(const RenderOptions& options);
 
-ErrorMetrics compareImages(const lighting::StageResult& image, const lighting::StageResult& reference);
+ErrorMetrics compareImages(const lighting::StageResult& image,
+                           const lighting::StageResult& reference);
 
-}  // namespace experiments
+} // namespace experiments

@@ -35,12 +35,13 @@ namespace {
 // The job images the report shows as thumbnails, in column order.
 constexpr const char* kJobImages[] = {"preview", "heatmap", "error"};
 // Axis columns named in a thumbnail's caption, when the results have them.
-constexpr const char* kCaptionColumns[] = {"scene", "stage", "lights", "width", "height",
-                                           "layout", "normals", "depth"};
+constexpr const char* kCaptionColumns[] = {"scene",  "stage",  "lights",  "width",
+                                           "height", "layout", "normals", "depth"};
 
 json readJsonFile(const fs::path& path) {
     std::ifstream file(path, std::ios::binary);
-    if (!file) throw std::runtime_error("cannot read " + path.string() + ": " + std::strerror(errno));
+    if (!file)
+        throw std::runtime_error("cannot read " + path.string() + ": " + std::strerror(errno));
     try {
         return json::parse(file);
     } catch (const json::exception& e) {
@@ -66,8 +67,10 @@ std::string urlPath(const std::string& path) {
 
 // Integers without a fraction, everything else with 4 significant digits.
 std::string formatNumber(double value) {
-    if (std::isnan(value)) return "NaN";
-    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    if (std::isnan(value))
+        return "NaN";
+    if (std::isinf(value))
+        return value > 0 ? "inf" : "-inf";
     char buffer[64];
     if (value == std::floor(value) && std::fabs(value) < 1e15)
         std::snprintf(buffer, sizeof buffer, "%.0f", value);
@@ -77,22 +80,29 @@ std::string formatNumber(double value) {
 }
 
 std::string formatCell(const json& value) {
-    if (value.is_null()) return "&mdash;";
-    if (value.is_number()) return formatNumber(value.get<double>());
-    if (value.is_boolean()) return value.get<bool>() ? "true" : "false";
-    if (value.is_string()) return htmlEscape(value.get<std::string>());
+    if (value.is_null())
+        return "&mdash;";
+    if (value.is_number())
+        return formatNumber(value.get<double>());
+    if (value.is_boolean())
+        return value.get<bool>() ? "true" : "false";
+    if (value.is_string())
+        return htmlEscape(value.get<std::string>());
     return htmlEscape(value.dump());
 }
 
 std::string formatOptional(const json& value, const char* suffix = "") {
-    if (value.is_null()) return "&mdash;";
+    if (value.is_null())
+        return "&mdash;";
     return formatCell(value) + suffix;
 }
 
 std::string metricLabel(const json& metric) {
-    if (metric.is_string()) return metric.get<std::string>();
+    if (metric.is_string())
+        return metric.get<std::string>();
     std::string label;
-    for (const json& part : metric) label += (label.empty() ? "" : " + ") + part.get<std::string>();
+    for (const json& part : metric)
+        label += (label.empty() ? "" : " + ") + part.get<std::string>();
     return label;
 }
 
@@ -107,37 +117,47 @@ std::vector<std::string> resultColumns(const json& results) {
     std::vector<std::string> columns;
     if (results.contains("columns") && results["columns"].is_array()) {
         for (const json& column : results["columns"])
-            if (column.is_string()) columns.push_back(column.get<std::string>());
+            if (column.is_string())
+                columns.push_back(column.get<std::string>());
         return columns;
     }
     std::set<std::string> seen;
     for (const json& job : results["jobs"])
         for (const auto& [key, value] : job.items())
-            if (seen.insert(key).second) columns.push_back(key);
+            if (seen.insert(key).second)
+                columns.push_back(key);
     return columns;
 }
 
-bool jobOk(const json& job) { return stringField(job, "status") == "ok"; }
+bool jobOk(const json& job) {
+    return stringField(job, "status") == "ok";
+}
 
 // Writes a thumbnail of source (at most width pixels wide, aspect kept) unless an up-to-date
 // one exists. Returns false when source is missing or unreadable (the page then says so).
 bool makeThumbnail(const fs::path& source, const fs::path& thumbnail, int width) {
     std::error_code error;
-    if (!fs::is_regular_file(source, error)) return false;
+    if (!fs::is_regular_file(source, error))
+        return false;
     if (fs::exists(thumbnail, error) &&
         fs::last_write_time(thumbnail, error) >= fs::last_write_time(source, error) && !error)
         return true;
     OIIO::ImageBuf image(source.string());
-    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT)) return false;
+    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+        return false;
     const OIIO::ImageSpec& spec = image.spec();
     const int thumbWidth = std::min(width, spec.width);
-    const int thumbHeight = std::max(1, int(std::lround(double(spec.height) * thumbWidth / spec.width)));
-    OIIO::ImageBuf small(OIIO::ImageSpec(thumbWidth, thumbHeight, spec.nchannels, OIIO::TypeDesc::FLOAT));
+    const int thumbHeight =
+        std::max(1, int(std::lround(double(spec.height) * thumbWidth / spec.width)));
+    OIIO::ImageBuf small(
+        OIIO::ImageSpec(thumbWidth, thumbHeight, spec.nchannels, OIIO::TypeDesc::FLOAT));
     if (!OIIO::ImageBufAlgo::resize(small, image))
-        throw std::runtime_error("cannot make a thumbnail of " + source.string() + ": " + small.geterror());
+        throw std::runtime_error("cannot make a thumbnail of " + source.string() + ": " +
+                                 small.geterror());
     writeFileAtomically(thumbnail, [&](const fs::path& tempPath) {
         if (!small.write(tempPath.string(), OIIO::TypeDesc::UINT8, "png"))
-            throw std::runtime_error("cannot write " + thumbnail.string() + ": " + small.geterror());
+            throw std::runtime_error("cannot write " + thumbnail.string() + ": " +
+                                     small.geterror());
     });
     return true;
 }
@@ -191,16 +211,19 @@ figcaption { font-size: 0.8em; max-width: 640px; }
 )";
 
 void appendPublishedSection(std::ostringstream& html, const json& table, int index) {
-    html << "<h3 id=\"published-" << index << "\">" << htmlEscape(stringField(table, "title")) << "</h3>\n";
+    html << "<h3 id=\"published-" << index << "\">" << htmlEscape(stringField(table, "title"))
+         << "</h3>\n";
     const std::string source = stringField(table, "source");
-    if (!source.empty()) html << "<p>Source: " << htmlEscape(source) << "</p>\n";
+    if (!source.empty())
+        html << "<p>Source: " << htmlEscape(source) << "</p>\n";
     html << "<p>Metric: <code>" << htmlEscape(stringField(table, "metric_label")) << "</code>";
     const json& ratioTo = table["ratio_to"];
     const json& columns = table["columns"];
     html << "; ratios are value / value of column &ldquo;"
          << htmlEscape(columns[ratioTo.get<size_t>()].get<std::string>())
          << "&rdquo; of the same row. Measured values are medians over the matching jobs.</p>\n";
-    html << "<div class=\"scroll\"><table class=\"published\">\n<tr><th class=\"text\" rowspan=\"2\">row</th>";
+    html << "<div class=\"scroll\"><table class=\"published\">\n<tr><th class=\"text\" "
+            "rowspan=\"2\">row</th>";
     for (const json& column : columns)
         html << "<th colspan=\"5\">" << htmlEscape(column.get<std::string>()) << "</th>";
     html << "</tr>\n<tr>";
@@ -221,7 +244,8 @@ void appendPublishedSection(std::ostringstream& html, const json& table, int ind
     html << "</table></div>\n";
     const std::string finding = stringField(table, "finding");
     if (!finding.empty())
-        html << "<p class=\"finding\"><b>Published finding:</b> " << htmlEscape(finding) << "</p>\n";
+        html << "<p class=\"finding\"><b>Published finding:</b> " << htmlEscape(finding)
+             << "</p>\n";
 }
 
 void appendPlots(std::ostringstream& html, const json& manifest) {
@@ -237,24 +261,30 @@ void appendPlots(std::ostringstream& html, const json& manifest) {
         html << "<ul>\n";
         for (const json& skipped : manifest["skipped"])
             html << "<li class=\"note\">" << htmlEscape(stringField(skipped, "title"))
-                 << ": not enough data (" << htmlEscape(stringField(skipped, "reason")) << ")</li>\n";
+                 << ": not enough data (" << htmlEscape(stringField(skipped, "reason"))
+                 << ")</li>\n";
         html << "</ul>\n";
     }
 }
 
-void appendResultsTable(std::ostringstream& html, const json& jobs, const std::vector<std::string>& columns) {
+void appendResultsTable(std::ostringstream& html, const json& jobs,
+                        const std::vector<std::string>& columns) {
     html << "<div class=\"scroll\"><table class=\"results\">\n<tr>";
-    for (const std::string& column : columns) html << "<th>" << htmlEscape(column) << "</th>";
+    for (const std::string& column : columns)
+        html << "<th>" << htmlEscape(column) << "</th>";
     html << "</tr>\n";
     for (const json& job : jobs) {
         html << "<tr" << (jobOk(job) ? "" : " class=\"failed\"") << ">";
         for (const std::string& column : columns) {
             const auto it = job.find(column);
             const json value = it == job.end() ? json() : *it;
-            const char* cls = column == "error" ? " class=\"error\"" : value.is_string() ? " class=\"text\"" : "";
-            html << "<td" << cls << ">" << (column == "error" && value.is_string() && value.get<std::string>().empty()
-                                               ? std::string()
-                                               : formatCell(value))
+            const char* cls = column == "error"   ? " class=\"error\""
+                              : value.is_string() ? " class=\"text\""
+                                                  : "";
+            html << "<td" << cls << ">"
+                 << (column == "error" && value.is_string() && value.get<std::string>().empty()
+                         ? std::string()
+                         : formatCell(value))
                  << "</td>";
         }
         html << "</tr>\n";
@@ -264,17 +294,22 @@ void appendResultsTable(std::ostringstream& html, const json& jobs, const std::v
 
 void appendThumbnails(std::ostringstream& html, const fs::path& dir, const json& jobs, int width) {
     html << "<table class=\"thumbs\">\n<tr><th class=\"text\">job</th>";
-    for (const char* image : kJobImages) html << "<th class=\"text\">" << image << ".png</th>";
+    for (const char* image : kJobImages)
+        html << "<th class=\"text\">" << image << ".png</th>";
     html << "</tr>\n";
     fs::create_directories(dir / "report" / "thumbs");
     for (const json& job : jobs) {
         const std::string id = stringField(job, "job_id");
-        if (id.empty()) continue;
-        html << "<tr" << (jobOk(job) ? "" : " class=\"failed\"") << "><td><b>" << htmlEscape(id) << "</b>";
+        if (id.empty())
+            continue;
+        html << "<tr" << (jobOk(job) ? "" : " class=\"failed\"") << "><td><b>" << htmlEscape(id)
+             << "</b>";
         for (const char* column : kCaptionColumns)
             if (job.contains(column) && !job[column].is_null())
                 html << "<br>" << column << " " << formatCell(job[column]);
-        if (!jobOk(job)) html << "<br><span class=\"error\">" << htmlEscape(stringField(job, "error")) << "</span>";
+        if (!jobOk(job))
+            html << "<br><span class=\"error\">" << htmlEscape(stringField(job, "error"))
+                 << "</span>";
         html << "</td>";
         for (const char* image : kJobImages) {
             const std::string full = "jobs/" + id + "/" + image + ".png";
@@ -292,29 +327,43 @@ void appendThumbnails(std::ostringstream& html, const fs::path& dir, const json&
 
 std::string shellQuote(const std::string& text) {
     std::string out = "'";
-    for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    for (char c : text)
+        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
     return out + "'";
 }
 
-}  // namespace
+} // namespace
 
 std::string htmlEscape(const std::string& text) {
     std::string out;
     out.reserve(text.size());
     for (char c : text) {
         switch (c) {
-        case '&': out += "&amp;"; break;
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '"': out += "&quot;"; break;
-        case '\'': out += "&#39;"; break;
-        default: out += c;
+        case '&':
+            out += "&amp;";
+            break;
+        case '<':
+            out += "&lt;";
+            break;
+        case '>':
+            out += "&gt;";
+            break;
+        case '"':
+            out += "&quot;";
+            break;
+        case '\'':
+            out += "&#39;";
+            break;
+        default:
+            out += c;
         }
     }
     return out;
 }
 
-const char* pageCheckScript() { return kPageCheckScript; }
+const char* pageCheckScript() {
+    return kPageCheckScript;
+}
 
 std::string normalisedSelectValue(const json& value) {
     auto number = [](double x) {
@@ -326,9 +375,12 @@ std::string normalisedSelectValue(const json& value) {
         const auto result = std::to_chars(buffer, buffer + sizeof buffer, x);
         return std::string(buffer, result.ptr);
     };
-    if (value.is_null()) return "";
-    if (value.is_boolean()) return value.get<bool>() ? "true" : "false";
-    if (value.is_number()) return number(value.get<double>());
+    if (value.is_null())
+        return "";
+    if (value.is_boolean())
+        return value.get<bool>() ? "true" : "false";
+    if (value.is_number())
+        return number(value.get<double>());
     if (value.is_string()) {
         const std::string text = value.get<std::string>();
         double x = 0.0;
@@ -342,30 +394,37 @@ std::string normalisedSelectValue(const json& value) {
 }
 
 bool jobMatchesSelect(const json& job, const json& select) {
-    if (select.is_null()) return true;
+    if (select.is_null())
+        return true;
     for (const auto& [key, wanted] : select.items()) {
         const auto it = job.find(key);
-        if (it == job.end() || normalisedSelectValue(*it) != normalisedSelectValue(wanted)) return false;
+        if (it == job.end() || normalisedSelectValue(*it) != normalisedSelectValue(wanted))
+            return false;
     }
     return true;
 }
 
 std::optional<double> jobMetric(const json& job, const json& metric) {
-    const std::vector<json> names = metric.is_array() ? metric.get<std::vector<json>>() : std::vector<json>{metric};
+    const std::vector<json> names =
+        metric.is_array() ? metric.get<std::vector<json>>() : std::vector<json>{metric};
     double sum = 0.0;
     for (const json& name : names) {
-        if (!name.is_string()) return std::nullopt;
+        if (!name.is_string())
+            return std::nullopt;
         const auto it = job.find(name.get<std::string>());
-        if (it == job.end() || !it->is_number()) return std::nullopt;
+        if (it == job.end() || !it->is_number())
+            return std::nullopt;
         const double value = it->get<double>();
-        if (!std::isfinite(value)) return std::nullopt;
+        if (!std::isfinite(value))
+            return std::nullopt;
         sum += value;
     }
     return sum;
 }
 
 std::optional<double> median(std::vector<double> values) {
-    if (values.empty()) return std::nullopt;
+    if (values.empty())
+        return std::nullopt;
     std::sort(values.begin(), values.end());
     const size_t middle = values.size() / 2;
     return values.size() % 2 ? values[middle] : 0.5 * (values[middle - 1] + values[middle]);
@@ -376,19 +435,24 @@ json comparePublished(const json& published, const json& jobs) {
     auto fail = [&](const std::string& what) -> std::runtime_error {
         return std::runtime_error("published entry '" + title + "': " + what);
     };
-    if (!published.is_object()) throw fail("expected an object");
+    if (!published.is_object())
+        throw fail("expected an object");
     const json metric = published.value("metric", json());
-    if (!(metric.is_string() || (metric.is_array() && !metric.empty() &&
-                                 std::all_of(metric.begin(), metric.end(), [](const json& m) { return m.is_string(); }))))
+    if (!(metric.is_string() ||
+          (metric.is_array() && !metric.empty() &&
+           std::all_of(metric.begin(), metric.end(), [](const json& m) { return m.is_string(); }))))
         throw fail("\"metric\" must be a column name or a non-empty list of column names");
     const json columns = published.value("columns", json());
     const json rows = published.value("rows", json());
-    if (!columns.is_array() || columns.empty()) throw fail("\"columns\" must be a non-empty list");
-    if (!rows.is_array()) throw fail("\"rows\" must be a list");
+    if (!columns.is_array() || columns.empty())
+        throw fail("\"columns\" must be a non-empty list");
+    if (!rows.is_array())
+        throw fail("\"rows\" must be a list");
     const json ratioToValue = published.value("ratio_to", json(0));
     if (!ratioToValue.is_number_integer() || ratioToValue.get<long>() < 0 ||
         ratioToValue.get<size_t>() >= columns.size())
-        throw fail("\"ratio_to\" must be a column index from 0 to " + std::to_string(columns.size() - 1));
+        throw fail("\"ratio_to\" must be a column index from 0 to " +
+                   std::to_string(columns.size() - 1));
     const size_t ratioTo = ratioToValue.get<size_t>();
 
     json table = {{"title", title},
@@ -400,22 +464,26 @@ json comparePublished(const json& published, const json& jobs) {
                   {"columns", json::array()},
                   {"rows", json::array()}};
     for (size_t c = 0; c < columns.size(); ++c) {
-        if (!columns[c].is_object()) throw fail("columns[" + std::to_string(c) + "] must be an object");
+        if (!columns[c].is_object())
+            throw fail("columns[" + std::to_string(c) + "] must be an object");
         table["columns"].push_back(columns[c].value("label", "column " + std::to_string(c)));
     }
     for (size_t r = 0; r < rows.size(); ++r) {
         const json& row = rows[r];
         const std::string where = "rows[" + std::to_string(r) + "]";
-        if (!row.is_object()) throw fail(where + " must be an object");
+        if (!row.is_object())
+            throw fail(where + " must be an object");
         const json values = row.value("values", json::array());
         if (!values.is_array() || values.size() != columns.size())
-            throw fail(where + ".values must have one entry per column (" + std::to_string(columns.size()) + ")");
+            throw fail(where + ".values must have one entry per column (" +
+                       std::to_string(columns.size()) + ")");
         std::vector<std::optional<double>> publishedValues, measuredValues;
         std::vector<int> matchCounts;
         for (size_t c = 0; c < columns.size(); ++c) {
             if (!values[c].is_null() && !values[c].is_number())
                 throw fail(where + ".values[" + std::to_string(c) + "] must be a number or null");
-            publishedValues.push_back(values[c].is_null() ? std::nullopt : std::optional(values[c].get<double>()));
+            publishedValues.push_back(values[c].is_null() ? std::nullopt
+                                                          : std::optional(values[c].get<double>()));
             std::vector<double> measured;
             int matched = 0;
             for (const json& job : jobs) {
@@ -423,13 +491,15 @@ json comparePublished(const json& published, const json& jobs) {
                     !jobMatchesSelect(job, columns[c].value("select", json::object())))
                     continue;
                 ++matched;
-                if (const auto value = jobMetric(job, metric)) measured.push_back(*value);
+                if (const auto value = jobMetric(job, metric))
+                    measured.push_back(*value);
             }
             measuredValues.push_back(median(measured));
             matchCounts.push_back(matched);
         }
         auto ratio = [&](const std::vector<std::optional<double>>& v, size_t c) -> json {
-            if (!v[c] || !v[ratioTo] || *v[ratioTo] == 0.0) return json();
+            if (!v[c] || !v[ratioTo] || *v[ratioTo] == 0.0)
+                return json();
             return *v[c] / *v[ratioTo];
         };
         auto toJson = [](const std::optional<double>& v) { return v ? json(*v) : json(); };
@@ -440,19 +510,23 @@ json comparePublished(const json& published, const json& jobs) {
                              {"published_ratio", ratio(publishedValues, c)},
                              {"measured_ratio", ratio(measuredValues, c)},
                              {"matched_jobs", matchCounts[c]}});
-        table["rows"].push_back({{"label", row.value("label", "row " + std::to_string(r))}, {"cells", cells}});
+        table["rows"].push_back(
+            {{"label", row.value("label", "row " + std::to_string(r))}, {"cells", cells}});
     }
     return table;
 }
 
-fs::path defaultPlotsScript() { return plotScriptPath("report.py"); }
+fs::path defaultPlotsScript() {
+    return plotScriptPath("report.py");
+}
 
 int runReportCommand(const ReportCommandOptions& options) {
     try {
         const fs::path& dir = options.dir;
         const json results = readJsonFile(dir / "results.json");
         if (!results.is_object() || !results.contains("jobs") || !results["jobs"].is_array())
-            throw std::runtime_error((dir / "results.json").string() + ": expected an object with a \"jobs\" list");
+            throw std::runtime_error((dir / "results.json").string() +
+                                     ": expected an object with a \"jobs\" list");
         if (options.thumbnailWidth < 16 || options.thumbnailWidth > 4096)
             throw std::runtime_error("thumbnail width must be from 16 to 4096 pixels");
         const json& jobs = results["jobs"];
@@ -463,57 +537,74 @@ int runReportCommand(const ReportCommandOptions& options) {
         json publishedTables = json::array();
         if (sweep.is_object() && sweep.contains("published")) {
             if (!sweep["published"].is_array())
-                throw std::runtime_error((dir / "results.json").string() + ": sweep.published must be a list");
-            for (const json& entry : sweep["published"]) publishedTables.push_back(comparePublished(entry, jobs));
+                throw std::runtime_error((dir / "results.json").string() +
+                                         ": sweep.published must be a list");
+            for (const json& entry : sweep["published"])
+                publishedTables.push_back(comparePublished(entry, jobs));
         }
         writeTextAtomically(reportDir / "published.json", publishedTables.dump(2) + "\n");
 
-        const fs::path script = options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
+        const fs::path script =
+            options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
         if (!fs::is_regular_file(script))
-            throw std::runtime_error("plot script " + script.string() + " not found (use --plots-script)");
+            throw std::runtime_error("plot script " + script.string() +
+                                     " not found (use --plots-script)");
         const std::string python = requirePythonWithMatplotlib(options.python);
-        const int status = runProcess({python, script.string(), "results", "--results", (dir / "results.json").string(),
-                                       "--published", (reportDir / "published.json").string(), "--out",
-                                       reportDir.string()});
+        const int status = runProcess(
+            {python, script.string(), "results", "--results", (dir / "results.json").string(),
+             "--published", (reportDir / "published.json").string(), "--out", reportDir.string()});
         if (status != 0)
-            throw std::runtime_error("plot script failed (exit status " + std::to_string(status) + "): " +
-                                     shellQuote(python) + " " + shellQuote(script.string()));
+            throw std::runtime_error("plot script failed (exit status " + std::to_string(status) +
+                                     "): " + shellQuote(python) + " " +
+                                     shellQuote(script.string()));
         const json manifest = readJsonFile(reportDir / "plots.json");
 
         const std::vector<std::string> columns = resultColumns(results);
-        const size_t failed = size_t(std::count_if(jobs.begin(), jobs.end(), [](const json& j) { return !jobOk(j); }));
+        const size_t failed = size_t(
+            std::count_if(jobs.begin(), jobs.end(), [](const json& j) { return !jobOk(j); }));
         const std::string name = sweep.is_object() ? stringField(sweep, "name") : "";
-        const std::string title = "testbed report: " + (name.empty() ? dir.filename().string() : name);
+        const std::string title =
+            "testbed report: " + (name.empty() ? dir.filename().string() : name);
 
         std::ostringstream html;
         html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>"
-             << htmlEscape(title) << "</title>\n" << kPageCheckScript << kStyle << "</head>\n<body>\n";
+             << htmlEscape(title) << "</title>\n"
+             << kPageCheckScript << kStyle << "</head>\n<body>\n";
         html << "<h1>" << htmlEscape(title) << "</h1>\n<p>";
         const std::string sweepFile = stringField(results, "sweep_file");
-        if (!sweepFile.empty()) html << "Sweep file <code>" << htmlEscape(sweepFile) << "</code>";
-        if (results.value("quick", false)) html << " (quick size)";
-        html << (sweepFile.empty() ? "" : ": ") << jobs.size() << " jobs, " << jobs.size() - failed << " ok, "
-             << failed << " failed.";
+        if (!sweepFile.empty())
+            html << "Sweep file <code>" << htmlEscape(sweepFile) << "</code>";
+        if (results.value("quick", false))
+            html << " (quick size)";
+        html << (sweepFile.empty() ? "" : ": ") << jobs.size() << " jobs, " << jobs.size() - failed
+             << " ok, " << failed << " failed.";
         const std::string description = sweep.is_object() ? stringField(sweep, "description") : "";
-        if (!description.empty()) html << " " << htmlEscape(description);
+        if (!description.empty())
+            html << " " << htmlEscape(description);
         html << "</p>\n<p>Contents: ";
-        if (!publishedTables.empty()) html << "<a href=\"#published\">published vs measured</a> &middot; ";
-        html << "<a href=\"#plots\">plots</a> &middot; <a href=\"#results\">results table</a> &middot; "
+        if (!publishedTables.empty())
+            html << "<a href=\"#published\">published vs measured</a> &middot; ";
+        html << "<a href=\"#plots\">plots</a> &middot; <a href=\"#results\">results table</a> "
+                "&middot; "
                 "<a href=\"#images\">images</a></p>\n";
         if (!publishedTables.empty()) {
             html << "<h2 id=\"published\">Published vs measured</h2>\n";
-            for (size_t i = 0; i < publishedTables.size(); ++i) appendPublishedSection(html, publishedTables[i], int(i));
+            for (size_t i = 0; i < publishedTables.size(); ++i)
+                appendPublishedSection(html, publishedTables[i], int(i));
         }
         html << "<h2 id=\"plots\">Plots</h2>\n";
         appendPlots(html, manifest);
         html << "<h2 id=\"results\">Results (" << jobs.size() << " jobs)</h2>\n"
-             << "<p>Times in ms (median, min, max over the repetitions); error against the reference "
+             << "<p>Times in ms (median, min, max over the repetitions); error against the "
+                "reference "
                 "render; &mdash; = not measured. Failed jobs in red with their error.</p>\n";
         appendResultsTable(html, jobs, columns);
-        html << "<h2 id=\"images\">Images</h2>\n<p>Tone-mapped render, lights evaluated per pixel, and "
+        html << "<h2 id=\"images\">Images</h2>\n<p>Tone-mapped render, lights evaluated per pixel, "
+                "and "
                 "|render &minus; reference| per job; click for the full-size image.</p>\n";
         appendThumbnails(html, dir, jobs, options.thumbnailWidth);
-        html << "<pre id=\"page-check\" data-status=\"pending\">PAGE-CHECK: PENDING</pre>\n</body>\n</html>\n";
+        html << "<pre id=\"page-check\" data-status=\"pending\">PAGE-CHECK: "
+                "PENDING</pre>\n</body>\n</html>\n";
         writeTextAtomically(dir / "report.html", html.str());
         std::cout << "testbed: report written to " << (dir / "report.html").string() << "\n";
         return 0;
@@ -523,4 +614,4 @@ int runReportCommand(const ReportCommandOptions& options) {
     }
 }
 
-}  // namespace experiments
+} // namespace experiments

@@ -40,11 +40,11 @@
 namespace experiments {
 
 struct ReportCommandOptions {
-    std::filesystem::path dir;          // the results folder (holds results.json)
-    std::filesystem::path plotsScript;  // empty = experiments/plots/report.py of the source tree
-    std::string python;                 // empty = the first of /usr/bin/python3, python3 that
-                                        // imports matplotlib
-    int thumbnailWidth = 192;           // pixels; thumbnails keep the image's aspect ratio
+    std::filesystem::path dir;         // the results folder (holds results.json)
+    std::filesystem::path plotsScript; // empty = experiments/plots/report.py of the source tree
+    std::string python;                // empty = the first of /usr/bin/python3, python3 that
+                                       // imports matplotlib
+    int thumbnailWidth = 192;          // pixels; thumbnails keep the image's aspect ratio
 };
 
 // The text a value is compared as when matching "select" entries: numbers (and strings that
@@ -80,7 +80,6 @@ int runReportCommand(const ReportCommandOptions& options);
 // The default plot script (the source tree's experiments/plots/report.py, fixed at build time).
 std::filesystem::path defaultPlotsScript();
 
-
 // HTML pieces shared by the report and the diff pages.
 std::string htmlEscape(const std::string& text);
 // An inline <script> for <head> that, once the page has loaded, writes "PAGE-CHECK: OK (N images)"
@@ -88,4 +87,4 @@ std::string htmlEscape(const std::string& text);
 // element with id "page-check" (which the page must contain).
 const char* pageCheckScript();
 
-}  // namespace experiments
+} // namespace experiments

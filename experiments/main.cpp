@@ -29,56 +29,70 @@ namespace {
 void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& options,
                       std::vector<std::string>& sceneOptionTexts) {
     experiments::RenderOptions& r = options.render;
-    render.add_option("--scene", r.scene, "built-in scene name or .gltf/.glb/.json file")->capture_default_str();
-    render.add_option("--scene-option", sceneOptionTexts,
-                      "scene-specific key=value (repeatable), e.g. behind=1000 for wall")
+    render.add_option("--scene", r.scene, "built-in scene name or .gltf/.glb/.json file")
+        ->capture_default_str();
+    render
+        .add_option("--scene-option", sceneOptionTexts,
+                    "scene-specific key=value (repeatable), e.g. behind=1000 for wall")
         ->allow_extra_args(false);
-    render.add_option("--stage", r.stage, "shading stage, NAME or NAME:key=value,...")->capture_default_str();
+    render.add_option("--stage", r.stage, "shading stage, NAME or NAME:key=value,...")
+        ->capture_default_str();
     render.add_option("--lights", r.lights, "generated point lights")->capture_default_str();
     render.add_option("--seed", r.seed, "seed of the light generator")->capture_default_str();
     render.add_option("--width", r.width, "image width in pixels")->capture_default_str();
     render.add_option("--height", r.height, "image height in pixels")->capture_default_str();
-    render.add_option("--threads", r.threads, "worker threads, 0 = all hardware threads")->capture_default_str();
+    render.add_option("--threads", r.threads, "worker threads, 0 = all hardware threads")
+        ->capture_default_str();
     render.add_option("--out", options.out, "output folder")->capture_default_str();
-    render.add_option("--heatmap-max", options.heatmapMax,
-                      "light count at the top of the heatmap scale, 0 = the image's maximum")
+    render
+        .add_option("--heatmap-max", options.heatmapMax,
+                    "light count at the top of the heatmap scale, 0 = the image's maximum")
         ->capture_default_str();
     render.add_flag("--compare-reference", r.compareReference,
                     "also render the double-precision reference and record the error");
-    render.add_option("--layout", r.layout,
-                      "G-buffer preset: reference, compact, stalker, clear-sky, killzone2, bf3, thesis "
-                      "(default: derived from the scene's materials and the stage's needs)");
-    render.add_option("--normals", r.normals, "normal encoding NAME:BITS, e.g. octahedral:24 (testbed list)");
-    render.add_option("--depth", r.depth,
-                      "depth format: f32, f32-reversed, unorm24, unorm16, f16-linear, optionally :infinite");
-    render.add_option("--position", r.position, "position reconstruction: inverse-projection or view-ray");
-    render.add_option("--normal-space", r.normalSpace, "space normals are encoded in: view (default) or world");
-    render.add_flag("--explain-layout", options.explainLayout,
-                    "print the G-buffer layout and why each plane is there, then exit without rendering");
-    render.add_option("--warmup", r.warmup, "untimed runs before the timed ones")->capture_default_str();
+    render.add_option(
+        "--layout", r.layout,
+        "G-buffer preset: reference, compact, stalker, clear-sky, killzone2, bf3, thesis "
+        "(default: derived from the scene's materials and the stage's needs)");
+    render.add_option("--normals", r.normals,
+                      "normal encoding NAME:BITS, e.g. octahedral:24 (testbed list)");
+    render.add_option(
+        "--depth", r.depth,
+        "depth format: f32, f32-reversed, unorm24, unorm16, f16-linear, optionally :infinite");
+    render.add_option("--position", r.position,
+                      "position reconstruction: inverse-projection or view-ray");
+    render.add_option("--normal-space", r.normalSpace,
+                      "space normals are encoded in: view (default) or world");
+    render.add_flag(
+        "--explain-layout", options.explainLayout,
+        "print the G-buffer layout and why each plane is there, then exit without rendering");
+    render.add_option("--warmup", r.warmup, "untimed runs before the timed ones")
+        ->capture_default_str();
     render.add_option("--repetitions", r.repetitions, "timed runs (median, min, max are recorded)")
         ->capture_default_str();
 }
 
 int listEverything() {
     std::cout << "scenes (default " << scenes::kDefaultSceneName << "):\n";
-    for (const std::string& name : scenes::proceduralSceneNames()) std::cout << "  " << name << "\n";
+    for (const std::string& name : scenes::proceduralSceneNames())
+        std::cout << "  " << name << "\n";
     std::cout << "  <file>.gltf | <file>.glb | <file>.json\n";
     std::cout << "stages:\n";
     for (const lighting::StageInfo& info : lighting::stageInfos())
         std::cout << "  " << info.name << "  - " << info.description << "\n";
     std::cout << "normal encodings (NAME:BITS, total bits; gbuffer/NormalCodec.h):\n";
     const std::vector<gbuffer::NormalCodecSpec> specs = gbuffer::allNormalCodecSpecs();
-    for (size_t i = 0; i < specs.size(); ++i) {  // grouped by codec, in registry order
+    for (size_t i = 0; i < specs.size(); ++i) { // grouped by codec, in registry order
         const bool first = i == 0 || specs[i - 1].kind != specs[i].kind;
         const bool last = i + 1 == specs.size() || specs[i + 1].kind != specs[i].kind;
-        if (first) std::cout << "  " << gbuffer::normalCodecName(specs[i].kind) << ":";
+        if (first)
+            std::cout << "  " << gbuffer::normalCodecName(specs[i].kind) << ":";
         std::cout << (first ? "" : "|") << specs[i].bits << (last ? "\n" : "");
     }
     return 0;
 }
 
-}  // namespace
+} // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"testbed: CPU rasterizer research testbed for deferred shading"};
@@ -89,20 +103,25 @@ int main(int argc, char** argv) {
     addRenderOptions(*render, renderOptions, sceneOptionTexts);
     CLI::App* list = app.add_subcommand("list", "list scenes and stages");
     experiments::ReportCommandOptions reportOptions;
-    CLI::App* report = app.add_subcommand("report", "write DIR/report.html for a sweep's results folder DIR");
+    CLI::App* report =
+        app.add_subcommand("report", "write DIR/report.html for a sweep's results folder DIR");
     report->add_option("dir", reportOptions.dir, "results folder (holds results.json)")->required();
     report->add_option("--plots-script", reportOptions.plotsScript, "matplotlib script")
         ->default_str(experiments::defaultPlotsScript().string());
     report->add_option("--python", reportOptions.python,
                        "Python with matplotlib (default: /usr/bin/python3, else python3 on PATH)");
-    report->add_option("--thumbnail-width", reportOptions.thumbnailWidth, "thumbnail width in pixels")
+    report
+        ->add_option("--thumbnail-width", reportOptions.thumbnailWidth, "thumbnail width in pixels")
         ->capture_default_str();
     experiments::DiffCommandOptions diffOptions;
-    CLI::App* diff = app.add_subcommand("diff", "image-diff report of two EXRs (B is the reference)");
+    CLI::App* diff =
+        app.add_subcommand("diff", "image-diff report of two EXRs (B is the reference)");
     diff->add_option("a", diffOptions.a, "first image (EXR with R, G, B)")->required();
     diff->add_option("b", diffOptions.b, "second image, the reference")->required();
-    diff->add_option("--out", diffOptions.out, "output folder (index.html, diff.json, PNGs)")->capture_default_str();
-    diff->add_option("--exposure", diffOptions.exposure, "linear exposure of the previews")->capture_default_str();
+    diff->add_option("--out", diffOptions.out, "output folder (index.html, diff.json, PNGs)")
+        ->capture_default_str();
+    diff->add_option("--exposure", diffOptions.exposure, "linear exposure of the previews")
+        ->capture_default_str();
     diff->add_option("--plots-script", diffOptions.plotsScript, "matplotlib script")
         ->default_str(experiments::defaultPlotsScript().string());
     diff->add_option("--python", diffOptions.python,
@@ -120,47 +139,63 @@ int main(int argc, char** argv) {
     std::uint64_t normalsDirections = experiments::kNormalStudyDirections;
     std::string normalsModels = experiments::kNormalStudyModelsDir;
     CLI::App* normals = app.add_subcommand(
-        "normals", "normal-encoding precision study: every codec x bits -> normals.csv/json, plots");
+        "normals",
+        "normal-encoding precision study: every codec x bits -> normals.csv/json, plots");
     normals->add_option("--out", normalsOptions.out, "output folder")->required();
-    normals->add_option("--directions", normalsDirections, "uniform sphere directions (--quick: 100000)")
+    normals
+        ->add_option("--directions", normalsDirections,
+                     "uniform sphere directions (--quick: 100000)")
         ->capture_default_str();
-    normals->add_option("--seed", normalsOptions.seed, "seed of every random set")->capture_default_str();
-    normals->add_option("--scene", normalsOptions.scenes, "built-in scene or scene file (repeatable)")
+    normals->add_option("--seed", normalsOptions.seed, "seed of every random set")
         ->capture_default_str();
-    normals->add_option("--models", normalsModels,
-                        "folder searched for .gltf/.glb models, skipped with a warning if missing "
-                        "(--quick: none unless given)")
+    normals
+        ->add_option("--scene", normalsOptions.scenes, "built-in scene or scene file (repeatable)")
+        ->capture_default_str();
+    normals
+        ->add_option("--models", normalsModels,
+                     "folder searched for .gltf/.glb models, skipped with a warning if missing "
+                     "(--quick: none unless given)")
         ->capture_default_str();
     normals->add_option("--width", normalsOptions.sceneWidth, "scene render width (--quick: 160)")
         ->capture_default_str();
     normals->add_option("--height", normalsOptions.sceneHeight, "scene render height (--quick: 90)")
         ->capture_default_str();
-    normals->add_option("--threads", normalsOptions.threads, "worker threads, 0 = all hardware threads")
+    normals
+        ->add_option("--threads", normalsOptions.threads,
+                     "worker threads, 0 = all hardware threads")
         ->capture_default_str();
     normals->add_flag("--quick", normalsOptions.quick,
                       "10^5 directions, 160x90 atrium, no models, sampled occupancy (seconds)");
     normals->add_flag("!--no-plots", normalsOptions.plots, "skip the matplotlib plots");
-    normals->add_option("--plots-script", normalsOptions.plotsScript,
-                        "matplotlib script (default: experiments/plots/normals.py of the source tree)");
+    normals->add_option(
+        "--plots-script", normalsOptions.plotsScript,
+        "matplotlib script (default: experiments/plots/normals.py of the source tree)");
     normals->add_option("--python", normalsOptions.python,
                         "Python with matplotlib (default: python3, else /usr/bin/python3)");
     experiments::SweepOptions sweepOptions;
     std::string shardText = "1/1";
     int sweepThreads = -1;
-    CLI::App* sweep = app.add_subcommand("sweep", "run a sweep file (JSON or TOML; experiments/README.md)");
+    CLI::App* sweep =
+        app.add_subcommand("sweep", "run a sweep file (JSON or TOML; experiments/README.md)");
     sweep->add_option("file", sweepOptions.file, "sweep file")->required();
-    sweep->add_option("--out", sweepOptions.out, "output folder (resumable: finished jobs are skipped)")
+    sweep
+        ->add_option("--out", sweepOptions.out,
+                     "output folder (resumable: finished jobs are skipped)")
         ->capture_default_str();
-    sweep->add_option("--shard", shardText, "run shard I of N (1-based): a deterministic 1/N of the jobs")
+    sweep
+        ->add_option("--shard", shardText,
+                     "run shard I of N (1-based): a deterministic 1/N of the jobs")
         ->capture_default_str();
     sweep->add_flag("--quick", sweepOptions.quick, "apply the file's \"quick\" block (CI size)");
-    sweep->add_option("--threads", sweepThreads,
-                      "worker threads of every job, 0 = all hardware threads (default: the file's)");
+    sweep->add_option(
+        "--threads", sweepThreads,
+        "worker threads of every job, 0 = all hardware threads (default: the file's)");
     std::vector<std::filesystem::path> mergeInputs;
     std::filesystem::path mergeOut;
     CLI::App* merge = app.add_subcommand("merge", "combine the output folders of a sweep's shards");
     merge->add_option("dirs", mergeInputs, "sweep output folders")->required();
-    merge->add_option("--out", mergeOut, "merged output folder (may be one of the inputs)")->required();
+    merge->add_option("--out", mergeOut, "merged output folder (may be one of the inputs)")
+        ->required();
     CLI11_PARSE(app, argc, argv);
     if (render->parsed()) {
         for (const std::string& text : sceneOptionTexts) {
@@ -173,24 +208,33 @@ int main(int argc, char** argv) {
         }
         return experiments::runRenderCommand(renderOptions);
     }
-    if (list->parsed()) return listEverything();
-    if (report->parsed()) return experiments::runReportCommand(reportOptions);
-    if (diff->parsed()) return experiments::runDiffCommand(diffOptions);
-    if (depth->parsed()) return experiments::runDepthCommand(depthOptions);
+    if (list->parsed())
+        return listEverything();
+    if (report->parsed())
+        return experiments::runReportCommand(reportOptions);
+    if (diff->parsed())
+        return experiments::runDiffCommand(diffOptions);
+    if (depth->parsed())
+        return experiments::runDepthCommand(depthOptions);
     if (sweep->parsed()) {
         try {
-            std::tie(sweepOptions.shardIndex, sweepOptions.shardCount) = experiments::parseShard(shardText);
+            std::tie(sweepOptions.shardIndex, sweepOptions.shardCount) =
+                experiments::parseShard(shardText);
         } catch (const std::exception& e) {
             std::cerr << "testbed: error: " << e.what() << "\n";
             return 2;
         }
-        if (sweepThreads >= 0) sweepOptions.threads = sweepThreads;
+        if (sweepThreads >= 0)
+            sweepOptions.threads = sweepThreads;
         return experiments::runSweepCommand(sweepOptions);
     }
-    if (merge->parsed()) return experiments::runMergeCommand(mergeInputs, mergeOut);
+    if (merge->parsed())
+        return experiments::runMergeCommand(mergeInputs, mergeOut);
     if (normals->parsed()) {
-        if (normals->count("--directions") > 0) normalsOptions.directions = normalsDirections;
-        if (normals->count("--models") > 0) normalsOptions.modelsDir = normalsModels;
+        if (normals->count("--directions") > 0)
+            normalsOptions.directions = normalsDirections;
+        if (normals->count("--models") > 0)
+            normalsOptions.modelsDir = normalsModels;
         return experiments::runNormalStudyCommand(normalsOptions);
     }
     return 1;

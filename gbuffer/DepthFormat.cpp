@@ -40,24 +40,27 @@ uint32_t unormMax(DepthFormatKind kind) {
 constexpr uint16_t kHalfMaxFiniteBits = 0x7BFF;
 constexpr uint16_t kHalfInfinityBits = 0x7C00;
 
-}  // namespace
+} // namespace
 
 const char* depthFormatName(DepthFormatKind kind) {
     for (const FormatInfo& f : kFormats)
-        if (f.kind == kind) return f.name;
+        if (f.kind == kind)
+            return f.name;
     return "?";
 }
 
 std::vector<std::string> depthFormatNames() {
     std::vector<std::string> names;
-    for (const FormatInfo& f : kFormats) names.emplace_back(f.name);
+    for (const FormatInfo& f : kFormats)
+        names.emplace_back(f.name);
     return names;
 }
 
 std::vector<DepthFormatSpec> allDepthFormatSpecs() {
     std::vector<DepthFormatSpec> specs;
     for (bool infinite : {false, true})
-        for (const FormatInfo& f : kFormats) specs.push_back({f.kind, infinite});
+        for (const FormatInfo& f : kFormats)
+            specs.push_back({f.kind, infinite});
     return specs;
 }
 
@@ -82,14 +85,16 @@ DepthFormatSpec DepthFormatSpec::parse(const std::string& text) {
             return spec;
         }
     std::string valid;
-    for (const FormatInfo& f : kFormats) valid += std::string(valid.empty() ? "" : ", ") + f.name;
+    for (const FormatInfo& f : kFormats)
+        valid += std::string(valid.empty() ? "" : ", ") + f.name;
     throw std::invalid_argument("unknown depth format '" + text + "'; valid: " + valid +
                                 " (each optionally with ':infinite')");
 }
 
 int DepthFormatSpec::bits() const {
     for (const FormatInfo& f : kFormats)
-        if (f.kind == kind) return f.bits;
+        if (f.kind == kind)
+            return f.bits;
     return 0;
 }
 
@@ -113,7 +118,8 @@ double DepthProjection::ndcFromViewDepth(double d) const {
 
 double DepthProjection::viewDepthFromNdc(double z) const {
     const double n = nearMetres, f = farMetres;
-    if (infiniteFar) return reversed ? n / z : n / (1.0 - z);
+    if (infiniteFar)
+        return reversed ? n / z : n / (1.0 - z);
     return reversed ? n * f / (n + z * (f - n)) : n * f / (f - z * (f - n));
 }
 
@@ -125,22 +131,27 @@ float DepthProjection::viewDepthFromNdcFloat(float z) const {
     // the float rounding of f - n alone then costs ~eps f / n relative (0.4% at 0.1/10000), as
     // much as the format's own quantisation.
     const float w = reversed ? z : 1.0f - z;
-    if (infiniteFar) return n / w;
+    if (infiniteFar)
+        return n / w;
     return n * f / (n + w * (f - n));
 }
 
 uint32_t clearDepthCode(const DepthFormatSpec& format, const DepthProjection& projection) {
     switch (format.kind) {
     case DepthFormatKind::F32:
-    case DepthFormatKind::F32Reversed: return std::bit_cast<uint32_t>(projection.clearDepthNdc());
+    case DepthFormatKind::F32Reversed:
+        return std::bit_cast<uint32_t>(projection.clearDepthNdc());
     case DepthFormatKind::Unorm24:
-    case DepthFormatKind::Unorm16: return projection.reversed ? 0u : unormMax(format.kind);
-    case DepthFormatKind::F16Linear: return kHalfInfinityBits;
+    case DepthFormatKind::Unorm16:
+        return projection.reversed ? 0u : unormMax(format.kind);
+    case DepthFormatKind::F16Linear:
+        return kHalfInfinityBits;
     }
     return 0;
 }
 
-uint32_t encodeDepth(const DepthFormatSpec& format, const DepthProjection& projection, float depthNdc) {
+uint32_t encodeDepth(const DepthFormatSpec& format, const DepthProjection& projection,
+                     float depthNdc) {
     const uint32_t clear = clearDepthCode(format, projection);
     switch (format.kind) {
     case DepthFormatKind::F32:
@@ -154,11 +165,12 @@ uint32_t encodeDepth(const DepthFormatSpec& format, const DepthProjection& proje
         const double clamped = std::clamp(double(depthNdc), 0.0, 1.0);
         uint32_t code = uint32_t(std::lround(clamped * max));
         if (depthNdc != projection.clearDepthNdc() && code == clear)
-            code = projection.reversed ? 1u : max - 1u;  // covered stays covered
+            code = projection.reversed ? 1u : max - 1u; // covered stays covered
         return code;
     }
     case DepthFormatKind::F16Linear: {
-        if (depthNdc == projection.clearDepthNdc()) return clear;
+        if (depthNdc == projection.clearDepthNdc())
+            return clear;
         // Clamped to [0, 65504]: NDC depth outside [0, 1] (unclipped input; reversed z < 0 far
         // enough gives a negative linear depth) must not give a negative half, whose bits the
         // final min would turn into 65504 m, the far end.
@@ -170,15 +182,18 @@ uint32_t encodeDepth(const DepthFormatSpec& format, const DepthProjection& proje
     return clear;
 }
 
-float decodeDepthNdc(const DepthFormatSpec& format, const DepthProjection& projection, uint32_t code) {
+float decodeDepthNdc(const DepthFormatSpec& format, const DepthProjection& projection,
+                     uint32_t code) {
     switch (format.kind) {
     case DepthFormatKind::F32:
-    case DepthFormatKind::F32Reversed: return std::bit_cast<float>(code);
+    case DepthFormatKind::F32Reversed:
+        return std::bit_cast<float>(code);
     case DepthFormatKind::Unorm24:
     case DepthFormatKind::Unorm16:
         return float(double(code & unormMax(format.kind)) / double(unormMax(format.kind)));
     case DepthFormatKind::F16Linear: {
-        if (code == kHalfInfinityBits) return projection.clearDepthNdc();
+        if (code == kHalfInfinityBits)
+            return projection.clearDepthNdc();
         Imath::half h;
         h.setBits(uint16_t(code));
         return float(projection.ndcFromViewDepth(double(float(h))));
@@ -187,9 +202,11 @@ float decodeDepthNdc(const DepthFormatSpec& format, const DepthProjection& proje
     return projection.clearDepthNdc();
 }
 
-float decodeViewDepth(const DepthFormatSpec& format, const DepthProjection& projection, uint32_t code) {
+float decodeViewDepth(const DepthFormatSpec& format, const DepthProjection& projection,
+                      uint32_t code) {
     if (format.kind == DepthFormatKind::F16Linear) {
-        if (code == kHalfInfinityBits) return std::numeric_limits<float>::infinity();
+        if (code == kHalfInfinityBits)
+            return std::numeric_limits<float>::infinity();
         Imath::half h;
         h.setBits(uint16_t(code));
         return float(h);
@@ -202,8 +219,10 @@ const char* positionMethodName(PositionMethod method) {
 }
 
 PositionMethod parsePositionMethod(const std::string& text) {
-    if (text == "inverse-projection") return PositionMethod::InverseProjection;
-    if (text == "view-ray") return PositionMethod::ViewRay;
+    if (text == "inverse-projection")
+        return PositionMethod::InverseProjection;
+    if (text == "view-ray")
+        return PositionMethod::ViewRay;
     throw std::invalid_argument("unknown position reconstruction '" + text +
                                 "'; valid: inverse-projection, view-ray");
 }
@@ -222,4 +241,4 @@ glm::vec3 positionByViewRay(const FrameView& view, glm::vec2 ndc, float viewDept
     return viewRayOfNdc(view, ndc) * viewDepthMetres;
 }
 
-}  // namespace gbuffer
+} // namespace gbuffer

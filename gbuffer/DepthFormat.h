@@ -36,9 +36,9 @@ struct DepthFormatSpec {
     DepthFormatKind kind = DepthFormatKind::F32Reversed;
     bool infiniteFar = false;
 
-    std::string text() const;  // "NAME" or "NAME:infinite"; parse(text()) == *this
+    std::string text() const; // "NAME" or "NAME:infinite"; parse(text()) == *this
     static DepthFormatSpec parse(const std::string& text);
-    int bits() const;          // storage bits per pixel: 32, 32, 24, 16, 16
+    int bits() const; // storage bits per pixel: 32, 32, 24, 16, 16
     // The working depth the rasterizer tests: reversed for f32-reversed and f16-linear (whose
     // stored value does not depend on it), standard for the others (reversed Z gains nothing in
     // fixed point, and hardware D24/D16 are standard).
@@ -48,13 +48,13 @@ struct DepthFormatSpec {
 
 const char* depthFormatName(DepthFormatKind kind);
 std::vector<std::string> depthFormatNames();        // the CLI names, finite far plane
-std::vector<DepthFormatSpec> allDepthFormatSpecs();  // every name, finite and infinite
+std::vector<DepthFormatSpec> allDepthFormatSpecs(); // every name, finite and infinite
 
 // The projection's depth mapping (perspective, zero-to-one). Finite standard:
 // z = f (d - n) / (d (f - n)); infinite standard: z = 1 - n / d; reversed: 1 - those.
 struct DepthProjection {
     double nearMetres = 0.1;
-    double farMetres = 100.0;  // ignored when infiniteFar
+    double farMetres = 100.0; // ignored when infiniteFar
     bool infiniteFar = false;
     bool reversed = true;
 
@@ -69,20 +69,23 @@ struct DepthProjection {
 };
 
 // Code of NDC depth `depthNdc` (as the rasterizer computed it, in `projection`'s convention).
-uint32_t encodeDepth(const DepthFormatSpec& format, const DepthProjection& projection, float depthNdc);
+uint32_t encodeDepth(const DepthFormatSpec& format, const DepthProjection& projection,
+                     float depthNdc);
 uint32_t clearDepthCode(const DepthFormatSpec& format, const DepthProjection& projection);
 // NDC depth the code stands for, in `projection`'s convention (what depth-reading code sees).
-float decodeDepthNdc(const DepthFormatSpec& format, const DepthProjection& projection, uint32_t code);
+float decodeDepthNdc(const DepthFormatSpec& format, const DepthProjection& projection,
+                     uint32_t code);
 // Linear view depth (metres) the code stands for, evaluated in float as a shader would: direct
 // for f16-linear, viewDepthFromNdcFloat of the NDC value otherwise.
-float decodeViewDepth(const DepthFormatSpec& format, const DepthProjection& projection, uint32_t code);
+float decodeViewDepth(const DepthFormatSpec& format, const DepthProjection& projection,
+                      uint32_t code);
 
 // The two reconstruction methods of the thesis (section 3.6).
 enum class PositionMethod {
-    InverseProjection,  // (ndc.x, ndc.y, depthNdc, 1) times the inverse projection, divided by w
-    ViewRay,            // linear view depth times the view ray through the pixel (z = -1)
+    InverseProjection, // (ndc.x, ndc.y, depthNdc, 1) times the inverse projection, divided by w
+    ViewRay,           // linear view depth times the view ray through the pixel (z = -1)
 };
-const char* positionMethodName(PositionMethod method);  // "inverse-projection", "view-ray"
+const char* positionMethodName(PositionMethod method); // "inverse-projection", "view-ray"
 PositionMethod parsePositionMethod(const std::string& text);
 
 glm::vec3 positionByInverseProjection(const FrameView& view, glm::vec2 ndc, float depthNdc);
@@ -90,4 +93,4 @@ glm::vec3 positionByViewRay(const FrameView& view, glm::vec2 ndc, float viewDept
 // The view ray through `ndc` with z = -1 (also the ray `pixel-view` normals are built on).
 glm::vec3 viewRayOfNdc(const FrameView& view, glm::vec2 ndc);
 
-}  // namespace gbuffer
+} // namespace gbuffer

@@ -22,7 +22,8 @@ void ExactSurface::computeGeometry(const SceneGeometry& geometry, const FrameVie
         for (int x = 0; x < width; ++x) {
             const size_t pixel = size_t(y) * width + x;
             const uint32_t t = triangle[pixel];
-            if (t == kNoTriangle) continue;
+            if (t == kNoTriangle)
+                continue;
             // View ray through the pixel centre: the point on the near plane, from the origin.
             const double ndcX = (x + 0.5) / width * 2.0 - 1.0;
             const double ndcY = 1.0 - (y + 0.5) / height * 2.0;
@@ -30,14 +31,15 @@ void ExactSurface::computeGeometry(const SceneGeometry& geometry, const FrameVie
             const glm::dvec3 direction = glm::dvec3(onNear) / onNear.w;
             glm::dvec3 p[3];
             for (int i = 0; i < 3; ++i)
-                p[i] = glm::dvec3(view.viewFromWorldExact *
-                                  glm::dvec4(geometry.positionWorldExact[geometry.indices[3 * t + i]], 1.0));
+                p[i] = glm::dvec3(
+                    view.viewFromWorldExact *
+                    glm::dvec4(geometry.positionWorldExact[geometry.indices[3 * t + i]], 1.0));
             // Moeller-Trumbore without the inside test: the rasterizer already decided coverage;
             // barycentrics slightly outside [0,1] at edges are the honest extrapolation.
             const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
             const glm::dvec3 h = glm::cross(direction, e2);
             const double det = glm::dot(e1, h);
-            if (det == 0.0) {  // ray parallel to the plane (edge-on): keep the float answer
+            if (det == 0.0) { // ray parallel to the plane (edge-on): keep the float answer
                 continue;
             }
             const double inv = 1.0 / det;
@@ -57,4 +59,4 @@ void ExactSurface::computeGeometry(const SceneGeometry& geometry, const FrameVie
     });
 }
 
-}  // namespace gbuffer
+} // namespace gbuffer

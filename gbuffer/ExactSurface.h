@@ -22,9 +22,9 @@ struct ExactSurface {
     int width = 0;
     int height = 0;
     std::vector<uint32_t> triangle;  // covering triangle per pixel, kNoTriangle for background
-    std::vector<uint8_t> backFacing;  // 1 where the visible side is the back face (normal flipped)
+    std::vector<uint8_t> backFacing; // 1 where the visible side is the back face (normal flipped)
     std::vector<glm::vec3> albedo;
-    std::vector<glm::vec2> specular;  // intensity, power
+    std::vector<glm::vec2> specular; // intensity, power
     std::vector<glm::dvec3> positionView;
     std::vector<glm::dvec3> normalView;
 
@@ -34,4 +34,4 @@ struct ExactSurface {
     void computeGeometry(const SceneGeometry& geometry, const FrameView& view);
 };
 
-}  // namespace gbuffer
+} // namespace gbuffer

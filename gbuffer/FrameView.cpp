@@ -17,8 +17,9 @@ FrameView FrameView::fromCamera(const scenes::Camera& camera, int width, int hei
     // Built in double, then rounded: the float matrices and the exact ones describe one camera.
     const glm::dvec3 eye(camera.positionWorld), forward(camera.forwardWorld), up(camera.upWorld);
     view.viewFromWorldExact = glm::lookAtRH(eye, eye + forward, up);
-    glm::dmat4 clipFromViewExact = glm::perspectiveRH_ZO(
-        double(camera.verticalFovRadians), aspect, double(camera.nearMetres), double(camera.farMetres));
+    glm::dmat4 clipFromViewExact =
+        glm::perspectiveRH_ZO(double(camera.verticalFovRadians), aspect, double(camera.nearMetres),
+                              double(camera.farMetres));
     if (infiniteFar) {
         // The limit f -> infinity of the zero-to-one perspective: z_clip = d - n, w = d, so
         // z_ndc = 1 - n / d (far plane at infinity, no far clipping).
@@ -40,4 +41,4 @@ FrameView FrameView::fromCamera(const scenes::Camera& camera, int width, int hei
     return view;
 }
 
-}  // namespace gbuffer
+} // namespace gbuffer

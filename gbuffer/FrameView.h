@@ -20,11 +20,11 @@ struct FrameView {
     float nearMetres = 0.1f;
     float farMetres = 100.0f;
     DepthConvention depthConvention = DepthConvention::Reversed;
-    bool infiniteFar = false;  // far plane at infinity: farMetres is then only the scene's extent
+    bool infiniteFar = false; // far plane at infinity: farMetres is then only the scene's extent
     glm::mat4 viewFromWorld{1.0f};
     glm::mat4 clipFromView{1.0f};
-    glm::mat4 viewFromClip{1.0f};   // inverse projection, for position reconstruction
-    glm::mat3 viewFromWorldNormal{1.0f};  // rotation part, for directions and normals
+    glm::mat4 viewFromClip{1.0f};        // inverse projection, for position reconstruction
+    glm::mat3 viewFromWorldNormal{1.0f}; // rotation part, for directions and normals
     glm::dmat4 viewFromWorldExact{1.0};
     glm::dmat4 viewFromClipExact{1.0};
 
@@ -44,4 +44,4 @@ struct FrameView {
     }
 };
 
-}  // namespace gbuffer
+} // namespace gbuffer

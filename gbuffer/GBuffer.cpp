@@ -33,44 +33,58 @@ const std::array<float, 256>& linearOfSrgb8() {
     return table;
 }
 
-uint32_t unorm8(float v) { return uint32_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+uint32_t unorm8(float v) {
+    return uint32_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+}
 
-}  // namespace
+} // namespace
 
 GBuffer::GBuffer(const GBufferLayout& layout, const FrameView& view)
-    : mLayout(layout), mView(view), mProjection(DepthProjection::of(view)), mClearDepth(view.clearDepth()) {
-    if (layout.depth.convention() != view.depthConvention || layout.depth.infiniteFar != view.infiniteFar)
-        throw std::invalid_argument("G-buffer layout '" + layout.name + "' stores depth as " +
-                                    layout.depth.text() + ", which needs a " +
-                                    (layout.depth.convention() == DepthConvention::Reversed ? "reversed" : "standard") +
-                                    "-Z view" + (layout.depth.infiniteFar ? " with an infinite far plane" : "") +
-                                    "; the frame's view differs");
+    : mLayout(layout), mView(view), mProjection(DepthProjection::of(view)),
+      mClearDepth(view.clearDepth()) {
+    if (layout.depth.convention() != view.depthConvention ||
+        layout.depth.infiniteFar != view.infiniteFar)
+        throw std::invalid_argument(
+            "G-buffer layout '" + layout.name + "' stores depth as " + layout.depth.text() +
+            ", which needs a " +
+            (layout.depth.convention() == DepthConvention::Reversed ? "reversed" : "standard") +
+            "-Z view" + (layout.depth.infiniteFar ? " with an infinite far plane" : "") +
+            "; the frame's view differs");
     mWorldFromView = glm::transpose(view.viewFromWorldNormal);
     const size_t n = pixelCount();
-    mDepth.assign(n, mClearDepth);  // depth is always there: coverage and positions come from it
+    mDepth.assign(n, mClearDepth); // depth is always there: coverage and positions come from it
     if (layout.hasNormals) {
         if (layout.normals.kind == NormalCodecKind::Float32)
-            for (auto& plane : mNormal) plane.assign(n, 0.0f);
+            for (auto& plane : mNormal)
+                plane.assign(n, 0.0f);
         else if (layout.normals.bits <= 32)
             mNormalCode32.assign(n, 0);
         else
             mNormalCode64.assign(n, 0);
     }
     if (layout.albedo == AlbedoEncoding::Float32)
-        for (auto& plane : mAlbedo) plane.assign(n, 0.0f);
-    if (layout.albedo == AlbedoEncoding::Rgb8Srgb) mAlbedoPacked.assign(n, 0);
+        for (auto& plane : mAlbedo)
+            plane.assign(n, 0.0f);
+    if (layout.albedo == AlbedoEncoding::Rgb8Srgb)
+        mAlbedoPacked.assign(n, 0);
     if (layout.specular == SpecularEncoding::Float32)
-        for (auto& plane : mSpecular) plane.assign(n, 0.0f);
-    if (layout.specular == SpecularEncoding::Unorm8Half || layout.specular == SpecularEncoding::Unorm8Log8)
+        for (auto& plane : mSpecular)
+            plane.assign(n, 0.0f);
+    if (layout.specular == SpecularEncoding::Unorm8Half ||
+        layout.specular == SpecularEncoding::Unorm8Log8)
         mSpecularPacked.assign(n, 0);
-    if (layout.hasMaterialIndex()) mMaterial.assign(n, 0);
+    if (layout.hasMaterialIndex())
+        mMaterial.assign(n, 0);
 }
 
-void GBuffer::clearDepth() { std::fill(mDepth.begin(), mDepth.end(), mClearDepth); }
+void GBuffer::clearDepth() {
+    std::fill(mDepth.begin(), mDepth.end(), mClearDepth);
+}
 
 void GBuffer::quantiseDepth() {
     const DepthFormatKind kind = mLayout.depth.kind;
-    if (kind == DepthFormatKind::F32 || kind == DepthFormatKind::F32Reversed) return;  // lossless
+    if (kind == DepthFormatKind::F32 || kind == DepthFormatKind::F32Reversed)
+        return; // lossless
     const bool reversed = mView.reversedZ();
     // One float step nearer than the clear value: where a covered pixel goes if its rounded depth
     // would read as background (e.g. f16-linear rounding past the far plane).
@@ -78,9 +92,12 @@ void GBuffer::quantiseDepth() {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, mDepth.size(), 16384), [&](const auto& range) {
         for (size_t pixel = range.begin(); pixel != range.end(); ++pixel) {
             const float z = mDepth[pixel];
-            if (z == mClearDepth) continue;
-            float q = decodeDepthNdc(mLayout.depth, mProjection, encodeDepth(mLayout.depth, mProjection, z));
-            if (reversed ? !(q > mClearDepth) : !(q < mClearDepth)) q = nearestCovered;
+            if (z == mClearDepth)
+                continue;
+            float q = decodeDepthNdc(mLayout.depth, mProjection,
+                                     encodeDepth(mLayout.depth, mProjection, z));
+            if (reversed ? !(q > mClearDepth) : !(q < mClearDepth))
+                q = nearestCovered;
             mDepth[pixel] = q;
         }
     });
@@ -97,7 +114,8 @@ GBuffer::Writer::Writer(GBuffer& target) {
         mNormal[c] = pointer(target.mNormal[c]);
         mAlbedo[c] = pointer(target.mAlbedo[c]);
     }
-    for (int c = 0; c < 2; ++c) mSpecular[c] = pointer(target.mSpecular[c]);
+    for (int c = 0; c < 2; ++c)
+        mSpecular[c] = pointer(target.mSpecular[c]);
     mMaterial = pointer(target.mMaterial);
     mEncoded = target.hasEncodedPlanes() ? &target : nullptr;
 }
@@ -109,14 +127,18 @@ bool GBuffer::hasEncodedPlanes() const {
 
 void GBuffer::writeEncoded(size_t pixel, const Surface& s) {
     if (!mNormalCode32.empty() || !mNormalCode64.empty()) {
-        const glm::vec3 normal =
-            mLayout.normalSpace == NormalSpace::World ? mWorldFromView * s.normalView : s.normalView;
+        const glm::vec3 normal = mLayout.normalSpace == NormalSpace::World
+                                     ? mWorldFromView * s.normalView
+                                     : s.normalView;
         const NormalCode code = encodeNormal(mLayout.normals, normal, viewRayOfPixel(pixel));
-        if (!mNormalCode32.empty()) mNormalCode32[pixel] = uint32_t(code.low);
-        else mNormalCode64[pixel] = code.low;
+        if (!mNormalCode32.empty())
+            mNormalCode32[pixel] = uint32_t(code.low);
+        else
+            mNormalCode64[pixel] = code.low;
     }
     if (!mAlbedoPacked.empty()) {
-        mAlbedoPacked[pixel] = unorm8(srgbFromLinear(s.albedo.r)) | unorm8(srgbFromLinear(s.albedo.g)) << 8 |
+        mAlbedoPacked[pixel] = unorm8(srgbFromLinear(s.albedo.r)) |
+                               unorm8(srgbFromLinear(s.albedo.g)) << 8 |
                                unorm8(srgbFromLinear(s.albedo.b)) << 16;
     }
     if (!mSpecularPacked.empty()) {
@@ -146,23 +168,35 @@ Surface GBuffer::decode(int x, int y) const {
     } else if (!mNormalCode32.empty() || !mNormalCode64.empty()) {
         NormalCode code;
         code.low = !mNormalCode32.empty() ? mNormalCode32[pixel] : mNormalCode64[pixel];
-        s.normalView = decodeNormal(mLayout.normals, code, viewRayOfNdc(mView, mView.ndcOfPixel(x, y)));
-        if (mLayout.normalSpace == NormalSpace::World) s.normalView = mView.viewFromWorldNormal * s.normalView;
+        s.normalView =
+            decodeNormal(mLayout.normals, code, viewRayOfNdc(mView, mView.ndcOfPixel(x, y)));
+        if (mLayout.normalSpace == NormalSpace::World)
+            s.normalView = mView.viewFromWorldNormal * s.normalView;
     }
-    if (!mMaterial.empty()) s.material = mMaterial[pixel];
-    const MaterialConstants* material =
-        !mMaterial.empty() && s.material < mLayout.materials.size() ? &mLayout.materials[s.material] : nullptr;
+    if (!mMaterial.empty())
+        s.material = mMaterial[pixel];
+    const MaterialConstants* material = !mMaterial.empty() && s.material < mLayout.materials.size()
+                                            ? &mLayout.materials[s.material]
+                                            : nullptr;
     switch (mLayout.albedo) {
-    case AlbedoEncoding::Float32: s.albedo = {mAlbedo[0][pixel], mAlbedo[1][pixel], mAlbedo[2][pixel]}; break;
+    case AlbedoEncoding::Float32:
+        s.albedo = {mAlbedo[0][pixel], mAlbedo[1][pixel], mAlbedo[2][pixel]};
+        break;
     case AlbedoEncoding::Rgb8Srgb: {
         const uint32_t packed = mAlbedoPacked[pixel];
         const auto& linear = linearOfSrgb8();
-        s.albedo = {linear[packed & 0xff], linear[(packed >> 8) & 0xff], linear[(packed >> 16) & 0xff]};
+        s.albedo = {linear[packed & 0xff], linear[(packed >> 8) & 0xff],
+                    linear[(packed >> 16) & 0xff]};
         break;
     }
-    case AlbedoEncoding::Material: s.albedo = material ? material->albedo : glm::vec3(0.0f); break;
-    case AlbedoEncoding::Constant: s.albedo = mLayout.constant.albedo; break;
-    case AlbedoEncoding::None: break;
+    case AlbedoEncoding::Material:
+        s.albedo = material ? material->albedo : glm::vec3(0.0f);
+        break;
+    case AlbedoEncoding::Constant:
+        s.albedo = mLayout.constant.albedo;
+        break;
+    case AlbedoEncoding::None:
+        break;
     }
     switch (mLayout.specular) {
     case SpecularEncoding::Float32:
@@ -192,9 +226,10 @@ Surface GBuffer::decode(int x, int y) const {
         s.specularIntensity = mLayout.constant.specularIntensity;
         s.specularPower = mLayout.constant.specularPower;
         break;
-    case SpecularEncoding::None: break;
+    case SpecularEncoding::None:
+        break;
     }
     return s;
 }
 
-}  // namespace gbuffer
+} // namespace gbuffer

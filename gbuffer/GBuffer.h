@@ -37,7 +37,7 @@ struct Surface {
     glm::vec3 albedo{0.0f};
     float specularIntensity = 0.0f;
     float specularPower = 1.0f;
-    uint32_t material = 0;  // index into the scene's materials (written, not always stored)
+    uint32_t material = 0; // index into the scene's materials (written, not always stored)
 };
 
 class GBuffer {
@@ -52,8 +52,8 @@ public:
     int height() const { return mView.height; }
     size_t pixelCount() const { return size_t(mView.width) * mView.height; }
 
-    // Resets depth to the far plane's value. Other planes are written for every pixel by the G-buffer
-    // pass (zero for background), so clearing them too would only cost bandwidth.
+    // Resets depth to the far plane's value. Other planes are written for every pixel by the
+    // G-buffer pass (zero for background), so clearing them too would only cost bandwidth.
     void clearDepth();
     // Rounds every covered pixel's depth through the layout's format (no-op for the float format
     // of the view's own convention). Parallel (TBB). A covered pixel stays covered.
@@ -81,8 +81,10 @@ public:
                 mSpecular[0][pixel] = s.specularIntensity;
                 mSpecular[1][pixel] = s.specularPower;
             }
-            if (mMaterial) mMaterial[pixel] = uint16_t(s.material);
-            if (mEncoded) mEncoded->writeEncoded(pixel, s);
+            if (mMaterial)
+                mMaterial[pixel] = uint16_t(s.material);
+            if (mEncoded)
+                mEncoded->writeEncoded(pixel, s);
         }
         // The background value in every plane but depth: Surface's defaults.
         void writeBackground(size_t pixel) const { write(pixel, Surface{}); }
@@ -92,7 +94,7 @@ public:
         float* mAlbedo[3] = {};
         float* mSpecular[2] = {};
         uint16_t* mMaterial = nullptr;
-        GBuffer* mEncoded = nullptr;  // the target when it has encoded planes
+        GBuffer* mEncoded = nullptr; // the target when it has encoded planes
     };
     Writer writer() { return Writer(*this); }
 
@@ -114,17 +116,18 @@ private:
     GBufferLayout mLayout;
     FrameView mView;
     DepthProjection mProjection;
-    glm::mat3 mWorldFromView{1.0f};  // for world-space normal codes (viewFromWorldNormal is a rotation)
+    glm::mat3 mWorldFromView{
+        1.0f}; // for world-space normal codes (viewFromWorldNormal is a rotation)
     float mClearDepth;
     Plane<float> mDepth;
-    Plane<float> mNormal[3];          // float32 normals
-    Plane<uint32_t> mNormalCode32;    // codes of up to 32 bits
-    Plane<uint64_t> mNormalCode64;    // longer codes (xyz:48)
-    Plane<float> mAlbedo[3];          // f32
-    Plane<uint32_t> mAlbedoPacked;    // rgb8-srgb
-    Plane<float> mSpecular[2];        // f32
-    Plane<uint32_t> mSpecularPacked;  // unorm8+f16, unorm8+log8
-    Plane<uint16_t> mMaterial;        // material index
+    Plane<float> mNormal[3];         // float32 normals
+    Plane<uint32_t> mNormalCode32;   // codes of up to 32 bits
+    Plane<uint64_t> mNormalCode64;   // longer codes (xyz:48)
+    Plane<float> mAlbedo[3];         // f32
+    Plane<uint32_t> mAlbedoPacked;   // rgb8-srgb
+    Plane<float> mSpecular[2];       // f32
+    Plane<uint32_t> mSpecularPacked; // unorm8+f16, unorm8+log8
+    Plane<uint16_t> mMaterial;       // material index
 };
 
-}  // namespace gbuffer
+} // namespace gbuffer

@@ -31,25 +31,35 @@ constexpr SpecularInfo kSpecularEncodings[] = {
 };
 
 // Bytes of the CPU array that holds a plane of `bits` bits (the next power-of-two word).
-int storageBytes(int bits) { return bits <= 8 ? 1 : bits <= 16 ? 2 : bits <= 32 ? 4 : 8; }
+int storageBytes(int bits) {
+    return bits <= 8 ? 1 : bits <= 16 ? 2 : bits <= 32 ? 4 : 8;
+}
 
-}  // namespace
+} // namespace
 
 const char* channelName(Channel channel) {
     switch (channel) {
-    case Channel::Depth: return "depth";
-    case Channel::Normal: return "normal";
-    case Channel::Albedo: return "albedo";
-    case Channel::Specular: return "specular";
+    case Channel::Depth:
+        return "depth";
+    case Channel::Normal:
+        return "normal";
+    case Channel::Albedo:
+        return "albedo";
+    case Channel::Specular:
+        return "specular";
     }
     return "?";
 }
 
-const char* normalSpaceName(NormalSpace space) { return space == NormalSpace::View ? "view" : "world"; }
+const char* normalSpaceName(NormalSpace space) {
+    return space == NormalSpace::View ? "view" : "world";
+}
 
 NormalSpace parseNormalSpace(const std::string& text) {
-    if (text == "view") return NormalSpace::View;
-    if (text == "world") return NormalSpace::World;
+    if (text == "view")
+        return NormalSpace::View;
+    if (text == "world")
+        return NormalSpace::World;
     throw std::invalid_argument("unknown normal space '" + text + "'; valid: view, world");
 }
 
@@ -59,20 +69,23 @@ bool codecWorksInWorldSpace(NormalCodecKind kind) {
 
 const char* albedoEncodingName(AlbedoEncoding encoding) {
     for (const AlbedoInfo& info : kAlbedoEncodings)
-        if (info.encoding == encoding) return info.name;
+        if (info.encoding == encoding)
+            return info.name;
     return "?";
 }
 
 const char* specularEncodingName(SpecularEncoding encoding) {
     for (const SpecularInfo& info : kSpecularEncodings)
-        if (info.encoding == encoding) return info.name;
+        if (info.encoding == encoding)
+            return info.name;
     return "?";
 }
 
 AlbedoEncoding parseAlbedoEncoding(const std::string& text) {
     std::string valid;
     for (const AlbedoInfo& info : kAlbedoEncodings) {
-        if (text == info.name) return info.encoding;
+        if (text == info.name)
+            return info.encoding;
         valid += std::string(valid.empty() ? "" : ", ") + info.name;
     }
     throw std::invalid_argument("unknown albedo encoding '" + text + "'; valid: " + valid);
@@ -81,7 +94,8 @@ AlbedoEncoding parseAlbedoEncoding(const std::string& text) {
 SpecularEncoding parseSpecularEncoding(const std::string& text) {
     std::string valid;
     for (const SpecularInfo& info : kSpecularEncodings) {
-        if (text == info.name) return info.encoding;
+        if (text == info.name)
+            return info.encoding;
         valid += std::string(valid.empty() ? "" : ", ") + info.name;
     }
     throw std::invalid_argument("unknown specular encoding '" + text + "'; valid: " + valid);
@@ -89,10 +103,14 @@ SpecularEncoding parseSpecularEncoding(const std::string& text) {
 
 bool GBufferLayout::provides(Channel channel) const {
     switch (channel) {
-    case Channel::Depth: return true;
-    case Channel::Normal: return hasNormals;
-    case Channel::Albedo: return albedo != AlbedoEncoding::None;
-    case Channel::Specular: return specular != SpecularEncoding::None;
+    case Channel::Depth:
+        return true;
+    case Channel::Normal:
+        return hasNormals;
+    case Channel::Albedo:
+        return albedo != AlbedoEncoding::None;
+    case Channel::Specular:
+        return specular != SpecularEncoding::None;
     }
     return false;
 }
@@ -103,10 +121,13 @@ std::vector<PlaneDesc> GBufferLayout::planes() const {
     if (hasNormals) {
         if (normals.kind == NormalCodecKind::Float32) {
             for (const char* name : {"N.X", "N.Y", "N.Z"})
-                result.push_back({name, std::string("f32, ") + normalSpaceName(normalSpace) + " space", 32, "normal"});
+                result.push_back({name,
+                                  std::string("f32, ") + normalSpaceName(normalSpace) + " space",
+                                  32, "normal"});
         } else {
-            result.push_back({"N", "code of " + normals.text() + ", " + normalSpaceName(normalSpace) + " space",
-                              normals.bits, "normal"});
+            result.push_back(
+                {"N", "code of " + normals.text() + ", " + normalSpaceName(normalSpace) + " space",
+                 normals.bits, "normal"});
         }
     }
     switch (albedo) {
@@ -114,8 +135,11 @@ std::vector<PlaneDesc> GBufferLayout::planes() const {
         for (const char* name : {"albedo.R", "albedo.G", "albedo.B"})
             result.push_back({name, "f32", 32, "albedo"});
         break;
-    case AlbedoEncoding::Rgb8Srgb: result.push_back({"albedo", "unorm8 x3, sRGB", 24, "albedo"}); break;
-    default: break;
+    case AlbedoEncoding::Rgb8Srgb:
+        result.push_back({"albedo", "unorm8 x3, sRGB", 24, "albedo"});
+        break;
+    default:
+        break;
     }
     switch (specular) {
     case SpecularEncoding::Float32:
@@ -130,10 +154,12 @@ std::vector<PlaneDesc> GBufferLayout::planes() const {
         result.push_back({"specular.intensity", "unorm8", 8, "specular"});
         result.push_back({"specular.power", "unorm8 of log2(power) / 13", 8, "specular"});
         break;
-    default: break;
+    default:
+        break;
     }
     if (hasMaterialIndex())
-        result.push_back({"material", "uint" + std::to_string(materialIndexBits()), materialIndexBits(), "material"});
+        result.push_back({"material", "uint" + std::to_string(materialIndexBits()),
+                          materialIndexBits(), "material"});
     for (PlaneDesc plane : unmodelled) {
         plane.unmodelled = true;
         plane.channel = "unmodelled";
@@ -144,15 +170,18 @@ std::vector<PlaneDesc> GBufferLayout::planes() const {
 
 double GBufferLayout::bytesPerPixel() const {
     int bits = 0;
-    for (const PlaneDesc& plane : planes()) bits += plane.bits;
+    for (const PlaneDesc& plane : planes())
+        bits += plane.bits;
     return bits / 8.0;
 }
 
 double GBufferLayout::allocatedBytesPerPixel() const {
     double bytes = 0.0;
     for (const PlaneDesc& plane : planes()) {
-        if (plane.unmodelled) continue;
-        // Depth is kept as the rasterizer's float working plane whatever its format (see GBuffer.h).
+        if (plane.unmodelled)
+            continue;
+        // Depth is kept as the rasterizer's float working plane whatever its format (see
+        // GBuffer.h).
         bytes += plane.channel == "depth" ? 4 : storageBytes(plane.bits);
     }
     return bytes;
@@ -164,45 +193,55 @@ std::string GBufferLayout::explain() const {
         << allocatedBytesPerPixel() << " allocated)\n";
     auto reasonOf = [&](const std::string& channel) -> std::string {
         for (const auto& [c, reason] : reasons)
-            if (channel == channelName(c)) return reason;
+            if (channel == channelName(c))
+                return reason;
         return {};
     };
     for (const PlaneDesc& plane : planes()) {
         out << "  " << std::left << std::setw(20) << plane.name << std::setw(36) << plane.format
             << std::right << std::setw(3) << plane.bits << " bits  ";
-        if (plane.unmodelled) out << "unmodelled: stored by the original layout, read by no stage here";
+        if (plane.unmodelled)
+            out << "unmodelled: stored by the original layout, read by no stage here";
         else if (plane.channel == "material")
             out << "material index: decodes "
                 << (albedo == AlbedoEncoding::Material ? std::string("albedo") : std::string())
-                << (albedo == AlbedoEncoding::Material && specular == SpecularEncoding::Material ? " and " : "")
-                << (specular == SpecularEncoding::Material ? "specular" : "") << " from the material table ("
-                << materials.size() << " materials)";
-        else out << reasonOf(plane.channel);
+                << (albedo == AlbedoEncoding::Material && specular == SpecularEncoding::Material
+                        ? " and "
+                        : "")
+                << (specular == SpecularEncoding::Material ? "specular" : "")
+                << " from the material table (" << materials.size() << " materials)";
+        else
+            out << reasonOf(plane.channel);
         out << "\n";
     }
     for (Channel channel : {Channel::Normal, Channel::Albedo, Channel::Specular}) {
         const bool stored = [&] {
             for (const PlaneDesc& plane : planes())
-                if (plane.channel == channelName(channel)) return true;
+                if (plane.channel == channelName(channel))
+                    return true;
             return channel != Channel::Normal && hasMaterialIndex() &&
                    (channel == Channel::Albedo ? albedo == AlbedoEncoding::Material
                                                : specular == SpecularEncoding::Material);
         }();
-        if (!stored) out << "  (no " << channelName(channel) << " plane)  " << reasonOf(channelName(channel)) << "\n";
+        if (!stored)
+            out << "  (no " << channelName(channel) << " plane)  " << reasonOf(channelName(channel))
+                << "\n";
     }
     out << "  position: " << positionMethodName(position) << " from " << depth.text() << "\n";
-    for (const std::string& note : notes) out << "  note: " << note << "\n";
+    for (const std::string& note : notes)
+        out << "  note: " << note << "\n";
     return out.str();
 }
 
 GBufferLayout GBufferLayout::reference() {
     GBufferLayout layout;
     layout.name = "reference";
-    layout.reasons = {{Channel::Depth, "position is reconstructed from depth (float32, reversed Z)"},
-                      {Channel::Normal, "view-space normal for diffuse and specular terms"},
-                      {Channel::Albedo, "diffuse colour"},
-                      {Channel::Specular, "Blinn-Phong specular intensity and exponent"}};
+    layout.reasons = {
+        {Channel::Depth, "position is reconstructed from depth (float32, reversed Z)"},
+        {Channel::Normal, "view-space normal for diffuse and specular terms"},
+        {Channel::Albedo, "diffuse colour"},
+        {Channel::Specular, "Blinn-Phong specular intensity and exponent"}};
     return layout;
 }
 
-}  // namespace gbuffer
+} // namespace gbuffer

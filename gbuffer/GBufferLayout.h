@@ -38,7 +38,7 @@ const char* channelName(Channel channel);
 // stereographic put their precision where visible normals are); world space keeps codes
 // independent of the camera (e.g. for temporal reuse) but needs full-sphere codecs.
 enum class NormalSpace { View, World };
-const char* normalSpaceName(NormalSpace space);  // "view", "world"
+const char* normalSpaceName(NormalSpace space); // "view", "world"
 NormalSpace parseNormalSpace(const std::string& text);
 // Whether a codec can hold world-space normals (every direction is equally likely there):
 // false for xy-z and pixel-view, which assume a visible hemisphere.
@@ -46,9 +46,9 @@ bool codecWorksInWorldSpace(NormalCodecKind kind);
 
 enum class AlbedoEncoding { None, Constant, Material, Rgb8Srgb, Float32 };
 enum class SpecularEncoding { None, Constant, Material, Unorm8Log8, Unorm8Half, Float32 };
-const char* albedoEncodingName(AlbedoEncoding encoding);      // "none", "constant", ...
+const char* albedoEncodingName(AlbedoEncoding encoding); // "none", "constant", ...
 const char* specularEncodingName(SpecularEncoding encoding);
-AlbedoEncoding parseAlbedoEncoding(const std::string& text);  // throws std::invalid_argument
+AlbedoEncoding parseAlbedoEncoding(const std::string& text); // throws std::invalid_argument
 SpecularEncoding parseSpecularEncoding(const std::string& text);
 
 // Per-material values the `material` and `constant` encodings decode from.
@@ -77,11 +77,11 @@ struct GBufferLayout {
     NormalSpace normalSpace = NormalSpace::View;
     AlbedoEncoding albedo = AlbedoEncoding::Float32;
     SpecularEncoding specular = SpecularEncoding::Float32;
-    std::vector<MaterialConstants> materials;  // index = scene material, for `material`
-    MaterialConstants constant;                // for `constant`
-    std::vector<PlaneDesc> unmodelled;         // historical presets only
-    std::map<Channel, std::string> reasons;    // why each channel is stored as it is
-    std::vector<std::string> notes;            // e.g. where a preset departs from its source
+    std::vector<MaterialConstants> materials; // index = scene material, for `material`
+    MaterialConstants constant;               // for `constant`
+    std::vector<PlaneDesc> unmodelled;        // historical presets only
+    std::map<Channel, std::string> reasons;   // why each channel is stored as it is
+    std::vector<std::string> notes;           // e.g. where a preset departs from its source
 
     // Whether a reader can decode this channel (a `constant` channel can, with no plane).
     bool provides(Channel channel) const;
@@ -94,7 +94,8 @@ struct GBufferLayout {
     // Sum of the planes' bits / 8: the layout's size as a GPU packs it (bits, not our CPU arrays).
     double bytesPerPixel() const;
     // Bytes per pixel this program actually allocates for the layout (planes are padded to 8,
-    // 16, 32 or 64-bit arrays, unmodelled planes are not allocated, depth is a float working plane).
+    // 16, 32 or 64-bit arrays, unmodelled planes are not allocated, depth is a float working
+    // plane).
     double allocatedBytesPerPixel() const;
     // One line per plane with its format, bits and the reason it is there, then the notes.
     std::string explain() const;
@@ -104,4 +105,4 @@ struct GBufferLayout {
     static GBufferLayout reference();
 };
 
-}  // namespace gbuffer
+} // namespace gbuffer

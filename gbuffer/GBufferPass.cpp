@@ -11,7 +11,8 @@ namespace gbuffer {
 
 namespace {
 double millisecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
 }
 
 // What surfaceOfTriangle reads per triangle, loaded once: resolve() reuses it while consecutive
@@ -25,12 +26,12 @@ struct TriangleCorners {
     // Flat triangles (the three normals bitwise equal: floors, walls) have one normal direction;
     // it is normalised here once, and per pixel only the sign of the weight sum is needed.
     bool flat;
-    bool flatNormalIsZero;     // flat with zero-length normals: the (0, 0, +-1) fallback
-    glm::vec3 flatNormalView;  // unit, valid when flat and not zero
+    bool flatNormalIsZero;    // flat with zero-length normals: the (0, 0, +-1) fallback
+    glm::vec3 flatNormalView; // unit, valid when flat and not zero
     glm::vec2 uv[3];
     uint32_t materialIndex;
     const scenes::Material* material;
-    const scenes::Texture* baseColorTexture;  // null when untextured
+    const scenes::Texture* baseColorTexture; // null when untextured
 };
 
 TriangleCorners loadTriangleCorners(const SceneGeometry& geometry, const scenes::Scene& scene,
@@ -93,7 +94,8 @@ Surface triangleSurface(const TriangleCorners& corners) {
 // Sets the pixel-varying parts of `surface` (from triangleSurface of the same corners) at the
 // pixel centre ndcX of the row `row` describes.
 [[gnu::always_inline]] inline void updateSurfaceAt(Surface& surface, const TriangleCorners& corners,
-                                                   const RowWeights& row, bool backFace, float ndcX) {
+                                                   const RowWeights& row, bool backFace,
+                                                   float ndcX) {
     // Unnormalised weights: the normal is renormalised anyway, so only the sign of the scale
     // matters there, and the division stays off the per-pixel path unless a texture needs the
     // true weights. sum = 0 (pixel ray parallel to the plane) gives equal weights.
@@ -108,12 +110,14 @@ Surface triangleSurface(const TriangleCorners& corners) {
     // Zero-length normals (degenerate input) face the viewer.
     const glm::vec3 zeroNormalFallback(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
     if (corners.flat) {
-        surface.normalView = corners.flatNormalIsZero ? zeroNormalFallback : corners.flatNormalView * sign;
+        surface.normalView =
+            corners.flatNormalIsZero ? zeroNormalFallback : corners.flatNormalView * sign;
     } else {
         const glm::vec3 normal = raster::interpolate(corners.normalView[0], corners.normalView[1],
                                                      corners.normalView[2], b);
         const float length2 = glm::dot(normal, normal);
-        surface.normalView = length2 > 0.0f ? normal * (sign / std::sqrt(length2)) : zeroNormalFallback;
+        surface.normalView =
+            length2 > 0.0f ? normal * (sign / std::sqrt(length2)) : zeroNormalFallback;
     }
     if (corners.baseColorTexture) {
         const glm::vec2 uv =
@@ -123,13 +127,14 @@ Surface triangleSurface(const TriangleCorners& corners) {
     }
 }
 
-}  // namespace
+} // namespace
 
 Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& scene,
                           std::span<const glm::vec4> clipPositions,
                           std::span<const glm::vec3> normalsView, uint32_t triangle, bool backFace,
                           glm::vec2 ndc) {
-    const TriangleCorners corners = loadTriangleCorners(geometry, scene, clipPositions, normalsView, triangle);
+    const TriangleCorners corners =
+        loadTriangleCorners(geometry, scene, clipPositions, normalsView, triangle);
     Surface surface = triangleSurface(corners);
     updateSurfaceAt(surface, corners, rowWeights(corners, ndc.y), backFace, ndc.x);
     return surface;
@@ -166,13 +171,14 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
     const GBuffer::Writer sharedWriter = target.writer();
     // ndcOfPixel's x per column, computed once: the same floats, without a division per pixel.
     std::vector<float> ndcXOfColumn(static_cast<size_t>(width));
-    for (int x = 0; x < width; ++x) ndcXOfColumn[size_t(x)] = view.ndcOfPixel(x, 0).x;
+    for (int x = 0; x < width; ++x)
+        ndcXOfColumn[size_t(x)] = view.ndcOfPixel(x, 0).x;
     tbb::parallel_for(0, target.height(), [&](int y) {
         // A copy whose address does not escape, so the plane pointers stay in registers (the
         // encoded planes' out-of-line call could otherwise change the shared one).
         const GBuffer::Writer writer = sharedWriter;
         const float ndcY = view.ndcOfPixel(0, y).y;
-        uint32_t cornersOf = kNoTriangle;  // the triangle `corners` and `row` describe
+        uint32_t cornersOf = kNoTriangle; // the triangle `corners` and `row` describe
         TriangleCorners corners;
         RowWeights row;
         Surface surface;
@@ -232,7 +238,8 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
 
     start = std::chrono::steady_clock::now();
     target.quantiseDepth();
-    if (exact) exact->resize(view.width, view.height);
+    if (exact)
+        exact->resize(view.width, view.height);
     resolve(target, exact);
     timings.resolveMs = millisecondsSince(start);
 
@@ -244,4 +251,4 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     return timings;
 }
 
-}  // namespace gbuffer
+} // namespace gbuffer

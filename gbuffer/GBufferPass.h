@@ -39,10 +39,10 @@ glm::vec3 positionViewOfPixel(const FrameView& view, int x, int y, float depth);
 
 struct GBufferPassTimings {
     double transformMs = 0.0;
-    double rasterMs = 0.0;     // set-up, binning, traversal into the visibility buffer
-    double resolveMs = 0.0;    // depth rounded to its format; attributes of the visible
-                               // triangles encoded into the G-buffer planes
-    double exactMs = 0.0;      // double-precision surface reconstruction (0 when not asked)
+    double rasterMs = 0.0;  // set-up, binning, traversal into the visibility buffer
+    double resolveMs = 0.0; // depth rounded to its format; attributes of the visible
+                            // triangles encoded into the G-buffer planes
+    double exactMs = 0.0;   // double-precision surface reconstruction (0 when not asked)
 };
 
 class GBufferPass {
@@ -75,4 +75,4 @@ private:
     Plane<uint32_t> mVisibleTriangle;
 };
 
-}  // namespace gbuffer
+} // namespace gbuffer

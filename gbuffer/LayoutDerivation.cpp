@@ -16,7 +16,8 @@ bool reads(const std::vector<Channel>& stageReads, Channel channel) {
 // Materials that some mesh uses: unused entries of a glTF file must not force a plane.
 std::set<uint32_t> usedMaterials(const scenes::Scene& scene) {
     std::set<uint32_t> used;
-    for (const scenes::Mesh& mesh : scene.meshes) used.insert(mesh.material);
+    for (const scenes::Mesh& mesh : scene.meshes)
+        used.insert(mesh.material);
     return used;
 }
 
@@ -31,7 +32,7 @@ std::string describe(const glm::vec3& v) {
 constexpr NormalCodecSpec kCompactNormals{NormalCodecKind::OctahedralPrecise, 24};
 constexpr DepthFormatSpec kCompactDepth{DepthFormatKind::Unorm24, false};
 
-}  // namespace
+} // namespace
 
 std::vector<std::string> layoutPresetNames() {
     return {"reference", "compact", "stalker", "clear-sky", "killzone2", "bf3", "thesis"};
@@ -49,27 +50,32 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
     layout.name = "derived";
     layout.materials = materialTable(scene);
     const std::set<uint32_t> used = usedMaterials(scene);
-    layout.reasons[Channel::Depth] =
-        reads(stageReads, Channel::Depth)
-            ? "the stage reads depth; position is reconstructed from it (float32 reversed Z, lossless)"
-            : "coverage only: the stage does not read depth, but the runner needs to know which pixels are covered";
+    layout.reasons[Channel::Depth] = reads(stageReads, Channel::Depth)
+                                         ? "the stage reads depth; position is reconstructed from "
+                                           "it (float32 reversed Z, lossless)"
+                                         : "coverage only: the stage does not read depth, but the "
+                                           "runner needs to know which pixels are covered";
 
     layout.hasNormals = reads(stageReads, Channel::Normal);
-    layout.reasons[Channel::Normal] = layout.hasNormals ? "the stage reads normals (float32, lossless)"
-                                                        : "the stage does not read normals";
+    layout.reasons[Channel::Normal] = layout.hasNormals
+                                          ? "the stage reads normals (float32, lossless)"
+                                          : "the stage does not read normals";
 
     bool textured = false, oneAlbedo = true, oneSpecular = true;
     const MaterialConstants* first = nullptr;
     for (uint32_t index : used) {
-        if (index >= layout.materials.size()) continue;  // validated by the scene loader
+        if (index >= layout.materials.size())
+            continue; // validated by the scene loader
         textured = textured || scene.materials[index].baseColorTexture >= 0;
         const MaterialConstants& m = layout.materials[index];
-        if (!first) first = &m;
+        if (!first)
+            first = &m;
         oneAlbedo = oneAlbedo && m.albedo == first->albedo;
         oneSpecular = oneSpecular && m.specularIntensity == first->specularIntensity &&
                       m.specularPower == first->specularPower;
     }
-    if (first) layout.constant = *first;
+    if (first)
+        layout.constant = *first;
     const std::string materialCount = std::to_string(used.size()) + " used material(s)";
 
     if (!reads(stageReads, Channel::Albedo)) {
@@ -77,15 +83,17 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
         layout.reasons[Channel::Albedo] = "the stage does not read albedo";
     } else if (textured) {
         layout.albedo = AlbedoEncoding::Float32;
-        layout.reasons[Channel::Albedo] = "textured materials: albedo varies per pixel (float32, lossless)";
+        layout.reasons[Channel::Albedo] =
+            "textured materials: albedo varies per pixel (float32, lossless)";
     } else if (oneAlbedo && first) {
         layout.albedo = AlbedoEncoding::Constant;
-        layout.reasons[Channel::Albedo] = "every used material has albedo " + describe(first->albedo) +
+        layout.reasons[Channel::Albedo] = "every used material has albedo " +
+                                          describe(first->albedo) +
                                           " and no texture: a constant, no plane";
     } else {
         layout.albedo = AlbedoEncoding::Material;
         layout.reasons[Channel::Albedo] = materialCount + ", no textures: one colour per material, "
-                                          "stored as a material index";
+                                                          "stored as a material index";
     }
 
     if (!reads(stageReads, Channel::Specular)) {
@@ -94,8 +102,9 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
     } else if (oneSpecular && first) {
         layout.specular = SpecularEncoding::Constant;
         layout.reasons[Channel::Specular] = "every used material has specular intensity " +
-                                            std::to_string(first->specularIntensity) + " and power " +
-                                            std::to_string(first->specularPower) + ": a constant, no plane";
+                                            std::to_string(first->specularIntensity) +
+                                            " and power " + std::to_string(first->specularPower) +
+                                            ": a constant, no plane";
     } else {
         layout.specular = SpecularEncoding::Material;
         layout.reasons[Channel::Specular] =
@@ -107,7 +116,8 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
 GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) {
     GBufferLayout layout;
     layout.materials = materialTable(scene);
-    const std::vector<Channel> everything = {Channel::Depth, Channel::Normal, Channel::Albedo, Channel::Specular};
+    const std::vector<Channel> everything = {Channel::Depth, Channel::Normal, Channel::Albedo,
+                                             Channel::Specular};
     if (name == "reference") {
         layout = GBufferLayout::reference();
         layout.materials = materialTable(scene);
@@ -118,36 +128,42 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
         layout.name = "compact";
         layout.normals = kCompactNormals;
         layout.depth = kCompactDepth;
-        layout.reasons[Channel::Normal] = "octahedral-precise:24: the smallest normal code under the "
-                                          "compact error threshold (gbuffer/README.md)";
-        layout.reasons[Channel::Depth] = "unorm24 standard Z: the smallest depth under the compact threshold";
+        layout.reasons[Channel::Normal] =
+            "octahedral-precise:24: the smallest normal code under the "
+            "compact error threshold (gbuffer/README.md)";
+        layout.reasons[Channel::Depth] =
+            "unorm24 standard Z: the smallest depth under the compact threshold";
         return layout;
     }
     layout.name = name;
     layout.albedo = AlbedoEncoding::Rgb8Srgb;
     layout.reasons[Channel::Albedo] = "RGB8 diffuse colour, as in the original";
-    if (name == "stalker") {  // S.T.A.L.K.E.R. (2005), thesis 3.1: 160 bits
+    if (name == "stalker") { // S.T.A.L.K.E.R. (2005), thesis 3.1: 160 bits
         layout.depth = {DepthFormatKind::F16Linear, false};
         layout.position = PositionMethod::ViewRay;
         layout.normals = {NormalCodecKind::Xyz, 48};
         layout.specular = SpecularEncoding::Unorm8Log8;
-        layout.unmodelled = {{"P.X,P.Y", "f16 x2", 32, "unmodelled"}, {"material-id", "f16", 16, "unmodelled"}, {"AO", "f16", 16, "unmodelled"}};
-        layout.reasons = {{Channel::Depth, "RT0 position.z (f16); x and y follow from the view ray"},
-                          {Channel::Normal, "RT1 normal xyz (RGB16F; 16-bit SNORM here)"},
-                          {Channel::Specular, "RT2 alpha gloss (8 bits)"}};
+        layout.unmodelled = {{"P.X,P.Y", "f16 x2", 32, "unmodelled"},
+                             {"material-id", "f16", 16, "unmodelled"},
+                             {"AO", "f16", 16, "unmodelled"}};
+        layout.reasons = {
+            {Channel::Depth, "RT0 position.z (f16); x and y follow from the view ray"},
+            {Channel::Normal, "RT1 normal xyz (RGB16F; 16-bit SNORM here)"},
+            {Channel::Specular, "RT2 alpha gloss (8 bits)"}};
         layout.notes = {"published 160 bits; +8 bits here: our BRDF also needs specular intensity",
                         "normals are RGB16F in the original, SNORM16 (xyz:48) here"};
-    } else if (name == "clear-sky") {  // S.T.A.L.K.E.R.: Clear Sky (2009), thesis 3.2: 96 bits
+    } else if (name == "clear-sky") { // S.T.A.L.K.E.R.: Clear Sky (2009), thesis 3.2: 96 bits
         layout.depth = {DepthFormatKind::F16Linear, false};
         layout.position = PositionMethod::ViewRay;
         layout.normals = {NormalCodecKind::XyReconstructZ, 32};
         layout.specular = SpecularEncoding::Unorm8Log8;
         layout.unmodelled = {{"material-id+AO", "f16 bit-packed", 16, "unmodelled"}};
-        layout.reasons = {{Channel::Depth, "RT0 linear depth in one f16"},
-                          {Channel::Normal, "RT0 normal X,Y (2 x f16), Z reconstructed (16-bit SNORM here)"},
-                          {Channel::Specular, "RT1 alpha gloss (8 bits)"}};
+        layout.reasons = {
+            {Channel::Depth, "RT0 linear depth in one f16"},
+            {Channel::Normal, "RT0 normal X,Y (2 x f16), Z reconstructed (16-bit SNORM here)"},
+            {Channel::Specular, "RT1 alpha gloss (8 bits)"}};
         layout.notes = {"published 96 bits; +8 bits here: our BRDF also needs specular intensity"};
-    } else if (name == "killzone2") {  // Killzone 2 (2007), thesis 3.3: 4 x RGBA8 + D24S8
+    } else if (name == "killzone2") { // Killzone 2 (2007), thesis 3.3: 4 x RGBA8 + D24S8
         layout.depth = {DepthFormatKind::Unorm24, false};
         layout.normals = {NormalCodecKind::XyReconstructZ, 32};
         layout.specular = SpecularEncoding::Unorm8Log8;
@@ -155,33 +171,40 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
                              {"light-accumulation", "RGBA8", 32, "unmodelled"},
                              {"motion-vectors", "unorm8 x2", 16, "unmodelled"},
                              {"sun-occlusion", "unorm8", 8, "unmodelled"}};
-        layout.reasons = {{Channel::Depth, "D24 hardware depth"},
-                          {Channel::Normal, "normal X,Y as FP16 (16-bit SNORM here), Z reconstructed"},
-                          {Channel::Specular, "spec-power and spec-intensity, 8 bits each"}};
-        layout.notes = {"published 128 bits in 4 RGBA8 targets plus the D24S8 depth buffer (160 in all)"};
-    } else if (name == "bf3") {  // Battlefield 3 / Frostbite 2 (2011), thesis 3.4: 4 x RGBA8 + D24S8
+        layout.reasons = {
+            {Channel::Depth, "D24 hardware depth"},
+            {Channel::Normal, "normal X,Y as FP16 (16-bit SNORM here), Z reconstructed"},
+            {Channel::Specular, "spec-power and spec-intensity, 8 bits each"}};
+        layout.notes = {
+            "published 128 bits in 4 RGBA8 targets plus the D24S8 depth buffer (160 in all)"};
+    } else if (name == "bf3") { // Battlefield 3 / Frostbite 2 (2011), thesis 3.4: 4 x RGBA8 + D24S8
         layout.depth = {DepthFormatKind::Unorm24, false};
         layout.normals = {NormalCodecKind::Xyz, 24};
         layout.specular = SpecularEncoding::Unorm8Log8;
-        layout.unmodelled = {{"stencil", "uint8", 8, "unmodelled"},
-                             {"sky-visibility,envmap-id,material-param,material-id", "RGBA8", 32, "unmodelled"},
-                             {"irradiance", "RGBA8", 32, "unmodelled"}};
-        layout.reasons = {{Channel::Depth, "D24 hardware depth"},
-                          {Channel::Normal, "GB0 normal xyz in RGB8"},
-                          {Channel::Specular, "GB0 alpha smoothness and GB1 alpha specular albedo"}};
-        layout.notes = {"published 128 bits in 4 RGBA8 targets plus the D24S8 depth buffer (160 in all)"};
-    } else if (name == "thesis") {  // Ishmukhametov 2013, chapter 4: RGBA8 + RGBA16F + D24S8
+        layout.unmodelled = {
+            {"stencil", "uint8", 8, "unmodelled"},
+            {"sky-visibility,envmap-id,material-param,material-id", "RGBA8", 32, "unmodelled"},
+            {"irradiance", "RGBA8", 32, "unmodelled"}};
+        layout.reasons = {
+            {Channel::Depth, "D24 hardware depth"},
+            {Channel::Normal, "GB0 normal xyz in RGB8"},
+            {Channel::Specular, "GB0 alpha smoothness and GB1 alpha specular albedo"}};
+        layout.notes = {
+            "published 128 bits in 4 RGBA8 targets plus the D24S8 depth buffer (160 in all)"};
+    } else if (name == "thesis") { // Ishmukhametov 2013, chapter 4: RGBA8 + RGBA16F + D24S8
         layout.depth = {DepthFormatKind::Unorm24, false};
         layout.normals = {NormalCodecKind::Xyz, 48};
         layout.specular = SpecularEncoding::Unorm8Half;
         layout.unmodelled = {{"stencil", "uint8", 8, "unmodelled"}};
-        layout.reasons = {{Channel::Depth, "D24S8 hardware depth"},
-                          {Channel::Normal, "RT1 normal xyz (RGB16F; 16-bit SNORM here)"},
-                          {Channel::Specular, "RT0 alpha intensity (8 bits), RT1 alpha exponent (f16)"}};
+        layout.reasons = {
+            {Channel::Depth, "D24S8 hardware depth"},
+            {Channel::Normal, "RT1 normal xyz (RGB16F; 16-bit SNORM here)"},
+            {Channel::Specular, "RT0 alpha intensity (8 bits), RT1 alpha exponent (f16)"}};
         layout.notes = {"published: RGBA8 + RGBA16F + D24S8 = 128 bits"};
     } else {
         std::string valid;
-        for (const std::string& preset : layoutPresetNames()) valid += (valid.empty() ? "" : ", ") + preset;
+        for (const std::string& preset : layoutPresetNames())
+            valid += (valid.empty() ? "" : ", ") + preset;
         throw std::invalid_argument("unknown G-buffer layout '" + name + "'; valid: " + valid +
                                     " (or none, to derive it from the scene and the stage)");
     }
@@ -195,32 +218,44 @@ GBufferLayout makeLayout(const scenes::Scene& scene, const std::vector<Channel>&
                                                   : presetLayout(request.preset, scene);
     if (request.normals) {
         if (!reads(stageReads, Channel::Normal) && !layout.hasNormals) {
-            layout.notes.push_back("stage '" + stageName + "' does not read normals: the normal encoding " +
+            layout.notes.push_back("stage '" + stageName +
+                                   "' does not read normals: the normal encoding " +
                                    request.normals->text() + " is not stored");
         } else {
             layout.normals = *request.normals;
-            layout.reasons[Channel::Normal] = "normal encoding " + request.normals->text() + " (requested)";
+            layout.reasons[Channel::Normal] =
+                "normal encoding " + request.normals->text() + " (requested)";
         }
     }
     if (request.depth) {
         layout.depth = *request.depth;
         layout.reasons[Channel::Depth] = "depth format " + request.depth->text() + " (requested)";
         if (!request.position)
-            layout.position = request.depth->kind == DepthFormatKind::F16Linear ? PositionMethod::ViewRay
-                                                                                 : PositionMethod::InverseProjection;
+            layout.position = request.depth->kind == DepthFormatKind::F16Linear
+                                  ? PositionMethod::ViewRay
+                                  : PositionMethod::InverseProjection;
     }
-    if (request.position) layout.position = *request.position;
-    if (request.normalSpace) layout.normalSpace = *request.normalSpace;
-    if (layout.hasNormals && layout.normalSpace == NormalSpace::World && !codecWorksInWorldSpace(layout.normals.kind))
-        throw std::invalid_argument("normal encoding " + layout.normals.text() +
-                                    " assumes view-space normals facing the camera; it cannot store world-space normals");
-    if (request.preset.empty() && (request.normals || request.depth || request.position || request.normalSpace)) layout.name = "derived+overrides";
-    if (!request.preset.empty() && (request.normals || request.depth || request.position || request.normalSpace)) layout.name += "+overrides";
+    if (request.position)
+        layout.position = *request.position;
+    if (request.normalSpace)
+        layout.normalSpace = *request.normalSpace;
+    if (layout.hasNormals && layout.normalSpace == NormalSpace::World &&
+        !codecWorksInWorldSpace(layout.normals.kind))
+        throw std::invalid_argument(
+            "normal encoding " + layout.normals.text() +
+            " assumes view-space normals facing the camera; it cannot store world-space normals");
+    if (request.preset.empty() &&
+        (request.normals || request.depth || request.position || request.normalSpace))
+        layout.name = "derived+overrides";
+    if (!request.preset.empty() &&
+        (request.normals || request.depth || request.position || request.normalSpace))
+        layout.name += "+overrides";
     for (Channel channel : stageReads)
         if (!layout.provides(channel))
-            throw std::invalid_argument("stage '" + stageName + "' reads the " + channelName(channel) +
-                                        " channel, which G-buffer layout '" + layout.name + "' does not store");
+            throw std::invalid_argument("stage '" + stageName + "' reads the " +
+                                        channelName(channel) + " channel, which G-buffer layout '" +
+                                        layout.name + "' does not store");
     return layout;
 }
 
-}  // namespace gbuffer
+} // namespace gbuffer

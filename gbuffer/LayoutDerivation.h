@@ -28,8 +28,8 @@
 namespace gbuffer {
 
 struct LayoutRequest {
-    std::string preset;                      // "" = derived from scene and stage
-    std::optional<NormalCodecSpec> normals;  // overrides
+    std::string preset;                     // "" = derived from scene and stage
+    std::optional<NormalCodecSpec> normals; // overrides
     std::optional<DepthFormatSpec> depth;
     std::optional<PositionMethod> position;
     std::optional<NormalSpace> normalSpace;
@@ -50,4 +50,4 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene);
 GBufferLayout makeLayout(const scenes::Scene& scene, const std::vector<Channel>& stageReads,
                          const std::string& stageName, const LayoutRequest& request);
 
-}  // namespace gbuffer
+} // namespace gbuffer

@@ -18,19 +18,18 @@
 
 namespace gbuffer {
 
-template <class T>
-struct StaggeredAllocator {
+template <class T> struct StaggeredAllocator {
     using value_type = T;
     // Start offsets cycle through kSlots cache lines; kSlots * kLine stays under a page.
     static constexpr size_t kLine = 64;
     static constexpr size_t kSlots = 61;
 
     StaggeredAllocator() = default;
-    template <class U>
-    StaggeredAllocator(const StaggeredAllocator<U>&) {}
+    template <class U> StaggeredAllocator(const StaggeredAllocator<U>&) {}
 
     T* allocate(size_t count) {
-        if (count > (SIZE_MAX - kLine * (kSlots + 1)) / sizeof(T)) throw std::bad_array_new_length();
+        if (count > (SIZE_MAX - kLine * (kSlots + 1)) / sizeof(T))
+            throw std::bad_array_new_length();
         static std::atomic<uint32_t> nextSlot{0};
         const size_t slot = nextSlot.fetch_add(1, std::memory_order_relaxed) % kSlots;
         // One line before the data holds the block's start, for deallocate.
@@ -46,11 +45,9 @@ struct StaggeredAllocator {
         ::operator delete(block, std::align_val_t(kLine));
     }
 
-    template <class U>
-    bool operator==(const StaggeredAllocator<U>&) const { return true; }
+    template <class U> bool operator==(const StaggeredAllocator<U>&) const { return true; }
 };
 
-template <class T>
-using Plane = std::vector<T, StaggeredAllocator<T>>;
+template <class T> using Plane = std::vector<T, StaggeredAllocator<T>>;
 
-}  // namespace gbuffer
+} // namespace gbuffer

@@ -26,11 +26,13 @@ SceneGeometry SceneGeometry::build(const scenes::Scene& scene) {
         const scenes::Mesh& mesh = scene.meshes[instance.mesh];
         const glm::dmat4 worldFromObject(instance.worldFromObject);
         // Normals transform with the inverse transpose; it also handles non-uniform scale.
-        const glm::dmat3 normalFromObject = glm::transpose(glm::inverse(glm::dmat3(worldFromObject)));
+        const glm::dmat3 normalFromObject =
+            glm::transpose(glm::inverse(glm::dmat3(worldFromObject)));
         const bool mirrored = glm::determinant(glm::dmat3(worldFromObject)) < 0.0;
         const uint32_t base = uint32_t(g.positionWorld.size());
         for (size_t v = 0; v < mesh.positions.size(); ++v) {
-            const glm::dvec3 p = glm::dvec3(worldFromObject * glm::dvec4(glm::dvec3(mesh.positions[v]), 1.0));
+            const glm::dvec3 p =
+                glm::dvec3(worldFromObject * glm::dvec4(glm::dvec3(mesh.positions[v]), 1.0));
             g.positionWorldExact.push_back(p);
             g.positionWorld.push_back(glm::vec3(p));
             glm::dvec3 n = normalFromObject * glm::dvec3(mesh.normals[v]);
@@ -39,7 +41,8 @@ SceneGeometry SceneGeometry::build(const scenes::Scene& scene) {
             g.uv.push_back(mesh.uvs.empty() ? glm::vec2(0.0f) : mesh.uvs[v]);
         }
         for (size_t t = 0; t < mesh.triangleCount(); ++t) {
-            const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1], c = mesh.indices[3 * t + 2];
+            const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1],
+                           c = mesh.indices[3 * t + 2];
             // A mirroring transform flips the winding; swap to keep counter-clockwise = front.
             g.indices.push_back(base + a);
             g.indices.push_back(base + (mirrored ? c : b));
@@ -51,4 +54,4 @@ SceneGeometry SceneGeometry::build(const scenes::Scene& scene) {
     return g;
 }
 
-}  // namespace gbuffer
+} // namespace gbuffer

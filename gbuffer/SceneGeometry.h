@@ -15,9 +15,9 @@ namespace gbuffer {
 
 struct SceneGeometry {
     std::vector<glm::vec3> positionWorld;
-    std::vector<glm::dvec3> positionWorldExact;  // unrounded instance transform, for the reference
-    std::vector<glm::vec3> normalWorld;          // unit
-    std::vector<glm::vec2> uv;                   // (0,0) where the mesh has none
+    std::vector<glm::dvec3> positionWorldExact; // unrounded instance transform, for the reference
+    std::vector<glm::vec3> normalWorld;         // unit
+    std::vector<glm::vec2> uv;                  // (0,0) where the mesh has none
     std::vector<uint32_t> indices;
     std::vector<uint32_t> triangleMaterial;
     std::vector<uint32_t> triangleInstance;
@@ -26,4 +26,4 @@ struct SceneGeometry {
     static SceneGeometry build(const scenes::Scene& scene);
 };
 
-}  // namespace gbuffer
+} // namespace gbuffer

@@ -21,7 +21,8 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             ShadingPoint<T> point;
-            if (!surfaceAt(x, y, point)) continue;
+            if (!surfaceAt(x, y, point))
+                continue;
             const size_t pixel = size_t(y) * width + x;
             const Vec3<T> toViewer = glm::normalize(-point.positionView);
             Vec3<T> sum(T(0));
@@ -35,17 +36,19 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
             result.radiance[1][pixel] = float(sum.y);
             result.radiance[2][pixel] = float(sum.z);
             result.lightsEvaluated[pixel] = uint32_t(lights.size());
-            if (countOracle) result.lightsOracle[pixel] = contributing;
+            if (countOracle)
+                result.lightsOracle[pixel] = contributing;
         }
     });
 }
 
 // The G-buffer's surface at (x, y) as a float ShadingPoint; false for background.
 inline bool gbufferSurfaceAt(const gbuffer::GBuffer& gb, int x, int y, ShadingPoint<float>& point) {
-    if (!gb.covered(size_t(y) * gb.width() + x)) return false;
+    if (!gb.covered(size_t(y) * gb.width() + x))
+        return false;
     const gbuffer::Surface s = gb.decode(x, y);
     point = {s.positionView, s.normalView, s.albedo, s.specularIntensity, s.specularPower};
     return true;
 }
 
-}  // namespace lighting
+} // namespace lighting

@@ -76,7 +76,7 @@ void depthPrepass(raster::Rasterizer& rasterizer, const ForwardFrame& forward,
     visible.assign(pixelCount, kNoVisibleTriangle);
     const int width = view.width;
     raster::RasterState state;
-    state.barycentrics = false;  // the surface comes from surfaceOfTriangle
+    state.barycentrics = false; // the surface comes from surfaceOfTriangle
     state.cullMode = raster::CullMode::Back;
     state.depthTest = closerTest(view);
     rasterizer.draw(forward.triangles(), state, depth.data(),

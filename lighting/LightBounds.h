@@ -25,18 +25,18 @@
 
 namespace lighting {
 
-inline constexpr float kCullingSlack = 1e-4f;         // relative to the range
-inline constexpr float kCullingSlackMetres = 1e-4f;   // absolute, for tiny ranges
+inline constexpr float kCullingSlack = 1e-4f;       // relative to the range
+inline constexpr float kCullingSlackMetres = 1e-4f; // absolute, for tiny ranges
 
 struct LightSphere {
-    glm::vec3 centreView{0.0f};  // centre of the bounding sphere of the lit region
+    glm::vec3 centreView{0.0f}; // centre of the bounding sphere of the lit region
     float radius = 0.0f;
-    bool unbounded = false;        // directional / ambient
-    glm::vec3 positionView{0.0f};  // the emitter (equal to centreView for point lights)
+    bool unbounded = false;       // directional / ambient
+    glm::vec3 positionView{0.0f}; // the emitter (equal to centreView for point lights)
     // Spot lights with a half-angle below 90 degrees: the raw cone, as the light is evaluated.
     bool spot = false;
-    glm::vec3 axisView{0.0f, 0.0f, -1.0f};  // unit, the direction the light travels
-    float spotOuterCos = -1.0f;              // cosine of the outer half-angle
+    glm::vec3 axisView{0.0f, 0.0f, -1.0f}; // unit, the direction the light travels
+    float spotOuterCos = -1.0f;            // cosine of the outer half-angle
     float rangeMetres = 0.0f;
 };
 
@@ -76,4 +76,4 @@ inline std::vector<LightSphere> boundingSpheresView(const LightList& lights) {
     return spheres;
 }
 
-}  // namespace lighting
+} // namespace lighting

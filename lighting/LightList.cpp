@@ -2,7 +2,8 @@
 
 namespace lighting {
 
-LightList LightList::build(const std::vector<scenes::Light>& sceneLights, const gbuffer::FrameView& view) {
+LightList LightList::build(const std::vector<scenes::Light>& sceneLights,
+                           const gbuffer::FrameView& view) {
     LightList list;
     list.lights.reserve(sceneLights.size());
     list.lightsExact.reserve(sceneLights.size());
@@ -10,7 +11,8 @@ LightList LightList::build(const std::vector<scenes::Light>& sceneLights, const 
     for (const scenes::Light& light : sceneLights) {
         LightInView<double> exact;
         exact.type = light.type;
-        exact.positionView = glm::dvec3(view.viewFromWorldExact * glm::dvec4(glm::dvec3(light.positionWorld), 1.0));
+        exact.positionView =
+            glm::dvec3(view.viewFromWorldExact * glm::dvec4(glm::dvec3(light.positionWorld), 1.0));
         const glm::dvec3 direction = rotation * glm::dvec3(light.directionWorld);
         const double length = glm::length(direction);
         exact.directionView = length > 0.0 ? direction / length : glm::dvec3(0, 0, -1);
@@ -33,4 +35,4 @@ LightList LightList::build(const std::vector<scenes::Light>& sceneLights, const 
     return list;
 }
 
-}  // namespace lighting
+} // namespace lighting

@@ -14,8 +14,9 @@ struct LightList {
     std::vector<LightInView<float>> lights;
     std::vector<LightInView<double>> lightsExact;
 
-    static LightList build(const std::vector<scenes::Light>& sceneLights, const gbuffer::FrameView& view);
+    static LightList build(const std::vector<scenes::Light>& sceneLights,
+                           const gbuffer::FrameView& view);
     size_t size() const { return lights.size(); }
 };
 
-}  // namespace lighting
+} // namespace lighting

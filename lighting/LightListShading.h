@@ -21,10 +21,12 @@ inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
                                std::span<const uint32_t> lightIndices, StageResult& result) {
     const size_t pixel = size_t(y) * gb.width() + x;
     ShadingPoint<float> point;
-    if (!gbufferSurfaceAt(gb, x, y, point)) return;
+    if (!gbufferSurfaceAt(gb, x, y, point))
+        return;
     const glm::vec3 toViewer = glm::normalize(-point.positionView);
     glm::vec3 sum(0.0f);
-    for (uint32_t index : lightIndices) sum += evaluateLight(point, toViewer, lights[index]);
+    for (uint32_t index : lightIndices)
+        sum += evaluateLight(point, toViewer, lights[index]);
     result.radiance[0][pixel] = sum.x;
     result.radiance[1][pixel] = sum.y;
     result.radiance[2][pixel] = sum.z;
@@ -59,4 +61,4 @@ inline SplitLighting splitLighting(const ShadingPoint<float>& point,
     return sum;
 }
 
-}  // namespace lighting
+} // namespace lighting

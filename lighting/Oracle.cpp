@@ -15,4 +15,4 @@ std::vector<uint32_t> countContributingLights(const Frame& frame) {
     return std::move(scratch.lightsOracle);
 }
 
-}  // namespace lighting
+} // namespace lighting

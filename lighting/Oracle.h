@@ -12,4 +12,4 @@ namespace lighting {
 
 std::vector<uint32_t> countContributingLights(const Frame& frame);
 
-}  // namespace lighting
+} // namespace lighting

@@ -4,8 +4,9 @@ namespace lighting {
 
 gbuffer::GBufferLayout losslessLayout(gbuffer::DepthConvention depth, bool infiniteFar) {
     gbuffer::GBufferLayout layout = gbuffer::GBufferLayout::reference();
-    layout.depth.kind = depth == gbuffer::DepthConvention::Reversed ? gbuffer::DepthFormatKind::F32Reversed
-                                                                    : gbuffer::DepthFormatKind::F32;
+    layout.depth.kind = depth == gbuffer::DepthConvention::Reversed
+                            ? gbuffer::DepthFormatKind::F32Reversed
+                            : gbuffer::DepthFormatKind::F32;
     layout.depth.infiniteFar = infiniteFar;
     return layout;
 }
@@ -14,10 +15,11 @@ PreparedFrame::PreparedFrame(scenes::Scene sceneIn, int width, int height, bool 
                              const gbuffer::GBufferLayout& layout)
     : scene(std::move(sceneIn)) {
     geometry = gbuffer::SceneGeometry::build(scene);
-    view = gbuffer::FrameView::fromCamera(scene.cameras.front(), width, height, layout.depth.convention(),
-                                          layout.depth.infiniteFar);
+    view = gbuffer::FrameView::fromCamera(scene.cameras.front(), width, height,
+                                          layout.depth.convention(), layout.depth.infiniteFar);
     gbuffer = std::make_unique<gbuffer::GBuffer>(layout, view);
-    if (withExactSurface) exact = std::make_unique<gbuffer::ExactSurface>();
+    if (withExactSurface)
+        exact = std::make_unique<gbuffer::ExactSurface>();
     mRasterizer = std::make_unique<raster::Rasterizer>(width, height);
     mPass = std::make_unique<gbuffer::GBufferPass>(scene, geometry);
     renderGBuffer();
@@ -40,14 +42,16 @@ void PreparedFrame::renderGBuffer() {
 }
 
 std::unique_ptr<gbuffer::GBuffer> PreparedFrame::renderLosslessGBuffer() {
-    auto lossless = std::make_unique<gbuffer::GBuffer>(losslessLayout(view.depthConvention, view.infiniteFar), view);
+    auto lossless = std::make_unique<gbuffer::GBuffer>(
+        losslessLayout(view.depthConvention, view.infiniteFar), view);
     mPass->render(*mRasterizer, *lossless, nullptr);
     return lossless;
 }
 
 void PreparedFrame::setLights(const std::vector<scenes::Light>& sceneLights) {
-    if (&sceneLights != &scene.lights) scene.lights = sceneLights;
+    if (&sceneLights != &scene.lights)
+        scene.lights = sceneLights;
     lights = LightList::build(scene.lights, view);
 }
 
-}  // namespace lighting
+} // namespace lighting

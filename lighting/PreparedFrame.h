@@ -26,7 +26,7 @@ struct PreparedFrame {
     gbuffer::SceneGeometry geometry;
     gbuffer::FrameView view;
     std::unique_ptr<gbuffer::GBuffer> gbuffer;
-    std::unique_ptr<gbuffer::ExactSurface> exact;  // null unless asked for
+    std::unique_ptr<gbuffer::ExactSurface> exact; // null unless asked for
     LightList lights;
     Frame frame;
     raster::RasterStats rasterStats;
@@ -63,4 +63,4 @@ private:
 // The reference layout for a view with the given float depth convention and far plane.
 gbuffer::GBufferLayout losslessLayout(gbuffer::DepthConvention depth, bool infiniteFar = false);
 
-}  // namespace lighting
+} // namespace lighting

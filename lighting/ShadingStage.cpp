@@ -6,11 +6,12 @@ void StageResult::resize(int w, int h, bool withOracle) {
     width = w;
     height = h;
     const size_t n = size_t(w) * h;
-    for (auto& plane : radiance) plane.assign(n, 0.0f);
+    for (auto& plane : radiance)
+        plane.assign(n, 0.0f);
     lightsEvaluated.assign(n, 0);
     lightsOracle.assign(withOracle ? n : 0, 0);
     timingsMs.clear();
     parameters.clear();
 }
 
-}  // namespace lighting
+} // namespace lighting

@@ -24,8 +24,8 @@
 namespace lighting {
 
 struct StageRequirements {
-    std::vector<gbuffer::Channel> channels;  // G-buffer channels the stage reads
-    bool exactSurface = false;               // reads gbuffer::ExactSurface (the reference)
+    std::vector<gbuffer::Channel> channels; // G-buffer channels the stage reads
+    bool exactSurface = false;              // reads gbuffer::ExactSurface (the reference)
 };
 
 // Everything a stage may read for one frame. Pointers are null when not required.
@@ -41,12 +41,12 @@ struct Frame {
 struct StageResult {
     int width = 0;
     int height = 0;
-    std::vector<float> radiance[3];          // linear HDR R, G, B
-    std::vector<uint32_t> lightsEvaluated;   // per pixel: lights the stage evaluated
-    std::vector<uint32_t> lightsOracle;      // per pixel: lights that contribute; empty when the
-                                             // stage cannot know (the runner then computes it)
-    std::vector<std::pair<std::string, double>> timingsMs;  // per pass, in execution order
-    std::map<std::string, std::string> parameters;          // the stage's effective options
+    std::vector<float> radiance[3];        // linear HDR R, G, B
+    std::vector<uint32_t> lightsEvaluated; // per pixel: lights the stage evaluated
+    std::vector<uint32_t> lightsOracle;    // per pixel: lights that contribute; empty when the
+                                           // stage cannot know (the runner then computes it)
+    std::vector<std::pair<std::string, double>> timingsMs; // per pass, in execution order
+    std::map<std::string, std::string> parameters;         // the stage's effective options
 
     void resize(int w, int h, bool withOracle);
 };
@@ -59,4 +59,4 @@ public:
     virtual void shade(const Frame& frame, StageResult& result) = 0;
 };
 
-}  // namespace lighting
+} // namespace lighting

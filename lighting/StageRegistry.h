@@ -19,7 +19,7 @@ struct StageError : std::runtime_error {
 struct StageSpec {
     std::string name;
     std::map<std::string, std::string> options;
-    static StageSpec parse(const std::string& spec);  // throws StageError on malformed text
+    static StageSpec parse(const std::string& spec); // throws StageError on malformed text
 };
 
 // What a stage promises about its image, which decides how tests check it:
@@ -40,4 +40,4 @@ std::vector<StageInfo> stageInfos();
 // Throws StageError for an unknown name or option.
 std::unique_ptr<ShadingStage> makeStage(const std::string& spec);
 
-}  // namespace lighting
+} // namespace lighting

@@ -24,12 +24,18 @@ constexpr int kClipPlaneCount = 6;
 
 float planeDistance(int plane, const glm::vec4& c, float guardX, float guardY) {
     switch (plane) {
-    case 0: return c.z;
-    case 1: return c.w - c.z;
-    case 2: return guardX * c.w - c.x;
-    case 3: return guardX * c.w + c.x;
-    case 4: return guardY * c.w - c.y;
-    default: return guardY * c.w + c.y;
+    case 0:
+        return c.z;
+    case 1:
+        return c.w - c.z;
+    case 2:
+        return guardX * c.w - c.x;
+    case 3:
+        return guardX * c.w + c.x;
+    case 4:
+        return guardY * c.w - c.y;
+    default:
+        return guardY * c.w + c.y;
     }
 }
 
@@ -55,7 +61,8 @@ int clipPolygon(const ClipVertex* in, int count, ClipVertex* out, int plane, flo
         const ClipVertex& b = in[(i + 1) % count];
         const float da = planeDistance(plane, a.clip, guardX, guardY);
         const float db = planeDistance(plane, b.clip, guardX, guardY);
-        if (da >= 0.0f) out[outCount++] = a;
+        if (da >= 0.0f)
+            out[outCount++] = a;
         if ((da >= 0.0f) != (db >= 0.0f)) {
             // Always interpolate from the inside vertex so that an edge shared by two
             // triangles is cut at exactly the same point whichever triangle clips it.
@@ -89,7 +96,7 @@ void setUpPlanes(SetupTriangle& s, SetupBarycentrics* barycentrics, double x[3],
         area = snappedArea;
     }
     double l1[3], l2[3];
-    const double inverseArea = 1.0 / area;  // one division per triangle, not six
+    const double inverseArea = 1.0 / area; // one division per triangle, not six
     auto plane = [&](int a, int b, double out[3]) {
         // E_ab at pixel (px, py), sampled at its centre (px + 0.5, py + 0.5), over the area.
         const double dx = x[b] - x[a], dy = y[b] - y[a];
@@ -100,8 +107,10 @@ void setUpPlanes(SetupTriangle& s, SetupBarycentrics* barycentrics, double x[3],
     plane(2, 0, l1);
     plane(0, 1, l2);
     for (int k = 0; k < 3; ++k)
-        s.z[k] = (k == 0 ? depth[0] : 0.0) + l1[k] * (depth[1] - depth[0]) + l2[k] * (depth[2] - depth[0]);
-    if (!barycentrics) return;
+        s.z[k] = (k == 0 ? depth[0] : 0.0) + l1[k] * (depth[1] - depth[0]) +
+                 l2[k] * (depth[2] - depth[0]);
+    if (!barycentrics)
+        return;
     // Barycentrics relative to the bounding-box corner, rounded to float.
     barycentrics->l1[0] = float(l1[0] + l1[1] * s.minX + l1[2] * s.minY);
     barycentrics->l2[0] = float(l2[0] + l2[1] * s.minX + l2[2] * s.minY);
@@ -111,12 +120,13 @@ void setUpPlanes(SetupTriangle& s, SetupBarycentrics* barycentrics, double x[3],
     }
 }
 
-}  // namespace
+} // namespace
 
 Rasterizer::ProjectedVertex Rasterizer::project(const glm::vec4& clip) const {
     // After clipping, w = 0 is only possible at the clip-space origin (the eye of a zero-near
     // projection): a piece touching it is seen edge-on and covers nothing (invW = 0 marks it).
-    if (!(clip.w > 0.0f)) return {0, 0, 0.0f, 0};
+    if (!(clip.w > 0.0f))
+        return {0, 0, 0.0f, 0};
     const float invW = 1.0f / clip.w;
     const float screenX = (clip.x * invW + 1.0f) * (0.5f * float(mWidth));
     const float screenY = (1.0f - clip.y * invW) * (0.5f * float(mHeight));
@@ -143,9 +153,11 @@ void Rasterizer::setUpAndBin(const TriangleList& triangles, const RasterState& s
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexCount, 8192), [&](const auto& range) {
         for (size_t v = range.begin(); v != range.end(); ++v) {
             const glm::vec4& c = triangles.clipPositions[v];
-            const bool insideGuardBand = std::abs(c.x) <= kGuardBandPixels / (0.5f * float(mWidth)) * c.w &&
-                                         std::abs(c.y) <= kGuardBandPixels / (0.5f * float(mHeight)) * c.w;
-            ProjectedVertex projected = insideGuardBand ? project(c) : ProjectedVertex{0, 0, 0.0f, 0};
+            const bool insideGuardBand =
+                std::abs(c.x) <= kGuardBandPixels / (0.5f * float(mWidth)) * c.w &&
+                std::abs(c.y) <= kGuardBandPixels / (0.5f * float(mHeight)) * c.w;
+            ProjectedVertex projected =
+                insideGuardBand ? project(c) : ProjectedVertex{0, 0, 0.0f, 0};
             projected.outcode = isFinite(c) ? frustumOutcode(c) : kNonFinite;
             mProjected[v] = projected;
         }
@@ -168,9 +180,10 @@ void Rasterizer::setUpAndBin(const TriangleList& triangles, const RasterState& s
 void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last,
                             const RasterState& state, Batch& batch) const {
     batch.triangles.clear();
-    batch.triangles.reserve(last - first);  // address space only; pages are touched on use
+    batch.triangles.reserve(last - first); // address space only; pages are touched on use
     batch.barycentrics.clear();
-    if (state.barycentrics) batch.barycentrics.reserve(last - first);
+    if (state.barycentrics)
+        batch.barycentrics.reserve(last - first);
     batch.clippedWeights.clear();
     batch.pairTile.clear();
     batch.pairTriangle.clear();
@@ -204,7 +217,8 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
         if (code0 | code1 | code2)
             for (int plane = 0; plane < kClipPlaneCount && !needsClip; ++plane)
                 for (int i = 0; i < 3; ++i)
-                    if (planeDistance(plane, *clipOfVertex[i], guardX, guardY) < 0.0f) needsClip = true;
+                    if (planeDistance(plane, *clipOfVertex[i], guardX, guardY) < 0.0f)
+                        needsClip = true;
 
         if (!needsClip) {
             emitTriangle(clipOfVertex, projected, nullptr, t, state, batch);
@@ -213,10 +227,12 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
         ++batch.stats.trianglesClipped;
         ClipVertex polygon[2][kMaxPolygon];
         int count = 3;
-        for (int i = 0; i < 3; ++i) polygon[0][i] = {*clipOfVertex[i], glm::vec3(i == 0, i == 1, i == 2)};
+        for (int i = 0; i < 3; ++i)
+            polygon[0][i] = {*clipOfVertex[i], glm::vec3(i == 0, i == 1, i == 2)};
         int current = 0;
         for (int plane = 0; plane < kClipPlaneCount && count >= 3; ++plane) {
-            count = clipPolygon(polygon[current], count, polygon[1 - current], plane, guardX, guardY);
+            count =
+                clipPolygon(polygon[current], count, polygon[1 - current], plane, guardX, guardY);
             current = 1 - current;
         }
         // Fan-triangulate the convex result; every piece keeps the original triangle's id.
@@ -226,22 +242,26 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
             const ClipVertex& c = polygon[current][i + 1];
             const glm::vec4* const pieceClip[3] = {&a.clip, &b.clip, &c.clip};
             const glm::vec3 pieceBarycentric[3] = {a.barycentric, b.barycentric, c.barycentric};
-            const ProjectedVertex pieceProjected[3] = {project(a.clip), project(b.clip), project(c.clip)};
+            const ProjectedVertex pieceProjected[3] = {project(a.clip), project(b.clip),
+                                                       project(c.clip)};
             emitTriangle(pieceClip, pieceProjected, pieceBarycentric, t, state, batch);
         }
     }
     // Counting sort of the (tile, triangle) pairs; stable, so each bin keeps submission order.
     const size_t tileCount = size_t(mTilesX) * mTilesY;
     batch.binOffsets.assign(tileCount + 1, 0);
-    for (uint32_t tile : batch.pairTile) ++batch.binOffsets[tile + 1];
-    for (size_t tile = 0; tile < tileCount; ++tile) batch.binOffsets[tile + 1] += batch.binOffsets[tile];
+    for (uint32_t tile : batch.pairTile)
+        ++batch.binOffsets[tile + 1];
+    for (size_t tile = 0; tile < tileCount; ++tile)
+        batch.binOffsets[tile + 1] += batch.binOffsets[tile];
     batch.binItems.resize(batch.pairTile.size());
     for (size_t pair = 0; pair < batch.pairTile.size(); ++pair) {
         const uint32_t tile = batch.pairTile[pair];
         batch.binItems[batch.binOffsets[tile]++] = batch.pairTriangle[pair];
     }
     // The loop advanced every offset to its bin's end; shift back to starts.
-    for (size_t tile = tileCount; tile > 0; --tile) batch.binOffsets[tile] = batch.binOffsets[tile - 1];
+    for (size_t tile = tileCount; tile > 0; --tile)
+        batch.binOffsets[tile] = batch.binOffsets[tile - 1];
     batch.binOffsets[0] = 0;
 }
 
@@ -260,10 +280,10 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
         invW[i] = projected[i].invW;
     }
     // Signed doubled area in fixed point; with y down, counter-clockwise in NDC is negative.
-    const int64_t area = int64_t(s.x[1] - s.x[0]) * (s.y[2] - s.y[0]) -
-                         int64_t(s.y[1] - s.y[0]) * (s.x[2] - s.x[0]);
+    const int64_t area =
+        int64_t(s.x[1] - s.x[0]) * (s.y[2] - s.y[0]) - int64_t(s.y[1] - s.y[0]) * (s.x[2] - s.x[0]);
     if (area == 0) {
-        ++batch.stats.trianglesCulled;  // degenerate after snapping: covers nothing
+        ++batch.stats.trianglesCulled; // degenerate after snapping: covers nothing
         return;
     }
     s.frontFacing = area < 0;
@@ -272,8 +292,8 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
         ++batch.stats.trianglesCulled;
         return;
     }
-    int order[3] = {0, 1, 2};  // which input vertex each set-up vertex is
-    if (area < 0) {  // traversal wants positive area: swap vertices 1 and 2
+    int order[3] = {0, 1, 2}; // which input vertex each set-up vertex is
+    if (area < 0) {           // traversal wants positive area: swap vertices 1 and 2
         std::swap(s.x[1], s.x[2]);
         std::swap(s.y[1], s.y[2]);
         std::swap(invW[1], invW[2]);
@@ -286,13 +306,13 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
     const int32_t minYf = std::min({s.y[0], s.y[1], s.y[2]});
     const int32_t maxYf = std::max({s.y[0], s.y[1], s.y[2]});
     constexpr int32_t kHalf = kSubpixelScale / 2;
-    auto ceilDiv = [](int32_t a) { return -((-a) >> kSubpixelBits); };  // ceil(a / 256)
+    auto ceilDiv = [](int32_t a) { return -((-a) >> kSubpixelBits); }; // ceil(a / 256)
     const int minX = std::max(0, ceilDiv(minXf - kHalf));
     const int minY = std::max(0, ceilDiv(minYf - kHalf));
     const int maxX = std::min(mWidth - 1, (maxXf - kHalf) >> kSubpixelBits);
     const int maxY = std::min(mHeight - 1, (maxYf - kHalf) >> kSubpixelBits);
     if (minX > maxX || minY > maxY) {
-        ++batch.stats.trianglesCulled;  // between sample points or off screen
+        ++batch.stats.trianglesCulled; // between sample points or off screen
         return;
     }
     s.minX = int16_t(minX);
@@ -312,12 +332,14 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
     SetupBarycentrics* barycentrics = nullptr;
     if (state.barycentrics) {
         barycentrics = &batch.barycentrics.emplace_back();
-        for (int i = 0; i < 3; ++i) barycentrics->invW[i] = invW[i];
+        for (int i = 0; i < 3; ++i)
+            barycentrics->invW[i] = invW[i];
         barycentrics->swapped = order[1] == 2;
         barycentrics->clippedWeights = SetupBarycentrics::kNotClipped;
         if (barycentric) {
             barycentrics->clippedWeights = uint32_t(batch.clippedWeights.size());
-            batch.clippedWeights.push_back({barycentric[order[0]], barycentric[order[1]], barycentric[order[2]]});
+            batch.clippedWeights.push_back(
+                {barycentric[order[0]], barycentric[order[1]], barycentric[order[2]]});
         }
     }
     setUpPlanes(s, barycentrics, screenXs, screenYs, depth);
@@ -327,7 +349,8 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
     ++batch.stats.trianglesSetUp;
     for (int ty = s.minY / kTileSize; ty <= s.maxY / kTileSize; ++ty)
         for (int tx = s.minX / kTileSize; tx <= s.maxX / kTileSize; ++tx)
-            batch.pairTile.push_back(uint32_t(ty * mTilesX + tx)), batch.pairTriangle.push_back(index);
+            batch.pairTile.push_back(uint32_t(ty * mTilesX + tx)),
+                batch.pairTriangle.push_back(index);
 }
 
-}  // namespace raster
+} // namespace raster

@@ -79,11 +79,11 @@ struct TriangleList {
 struct Fragment {
     int x = 0;
     int y = 0;
-    float depth = 0.0f;  // z / w, interpolated linearly in screen space, in [0, 1]
+    float depth = 0.0f; // z / w, interpolated linearly in screen space, in [0, 1]
     // Perspective-correct weights of the ORIGINAL triangle's three vertices (also after
     // clipping), so varyings are interpolated with interpolate(a, b, c, fragment.barycentric).
     glm::vec3 barycentric{0.0f};
-    uint32_t triangle = 0;  // index into the TriangleList
+    uint32_t triangle = 0; // index into the TriangleList
     bool frontFacing = true;
 };
 
@@ -94,11 +94,11 @@ inline T interpolate(const T& a, const T& b, const T& c, const glm::vec3& weight
 
 struct RasterStats {
     uint64_t trianglesIn = 0;
-    uint64_t trianglesCulled = 0;   // back/front-face or degenerate
-    uint64_t trianglesClipped = 0;  // needed polygon clipping
-    uint64_t trianglesSetUp = 0;    // after clipping (a clipped triangle can become several)
+    uint64_t trianglesCulled = 0;  // back/front-face or degenerate
+    uint64_t trianglesClipped = 0; // needed polygon clipping
+    uint64_t trianglesSetUp = 0;   // after clipping (a clipped triangle can become several)
     uint64_t samplesCovered = 0;
-    uint64_t samplesPassed = 0;  // passed the depth test
+    uint64_t samplesPassed = 0; // passed the depth test
 };
 
 // A triangle after clipping, snapping and orientation fix-up, as the traversal reads it for
@@ -115,8 +115,8 @@ struct RasterStats {
 // edge-function convention used by the traversal.
 struct alignas(64) SetupTriangle {
     double z[3];
-    int32_t x[3], y[3];  // fixed point, kSubpixelBits fraction bits
-    int16_t minX, minY, maxX, maxY;  // inclusive pixel bounds, clamped to the viewport
+    int32_t x[3], y[3];             // fixed point, kSubpixelBits fraction bits
+    int16_t minX, minY, maxX, maxY; // inclusive pixel bounds, clamped to the viewport
     uint32_t triangle;
     bool frontFacing;
 };
@@ -163,7 +163,7 @@ private:
     // slowdown).
     struct alignas(64) Batch {
         std::vector<SetupTriangle> triangles;
-        std::vector<SetupBarycentrics> barycentrics;  // empty unless RasterState::barycentrics
+        std::vector<SetupBarycentrics> barycentrics; // empty unless RasterState::barycentrics
         std::vector<std::array<glm::vec3, 3>> clippedWeights;
         // Bins as one compressed table: the triangles (indices into `triangles`, in submission
         // order) of tile t are binItems[binOffsets[t] .. binOffsets[t+1]). Built by a counting
@@ -211,7 +211,7 @@ private:
     int mHeight;
     int mTilesX;
     int mTilesY;
-    std::vector<ProjectedVertex> mProjected;  // per input vertex, for unclipped triangles
+    std::vector<ProjectedVertex> mProjected; // per input vertex, for unclipped triangles
     std::vector<Batch> mBatches;
     struct alignas(64) TileStats {
         RasterStats stats;
@@ -224,14 +224,18 @@ private:
 // Template implementation: the per-tile traversal is inlined with the fragment function.
 
 namespace detail {
-template <DepthTest test>
-inline bool depthPasses(float fragmentDepth, float storedDepth) {
+template <DepthTest test> inline bool depthPasses(float fragmentDepth, float storedDepth) {
     switch (test) {
-    case DepthTest::Always: return true;
-    case DepthTest::Less: return fragmentDepth < storedDepth;
-    case DepthTest::LessEqual: return fragmentDepth <= storedDepth;
-    case DepthTest::Greater: return fragmentDepth > storedDepth;
-    case DepthTest::GreaterEqual: return fragmentDepth >= storedDepth;
+    case DepthTest::Always:
+        return true;
+    case DepthTest::Less:
+        return fragmentDepth < storedDepth;
+    case DepthTest::LessEqual:
+        return fragmentDepth <= storedDepth;
+    case DepthTest::Greater:
+        return fragmentDepth > storedDepth;
+    case DepthTest::GreaterEqual:
+        return fragmentDepth >= storedDepth;
     }
     return false;
 }
@@ -244,7 +248,7 @@ inline int64_t fillBias(int32_t ax, int32_t ay, int32_t bx, int32_t by) {
     bool topLeft = dy < 0 || (dy == 0 && dx > 0);
     return topLeft ? 0 : -1;
 }
-}  // namespace detail
+} // namespace detail
 
 template <class FragmentFn>
 void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, float* depth,
@@ -258,7 +262,9 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
         case DepthTest::Always:
             rasterizeTile<DepthTest::Always>(tile, state, depth, fragmentFn, stats);
             break;
-        case DepthTest::Less: rasterizeTile<DepthTest::Less>(tile, state, depth, fragmentFn, stats); break;
+        case DepthTest::Less:
+            rasterizeTile<DepthTest::Less>(tile, state, depth, fragmentFn, stats);
+            break;
         case DepthTest::LessEqual:
             rasterizeTile<DepthTest::LessEqual>(tile, state, depth, fragmentFn, stats);
             break;
@@ -276,7 +282,8 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
     tbb::parallel_for(
         tbb::blocked_range<int>(0, tileCount, 1),
         [&](const tbb::blocked_range<int>& tiles) {
-            for (int tile = tiles.begin(); tile != tiles.end(); ++tile) rasterize(tile);
+            for (int tile = tiles.begin(); tile != tiles.end(); ++tile)
+                rasterize(tile);
         },
         tbb::simple_partitioner());
     // Sum in a fixed order so the statistics are as deterministic as the pixels.
@@ -286,8 +293,8 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
     }
 }
 
-inline glm::vec3 Rasterizer::barycentricAt(const Batch& batch, uint32_t index, const SetupTriangle& t,
-                                           int px, int py) {
+inline glm::vec3 Rasterizer::barycentricAt(const Batch& batch, uint32_t index,
+                                           const SetupTriangle& t, int px, int py) {
     const SetupBarycentrics& s = batch.barycentrics[index];
     const float dx = float(px - t.minX), dy = float(py - t.minY);
     const float l1 = s.l1[0] + s.l1[1] * dx + s.l1[2] * dy;
@@ -297,7 +304,8 @@ inline glm::vec3 Rasterizer::barycentricAt(const Batch& batch, uint32_t index, c
     const glm::vec3 b(q0 * invSum, q1 * invSum, q2 * invSum);
     // Map back to the original vertices (set-up may have clipped the triangle or swapped two
     // vertices to fix the orientation).
-    if (s.clippedWeights == SetupBarycentrics::kNotClipped) return s.swapped ? glm::vec3(b.x, b.z, b.y) : b;
+    if (s.clippedWeights == SetupBarycentrics::kNotClipped)
+        return s.swapped ? glm::vec3(b.x, b.z, b.y) : b;
     const auto& w = batch.clippedWeights[s.clippedWeights];
     return w[0] * b.x + w[1] * b.y + w[2] * b.z;
 }
@@ -318,9 +326,12 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
         for (uint32_t item = batch.binOffsets[size_t(tileIndex)]; item < binEnd; ++item) {
             const uint32_t index = batch.binItems[item];
             const SetupTriangle& t = batch.triangles[index];
-            const int minX = std::max(int(t.minX), tileMinX), maxX = std::min(int(t.maxX), tileMaxX);
-            const int minY = std::max(int(t.minY), tileMinY), maxY = std::min(int(t.maxY), tileMaxY);
-            if (minX > maxX || minY > maxY) continue;
+            const int minX = std::max(int(t.minX), tileMinX),
+                      maxX = std::min(int(t.maxX), tileMaxX);
+            const int minY = std::max(int(t.minY), tileMinY),
+                      maxY = std::min(int(t.maxY), tileMaxY);
+            if (minX > maxX || minY > maxY)
+                continue;
 
             // Edge i is opposite vertex i: e0 = v1->v2, e1 = v2->v0, e2 = v0->v1.
             const int32_t* x = t.x;
@@ -355,7 +366,8 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                 bool spanStarted = false;
                 for (int px = minX; px <= maxX; ++px, pxDouble += 1.0) {
                     if (((w0 + bias0) | (w1 + bias1) | (w2 + bias2)) < 0) {
-                        if (spanStarted) break;
+                        if (spanStarted)
+                            break;
                     } else {
                         spanStarted = true;
                         ++samplesCovered;
@@ -363,7 +375,8 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                         bool pass = !depthRow || detail::depthPasses<kDepthTest>(z, depthRow[px]);
                         if (pass) {
                             ++samplesPassed;
-                            if (depthRow && state.depthWrite) depthRow[px] = z;
+                            if (depthRow && state.depthWrite)
+                                depthRow[px] = z;
                             Fragment fragment;
                             fragment.x = px;
                             fragment.y = py;
@@ -389,4 +402,4 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     tileStats.samplesPassed = samplesPassed;
 }
 
-}  // namespace raster
+} // namespace raster

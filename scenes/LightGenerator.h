@@ -14,7 +14,7 @@ namespace scenes {
 class DeterministicRandom {
 public:
     explicit DeterministicRandom(uint64_t seed) : mEngine(seed) {}
-    double uniform01() { return double(mEngine() >> 11) * 0x1.0p-53; }  // [0,1)
+    double uniform01() { return double(mEngine() >> 11) * 0x1.0p-53; } // [0,1)
     float uniform(float lo, float hi) { return lo + float(uniform01()) * (hi - lo); }
 
 private:
@@ -22,7 +22,7 @@ private:
 };
 
 struct PointLightScatter {
-    Aabb region;                 // light centres are uniform inside this box
+    Aabb region; // light centres are uniform inside this box
     float minRangeMetres = 1.0f;
     float maxRangeMetres = 4.0f;
     float minIntensity = 0.5f;
@@ -36,4 +36,4 @@ void scatterPointLights(Scene& scene, const PointLightScatter& scatter, int coun
 // generator): the scene's bounds, radii a fraction of its diagonal.
 PointLightScatter defaultScatterFor(const Scene& scene);
 
-}  // namespace scenes
+} // namespace scenes

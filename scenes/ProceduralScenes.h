@@ -21,4 +21,4 @@ bool isProceduralScene(const std::string& name);
 // Throws SceneError for an unknown name (listing the valid ones) or an unknown/invalid option.
 Scene buildProceduralScene(const std::string& name, const SceneRequest& request);
 
-}  // namespace scenes
+} // namespace scenes

@@ -12,7 +12,8 @@ glm::mat4 Camera::viewFromWorld() const {
 
 uint64_t Scene::triangleCount() const {
     uint64_t count = 0;
-    for (const Instance& instance : instances) count += meshes[instance.mesh].triangleCount();
+    for (const Instance& instance : instances)
+        count += meshes[instance.mesh].triangleCount();
     return count;
 }
 
@@ -22,7 +23,8 @@ Aabb Scene::boundsWorld() const {
         for (const glm::vec3& p : meshes[instance.mesh].positions)
             bounds.extend(glm::vec3(instance.worldFromObject * glm::vec4(p, 1.0f)));
     }
-    for (const Camera& camera : cameras) bounds.extend(camera.positionWorld);
+    for (const Camera& camera : cameras)
+        bounds.extend(camera.positionWorld);
     return bounds;
 }
 
@@ -35,7 +37,8 @@ void validate(const Scene& scene) {
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
         const std::string where = "mesh " + std::to_string(m) + " '" + mesh.name + "'";
-        if (mesh.indices.size() % 3 != 0) fail(where + ": index count is not a multiple of 3");
+        if (mesh.indices.size() % 3 != 0)
+            fail(where + ": index count is not a multiple of 3");
         if (mesh.normals.size() != mesh.positions.size())
             fail(where + ": " + std::to_string(mesh.normals.size()) + " normals for " +
                  std::to_string(mesh.positions.size()) + " positions");
@@ -48,9 +51,11 @@ void validate(const Scene& scene) {
                 fail(where + ": index " + std::to_string(index) + " out of range (" +
                      std::to_string(mesh.positions.size()) + " vertices)");
         for (const glm::vec3& p : mesh.positions)
-            if (!finite(p)) fail(where + ": position is NaN or infinite");
+            if (!finite(p))
+                fail(where + ": position is NaN or infinite");
         for (const glm::vec3& n : mesh.normals)
-            if (!finite(n)) fail(where + ": normal is NaN or infinite");
+            if (!finite(n))
+                fail(where + ": normal is NaN or infinite");
         if (mesh.material >= scene.materials.size())
             fail(where + ": material " + std::to_string(mesh.material) + " out of range");
     }
@@ -60,8 +65,10 @@ void validate(const Scene& scene) {
                 fail("material '" + material.name + "': texture index out of range");
     }
     for (const Instance& instance : scene.instances)
-        if (instance.mesh >= scene.meshes.size()) fail("instance refers to a missing mesh");
-    if (scene.cameras.empty()) fail("no camera");
+        if (instance.mesh >= scene.meshes.size())
+            fail("instance refers to a missing mesh");
+    if (scene.cameras.empty())
+        fail("no camera");
     for (const Camera& camera : scene.cameras) {
         if (!finite(camera.positionWorld) || !finite(camera.forwardWorld))
             fail("camera '" + camera.name + "' is not finite");
@@ -71,10 +78,10 @@ void validate(const Scene& scene) {
             fail("camera '" + camera.name + "': vertical field of view out of (0, pi)");
     }
     for (const Light& light : scene.lights) {
-        if (!finite(light.positionWorld) || !finite(light.color) || !std::isfinite(light.intensity) ||
-            !(light.rangeMetres >= 0.0f))
+        if (!finite(light.positionWorld) || !finite(light.color) ||
+            !std::isfinite(light.intensity) || !(light.rangeMetres >= 0.0f))
             fail("a light is not finite or has a negative range");
     }
 }
 
-}  // namespace scenes
+} // namespace scenes

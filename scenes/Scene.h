@@ -1,4 +1,5 @@
-// Scene: the data every other folder reads. Meshes, materials, textures, instances, cameras, lights.
+// Scene: the data every other folder reads. Meshes, materials, textures, instances, cameras,
+// lights.
 //
 // Conventions (see ../shared/DESIGN.md): right-handed world space, metres, cameras look down -Z of
 // their own view space (glTF's convention). Transforms are named destination-from-source
@@ -43,24 +44,24 @@ struct Aabb {
 // materials are mapped onto it by the loader: specularPower = 2 / roughness^4 - 2.
 struct Material {
     std::string name;
-    glm::vec4 baseColorFactor{1.0f};  // linear RGBA, multiplied with the texture
-    int baseColorTexture = -1;        // index into Scene::textures, -1 = none
-    float specularIntensity = 0.04f;  // ks, unitless reflectance at normal incidence
-    float specularPower = 32.0f;      // Blinn-Phong exponent
-    float roughness = 0.5f;           // as given by glTF (informative; power is derived from it)
+    glm::vec4 baseColorFactor{1.0f}; // linear RGBA, multiplied with the texture
+    int baseColorTexture = -1;       // index into Scene::textures, -1 = none
+    float specularIntensity = 0.04f; // ks, unitless reflectance at normal incidence
+    float specularPower = 32.0f;     // Blinn-Phong exponent
+    float roughness = 0.5f;          // as given by glTF (informative; power is derived from it)
     float metallic = 0.0f;
-    int normalTexture = -1;  // tangent-space normal map, index into Scene::textures, -1 = none
+    int normalTexture = -1; // tangent-space normal map, index into Scene::textures, -1 = none
 };
 
 // One triangle list with one material. Attributes are per vertex, in object space.
 struct Mesh {
     std::string name;
     std::vector<glm::vec3> positions;
-    std::vector<glm::vec3> normals;   // unit length, same count as positions
-    std::vector<glm::vec4> tangents;  // xyz tangent, w = bitangent sign; empty when unknown
-    std::vector<glm::vec2> uvs;       // empty when the mesh has no texture coordinates
-    std::vector<uint32_t> indices;    // triangle list, 3 per triangle, counter-clockwise = front
-    uint32_t material = 0;            // index into Scene::materials
+    std::vector<glm::vec3> normals;  // unit length, same count as positions
+    std::vector<glm::vec4> tangents; // xyz tangent, w = bitangent sign; empty when unknown
+    std::vector<glm::vec2> uvs;      // empty when the mesh has no texture coordinates
+    std::vector<uint32_t> indices;   // triangle list, 3 per triangle, counter-clockwise = front
+    uint32_t material = 0;           // index into Scene::materials
 
     size_t triangleCount() const { return indices.size() / 3; }
 };
@@ -75,7 +76,7 @@ struct Instance {
 struct Camera {
     std::string name;
     glm::vec3 positionWorld{0.0f};
-    glm::vec3 forwardWorld{0.0f, 0.0f, -1.0f};  // unit
+    glm::vec3 forwardWorld{0.0f, 0.0f, -1.0f}; // unit
     glm::vec3 upWorld{0.0f, 1.0f, 0.0f};
     float verticalFovRadians = 1.0f;
     float nearMetres = 0.1f;
@@ -90,12 +91,12 @@ enum class LightType { Point, Spot, Directional, Ambient };
 struct Light {
     LightType type = LightType::Point;
     glm::vec3 positionWorld{0.0f};
-    glm::vec3 directionWorld{0.0f, -1.0f, 0.0f};  // spot axis / direction the light travels
-    glm::vec3 color{1.0f};                        // linear RGB
+    glm::vec3 directionWorld{0.0f, -1.0f, 0.0f}; // spot axis / direction the light travels
+    glm::vec3 color{1.0f};                       // linear RGB
     float intensity = 1.0f;
     float rangeMetres = 1.0f;
-    float spotInnerCos = 0.9f;  // spot: full intensity inside this cosine
-    float spotOuterCos = 0.8f;  // spot: zero outside this cosine
+    float spotInnerCos = 0.9f; // spot: full intensity inside this cosine
+    float spotOuterCos = 0.8f; // spot: zero outside this cosine
 };
 
 struct Scene {
@@ -104,16 +105,16 @@ struct Scene {
     std::vector<Material> materials;
     std::vector<Texture> textures;
     std::vector<Instance> instances;
-    std::vector<Camera> cameras;  // cameras[0] is the one rendered
+    std::vector<Camera> cameras; // cameras[0] is the one rendered
     std::vector<Light> lights;
-    std::vector<std::string> warnings;  // non-fatal problems met while building (missing textures)
+    std::vector<std::string> warnings; // non-fatal problems met while building (missing textures)
 
-    uint64_t triangleCount() const;  // over instances
-    Aabb boundsWorld() const;        // over instances
+    uint64_t triangleCount() const; // over instances
+    Aabb boundsWorld() const;       // over instances
 };
 
 // Throws SceneError naming the scene when indices are out of range, attributes have the wrong
 // count, or positions are not finite. Every builder and loader calls it before returning.
 void validate(const Scene& scene);
 
-}  // namespace scenes
+} // namespace scenes

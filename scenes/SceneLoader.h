@@ -29,4 +29,4 @@ Camera cameraFramingBounds(const Aabb& boundsWorld);
 // The JSON scene format (documented in scenes/README.md).
 Scene loadJsonScene(const std::filesystem::path& path, const SceneRequest& request);
 
-}  // namespace scenes
+} // namespace scenes

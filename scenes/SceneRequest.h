@@ -9,11 +9,11 @@
 namespace scenes {
 
 struct SceneRequest {
-    int lightCount = 0;   // generated point lights, placed deterministically from seed
+    int lightCount = 0; // generated point lights, placed deterministically from seed
     uint64_t seed = 1;
     // Scene-specific options as key=value. A builder must reject keys it does not know
     // (SceneError naming the key and the valid ones), never silently ignore them.
     std::map<std::string, std::string> options;
 };
 
-}  // namespace scenes
+} // namespace scenes

@@ -25,23 +25,27 @@ int wrap(int i, int n) {
     return r < 0 ? r + n : r;
 }
 
-}  // namespace
+} // namespace
 
 glm::vec4 Texture::sample(glm::vec2 uv) const {
-    if (!valid()) return glm::vec4(1.0f);
+    if (!valid())
+        return glm::vec4(1.0f);
     const std::array<float, 256>& toLinear = srgbToLinearTable();
     // Texel centres at half-integers; bilinear between the four around the lookup.
     float x = uv.x * float(width) - 0.5f;
     float y = uv.y * float(height) - 0.5f;
-    if (!std::isfinite(x) || !std::isfinite(y)) return glm::vec4(1.0f);
+    if (!std::isfinite(x) || !std::isfinite(y))
+        return glm::vec4(1.0f);
     float fx = std::floor(x), fy = std::floor(y);
     float tx = x - fx, ty = y - fy;
     // Reduce before converting to int so huge uvs cannot overflow.
-    int x0 = wrap(int(std::fmod(fx, float(width))), width), y0 = wrap(int(std::fmod(fy, float(height))), height);
+    int x0 = wrap(int(std::fmod(fx, float(width))), width),
+        y0 = wrap(int(std::fmod(fy, float(height))), height);
     int x1 = wrap(x0 + 1, width), y1 = wrap(y0 + 1, height);
     auto texel = [&](int xi, int yi) {
         const uint8_t* p = &rgba8[(size_t(yi) * width + xi) * 4];
-        if (srgb) return glm::vec4(toLinear[p[0]], toLinear[p[1]], toLinear[p[2]], p[3] / 255.0f);
+        if (srgb)
+            return glm::vec4(toLinear[p[0]], toLinear[p[1]], toLinear[p[2]], p[3] / 255.0f);
         return glm::vec4(p[0], p[1], p[2], p[3]) / 255.0f;
     };
     glm::vec4 top = glm::mix(texel(x0, y0), texel(x1, y0), tx);
@@ -49,4 +53,4 @@ glm::vec4 Texture::sample(glm::vec2 uv) const {
     return glm::mix(top, bottom, ty);
 }
 
-}  // namespace scenes
+} // namespace scenes

@@ -14,20 +14,22 @@ namespace {
 ProxyMesh buildUnitProxySphere() {
     // Icosahedron: the cyclic permutations of (0, +-1, +-phi).
     const float phi = (1.0f + std::sqrt(5.0f)) * 0.5f;
-    std::vector<glm::vec3> positions = {
-        {-1, phi, 0}, {1, phi, 0}, {-1, -phi, 0}, {1, -phi, 0}, {0, -1, phi}, {0, 1, phi},
-        {0, -1, -phi}, {0, 1, -phi}, {phi, 0, -1}, {phi, 0, 1}, {-phi, 0, -1}, {-phi, 0, 1}};
-    for (glm::vec3& p : positions) p = glm::normalize(p);
-    const std::vector<uint32_t> faces = {0, 11, 5, 0, 5,  1,  0,  1,  7,  0,  7,  10, 0, 10, 11,
-                                         1, 5,  9, 5, 11, 4,  11, 10, 2,  10, 7,  6,  7, 1,  8,
-                                         3, 9,  4, 3, 4,  2,  3,  2,  6,  3,  6,  8,  3, 8,  9,
-                                         4, 9,  5, 2, 4,  11, 6,  2,  10, 8,  6,  7,  9, 8,  1};
+    std::vector<glm::vec3> positions = {{-1, phi, 0}, {1, phi, 0}, {-1, -phi, 0}, {1, -phi, 0},
+                                        {0, -1, phi}, {0, 1, phi}, {0, -1, -phi}, {0, 1, -phi},
+                                        {phi, 0, -1}, {phi, 0, 1}, {-phi, 0, -1}, {-phi, 0, 1}};
+    for (glm::vec3& p : positions)
+        p = glm::normalize(p);
+    const std::vector<uint32_t> faces = {0, 11, 5, 0, 5,  1,  0,  1,  7,  0,  7, 10, 0, 10, 11,
+                                         1, 5,  9, 5, 11, 4,  11, 10, 2,  10, 7, 6,  7, 1,  8,
+                                         3, 9,  4, 3, 4,  2,  3,  2,  6,  3,  6, 8,  3, 8,  9,
+                                         4, 9,  5, 2, 4,  11, 6,  2,  10, 8,  6, 7,  9, 8,  1};
     // One subdivision: each edge's midpoint, pushed to the unit sphere, shared between faces.
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
     auto midpoint = [&](uint32_t a, uint32_t b) {
         const auto key = std::minmax(a, b);
         const auto found = midpoints.find(key);
-        if (found != midpoints.end()) return found->second;
+        if (found != midpoints.end())
+            return found->second;
         positions.push_back(glm::normalize(positions[a] + positions[b]));
         const uint32_t index = uint32_t(positions.size() - 1);
         midpoints.emplace(key, index);
@@ -37,13 +39,15 @@ ProxyMesh buildUnitProxySphere() {
     for (size_t f = 0; f < faces.size(); f += 3) {
         const uint32_t a = faces[f], b = faces[f + 1], c = faces[f + 2];
         const uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-        for (uint32_t t : {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca}) mesh.indices.push_back(t);
+        for (uint32_t t : {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca})
+            mesh.indices.push_back(t);
     }
     // Counter-clockwise seen from outside (the outward normal by the right-hand rule).
     for (size_t t = 0; t < mesh.indices.size(); t += 3) {
         const glm::vec3 &a = positions[mesh.indices[t]], &b = positions[mesh.indices[t + 1]],
                         &c = positions[mesh.indices[t + 2]];
-        if (glm::dot(glm::cross(b - a, c - a), a + b + c) < 0.0f) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+        if (glm::dot(glm::cross(b - a, c - a), a + b + c) < 0.0f)
+            std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
     }
     // Scale so the smallest face-plane distance (the inradius) is 1, computed in double and
     // rounded up by a relative 1e-6 so float rounding cannot leave it just below 1.
@@ -77,15 +81,15 @@ std::vector<uint32_t> buildConeProxyIndices() {
     for (uint32_t k = 0; k < n; ++k) {
         const uint32_t b = 1 + k, next = 1 + (k + 1) % n;
         for (uint32_t i : {0u, next, b})
-            indices.push_back(i);  // side
+            indices.push_back(i); // side
     }
     for (uint32_t k = 1; k + 1 < n; ++k)
         for (uint32_t i : {1u, 1 + k, 2 + k})
-            indices.push_back(i);  // base fan
+            indices.push_back(i); // base fan
     return indices;
 }
 
-}  // namespace
+} // namespace
 
 const ProxyMesh& unitProxySphere() {
     static const ProxyMesh mesh = buildUnitProxySphere();
@@ -162,35 +166,44 @@ std::vector<uint32_t> LightVolumeRasterizer::lightsToDraw(const std::vector<Ligh
     std::vector<uint32_t> drawn;
     drawn.reserve(spheres.size());
     for (uint32_t i = 0; i < uint32_t(spheres.size()); ++i)
-        if (!frustumCull || inViewFrustum(spheres[i])) drawn.push_back(i);
+        if (!frustumCull || inViewFrustum(spheres[i]))
+            drawn.push_back(i);
     return drawn;
 }
 
 bool LightVolumeRasterizer::inViewFrustum(const LightSphere& sphere) const {
-    if (sphere.unbounded) return true;
+    if (sphere.unbounded)
+        return true;
     const glm::dvec3 c(sphere.centreView);
     const double r = double(sphere.radius) * (1.0 + 1e-6);
-    if (c.z - r > -double(mNearMetres)) return false;  // wholly nearer than the near plane
-    if (c.z + r < -double(mFarMetres)) return false;   // wholly beyond the far plane
+    if (c.z - r > -double(mNearMetres))
+        return false; // wholly nearer than the near plane
+    if (c.z + r < -double(mFarMetres))
+        return false; // wholly beyond the far plane
     // Side planes through the eye: inside when +-p * x + z <= 0 (p = projection scale).
     const double px = mProjX, py = mProjY;
     const double lengthX = std::sqrt(px * px + 1.0), lengthY = std::sqrt(py * py + 1.0);
-    if ((px * c.x + c.z) / lengthX > r || (-px * c.x + c.z) / lengthX > r) return false;
-    if ((py * c.y + c.z) / lengthY > r || (-py * c.y + c.z) / lengthY > r) return false;
+    if ((px * c.x + c.z) / lengthX > r || (-px * c.x + c.z) / lengthX > r)
+        return false;
+    if ((py * c.y + c.z) / lengthY > r || (-py * c.y + c.z) / lengthY > r)
+        return false;
     return true;
 }
 
-LightVolumeRasterizer::PixelRect LightVolumeRasterizer::screenRect(const LightSphere& sphere) const {
+LightVolumeRasterizer::PixelRect
+LightVolumeRasterizer::screenRect(const LightSphere& sphere) const {
     const int width = mGBuffer.width(), height = mGBuffer.height();
     const PixelRect full{0, 0, width - 1, height - 1};
     const glm::dvec3 c(sphere.centreView);
     const double r = double(sphere.radius) * (1.0 + 1e-6);
-    if (c.z + r >= -double(mNearMetres)) return full;  // crosses the near plane (or behind)
+    if (c.z + r >= -double(mNearMetres))
+        return full; // crosses the near plane (or behind)
     // The sphere is wholly in front of the eye: in the xz (yz) plane its shadow is a disc of
     // radius r, whose tangents from the eye bound x / -z (y / -z).
     auto tangentRange = [&](double lateral, double& tanMin, double& tanMax) {
         const double centreAngle = std::atan2(lateral, -c.z);
-        const double halfAngle = std::asin(std::min(1.0, r / std::sqrt(lateral * lateral + c.z * c.z)));
+        const double halfAngle =
+            std::asin(std::min(1.0, r / std::sqrt(lateral * lateral + c.z * c.z)));
         tanMin = std::tan(centreAngle - halfAngle);
         tanMax = std::tan(centreAngle + halfAngle);
     };
@@ -199,8 +212,10 @@ LightVolumeRasterizer::PixelRect LightVolumeRasterizer::screenRect(const LightSp
     tangentRange(c.y, tanMinY, tanMaxY);
     // Screen x = (ndc + 1) w / 2, y = (1 - ndc) h / 2; pixel p is sampled at p + 0.5. One extra
     // pixel each side absorbs every rounding of the above.
-    const double xMin = (mProjX * tanMinX + 1.0) * 0.5 * width, xMax = (mProjX * tanMaxX + 1.0) * 0.5 * width;
-    const double yMin = (1.0 - mProjY * tanMaxY) * 0.5 * height, yMax = (1.0 - mProjY * tanMinY) * 0.5 * height;
+    const double xMin = (mProjX * tanMinX + 1.0) * 0.5 * width,
+                 xMax = (mProjX * tanMaxX + 1.0) * 0.5 * width;
+    const double yMin = (1.0 - mProjY * tanMaxY) * 0.5 * height,
+                 yMax = (1.0 - mProjY * tanMinY) * 0.5 * height;
     auto clampTo = [](double v, int hi) { return int(std::clamp(v, -1.0, double(hi))); };
     PixelRect rect;
     rect.minX = std::max(0, clampTo(std::ceil(xMin - 0.5) - 1.0, width));
@@ -210,7 +225,8 @@ LightVolumeRasterizer::PixelRect LightVolumeRasterizer::screenRect(const LightSp
     return rect;
 }
 
-LightVolumeRasterizer::DepthRange LightVolumeRasterizer::depthBounds(const LightSphere& sphere) const {
+LightVolumeRasterizer::DepthRange
+LightVolumeRasterizer::depthBounds(const LightSphere& sphere) const {
     return depthBoundsOfViewZ(double(sphere.centreView.z) + sphere.radius,
                               double(sphere.centreView.z) - sphere.radius);
 }
@@ -225,7 +241,8 @@ LightVolumeRasterizer::depthBoundsOfViewZ(double zNearest, double zFarthest) con
     const glm::dmat4& m = mClipFromViewExact;
     auto depthOf = [&](double z) { return (m[2][2] * z + m[3][2]) / (m[2][3] * z + m[3][3]); };
     double a = depthOf(zNearest), b = depthOf(zFarthest);
-    if (a > b) std::swap(a, b);
+    if (a > b)
+        std::swap(a, b);
     const double toleranceLo = kDepthTolerance * (mReversedZ ? a : 1.0);
     const double toleranceHi = kDepthTolerance * (mReversedZ ? b : 1.0);
     return {float(a - toleranceLo), float(b + toleranceHi)};
@@ -235,7 +252,8 @@ void LightVolumeRasterizer::buildGeometry(const std::vector<LightSphere>& sphere
                                           const std::vector<uint32_t>& lightIndices) {
     mStats = {};
     mVisitedStamp.assign(mGBuffer.pixelCount(), 0u);
-    if (mStencil) mFrontStamp.assign(mGBuffer.pixelCount(), 0u);
+    if (mStencil)
+        mFrontStamp.assign(mGBuffer.pixelCount(), 0u);
     mClip.clear();
     mIndices.clear();
     mTriangleSlot.clear();
@@ -259,19 +277,22 @@ void LightVolumeRasterizer::buildGeometry(const std::vector<LightSphere>& sphere
             }
             // The proxy's extent: the grown radius times the proxy's circumradius.
             const float margin = marginMetres(glm::length(sphere.centreView) + sphere.radius);
-            const float extent = (sphere.radius + margin) * unitProxySphere().circumradius * (1.0f + 1e-5f);
+            const float extent =
+                (sphere.radius + margin) * unitProxySphere().circumradius * (1.0f + 1e-5f);
             // Back faces beyond the far plane would be clipped away: use the rectangle instead.
             if (sphere.centreView.z - extent > -mFarMetres) {
                 mSlots[slot].backFaceTest = true;
                 // Front faces are complete only when the proxy is wholly beyond the near plane.
-                mSlots[slot].frontFaceTest = mStencil && sphere.centreView.z + extent < -mNearMetres;
+                mSlots[slot].frontFaceTest =
+                    mStencil && sphere.centreView.z + extent < -mNearMetres;
                 addProxy(sphere, slot);
                 continue;
             }
             ++mStats.rectFallbacks;
         }
         const PixelRect rect = screenRect(sphere);
-        if (rect.minX <= rect.maxX && rect.minY <= rect.maxY) addQuad(rect, slot);
+        if (rect.minX <= rect.maxX && rect.minY <= rect.maxY)
+            addQuad(rect, slot);
     }
 }
 
@@ -343,16 +364,17 @@ void LightVolumeRasterizer::addQuad(const PixelRect& rect, uint32_t slot) {
     // is inside the clip volume. Clockwise in NDC: back-facing, like the proxies' drawn faces.
     const float x0 = float(rect.minX) / float(mGBuffer.width()) * 2.0f - 1.0f;
     const float x1 = float(rect.maxX + 1) / float(mGBuffer.width()) * 2.0f - 1.0f;
-    const float y0 = 1.0f - float(rect.maxY + 1) / float(mGBuffer.height()) * 2.0f;  // bottom
-    const float y1 = 1.0f - float(rect.minY) / float(mGBuffer.height()) * 2.0f;      // top
+    const float y0 = 1.0f - float(rect.maxY + 1) / float(mGBuffer.height()) * 2.0f; // bottom
+    const float y1 = 1.0f - float(rect.minY) / float(mGBuffer.height()) * 2.0f;     // top
     const uint32_t base = uint32_t(mClip.size());
     mClip.push_back({x0, y0, 0.5f, 1.0f});
     mClip.push_back({x1, y0, 0.5f, 1.0f});
     mClip.push_back({x1, y1, 0.5f, 1.0f});
     mClip.push_back({x0, y1, 0.5f, 1.0f});
-    for (uint32_t i : {0u, 2u, 1u, 0u, 3u, 2u}) mIndices.push_back(base + i);
+    for (uint32_t i : {0u, 2u, 1u, 0u, 3u, 2u})
+        mIndices.push_back(base + i);
     mTriangleSlot.push_back(slot);
     mTriangleSlot.push_back(slot);
 }
 
-}  // namespace lighting
+} // namespace lighting

@@ -38,11 +38,11 @@
 // Batching: all lights of a frame are drawn in ONE rasterizer draw, light after light in ascending
 // index order. Inside a screen tile the rasterizer visits triangles in submission order, and a
 // pixel belongs to one tile, so every pixel meets its lights in ascending order (what exactness
-// needs) while all tiles work in parallel and the set-up cost is paid once. Rectangles (volume=rect,
-// far-plane fallback) and unbounded lights (directional, ambient: full screen) are drawn as
-// screen-aligned quads in the same stream, at their place in the light order. With stencil=1
-// each proxy is submitted twice with no face culling: the first copy's front faces mark pixels,
-// the second copy's back faces test; light i's copies precede light i+1's in every tile.
+// needs) while all tiles work in parallel and the set-up cost is paid once. Rectangles
+// (volume=rect, far-plane fallback) and unbounded lights (directional, ambient: full screen) are
+// drawn as screen-aligned quads in the same stream, at their place in the light order. With
+// stencil=1 each proxy is submitted twice with no face culling: the first copy's front faces mark
+// pixels, the second copy's back faces test; light i's copies precede light i+1's in every tile.
 //
 // Depth comparisons are done in the fragment function against the G-buffer's depth plane with a
 // tolerance (kDepthTolerance) that only ever keeps more pixels: float rounding of the proxy's
@@ -72,8 +72,8 @@ namespace lighting {
 struct ProxyMesh {
     std::vector<glm::vec3> positions;
     std::vector<uint32_t> indices;
-    float circumradius = 1.0f;  // largest vertex distance from the origin
-    double volume = 0.0;        // enclosed volume
+    float circumradius = 1.0f; // largest vertex distance from the origin
+    double volume = 0.0;       // enclosed volume
 };
 // The icosahedron subdivided once (42 vertices, 80 faces), scaled so its inradius is 1.
 const ProxyMesh& unitProxySphere();
@@ -99,7 +99,7 @@ inline constexpr double kConeCosSlack = 1e-6;
 // (1..kConeProxySides). Faces are coneProxyIndices(), counter-clockwise seen from outside.
 struct ConeProxy {
     std::array<glm::vec3, kConeProxySides + 1> positionsView;
-    double volume = 0.0;  // cubic metres
+    double volume = 0.0; // cubic metres
 };
 const std::vector<uint32_t>& coneProxyIndices();
 // The pyramid around `light`'s lit cone, its faces at least `marginMetres` (plus LightBounds'
@@ -115,10 +115,10 @@ enum class SpotProxy { Cone, Sphere };
 inline constexpr float kDepthTolerance = 1e-5f;
 
 struct LightVolumeStats {
-    uint64_t lightsDrawn = 0;    // bounded lights that reached a volume draw
-    uint64_t rectFallbacks = 0;  // sphere volumes replaced by the rectangle (far plane)
-    uint64_t coneProxies = 0;    // spot lights drawn with their cone proxy
-    uint64_t fragments = 0;      // samples covered by the volume draw (before any depth test)
+    uint64_t lightsDrawn = 0;   // bounded lights that reached a volume draw
+    uint64_t rectFallbacks = 0; // sphere volumes replaced by the rectangle (far plane)
+    uint64_t coneProxies = 0;   // spot lights drawn with their cone proxy
+    uint64_t fragments = 0;     // samples covered by the volume draw (before any depth test)
 };
 
 class LightVolumeRasterizer {
@@ -130,14 +130,16 @@ public:
     bool inViewFrustum(const LightSphere& sphere) const;
     // Indices (ascending) of the lights to draw: all of them, or with `frustumCull` only those
     // whose sphere may touch the view frustum (CPU view-frustum culling).
-    std::vector<uint32_t> lightsToDraw(const std::vector<LightSphere>& spheres, bool frustumCull) const;
+    std::vector<uint32_t> lightsToDraw(const std::vector<LightSphere>& spheres,
+                                       bool frustumCull) const;
 
     // Draws the volumes of `lightIndices` (ascending; unbounded lights included) in one pass and
     // calls fn(light, x, y, pixel) as described in the file comment. Cost: set-up of 80 (160 with
     // stencil) triangles per sphere, 22 (44) per cone, then O(covered bounding-box pixels) in
     // parallel over tiles.
     template <class Fn>
-    void draw(const std::vector<LightSphere>& spheres, const std::vector<uint32_t>& lightIndices, Fn&& fn);
+    void draw(const std::vector<LightSphere>& spheres, const std::vector<uint32_t>& lightIndices,
+              Fn&& fn);
 
     const LightVolumeStats& stats() const { return mStats; }
 
@@ -161,8 +163,8 @@ private:
     struct Slot {
         uint32_t light;
         DepthRange depth;
-        bool backFaceTest;   // a proxy (else a screen quad: no depth test)
-        bool frontFaceTest;  // stencil: the surface must not be in front of the front face
+        bool backFaceTest;  // a proxy (else a screen quad: no depth test)
+        bool frontFaceTest; // stencil: the surface must not be in front of the front face
     };
     // Triangles of a stencil front-marking copy carry this bit in mTriangleSlot.
     static constexpr uint32_t kFrontCopy = 0x80000000u;
@@ -180,7 +182,8 @@ private:
                           : fragmentDepth <= surfaceDepth + tolerance;
     }
     // Fills mClip, mIndices, mTriangleSlot and mSlots for the lights to draw.
-    void buildGeometry(const std::vector<LightSphere>& spheres, const std::vector<uint32_t>& lightIndices);
+    void buildGeometry(const std::vector<LightSphere>& spheres,
+                       const std::vector<uint32_t>& lightIndices);
     // The metric margin that grows a proxy by kProxyMarginPixels for surfaces up to
     // `farthestMetres` from the eye.
     float marginMetres(float farthestMetres) const;
@@ -200,17 +203,17 @@ private:
     bool mReversedZ;
     float mClearDepth;
     float mNearMetres, mFarMetres;
-    float mProjX, mProjY;                  // clipFromView[0][0], [1][1]
-    float mPixelsPerTanX, mPixelsPerTanY;  // focal lengths in pixels
+    float mProjX, mProjY;                 // clipFromView[0][0], [1][1]
+    float mPixelsPerTanX, mPixelsPerTanY; // focal lengths in pixels
     glm::dmat4 mClipFromViewExact;
     glm::mat4 mClipFromView;
     raster::Rasterizer mRasterizer;
     std::vector<glm::vec4> mClip;
     std::vector<uint32_t> mIndices;
-    std::vector<uint32_t> mTriangleSlot;  // per triangle: index into mSlots (| kFrontCopy)
+    std::vector<uint32_t> mTriangleSlot; // per triangle: index into mSlots (| kFrontCopy)
     std::vector<Slot> mSlots;
-    std::vector<uint32_t> mVisitedStamp;  // light index + 1 of the last light that visited a pixel
-    std::vector<uint32_t> mFrontStamp;    // stencil: light index + 1 passing the front-face test
+    std::vector<uint32_t> mVisitedStamp; // light index + 1 of the last light that visited a pixel
+    std::vector<uint32_t> mFrontStamp;   // stencil: light index + 1 passing the front-face test
     LightVolumeStats mStats;
 };
 
@@ -225,7 +228,7 @@ void LightVolumeRasterizer::draw(const std::vector<LightSphere>& spheres,
     const raster::TriangleList triangles{mClip, mIndices};
     raster::RasterState state;
     state.depthWrite = false;
-    state.barycentrics = false;  // a volume has no varyings
+    state.barycentrics = false; // a volume has no varyings
     // Without stencil only back faces are drawn; quads are wound clockwise (back-facing).
     state.cullMode = mStencil ? raster::CullMode::None : raster::CullMode::Front;
     const bool stencil = mStencil;
@@ -235,24 +238,30 @@ void LightVolumeRasterizer::draw(const std::vector<LightSphere>& spheres,
         const size_t pixel = size_t(f.y) * width + f.x;
         // Background and the depth-bounds test, on depth values (no division per pixel).
         const float depth = mDepth[pixel];
-        if (depth == clearDepth || depth < slot.depth.lo || depth > slot.depth.hi) return;
+        if (depth == clearDepth || depth < slot.depth.lo || depth > slot.depth.hi)
+            return;
         const uint32_t stamp = slot.light + 1;
         if (code & kFrontCopy) {
-            if (f.frontFacing && surfaceNotInFront(f.depth, depth)) mFrontStamp[pixel] = stamp;
+            if (f.frontFacing && surfaceNotInFront(f.depth, depth))
+                mFrontStamp[pixel] = stamp;
             return;
         }
         if (slot.backFaceTest) {
-            if (stencil && f.frontFacing) return;
-            if (!surfaceNotBehind(f.depth, depth)) return;
-            if (slot.frontFaceTest && mFrontStamp[pixel] != stamp) return;
+            if (stencil && f.frontFacing)
+                return;
+            if (!surfaceNotBehind(f.depth, depth))
+                return;
+            if (slot.frontFaceTest && mFrontStamp[pixel] != stamp)
+                return;
         }
         // A watertight convex proxy covers a pixel with one back face; the stamp guards the
         // sum against a double visit all the same (one light must be added once).
-        if (mVisitedStamp[pixel] == stamp) return;
+        if (mVisitedStamp[pixel] == stamp)
+            return;
         mVisitedStamp[pixel] = stamp;
         fn(slot.light, f.x, f.y, pixel);
     });
     mStats.fragments += mRasterizer.lastStats().samplesCovered;
 }
 
-}  // namespace lighting
+} // namespace lighting

@@ -233,7 +233,8 @@ bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
 
 std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, const TileGrid& grid,
                                             const TileEdgePlanes& edges,
-                                            const std::vector<LightSphere>& spheres, bool frustumCull) {
+                                            const std::vector<LightSphere>& spheres,
+                                            bool frustumCull) {
     std::vector<uint32_t> visible;
     if (frustumCull) {
         visible = lightsInViewFrustum(view, grid, edges, spheres);
@@ -301,9 +302,10 @@ uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, in
     return backfaceRejected;
 }
 
-std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb, const TileGrid& grid,
-                                                     const std::vector<LightSphere>& spheres,
-                                                     std::vector<TileSurfaceBounds>& bounds) {
+std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb,
+                                                       const TileGrid& grid,
+                                                       const std::vector<LightSphere>& spheres,
+                                                       std::vector<TileSurfaceBounds>& bounds) {
     const TileEdgePlanes edges = TileEdgePlanes::make(gb.view(), grid);
     bounds = computeTileSurfaceBounds(gb, grid, {false, false});
     std::vector<std::vector<uint32_t>> lists(size_t(grid.tileCount()));
@@ -318,12 +320,14 @@ std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& g
             const LightSphere& s = spheres[i];
             if (!s.unbounded) {
                 const float centreDepth = -s.centreView.z;
-                if (centreDepth + s.radius < b.minDepthMetres || centreDepth - s.radius > b.maxDepthMetres)
+                if (centreDepth + s.radius < b.minDepthMetres ||
+                    centreDepth - s.radius > b.maxDepthMetres)
                     continue;
                 if (!sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius) ||
                     !sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius))
                     continue;
-                if (distanceSquaredToBox(s.centreView, box.boxMin, box.boxMax) > s.radius * s.radius)
+                if (distanceSquaredToBox(s.centreView, box.boxMin, box.boxMax) >
+                    s.radius * s.radius)
                     continue;
             }
             list.push_back(i);

@@ -148,7 +148,7 @@ std::vector<uint32_t> lightsInViewFrustum(const gbuffer::FrameView& view, const 
 struct CandidateLight {
     uint32_t index = 0;
     glm::vec3 centreView{0.0f};
-    glm::vec3 positionView{0.0f};  // the emitter (LightSphere::positionView)
+    glm::vec3 positionView{0.0f}; // the emitter (LightSphere::positionView)
     float radius = 0.0f;
     bool unbounded = false;
     int columnMin = 0, columnMax = -1, rowMin = 0, rowMax = -1;
@@ -158,7 +158,8 @@ struct CandidateLight {
 // lightsInViewFrustum keeps. Parallel over lights.
 std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, const TileGrid& grid,
                                             const TileEdgePlanes& edges,
-                                            const std::vector<LightSphere>& spheres, bool frustumCull);
+                                            const std::vector<LightSphere>& spheres,
+                                            bool frustumCull);
 
 // Back-face test of the thesis (Ishmukhametov 2013, ch. 4) made exactly conservative. A light
 // is a point source at its centre for the BRDF: radiance needs dot(n, centre - p) > 0. The
@@ -189,7 +190,8 @@ uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, in
 // Per-tile light lists (ascending indices) for the covered tiles of `grid` over `gb`, with the
 // conservative tests of `tiled` and none of its optional extras (vfc, masks, cones); `bounds`
 // receives the tiles' surface bounds. Used by the stages that only need plain tile culling.
-std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb, const TileGrid& grid,
+std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb,
+                                                       const TileGrid& grid,
                                                        const std::vector<LightSphere>& spheres,
                                                        std::vector<TileSurfaceBounds>& bounds);
 

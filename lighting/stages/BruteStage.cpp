@@ -24,18 +24,21 @@ public:
         const auto start = std::chrono::steady_clock::now();
         shadeWithEveryLight<float>(
             gb.width(), gb.height(), frame.lights->lights,
-            [&](int x, int y, ShadingPoint<float>& point) { return gbufferSurfaceAt(gb, x, y, point); },
+            [&](int x, int y, ShadingPoint<float>& point) {
+                return gbufferSurfaceAt(gb, x, y, point);
+            },
             result);
-        result.timingsMs.emplace_back(
-            "shading", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        result.timingsMs.emplace_back("shading", std::chrono::duration<double, std::milli>(
+                                                     std::chrono::steady_clock::now() - start)
+                                                     .count());
     }
 };
 
-}  // namespace
+} // namespace
 
 std::unique_ptr<ShadingStage> makeBruteStage(const StageSpec& spec) {
     rejectUnknownOptions(spec, {});
     return std::make_unique<BruteStage>();
 }
 
-}  // namespace lighting
+} // namespace lighting

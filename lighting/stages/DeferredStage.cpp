@@ -35,7 +35,8 @@ namespace lighting {
 namespace {
 
 double millisecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
 }
 
 class DeferredStage final : public ShadingStage {
@@ -58,18 +59,22 @@ public:
         auto start = std::chrono::steady_clock::now();
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
         LightVolumeRasterizer volumes(gb, mVolume.shape, mVolume.stencil, mVolume.spotProxy);
-        const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mVolume.frustumCull);  // ascending
+        const std::vector<uint32_t> drawn =
+            volumes.lightsToDraw(spheres, mVolume.frustumCull); // ascending
         const size_t culled = spheres.size() - drawn.size();
         result.timingsMs.emplace_back("cull", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
-        float* radiance[3] = {result.radiance[0].data(), result.radiance[1].data(), result.radiance[2].data()};
+        float* radiance[3] = {result.radiance[0].data(), result.radiance[1].data(),
+                              result.radiance[2].data()};
         uint32_t* evaluated = result.lightsEvaluated.data();
         // Adds one light at one pixel; the pixel belongs to the calling task alone.
         auto addLight = [&](int x, int y, size_t pixel, const LightInView<float>& light) {
             ShadingPoint<float> point;
-            if (!gbufferSurfaceAt(gb, x, y, point)) return;
-            const glm::vec3 value = evaluateLight(point, glm::normalize(-point.positionView), light);
+            if (!gbufferSurfaceAt(gb, x, y, point))
+                return;
+            const glm::vec3 value =
+                evaluateLight(point, glm::normalize(-point.positionView), light);
             radiance[0][pixel] += value.x;
             radiance[1][pixel] += value.y;
             radiance[2][pixel] += value.z;
@@ -87,11 +92,11 @@ private:
     VolumeStageOptions mVolume;
 };
 
-}  // namespace
+} // namespace
 
 std::unique_ptr<ShadingStage> makeDeferredStage(const StageSpec& spec) {
     rejectUnknownOptions(spec, {"volume", "spot", "stencil", "vfc"});
     return std::make_unique<DeferredStage>(parseVolumeStageOptions(spec));
 }
 
-}  // namespace lighting
+} // namespace lighting

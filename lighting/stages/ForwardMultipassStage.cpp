@@ -57,7 +57,7 @@ public:
         const std::vector<ForwardObject>& objects = mForward.objects();
         const std::vector<uint32_t>& allIndices = frame.geometry->indices;
         raster::RasterState state;
-        state.barycentrics = false;  // the surface comes from surfaceOfTriangle
+        state.barycentrics = false; // the surface comes from surfaceOfTriangle
         state.cullMode = raster::CullMode::Back;
         state.depthTest = closerOrEqualTest(view);
         state.depthWrite = false;

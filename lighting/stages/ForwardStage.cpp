@@ -79,7 +79,7 @@ public:
             result.lightsEvaluated[pixel] += mLightOffsets[object + 1] - mLightOffsets[object];
         };
         raster::RasterState state;
-        state.barycentrics = false;  // the surface comes from surfaceOfTriangle
+        state.barycentrics = false; // the surface comes from surfaceOfTriangle
         state.cullMode = raster::CullMode::Back;
         state.depthTest = mPrepass ? closerOrEqualTest(view) : closerTest(view);
         state.depthWrite = !mPrepass;

@@ -30,15 +30,16 @@
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/culling/LightVolumes.h"
-#include "lighting/stages/VolumeStageOptions.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/stages/VolumeStageOptions.h"
 
 namespace lighting {
 
 namespace {
 
 double millisecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
 }
 
 // Marks an overflowed pixel in the count plane (counts never exceed 255).
@@ -68,7 +69,8 @@ public:
         auto start = std::chrono::steady_clock::now();
         const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
         LightVolumeRasterizer volumes(gb, mVolume.shape, mVolume.stencil, mVolume.spotProxy);
-        const std::vector<uint32_t> drawn = volumes.lightsToDraw(spheres, mVolume.frustumCull);  // ascending
+        const std::vector<uint32_t> drawn =
+            volumes.lightsToDraw(spheres, mVolume.frustumCull); // ascending
         const size_t culled = spheres.size() - drawn.size();
         result.timingsMs.emplace_back("cull", millisecondsSince(start));
 
@@ -79,14 +81,16 @@ public:
         uint32_t* lists = mLists.data();
         auto append = [&](size_t pixel, uint32_t light) {
             uint16_t& count = counts[pixel];
-            if (count == kOverflowed) return;
+            if (count == kOverflowed)
+                return;
             if (count == capacity) {
                 count = kOverflowed;
                 return;
             }
             lists[pixel * capacity + count++] = light;
         };
-        volumes.draw(spheres, drawn, [&](uint32_t light, int, int, size_t pixel) { append(pixel, light); });
+        volumes.draw(spheres, drawn,
+                     [&](uint32_t light, int, int, size_t pixel) { append(pixel, light); });
         result.timingsMs.emplace_back("index", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
@@ -109,8 +113,9 @@ public:
                                         size_t(x / kOverflowTileSize);
                     shadeWithLightList(gb, x, y, lights, overflowLists[tile], result);
                 } else {
-                    shadeWithLightList(gb, x, y, lights,
-                                       std::span<const uint32_t>(lists + pixel * capacity, counts[pixel]), result);
+                    shadeWithLightList(
+                        gb, x, y, lights,
+                        std::span<const uint32_t>(lists + pixel * capacity, counts[pixel]), result);
                 }
             }
             overflowPerRow[size_t(y)] = overflowed;
@@ -118,7 +123,8 @@ public:
         result.timingsMs.emplace_back("shading", millisecondsSince(start));
 
         uint64_t overflowPixels = 0;
-        for (uint32_t n : overflowPerRow) overflowPixels += n;
+        for (uint32_t n : overflowPerRow)
+            overflowPixels += n;
         result.parameters["max"] = std::to_string(mMaxLights);
         recordVolumeParameters(mVolume, culled, volumes.stats(), result.parameters);
         result.parameters["overflow_pixels"] = std::to_string(overflowPixels);
@@ -128,11 +134,11 @@ private:
     int mMaxLights;
     VolumeStageOptions mVolume;
     // Kept between frames so steady-state frames do not allocate.
-    std::vector<uint16_t> mCounts;  // entries used, or kOverflowed
+    std::vector<uint16_t> mCounts; // entries used, or kOverflowed
     std::vector<uint32_t> mLists;  // capacity entries per pixel
 };
 
-}  // namespace
+} // namespace
 
 std::unique_ptr<ShadingStage> makeLightIndexedStage(const StageSpec& spec) {
     rejectUnknownOptions(spec, {"max", "volume", "spot", "stencil", "vfc"});
@@ -140,4 +146,4 @@ std::unique_ptr<ShadingStage> makeLightIndexedStage(const StageSpec& spec) {
     return std::make_unique<LightIndexedStage>(intOption(spec, "max", 16, 1, 255), volume);
 }
 
-}  // namespace lighting
+} // namespace lighting

@@ -52,15 +52,19 @@ namespace lighting {
 
 namespace {
 
-inline float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+inline float luminance(const glm::vec3& c) {
+    return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
+}
 
 class LightPrepassStage final : public ShadingStage {
 public:
-    LightPrepassStage(bool chroma, int tileSizePixels) : mChroma(chroma), mTileSizePixels(tileSizePixels) {}
+    LightPrepassStage(bool chroma, int tileSizePixels)
+        : mChroma(chroma), mTileSizePixels(tileSizePixels) {}
 
     std::string name() const override { return "light-prepass"; }
     StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Specular}, false};
+        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Specular},
+                false};
     }
 
     void shade(const Frame& frame, StageResult& result) override {
@@ -95,7 +99,7 @@ public:
                         continue;
                     const SplitLighting lighting = splitLighting(point, lights, list);
                     mDiffuse[pixel] = lighting.diffuse;
-                    mSpecular[pixel] = luminance(lighting.specular);  // one monochrome scalar
+                    mSpecular[pixel] = luminance(lighting.specular); // one monochrome scalar
                     result.lightsEvaluated[pixel] = uint32_t(list.size());
                 }
         });

@@ -23,23 +23,25 @@ public:
             exact.width, exact.height, frame.lights->lightsExact,
             [&](int x, int y, ShadingPoint<double>& point) {
                 const size_t pixel = size_t(y) * exact.width + x;
-                if (!exact.covered(pixel)) return false;
+                if (!exact.covered(pixel))
+                    return false;
                 point = {exact.positionView[pixel], exact.normalView[pixel],
                          glm::dvec3(exact.albedo[pixel]), double(exact.specular[pixel].x),
                          double(exact.specular[pixel].y)};
                 return true;
             },
             result);
-        result.timingsMs.emplace_back(
-            "shading", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        result.timingsMs.emplace_back("shading", std::chrono::duration<double, std::milli>(
+                                                     std::chrono::steady_clock::now() - start)
+                                                     .count());
     }
 };
 
-}  // namespace
+} // namespace
 
 std::unique_ptr<ShadingStage> makeReferenceStage(const StageSpec& spec) {
     rejectUnknownOptions(spec, {});
     return std::make_unique<ReferenceStage>();
 }
 
-}  // namespace lighting
+} // namespace lighting

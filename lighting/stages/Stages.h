@@ -18,7 +18,8 @@ void rejectUnknownOptions(const StageSpec& spec, std::initializer_list<const cha
 // accepted values when malformed. The first choice is the default.
 int intOption(const StageSpec& spec, const char* key, int defaultValue, int minValue, int maxValue);
 bool boolOption(const StageSpec& spec, const char* key, bool defaultValue);
-std::string choiceOption(const StageSpec& spec, const char* key, const std::vector<std::string>& choices);
+std::string choiceOption(const StageSpec& spec, const char* key,
+                         const std::vector<std::string>& choices);
 
 std::unique_ptr<ShadingStage> makeBruteStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeReferenceStage(const StageSpec& spec);
@@ -33,4 +34,4 @@ std::unique_ptr<ShadingStage> makeLightPrepassStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeInferredStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeTiledForwardStage(const StageSpec& spec);
 
-}  // namespace lighting
+} // namespace lighting

@@ -97,7 +97,7 @@ public:
             result.lightsEvaluated[pixel] = uint32_t(list.size());
         };
         raster::RasterState state;
-        state.barycentrics = false;  // the surface comes from surfaceOfTriangle
+        state.barycentrics = false; // the surface comes from surfaceOfTriangle
         state.cullMode = raster::CullMode::Back;
         state.depthTest = closerOrEqualTest(view);
         state.depthWrite = false;

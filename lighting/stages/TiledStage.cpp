@@ -46,7 +46,6 @@ struct TiledOptions {
     bool backface = false;
 };
 
-
 class TiledStage final : public ShadingStage {
 public:
     explicit TiledStage(const TiledOptions& options) : mOptions(options) {}
@@ -83,8 +82,8 @@ public:
             const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
             const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
             tileBackfaceRejected[size_t(tile)] =
-                appendTileLights(candidates, tx, ty, b, box, {mOptions.depthMask, mOptions.backface},
-                                 tileLights[size_t(tile)]);
+                appendTileLights(candidates, tx, ty, b, box,
+                                 {mOptions.depthMask, mOptions.backface}, tileLights[size_t(tile)]);
         });
         const double cullMs =
             std::chrono::duration<double, std::milli>(Clock::now() - cullStart).count();

@@ -6,19 +6,22 @@ namespace lighting {
 
 VolumeStageOptions parseVolumeStageOptions(const StageSpec& spec) {
     VolumeStageOptions options;
-    options.shape =
-        choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere" ? VolumeShape::Sphere : VolumeShape::Rect;
+    options.shape = choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere"
+                        ? VolumeShape::Sphere
+                        : VolumeShape::Rect;
     if (options.shape == VolumeShape::Rect && spec.options.count("spot"))
         throw StageError("stage '" + spec.name + "': option spot applies to volume=sphere only");
-    options.spotProxy =
-        choiceOption(spec, "spot", {"cone", "sphere"}) == "cone" ? SpotProxy::Cone : SpotProxy::Sphere;
+    options.spotProxy = choiceOption(spec, "spot", {"cone", "sphere"}) == "cone"
+                            ? SpotProxy::Cone
+                            : SpotProxy::Sphere;
     options.stencil = boolOption(spec, "stencil", false);
     options.frustumCull = boolOption(spec, "vfc", true);
     return options;
 }
 
 void recordVolumeParameters(const VolumeStageOptions& options, size_t culled,
-                            const LightVolumeStats& stats, std::map<std::string, std::string>& parameters) {
+                            const LightVolumeStats& stats,
+                            std::map<std::string, std::string>& parameters) {
     parameters["volume"] = options.shape == VolumeShape::Sphere ? "sphere" : "rect";
     if (options.shape == VolumeShape::Sphere)
         parameters["spot"] = options.spotProxy == SpotProxy::Cone ? "cone" : "sphere";
@@ -31,4 +34,4 @@ void recordVolumeParameters(const VolumeStageOptions& options, size_t culled,
     parameters["volume_fragments"] = std::to_string(stats.fragments);
 }
 
-}  // namespace lighting
+} // namespace lighting

@@ -26,6 +26,7 @@ VolumeStageOptions parseVolumeStageOptions(const StageSpec& spec);
 // Records the options and the volume draw's statistics (`culled`: lights removed by view-frustum
 // culling) in a stage's parameters.
 void recordVolumeParameters(const VolumeStageOptions& options, size_t culled,
-                            const LightVolumeStats& stats, std::map<std::string, std::string>& parameters);
+                            const LightVolumeStats& stats,
+                            std::map<std::string, std::string>& parameters);
 
-}  // namespace lighting
+} // namespace lighting

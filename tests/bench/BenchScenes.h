@@ -24,8 +24,10 @@ inline scenes::Scene proceduralScene(const std::string& name, int lightCount,
 
 // A benchmark frame: the prepared frame of a built-in scene at 1280x720.
 struct BenchFrame : lighting::PreparedFrame {
-    BenchFrame(const std::string& name, int lightCount, std::map<std::string, std::string> options = {})
-        : lighting::PreparedFrame(proceduralScene(name, lightCount, std::move(options)), kWidth, kHeight) {}
+    BenchFrame(const std::string& name, int lightCount,
+               std::map<std::string, std::string> options = {})
+        : lighting::PreparedFrame(proceduralScene(name, lightCount, std::move(options)), kWidth,
+                                  kHeight) {}
 };
 
-}  // namespace bench
+} // namespace bench

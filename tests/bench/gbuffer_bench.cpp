@@ -27,8 +27,9 @@ void gbufferPass(benchmark::State& state) {
     const bench::BenchFrame& f = atrium();
     tbb::task_arena arena(int(state.range(0)));
     const gbuffer::GBufferLayout layout =
-        state.range(1) == 0 ? gbuffer::GBufferLayout::reference()
-                            : gbuffer::deriveLayout(f.scene, lighting::makeStage("brute")->requirements().channels);
+        state.range(1) == 0
+            ? gbuffer::GBufferLayout::reference()
+            : gbuffer::deriveLayout(f.scene, lighting::makeStage("brute")->requirements().channels);
     state.SetLabel(state.range(1) == 0 ? "reference layout" : "derived layout");
     gbuffer::GBuffer target(layout, f.view);
     raster::Rasterizer rasterizer(bench::kWidth, bench::kHeight);
@@ -42,7 +43,8 @@ void gbufferPass(benchmark::State& state) {
         const auto start = std::chrono::steady_clock::now();
         gbuffer::GBufferPassTimings timings;
         arena.execute([&] { timings = pass.render(rasterizer, target); });
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         state.SetIterationTime(seconds);
         frameMs.push_back(seconds * 1e3);
         fastest.transformMs = std::min(fastest.transformMs, timings.transformMs);
@@ -56,8 +58,8 @@ void gbufferPass(benchmark::State& state) {
     state.counters["raster_ms_min"] = fastest.rasterMs;
     state.counters["resolve_ms_min"] = fastest.resolveMs;
     state.counters["triangles"] = double(f.geometry.triangleCount());
-    state.counters["triangles/s"] = benchmark::Counter(double(f.geometry.triangleCount()),
-                                                       benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["triangles/s"] = benchmark::Counter(
+        double(f.geometry.triangleCount()), benchmark::Counter::kIsIterationInvariantRate);
     state.counters["fragments"] = double(rasterizer.lastStats().samplesCovered);
 }
 BENCHMARK(gbufferPass)
@@ -76,16 +78,24 @@ void bruteShading(benchmark::State& state) {
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
         arena.execute([&] { stage->shade(f.frame, result); });
-        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         state.SetIterationTime(elapsed);
         seconds += elapsed;
         samples = 0;
-        for (uint32_t n : result.lightsEvaluated) samples += n;
+        for (uint32_t n : result.lightsEvaluated)
+            samples += n;
     }
     state.counters["light_samples"] = double(samples);
     // Wall-clock nanoseconds per evaluated light-sample (not per core).
-    state.counters["ns/light-sample"] = seconds * 1e9 / (double(state.iterations()) * double(samples));
+    state.counters["ns/light-sample"] =
+        seconds * 1e9 / (double(state.iterations()) * double(samples));
 }
-BENCHMARK(bruteShading)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(bruteShading)
+    ->Arg(1)
+    ->Arg(2)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
 
-}  // namespace
+} // namespace

@@ -40,41 +40,64 @@ void shadeStage(benchmark::State& state, const VolumeFixture& f, const std::stri
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
         arena.execute([&] { stage->shade(f.frame, result); });
-        state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        state.SetIterationTime(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         samples = 0;
-        for (uint32_t n : result.lightsEvaluated) samples += n;
+        for (uint32_t n : result.lightsEvaluated)
+            samples += n;
     }
     state.counters["light_samples"] = double(samples);
-    state.counters["ns/light-sample"] = benchmark::Counter(
-        double(samples) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-    for (const auto& [pass, ms] : result.timingsMs) state.counters[pass + "_ms"] = ms;
+    state.counters["ns/light-sample"] =
+        benchmark::Counter(double(samples) * 1e-9, benchmark::Counter::kIsIterationInvariantRate |
+                                                       benchmark::Counter::kInvert);
+    for (const auto& [pass, ms] : result.timingsMs)
+        state.counters[pass + "_ms"] = ms;
     for (const char* key : {"overflow_pixels", "volume_fragments"}) {
         const auto found = result.parameters.find(key);
-        if (found != result.parameters.end()) state.counters[key] = std::stod(found->second);
+        if (found != result.parameters.end())
+            state.counters[key] = std::stod(found->second);
     }
 }
 
-void volumeWall(benchmark::State& state, const std::string& stageSpec) { shadeStage(state, wallFixture(), stageSpec); }
+void volumeWall(benchmark::State& state, const std::string& stageSpec) {
+    shadeStage(state, wallFixture(), stageSpec);
+}
 void volumeAtrium(benchmark::State& state, const std::string& stageSpec) {
     shadeStage(state, atriumFixture(), stageSpec);
 }
 
 BENCHMARK_CAPTURE(volumeWall, brute, std::string("brute"))
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(volumeWall, deferred, std::string("deferred"))
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
 BENCHMARK_CAPTURE(volumeWall, deferred_stencil, std::string("deferred:stencil=1"))
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
 BENCHMARK_CAPTURE(volumeWall, deferred_rect, std::string("deferred:volume=rect"))
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
 BENCHMARK_CAPTURE(volumeWall, light_indexed, std::string("light-indexed"))
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
 
 BENCHMARK_CAPTURE(volumeAtrium, brute, std::string("brute"))
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(volumeAtrium, deferred, std::string("deferred"))
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
 BENCHMARK_CAPTURE(volumeAtrium, light_indexed, std::string("light-indexed"))
-    ->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
 
-}  // namespace
+} // namespace

@@ -24,9 +24,11 @@ namespace {
 // wall takes its lights-behind count as a scene option; other scenes take none.
 struct PreparedFrame : bench::BenchFrame {
     PreparedFrame(const std::string& sceneName, int lightCount, int behind)
-        : bench::BenchFrame(sceneName, lightCount,
-                            sceneName == "wall" ? std::map<std::string, std::string>{{"behind", std::to_string(behind)}}
-                                                : std::map<std::string, std::string>{}) {}
+        : bench::BenchFrame(
+              sceneName, lightCount,
+              sceneName == "wall"
+                  ? std::map<std::string, std::string>{{"behind", std::to_string(behind)}}
+                  : std::map<std::string, std::string>{}) {}
 };
 
 const PreparedFrame& prepared(const std::string& sceneName, int lightCount, int behind) {

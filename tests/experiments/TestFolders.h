@@ -30,4 +30,4 @@ inline std::string readText(const std::filesystem::path& path) {
     return text.str();
 }
 
-}  // namespace experiments::test_files
+} // namespace experiments::test_files

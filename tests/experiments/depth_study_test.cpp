@@ -49,7 +49,8 @@ TEST(DepthStudy, QuickCommandWritesEveryRowAndThePlots) {
               0u)
         << header;
     size_t rowCount = 0;
-    while (std::getline(lines, line)) rowCount += !line.empty();
+    while (std::getline(lines, line))
+        rowCount += !line.empty();
     EXPECT_EQ(rowCount, kQuickRows) << dir / "depth.csv";
 
     const nlohmann::json json = nlohmann::json::parse(readText(dir / "depth.json"));
@@ -61,7 +62,7 @@ TEST(DepthStudy, QuickCommandWritesEveryRowAndThePlots) {
     EXPECT_TRUE(fs::exists(dir / "depth_steps.csv"));
 
     if (findPythonWithMatplotlib("").empty()) {
-        EXPECT_EQ(status, 1);  // the study's data is written, the plots are an error
+        EXPECT_EQ(status, 1); // the study's data is written, the plots are an error
         GTEST_SKIP() << "no python3 with matplotlib: plots not checked";
     }
     ASSERT_EQ(status, 0);
@@ -82,17 +83,19 @@ TEST(DepthStudy, ReversedFloatBeatsStandardFloatAtFarDistances) {
     std::map<SeriesKey, double> farMax;
     std::map<SeriesKey, int> lost;
     for (const nlohmann::json& row : json.at("rows")) {
-        const SeriesKey key{row.at("format"), row.at("infinite"), row.at("method"),
-                            row.at("near"), row.at("far")};
+        const SeriesKey key{row.at("format"), row.at("infinite"), row.at("method"), row.at("near"),
+                            row.at("far")};
         lost[key] += row.at("lost_samples").get<int>();
-        if (row.at("distance").get<double>() < row.at("far").get<double>() / 2.0) continue;
+        if (row.at("distance").get<double>() < row.at("far").get<double>() / 2.0)
+            continue;
         if (!row.at("max_rel_error").is_null())
             farMax[key] = std::max(farMax[key], row.at("max_rel_error").get<double>());
     }
     for (const DepthStudyCamera& camera : result.options.cameras)
         for (bool infinite : {false, true})
             for (const char* method : {"inverse-projection", "view-ray"}) {
-                const SeriesKey standard{"f32", infinite, method, camera.nearMetres, camera.farMetres};
+                const SeriesKey standard{"f32", infinite, method, camera.nearMetres,
+                                         camera.farMetres};
                 const SeriesKey reversed{"f32-reversed", infinite, method, camera.nearMetres,
                                          camera.farMetres};
                 ASSERT_TRUE(farMax.count(standard) && farMax.count(reversed));
@@ -135,8 +138,8 @@ TEST(DepthStudy, BadOptionsAndAMissingScriptAreClearErrors) {
     EXPECT_EQ(runDepthCommand(command), 1);
     const std::string message = testing::internal::GetCapturedStderr();
     EXPECT_NE(message.find("testbed: error: plot script"), std::string::npos) << message;
-    EXPECT_FALSE(fs::exists(command.out / "depth.json"));  // checked before any work
+    EXPECT_FALSE(fs::exists(command.out / "depth.json")); // checked before any work
 }
 
-}  // namespace
-}  // namespace experiments
+} // namespace
+} // namespace experiments

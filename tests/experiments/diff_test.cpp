@@ -33,21 +33,33 @@ fs::path writeImage(const fs::path& path, float offset, bool (*offsetWhere)(int 
                     const std::string& extraName = "", int width = kWidth, int height = kHeight) {
     const size_t n = size_t(width) * height;
     std::vector<float> rgb(n), z(n, depth), normal(n, 0.25f), extra(n, 1.0f);
-    for (size_t i = 0; i < n; ++i) rgb[i] = 0.5f + (offsetWhere(int(i % width)) ? offset : 0.0f);
-    std::vector<ImagePlane> planes = {{"R", rgb.data()}, {"G", rgb.data()}, {"B", rgb.data()},
-                                      {"Z", z.data()},   {"N.X", normal.data()}};
-    if (!extraName.empty()) planes.push_back({extraName, extra.data()});
+    for (size_t i = 0; i < n; ++i)
+        rgb[i] = 0.5f + (offsetWhere(int(i % width)) ? offset : 0.0f);
+    std::vector<ImagePlane> planes = {{"R", rgb.data()},
+                                      {"G", rgb.data()},
+                                      {"B", rgb.data()},
+                                      {"Z", z.data()},
+                                      {"N.X", normal.data()}};
+    if (!extraName.empty())
+        planes.push_back({extraName, extra.data()});
     writeMultiLayerExr(path, width, height, planes, {});
     return path;
 }
 
-bool everywhere(int) { return true; }
-bool leftHalf(int x) { return x < kWidth / 2; }
-bool nowhere(int) { return false; }
+bool everywhere(int) {
+    return true;
+}
+bool leftHalf(int x) {
+    return x < kWidth / 2;
+}
+bool nowhere(int) {
+    return false;
+}
 
 const ChannelStatistics* channel(const ImageDiff& diff, const std::string& name) {
     for (const ChannelStatistics& c : diff.channels)
-        if (c.name == name) return &c;
+        if (c.name == name)
+            return &c;
     return nullptr;
 }
 
@@ -121,7 +133,8 @@ TEST(DiffCommand, WritesPageJsonAndImages) {
     options.b = writeImage(dir / "b.exr", 0.0f, nowhere, 3.0f);
     options.out = dir / "diff";
     ASSERT_EQ(runDiffCommand(options), 0);
-    for (const char* file : {"index.html", "diff.json", "a.png", "b.png", "absdiff.png", "absdiff.exr"})
+    for (const char* file :
+         {"index.html", "diff.json", "a.png", "b.png", "absdiff.png", "absdiff.exr"})
         EXPECT_TRUE(fs::is_regular_file(options.out / file)) << file;
     const json result = json::parse(readText(options.out / "diff.json"));
     EXPECT_NEAR(result["metrics"]["rmse"].get<double>(), std::sqrt(0.5) * 0.125, 1e-12);
@@ -132,7 +145,8 @@ TEST(DiffCommand, WritesPageJsonAndImages) {
     EXPECT_NE(html.find("<td class=\"text\">Z</td>"), std::string::npos);
     EXPECT_EQ(html.find("http"), std::string::npos);
     for (const fs::directory_entry& entry : fs::directory_iterator(options.out))
-        EXPECT_NE(entry.path().filename().string()[0], '.') << "temporary file left: " << entry.path();
+        EXPECT_NE(entry.path().filename().string()[0], '.')
+            << "temporary file left: " << entry.path();
 
     options.out = dir / "identical";
     options.a = options.b;
@@ -149,8 +163,8 @@ TEST(DiffCommand, RefusesImagesOfDifferentSizes) {
     testing::internal::CaptureStderr();
     EXPECT_EQ(runDiffCommand(options), 1);
     const std::string error = testing::internal::GetCapturedStderr();
-    EXPECT_NE(error.find("testbed: error: image sizes differ: " + options.a.string() + " is 40x20, " +
-                         options.b.string() + " is 20x20"),
+    EXPECT_NE(error.find("testbed: error: image sizes differ: " + options.a.string() +
+                         " is 40x20, " + options.b.string() + " is 20x20"),
               std::string::npos)
         << error;
     EXPECT_FALSE(fs::exists(options.out)) << "nothing written";
@@ -161,5 +175,5 @@ TEST(DiffCommand, RefusesImagesOfDifferentSizes) {
     EXPECT_NE(testing::internal::GetCapturedStderr().find("cannot read"), std::string::npos);
 }
 
-}  // namespace
-}  // namespace experiments
+} // namespace
+} // namespace experiments

@@ -6,19 +6,19 @@
 #include <filesystem>
 #include <fstream>
 
-#include <nlohmann/json.hpp>
 #include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
 
 #include "experiments/RenderCommand.h"
 #include "experiments/RenderJob.h"
 
 namespace {
 
+using experiments::PassTiming;
 using experiments::RenderOptions;
+using experiments::renderReference;
 using experiments::RenderRun;
 using experiments::runRender;
-using experiments::PassTiming;
-using experiments::renderReference;
 
 RenderOptions smallAtrium(int threads) {
     RenderOptions options;
@@ -32,21 +32,22 @@ RenderOptions smallAtrium(int threads) {
     return options;
 }
 
-template <class A, class B>
-bool bitwiseEqual(const A& a, const B& b) {
+template <class A, class B> bool bitwiseEqual(const A& a, const B& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
 }
 
 // Every decoded G-buffer value of two runs, compared bit for bit.
 bool sameDecodedGBuffer(const gbuffer::GBuffer& a, const gbuffer::GBuffer& b) {
-    if (a.width() != b.width() || a.height() != b.height()) return false;
+    if (a.width() != b.width() || a.height() != b.height())
+        return false;
     for (int y = 0; y < a.height(); ++y)
         for (int x = 0; x < a.width(); ++x) {
             const gbuffer::Surface sa = a.decode(x, y), sb = b.decode(x, y);
             if (std::memcmp(&sa.positionView, &sb.positionView, sizeof(glm::vec3)) != 0 ||
                 std::memcmp(&sa.normalView, &sb.normalView, sizeof(glm::vec3)) != 0 ||
                 std::memcmp(&sa.albedo, &sb.albedo, sizeof(glm::vec3)) != 0 ||
-                sa.specularIntensity != sb.specularIntensity || sa.specularPower != sb.specularPower)
+                sa.specularIntensity != sb.specularIntensity ||
+                sa.specularPower != sb.specularPower)
                 return false;
         }
     return true;
@@ -62,7 +63,8 @@ TEST(RenderJob, BitwiseIdenticalForAnyThreadCount) {
             EXPECT_TRUE(bitwiseEqual(one.result.radiance[c], many.result.radiance[c])) << threads;
         EXPECT_TRUE(bitwiseEqual(one.result.lightsEvaluated, many.result.lightsEvaluated));
         EXPECT_TRUE(bitwiseEqual(one.oracle, many.oracle));
-        EXPECT_EQ(one.prepared->rasterStats.samplesPassed, many.prepared->rasterStats.samplesPassed);
+        EXPECT_EQ(one.prepared->rasterStats.samplesPassed,
+                  many.prepared->rasterStats.samplesPassed);
     }
 }
 
@@ -75,7 +77,8 @@ TEST(RenderJob, BruteMatchesReferenceOnAtrium) {
     EXPECT_GT(run.error->relativeRmse, 0.0) << "float and double should differ a little";
     // The scene is lit: not a black image compared with a black image.
     double sum = 0.0;
-    for (float v : run.reference.radiance[1]) sum += v;
+    for (float v : run.reference.radiance[1])
+        sum += v;
     EXPECT_GT(sum / run.reference.radiance[1].size(), 1e-3);
 }
 
@@ -91,8 +94,8 @@ TEST(RenderJob, BruteEvaluatesEveryLightAndCountsTheOracle) {
         oracle += run.oracle[pixel];
     }
     EXPECT_GT(covered, run.oracle.size() / 2);
-    EXPECT_GT(oracle, covered);             // more than the ambient light somewhere
-    EXPECT_LT(oracle, covered * lightCount);  // the falloff has finite support
+    EXPECT_GT(oracle, covered);              // more than the ambient light somewhere
+    EXPECT_LT(oracle, covered * lightCount); // the falloff has finite support
 }
 
 // Culling on a lossy G-buffer must stay conservative for the surface it shades: the normal cone
@@ -100,9 +103,9 @@ TEST(RenderJob, BruteEvaluatesEveryLightAndCountsTheOracle) {
 // oracle is counted on the same decoded surface.
 TEST(RenderJob, CullingStaysConservativeOnLossyLayouts) {
     for (const char* stage : {"tiled-backface", "clustered", "deferred", "light-indexed"})
-        for (const auto& [normals, depth] : {std::pair{"octahedral:16", "unorm16"},
-                                             std::pair{"pixel-view:16", "f16-linear"},
-                                             std::pair{"xy-z:16", "unorm24"}}) {
+        for (const auto& [normals, depth] :
+             {std::pair{"octahedral:16", "unorm16"}, std::pair{"pixel-view:16", "f16-linear"},
+              std::pair{"xy-z:16", "unorm24"}}) {
             RenderOptions options = smallAtrium(0);
             options.scene = "wall";
             options.sceneOptions["behind"] = "24";
@@ -133,7 +136,8 @@ TEST(RenderJob, NormalEncodingsTradeBytesForError) {
     ASSERT_TRUE(spheremap.error && octahedral.error && exact.error);
     EXPECT_GT(spheremap.error->rmse, octahedral.error->rmse);
     EXPECT_GT(octahedral.error->rmse, exact.error->rmse);
-    EXPECT_LT(spheremap.gbuffer().layout().bytesPerPixel(), exact.gbuffer().layout().bytesPerPixel());
+    EXPECT_LT(spheremap.gbuffer().layout().bytesPerPixel(),
+              exact.gbuffer().layout().bytesPerPixel());
     EXPECT_GT(spheremap.error->p99Abs, 0.0);
     EXPECT_LE(spheremap.error->p99Abs, spheremap.error->maxAbs);
 }
@@ -166,7 +170,9 @@ struct BadCase {
     RenderOptions options;
 };
 // Keeps gtest from printing the options' bytes into every test name.
-void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const BadCase& c, std::ostream* os) {
+    *os << c.name;
+}
 
 class BadInput : public ::testing::TestWithParam<BadCase> {};
 
@@ -207,7 +213,8 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(RenderCommand, UnwritableOutputFolderIsRefused) {
-    const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "a_regular_file";
+    const std::filesystem::path file =
+        std::filesystem::path(::testing::TempDir()) / "a_regular_file";
     std::ofstream(file) << "x";
     experiments::RenderCommandOptions options;
     options.render = smallAtrium(1);
@@ -233,9 +240,22 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
 
     auto input = OIIO::ImageInput::open((out / "render.exr").string());
     ASSERT_TRUE(input);
-    const std::vector<std::string> expected = {"R", "G", "B", "N.X", "N.Y", "N.Z", "Z", "albedo.R",
-                                               "albedo.G", "albedo.B", "lights.evaluated", "lights.oracle",
-                                               "lights.wasted", "error.R", "error.G", "error.B"};
+    const std::vector<std::string> expected = {"R",
+                                               "G",
+                                               "B",
+                                               "N.X",
+                                               "N.Y",
+                                               "N.Z",
+                                               "Z",
+                                               "albedo.R",
+                                               "albedo.G",
+                                               "albedo.B",
+                                               "lights.evaluated",
+                                               "lights.oracle",
+                                               "lights.wasted",
+                                               "error.R",
+                                               "error.G",
+                                               "error.B"};
     for (const std::string& name : expected) {
         const auto& names = input->spec().channelnames;
         EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
@@ -254,11 +274,12 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
     // The layout: every plane with name, format and bits, and the bytes per pixel they add up to.
     int bits = 0;
     for (const auto& plane : stats["layout"]["planes"]) {
-        for (const char* key : {"name", "format", "bits"}) EXPECT_TRUE(plane.contains(key)) << key;
+        for (const char* key : {"name", "format", "bits"})
+            EXPECT_TRUE(plane.contains(key)) << key;
         bits += plane["bits"].get<int>();
     }
     EXPECT_DOUBLE_EQ(stats["bytes_per_pixel"].get<double>(), bits / 8.0);
     EXPECT_GE(stats["triangles"].get<uint64_t>(), 250000u);
 }
 
-}  // namespace
+} // namespace

@@ -29,8 +29,13 @@ using experiments::test_files::freshTestFolder;
 using experiments::test_files::readText;
 
 json okJob(const std::string& id, const std::string& stage, int lights, json time) {
-    return {{"job_id", id}, {"status", "ok"}, {"error", ""}, {"stage", stage}, {"lights", lights},
-            {"time_total_median_ms", time}, {"time_shading_median_ms", 1.0}};
+    return {{"job_id", id},
+            {"status", "ok"},
+            {"error", ""},
+            {"stage", stage},
+            {"lights", lights},
+            {"time_total_median_ms", time},
+            {"time_shading_median_ms", 1.0}};
 }
 
 TEST(ReportSelect, NumbersCompareByValueWhateverTheirSpelling) {
@@ -65,22 +70,28 @@ TEST(ReportSelect, MetricListsAreSummedAndMissingValuesGiveNothing) {
 TEST(ReportPublished, KnownNumbersGiveKnownMediansAndRatios) {
     const json jobs = json::array({
         okJob("0", "deferred", 1500, 10.0),
-        okJob("1", "deferred", 1500, 14.0),  // two matches: median 12
+        okJob("1", "deferred", 1500, 14.0), // two matches: median 12
         okJob("2", "tiled", 1500, 3.0),
-        {{"job_id", "3"}, {"status", "failed"}, {"error", "boom"}, {"stage", "tiled"},
-         {"lights", 1500}, {"time_total_median_ms", 1000.0}},  // failed: never counted
+        {{"job_id", "3"},
+         {"status", "failed"},
+         {"error", "boom"},
+         {"stage", "tiled"},
+         {"lights", 1500},
+         {"time_total_median_ms", 1000.0}}, // failed: never counted
         okJob("4", "deferred", 2000, 40.0),
-        okJob("5", "tiled", 2000, nullptr),  // matches, but its metric is missing
+        okJob("5", "tiled", 2000, nullptr), // matches, but its metric is missing
     });
     const json published = {
         {"title", "T"},
         {"source", "S"},
         {"metric", "time_total_median_ms"},
-        {"columns", {{{"label", "deferred"}, {"select", {{"stage", "deferred"}}}},
-                     {{"label", "tiled"}, {"select", {{"stage", "tiled"}}}}}},
-        {"rows", {{{"label", "Test 1"}, {"select", {{"lights", "1500"}}}, {"values", {30.0, 15.0}}},
-                  {{"label", "Test 2"}, {"select", {{"lights", 2000.0}}}, {"values", {60.0, nullptr}}},
-                  {{"label", "Test 3"}, {"select", {{"lights", 9999}}}, {"values", {1.0, 2.0}}}}},
+        {"columns",
+         {{{"label", "deferred"}, {"select", {{"stage", "deferred"}}}},
+          {{"label", "tiled"}, {"select", {{"stage", "tiled"}}}}}},
+        {"rows",
+         {{{"label", "Test 1"}, {"select", {{"lights", "1500"}}}, {"values", {30.0, 15.0}}},
+          {{"label", "Test 2"}, {"select", {{"lights", 2000.0}}}, {"values", {60.0, nullptr}}},
+          {{"label", "Test 3"}, {"select", {{"lights", 9999}}}, {"values", {1.0, 2.0}}}}},
         {"ratio_to", 0},
         {"finding", "F"}};
     const json table = comparePublished(published, jobs);
@@ -110,12 +121,13 @@ TEST(ReportPublished, KnownNumbersGiveKnownMediansAndRatios) {
 
 TEST(ReportPublished, SummedMetricAndAnotherBaseline) {
     json jobs = json::array({okJob("0", "a", 10, 4.0), okJob("1", "b", 10, 7.0)});
-    const json published = {
-        {"title", "sum"},
-        {"metric", {"time_total_median_ms", "time_shading_median_ms"}},
-        {"columns", {{{"label", "a"}, {"select", {{"stage", "a"}}}}, {{"label", "b"}, {"select", {{"stage", "b"}}}}}},
-        {"rows", {{{"label", "r"}, {"values", {2.0, 4.0}}}}},
-        {"ratio_to", 1}};
+    const json published = {{"title", "sum"},
+                            {"metric", {"time_total_median_ms", "time_shading_median_ms"}},
+                            {"columns",
+                             {{{"label", "a"}, {"select", {{"stage", "a"}}}},
+                              {{"label", "b"}, {"select", {{"stage", "b"}}}}}},
+                            {"rows", {{{"label", "r"}, {"values", {2.0, 4.0}}}}},
+                            {"ratio_to", 1}};
     const json table = comparePublished(published, jobs);
     EXPECT_EQ(table["metric_label"], "time_total_median_ms + time_shading_median_ms");
     const json& cells = table["rows"][0]["cells"];
@@ -136,16 +148,22 @@ TEST(ReportPublished, MalformedEntriesAreRefusedByName) {
         }
         return std::string();
     };
-    EXPECT_NE(messageOf({{"title", "X"}, {"metric", "m"}, {"columns", columns},
+    EXPECT_NE(messageOf({{"title", "X"},
+                         {"metric", "m"},
+                         {"columns", columns},
                          {"rows", {{{"label", "r"}, {"values", {1.0, 2.0}}}}}})
                   .find("published entry 'X': rows[0].values must have one entry per column"),
               std::string::npos);
-    EXPECT_NE(messageOf({{"title", "X"}, {"metric", "m"}, {"columns", columns}, {"rows", json::array()},
+    EXPECT_NE(messageOf({{"title", "X"},
+                         {"metric", "m"},
+                         {"columns", columns},
+                         {"rows", json::array()},
                          {"ratio_to", 3}})
                   .find("ratio_to"),
               std::string::npos);
-    EXPECT_NE(messageOf({{"title", "X"}, {"columns", columns}, {"rows", json::array()}}).find("metric"),
-              std::string::npos);
+    EXPECT_NE(
+        messageOf({{"title", "X"}, {"columns", columns}, {"rows", json::array()}}).find("metric"),
+        std::string::npos);
 }
 
 // A results folder in the sweep runner's format: six ok jobs (two stages x three light counts)
@@ -156,7 +174,8 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
     std::vector<uint32_t> counts(w * h);
     json jobs = json::array();
     const std::vector<std::string> stages = {"brute", "tiled"};
-    const std::vector<int> lightCounts = singleJob ? std::vector<int>{64} : std::vector<int>{16, 64, 256};
+    const std::vector<int> lightCounts =
+        singleJob ? std::vector<int>{64} : std::vector<int>{16, 64, 256};
     int ordinal = 0;
     for (const std::string& stage : singleJob ? std::vector<std::string>{"tiled"} : stages)
         for (int lights : lightCounts) {
@@ -172,12 +191,20 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
             }
             writePreviewPng(jobDir / "preview.png", w, h, red.data(), green.data(), blue.data());
             writeHeatmapPng(jobDir / "heatmap.png", w, h, counts.data(), 0);
-            if (ordinal != 5) writePreviewPng(jobDir / "error.png", w, h, blue.data(), red.data(), green.data());
+            if (ordinal != 5)
+                writePreviewPng(jobDir / "error.png", w, h, blue.data(), red.data(), green.data());
             const bool brute = stage == "brute";
             const double time = (brute ? 2.0 : 0.5) * lights + ordinal;
-            jobs.push_back({{"job_id", id}, {"status", "ok"}, {"error", ""}, {"scene", "atrium"},
-                            {"stage", stage}, {"lights", lights}, {"width", w}, {"height", h},
-                            {"time_total_median_ms", time}, {"time_total_min_ms", time},
+            jobs.push_back({{"job_id", id},
+                            {"status", "ok"},
+                            {"error", ""},
+                            {"scene", "atrium"},
+                            {"stage", stage},
+                            {"lights", lights},
+                            {"width", w},
+                            {"height", h},
+                            {"time_total_median_ms", time},
+                            {"time_total_min_ms", time},
                             {"time_total_max_ms", time},
                             {"light_evaluations", (brute ? 1.0 : 0.2) * lights * w * h},
                             {"culling_efficiency", brute ? 0.05 : 0.4 + 0.001 * lights},
@@ -187,23 +214,49 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
                             {"max_abs", ordinal == 1 ? json() : json(1e-5)}});
             ++ordinal;
         }
-    jobs.push_back({{"job_id", "9999-failed"}, {"status", "failed"}, {"error", "stage 'nope' <unknown>"},
-                    {"scene", "atrium"}, {"stage", "nope"}, {"lights", 16}, {"width", w}, {"height", h},
-                    {"time_total_median_ms", nullptr}, {"time_total_min_ms", nullptr},
-                    {"time_total_max_ms", nullptr}, {"light_evaluations", nullptr},
-                    {"culling_efficiency", nullptr}, {"bytes_per_pixel", nullptr}, {"rmse", nullptr},
-                    {"psnr", nullptr}, {"max_abs", nullptr}});
-    const json columns = {"job_id", "status", "error", "scene", "stage", "lights", "width", "height",
-                          "time_total_median_ms", "time_total_min_ms", "time_total_max_ms",
-                          "light_evaluations", "culling_efficiency", "bytes_per_pixel", "rmse", "psnr",
+    jobs.push_back({{"job_id", "9999-failed"},
+                    {"status", "failed"},
+                    {"error", "stage 'nope' <unknown>"},
+                    {"scene", "atrium"},
+                    {"stage", "nope"},
+                    {"lights", 16},
+                    {"width", w},
+                    {"height", h},
+                    {"time_total_median_ms", nullptr},
+                    {"time_total_min_ms", nullptr},
+                    {"time_total_max_ms", nullptr},
+                    {"light_evaluations", nullptr},
+                    {"culling_efficiency", nullptr},
+                    {"bytes_per_pixel", nullptr},
+                    {"rmse", nullptr},
+                    {"psnr", nullptr},
+                    {"max_abs", nullptr}});
+    const json columns = {"job_id",
+                          "status",
+                          "error",
+                          "scene",
+                          "stage",
+                          "lights",
+                          "width",
+                          "height",
+                          "time_total_median_ms",
+                          "time_total_min_ms",
+                          "time_total_max_ms",
+                          "light_evaluations",
+                          "culling_efficiency",
+                          "bytes_per_pixel",
+                          "rmse",
+                          "psnr",
                           "max_abs"};
     const json published = json::array(
         {{{"title", "Thesis-like table"},
           {"source", "made up"},
           {"metric", "time_total_median_ms"},
-          {"columns", {{{"label", "brute"}, {"select", {{"stage", "brute"}}}},
-                       {{"label", "tiled"}, {"select", {{"stage", "tiled"}}}}}},
-          {"rows", {{{"label", "Test 64"}, {"select", {{"lights", 64}}}, {"values", {128.0, 32.0}}}}},
+          {"columns",
+           {{{"label", "brute"}, {"select", {{"stage", "brute"}}}},
+            {{"label", "tiled"}, {"select", {{"stage", "tiled"}}}}}},
+          {"rows",
+           {{{"label", "Test 64"}, {"select", {{"lights", 64}}}, {"values", {128.0, 32.0}}}}},
           {"ratio_to", 0},
           {"finding", "tiled wins <by far>"}}});
     const json results = {{"sweep", {{"name", "fixture"}, {"published", published}}},
@@ -227,7 +280,8 @@ void expectNotBlank(const fs::path& png) {
     rgb.get_pixels(rgb.roi(), OIIO::TypeDesc::FLOAT, pixels.data());
     std::set<uint32_t> colours;
     for (size_t i = 0; i < pixels.size(); i += 3)
-        colours.insert(uint32_t(std::lround(pixels[i] * 255)) << 16 | uint32_t(std::lround(pixels[i + 1] * 255)) << 8 |
+        colours.insert(uint32_t(std::lround(pixels[i] * 255)) << 16 |
+                       uint32_t(std::lround(pixels[i + 1] * 255)) << 8 |
                        uint32_t(std::lround(pixels[i + 2] * 255)));
     EXPECT_GT(colours.size(), 32u) << png;
 }
@@ -238,19 +292,23 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
     options.dir = dir;
     ASSERT_EQ(runReportCommand(options), 0) << dir;
     const std::string html = readText(dir / "report.html");
-    for (const char* id : {"0000-brute", "0001-brute", "0002-brute", "0003-tiled", "0004-tiled", "0005-tiled",
-                           "9999-failed"})
-        EXPECT_NE(html.find(std::string("<td class=\"text\">") + id + "</td>"), std::string::npos) << id;
+    for (const char* id : {"0000-brute", "0001-brute", "0002-brute", "0003-tiled", "0004-tiled",
+                           "0005-tiled", "9999-failed"})
+        EXPECT_NE(html.find(std::string("<td class=\"text\">") + id + "</td>"), std::string::npos)
+            << id;
     EXPECT_NE(html.find("<tr class=\"failed\">"), std::string::npos);
-    EXPECT_NE(html.find("stage &#39;nope&#39; &lt;unknown&gt;"), std::string::npos) << "error shown, escaped";
-    EXPECT_NE(html.find("<td class=\"text\">inf</td>"), std::string::npos) << "psnr inf shown as text";
+    EXPECT_NE(html.find("stage &#39;nope&#39; &lt;unknown&gt;"), std::string::npos)
+        << "error shown, escaped";
+    EXPECT_NE(html.find("<td class=\"text\">inf</td>"), std::string::npos)
+        << "psnr inf shown as text";
     EXPECT_NE(html.find("tiled wins &lt;by far&gt;"), std::string::npos);
     // Published table, row "Test 64": brute measured 129 (2*64 + ordinal 1), tiled 36 (0.5*64 +
     // ordinal 4): published ratio 32/128 = 0.25, measured 36/129 = 0.2791.
     EXPECT_NE(html.find("<td>128</td><td>129</td><td>1&times;</td><td>1&times;</td><td>1</td>"),
               std::string::npos);
-    EXPECT_NE(html.find("<td>32</td><td>36</td><td>0.25&times;</td><td>0.2791&times;</td><td>1</td>"),
-              std::string::npos);
+    EXPECT_NE(
+        html.find("<td>32</td><td>36</td><td>0.25&times;</td><td>0.2791&times;</td><td>1</td>"),
+        std::string::npos);
     EXPECT_NE(html.find("no error.png"), std::string::npos) << "job 0005 has no error image";
     EXPECT_NE(html.find("id=\"page-check\""), std::string::npos);
     EXPECT_EQ(html.find("http://"), std::string::npos) << "nothing from the network";
@@ -261,10 +319,11 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
     for (const json& plot : manifest["plots"]) {
         files.insert(plot["file"].get<std::string>());
         expectNotBlank(dir / "report" / plot["file"].get<std::string>());
-        EXPECT_NE(html.find("src=\"report/" + plot["file"].get<std::string>() + "\""), std::string::npos);
+        EXPECT_NE(html.find("src=\"report/" + plot["file"].get<std::string>() + "\""),
+                  std::string::npos);
     }
-    for (const char* expected : {"time_vs_error_by_stage.png", "evaluations_vs_lights.png", "culling_vs_lights.png",
-                                 "time_vs_lights.png", "published_0.png"})
+    for (const char* expected : {"time_vs_error_by_stage.png", "evaluations_vs_lights.png",
+                                 "culling_vs_lights.png", "time_vs_lights.png", "published_0.png"})
         EXPECT_EQ(files.count(expected), 1u) << expected << " in " << manifest.dump();
     EXPECT_EQ(files.count("bytes_vs_error.png"), 0u) << "one bytes-per-pixel value: not drawn";
     EXPECT_NE(html.find("not enough data"), std::string::npos);
@@ -272,7 +331,8 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
     EXPECT_TRUE(fs::exists(dir / "report" / "thumbs" / "0000-brute-heatmap.png"));
     EXPECT_FALSE(fs::exists(dir / "report" / "thumbs" / "0005-tiled-error.png"));
     const json published = json::parse(readText(dir / "report" / "published.json"));
-    EXPECT_NEAR(published[0]["rows"][0]["cells"][1]["measured_ratio"].get<double>(), 36.0 / 129.0, 1e-12);
+    EXPECT_NEAR(published[0]["rows"][0]["cells"][1]["measured_ratio"].get<double>(), 36.0 / 129.0,
+                1e-12);
 }
 
 TEST(ReportCommand, SingleValuedAxesSayNotEnoughDataInsteadOfEmptyPlots) {
@@ -281,11 +341,13 @@ TEST(ReportCommand, SingleValuedAxesSayNotEnoughDataInsteadOfEmptyPlots) {
     options.dir = dir;
     ASSERT_EQ(runReportCommand(options), 0) << dir;
     const json manifest = json::parse(readText(dir / "report" / "plots.json"));
-    EXPECT_TRUE(manifest["plots"].empty()) << "one ok job, no brute baseline: nothing to plot: " << manifest.dump();
+    EXPECT_TRUE(manifest["plots"].empty())
+        << "one ok job, no brute baseline: nothing to plot: " << manifest.dump();
     EXPECT_GE(manifest["skipped"].size(), 4u);
     const std::string html = readText(dir / "report.html");
     EXPECT_NE(html.find("Time against error, per stage: not enough data"), std::string::npos);
-    EXPECT_NE(html.find("Culling efficiency against light count: not enough data"), std::string::npos);
+    EXPECT_NE(html.find("Culling efficiency against light count: not enough data"),
+              std::string::npos);
 }
 
 TEST(ReportCommand, MissingResultsOrPythonIsOneClearError) {
@@ -295,7 +357,8 @@ TEST(ReportCommand, MissingResultsOrPythonIsOneClearError) {
     testing::internal::CaptureStderr();
     EXPECT_EQ(runReportCommand(options), 1);
     std::string error = testing::internal::GetCapturedStderr();
-    EXPECT_NE(error.find("testbed: error: cannot read " + (dir / "results.json").string()), std::string::npos)
+    EXPECT_NE(error.find("testbed: error: cannot read " + (dir / "results.json").string()),
+              std::string::npos)
         << error;
     EXPECT_FALSE(fs::exists(dir / "report.html"));
 
@@ -315,5 +378,5 @@ TEST(ReportCommand, MissingResultsOrPythonIsOneClearError) {
     EXPECT_NE(error.find("missing.py not found"), std::string::npos) << error;
 }
 
-}  // namespace
-}  // namespace experiments
+} // namespace
+} // namespace experiments

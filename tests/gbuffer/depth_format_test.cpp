@@ -26,8 +26,10 @@
 #include "scenes/Scene.h"
 
 namespace gbuffer {
-void PrintTo(const DepthFormatSpec& spec, std::ostream* os) { *os << spec.text(); }
-}  // namespace gbuffer
+void PrintTo(const DepthFormatSpec& spec, std::ostream* os) {
+    *os << spec.text();
+}
+} // namespace gbuffer
 
 namespace {
 
@@ -50,10 +52,11 @@ struct Planes {
     float nearMetres;
     float farMetres;
 };
-constexpr Planes kCameras[] = {{0.01f, 100.0f}, {0.1f, 1000.0f}, {0.1f, 10000.0f}, {1.0f, 10000.0f}};
+constexpr Planes kCameras[] = {
+    {0.01f, 100.0f}, {0.1f, 1000.0f}, {0.1f, 10000.0f}, {1.0f, 10000.0f}};
 
 FrameView viewOf(Planes planes, DepthConvention convention, bool infinite) {
-    scenes::Camera camera;  // origin, looking down -Z
+    scenes::Camera camera; // origin, looking down -Z
     camera.verticalFovRadians = float(kFovYRadians);
     camera.nearMetres = planes.nearMetres;
     camera.farMetres = planes.farMetres;
@@ -70,7 +73,8 @@ std::vector<double> logDistances(double from, double to, int count) {
     from *= 1.0 + 1e-6;
     to *= 1.0 - 1e-6;
     std::vector<double> d;
-    for (int i = 0; i < count; ++i) d.push_back(from * std::pow(to / from, double(i) / (count - 1)));
+    for (int i = 0; i < count; ++i)
+        d.push_back(from * std::pow(to / from, double(i) / (count - 1)));
     return d;
 }
 
@@ -86,10 +90,11 @@ float rasterNdc(const FrameView& view, const glm::dvec3& p) {
     return float(clip.z / clip.w);
 }
 
-std::vector<glm::ivec2> pixelGrid() {  // 9 x 5 pixels, corners included
+std::vector<glm::ivec2> pixelGrid() { // 9 x 5 pixels, corners included
     std::vector<glm::ivec2> pixels;
     for (int j = 0; j < 5; ++j)
-        for (int i = 0; i < 9; ++i) pixels.push_back({i * (kWidth - 1) / 8, j * (kHeight - 1) / 4});
+        for (int i = 0; i < 9; ++i)
+            pixels.push_back({i * (kWidth - 1) / 8, j * (kHeight - 1) / 4});
     return pixels;
 }
 
@@ -99,14 +104,15 @@ glm::vec3 reconstruct(const DepthFormatSpec& format, const FrameView& view, Posi
     const uint32_t code = gbuffer::encodeDepth(format, projection, depthNdc);
     const glm::vec2 ndc = view.ndcOfPixel(pixel.x, pixel.y);
     if (method == PositionMethod::InverseProjection)
-        return gbuffer::positionByInverseProjection(view, ndc,
-                                                    gbuffer::decodeDepthNdc(format, projection, code));
-    return gbuffer::positionByViewRay(view, ndc, gbuffer::decodeViewDepth(format, projection, code));
+        return gbuffer::positionByInverseProjection(
+            view, ndc, gbuffer::decodeDepthNdc(format, projection, code));
+    return gbuffer::positionByViewRay(view, ndc,
+                                      gbuffer::decodeViewDepth(format, projection, code));
 }
 
 struct ErrorStats {
     double maxRelative = 0.0;
-    int lost = 0;  // float NDC equal to the clear value or outside [0, 1]: reads as background
+    int lost = 0; // float NDC equal to the clear value or outside [0, 1]: reads as background
 };
 
 ErrorStats positionError(const DepthFormatSpec& format, Planes planes, PositionMethod method,
@@ -136,8 +142,9 @@ TEST(DepthFormatNames, TextParsesBackToTheSameSpec) {
         EXPECT_EQ(DepthFormatSpec::parse(spec.text()), spec) << spec.text();
         EXPECT_EQ(spec.text().ends_with(":infinite"), spec.infiniteFar) << spec.text();
     }
-    EXPECT_EQ(gbuffer::depthFormatNames(),
-              (std::vector<std::string>{"f32", "f32-reversed", "unorm24", "unorm16", "f16-linear"}));
+    EXPECT_EQ(
+        gbuffer::depthFormatNames(),
+        (std::vector<std::string>{"f32", "f32-reversed", "unorm24", "unorm16", "f16-linear"}));
     EXPECT_EQ(DepthFormatSpec::parse("unorm24").bits(), 24);
     EXPECT_EQ(DepthFormatSpec::parse("unorm16:infinite").bits(), 16);
     EXPECT_EQ(DepthFormatSpec::parse("f16-linear").bits(), 16);
@@ -159,9 +166,11 @@ std::string parseError(const std::string& text) {
 TEST(DepthFormatNames, BadNamesGiveOneMessageListingTheValidNames) {
     for (const char* bad : {"f64", "F32", "", ":infinite", "unorm32:infinite"}) {
         const std::string message = parseError(bad);
-        EXPECT_NE(message.find("unknown depth format '" + std::string(bad) + "'"), std::string::npos)
+        EXPECT_NE(message.find("unknown depth format '" + std::string(bad) + "'"),
+                  std::string::npos)
             << message;
-        EXPECT_NE(message.find("f32, f32-reversed, unorm24, unorm16, f16-linear"), std::string::npos)
+        EXPECT_NE(message.find("f32, f32-reversed, unorm24, unorm16, f16-linear"),
+                  std::string::npos)
             << message;
     }
     for (const char* bad : {"f32:finite", "f32:", "f32:infinite:infinite"})
@@ -176,12 +185,14 @@ struct ProjectionCase {
     bool reversed;
     bool infinite;
 };
-constexpr ProjectionCase kProjections[] = {{false, false}, {true, false}, {false, true}, {true, true}};
+constexpr ProjectionCase kProjections[] = {
+    {false, false}, {true, false}, {false, true}, {true, true}};
 
 TEST(DepthProjection, ViewDepthFromNdcInvertsNdcFromViewDepth) {
     for (const Planes& planes : kCameras)
         for (const ProjectionCase& c : kProjections) {
-            const DepthProjection projection{planes.nearMetres, planes.farMetres, c.infinite, c.reversed};
+            const DepthProjection projection{planes.nearMetres, planes.farMetres, c.infinite,
+                                             c.reversed};
             const double farEnd = c.infinite ? 1e3 * planes.farMetres : planes.farMetres;
             for (double d : logDistances(planes.nearMetres, farEnd, 500)) {
                 const double z = projection.ndcFromViewDepth(d);
@@ -189,7 +200,8 @@ TEST(DepthProjection, ViewDepthFromNdcInvertsNdcFromViewDepth) {
                 EXPECT_LE(z, 1.0);
                 // Standard Z stores 1 - n/d: even in double its inverse loses d/n ulps (the
                 // collapse this file is about, at 2^-53 instead of 2^-24).
-                const double tolerance = 1e-14 + (c.reversed ? 0.0 : 4.0 * 0x1.0p-53 * d / planes.nearMetres);
+                const double tolerance =
+                    1e-14 + (c.reversed ? 0.0 : 4.0 * 0x1.0p-53 * d / planes.nearMetres);
                 EXPECT_NEAR(projection.viewDepthFromNdc(z), d, tolerance * d)
                     << "reversed " << c.reversed << " infinite " << c.infinite << " d " << d;
             }
@@ -209,19 +221,23 @@ TEST(DepthProjection, ViewDepthFromNdcInvertsNdcFromViewDepth) {
 TEST(DepthProjection, FloatInverseIsAccurateToAFewRoundingsEverywhere) {
     for (const Planes& planes : kCameras)
         for (const ProjectionCase& c : kProjections) {
-            const DepthProjection projection{planes.nearMetres, planes.farMetres, c.infinite, c.reversed};
+            const DepthProjection projection{planes.nearMetres, planes.farMetres, c.infinite,
+                                             c.reversed};
             double worst = 0.0;
             std::vector<float> zs;
-            for (int i = 1; i < 4096; ++i) zs.push_back(float(i) / 4096.0f);
-            for (int k = 1; k < 2000; ++k) {  // the last float ulps on both ends
+            for (int i = 1; i < 4096; ++i)
+                zs.push_back(float(i) / 4096.0f);
+            for (int k = 1; k < 2000; ++k) { // the last float ulps on both ends
                 zs.push_back(std::nextafter(1.0f, 0.0f) - float(k) * 0x1.0p-24f);
                 zs.push_back(float(k) * std::numeric_limits<float>::denorm_min() * 1e6f);
             }
             for (float z : zs) {
-                if (z <= 0.0f || z >= 1.0f) continue;
+                if (z <= 0.0f || z >= 1.0f)
+                    continue;
                 const double exact = projection.viewDepthFromNdc(double(z));
                 const double got = projection.viewDepthFromNdcFloat(z);
-                if (!std::isfinite(exact) || exact > 1e30) continue;
+                if (!std::isfinite(exact) || exact > 1e30)
+                    continue;
                 worst = std::max(worst, std::abs(got - exact) / exact);
             }
             EXPECT_LE(worst, kDecodeArithmetic)
@@ -233,8 +249,9 @@ TEST(DepthProjection, FloatInverseIsAccurateToAFewRoundingsEverywhere) {
 TEST(FrameViewDepth, MatricesAgreeWithDepthProjection) {
     for (const Planes& planes : kCameras)
         for (const ProjectionCase& c : kProjections) {
-            const FrameView view = viewOf(
-                planes, c.reversed ? DepthConvention::Reversed : DepthConvention::Standard, c.infinite);
+            const FrameView view =
+                viewOf(planes, c.reversed ? DepthConvention::Reversed : DepthConvention::Standard,
+                       c.infinite);
             const DepthProjection projection = DepthProjection::of(view);
             EXPECT_EQ(projection.reversed, c.reversed);
             EXPECT_EQ(projection.infiniteFar, c.infinite);
@@ -242,7 +259,8 @@ TEST(FrameViewDepth, MatricesAgreeWithDepthProjection) {
             const glm::dmat4 clipFromViewExact = glm::inverse(view.viewFromClipExact);
             const double farEnd = c.infinite ? 1e3 * planes.farMetres : planes.farMetres;
             for (double d : logDistances(planes.nearMetres, farEnd, 200))
-                for (glm::ivec2 pixel : {glm::ivec2(0, 0), glm::ivec2(640, 360), glm::ivec2(1279, 719)}) {
+                for (glm::ivec2 pixel :
+                     {glm::ivec2(0, 0), glm::ivec2(640, 360), glm::ivec2(1279, 719)}) {
                     const glm::dvec3 p = exactPoint(pixel.x, pixel.y, d);
                     const double expected = projection.ndcFromViewDepth(d);
                     const glm::dvec4 exactClip = clipFromViewExact * glm::dvec4(p, 1.0);
@@ -255,7 +273,8 @@ TEST(FrameViewDepth, MatricesAgreeWithDepthProjection) {
                         << "d " << d << " reversed " << c.reversed << " infinite " << c.infinite;
                     // x, y of the exact point project to the pixel centre; the view ray there
                     // (times d) is the point.
-                    const glm::vec3 ray = gbuffer::viewRayOfNdc(view, view.ndcOfPixel(pixel.x, pixel.y));
+                    const glm::vec3 ray =
+                        gbuffer::viewRayOfNdc(view, view.ndcOfPixel(pixel.x, pixel.y));
                     EXPECT_NEAR(glm::length(glm::dvec3(ray) * d - p) / d, 0.0, 4.0 * kEps);
                 }
         }
@@ -270,7 +289,7 @@ DepthProjection projectionOf(const DepthFormatSpec& format, Planes planes = {0.1
 TEST(DepthCodes, UnormCodesRoundTripExactly) {
     for (DepthFormatKind kind : {DepthFormatKind::Unorm16, DepthFormatKind::Unorm24})
         for (bool infinite : {false, true})
-            for (bool reversed : {false, true}) {  // unorm is standard, but works either way
+            for (bool reversed : {false, true}) { // unorm is standard, but works either way
                 const DepthFormatSpec format{kind, infinite};
                 DepthProjection projection = projectionOf(format);
                 projection.reversed = reversed;
@@ -291,12 +310,14 @@ TEST(DepthCodes, Float32IsBitExact) {
         const DepthProjection projection = projectionOf(format);
         // Every 4099th float in [0, 1], both ends included.
         std::vector<uint32_t> bits{0u, 1u, 0x3F800000u, 0x3F7FFFFFu};
-        for (uint32_t b = 0; b < 0x3F800000u; b += 4099u) bits.push_back(b);
+        for (uint32_t b = 0; b < 0x3F800000u; b += 4099u)
+            bits.push_back(b);
         for (uint32_t b : bits) {
             const float z = std::bit_cast<float>(b);
             const uint32_t code = gbuffer::encodeDepth(format, projection, z);
             EXPECT_EQ(code, b) << name;
-            EXPECT_EQ(std::bit_cast<uint32_t>(gbuffer::decodeDepthNdc(format, projection, code)), b);
+            EXPECT_EQ(std::bit_cast<uint32_t>(gbuffer::decodeDepthNdc(format, projection, code)),
+                      b);
         }
         EXPECT_EQ(gbuffer::clearDepthCode(format, projection),
                   std::bit_cast<uint32_t>(projection.clearDepthNdc()));
@@ -318,8 +339,9 @@ TEST(DepthCodes, HalfLinearCodesRoundTripExactly) {
                 Imath::half h;
                 h.setBits(uint16_t(code));
                 const double d = double(float(h));
-                if (d <= projection.nearMetres || (!format.infiniteFar && d >= projection.farMetres))
-                    continue;  // in front of the near plane or behind the far plane: clipped
+                if (d <= projection.nearMetres ||
+                    (!format.infiniteFar && d >= projection.farMetres))
+                    continue; // in front of the near plane or behind the far plane: clipped
                 ++checked;
                 EXPECT_EQ(gbuffer::decodeViewDepth(format, projection, code), float(h));
                 const float z = gbuffer::decodeDepthNdc(format, projection, code);
@@ -343,9 +365,11 @@ TEST(DepthCodes, CoveredPixelsNeverEncodeToTheClearCode) {
             // NDC depths from the clear value inwards, 1, 2, 4, ... float steps.
             for (float step = std::numeric_limits<float>::denorm_min(); step < 0.1f; step *= 2.0f) {
                 const float z = projection.reversed ? clearNdc + step : clearNdc - step;
-                if (z == clearNdc) continue;  // 1 - denorm_min rounds back to 1
+                if (z == clearNdc)
+                    continue; // 1 - denorm_min rounds back to 1
                 EXPECT_NE(gbuffer::encodeDepth(format, projection, z), clear)
-                    << format.text() << " " << planes.nearMetres << "/" << planes.farMetres << " z " << z;
+                    << format.text() << " " << planes.nearMetres << "/" << planes.farMetres << " z "
+                    << z;
             }
         }
     // Depth right at the far plane in unorm: one code nearer, not the clear code.
@@ -368,8 +392,9 @@ TEST(DepthCodes, CoveredPixelsNeverEncodeToTheClearCode) {
     // depth) saturates to the near end, never to the far end.
     const DepthProjection finite = projectionOf(DepthFormatSpec::parse("f16-linear"));
     for (float z : {1.0000001f, 1.5f, -0.5f})
-        EXPECT_LE(gbuffer::decodeViewDepth(DepthFormatSpec::parse("f16-linear"), finite,
-                                           gbuffer::encodeDepth(DepthFormatSpec::parse("f16-linear"), finite, z)),
+        EXPECT_LE(gbuffer::decodeViewDepth(
+                      DepthFormatSpec::parse("f16-linear"), finite,
+                      gbuffer::encodeDepth(DepthFormatSpec::parse("f16-linear"), finite, z)),
                   finite.nearMetres * 1.001)
             << z;
 }
@@ -383,9 +408,10 @@ TEST(DepthCodes, CoveredPixelsNeverEncodeToTheClearCode) {
 //   dz: f32 one ulp of z (the rasterizer's rounding is half an ulp); unorm half a step (1.5 steps
 //   for the code clamped off the clear value) plus the float roundings of the input and of the
 //   decoded NDC value (2^-25 each).
-double decodeBound(const DepthFormatSpec& format, const DepthProjection& projection, double d, float z,
-                   uint32_t code) {
-    if (format.kind == DepthFormatKind::F16Linear) return 0x1.0p-11 + 2.0 * kEps + kDecodeArithmetic;
+double decodeBound(const DepthFormatSpec& format, const DepthProjection& projection, double d,
+                   float z, uint32_t code) {
+    if (format.kind == DepthFormatKind::F16Linear)
+        return 0x1.0p-11 + 2.0 * kEps + kDecodeArithmetic;
     double dz = 0.0;
     if (format.kind == DepthFormatKind::F32 || format.kind == DepthFormatKind::F32Reversed) {
         dz = double(std::nextafter(z, 2.0f)) - double(z);
@@ -410,9 +436,11 @@ TEST(DepthAccuracy, DecodedViewDepthIsWithinEachFormatsAnalyticBound) {
             const FrameView view = viewOf(planes, format);
             const DepthProjection projection = DepthProjection::of(view);
             for (double d : logDistances(planes.nearMetres, planes.farMetres, 2000)) {
-                if (format.kind == DepthFormatKind::F16Linear && d > 65504.0) continue;
+                if (format.kind == DepthFormatKind::F16Linear && d > 65504.0)
+                    continue;
                 const float z = float(projection.ndcFromViewDepth(d));
-                if (z == projection.clearDepthNdc()) continue;  // lost: the far-plane band
+                if (z == projection.clearDepthNdc())
+                    continue; // lost: the far-plane band
                 const uint32_t code = gbuffer::encodeDepth(format, projection, z);
                 const double got = gbuffer::decodeViewDepth(format, projection, code);
                 const double error = std::abs(got - d) / d;
@@ -432,7 +460,8 @@ TEST(DepthAccuracy, DecodedViewDepthIsWithinEachFormatsAnalyticBound) {
 TEST(DepthAccuracy, BothMethodsGiveTheExactPositionWithReversedFloatDepth) {
     for (const char* name : {"f32-reversed", "f32-reversed:infinite"})
         for (const Planes& planes : kCameras)
-            for (PositionMethod method : {PositionMethod::InverseProjection, PositionMethod::ViewRay}) {
+            for (PositionMethod method :
+                 {PositionMethod::InverseProjection, PositionMethod::ViewRay}) {
                 const ErrorStats stats =
                     positionError(DepthFormatSpec::parse(name), planes, method,
                                   logDistances(planes.nearMetres, planes.farMetres, 100));
@@ -461,8 +490,9 @@ TEST(DepthAccuracy, ReversedFloatBeatsStandardFloatTenfoldAtTheFarPlane) {
                     standard.maxRelative / reversed.maxRelative);
         EXPECT_EQ(standard.lost, 0);
         EXPECT_EQ(reversed.lost, 0);
-        EXPECT_GE(standard.maxRelative, 10.0 * reversed.maxRelative) << gbuffer::positionMethodName(method);
-        EXPECT_GT(standard.maxRelative, 1e-4);  // the collapse is real, not a tiny test artefact
+        EXPECT_GE(standard.maxRelative, 10.0 * reversed.maxRelative)
+            << gbuffer::positionMethodName(method);
+        EXPECT_GT(standard.maxRelative, 1e-4); // the collapse is real, not a tiny test artefact
     }
 }
 
@@ -480,4 +510,4 @@ TEST(DepthAccuracy, StandardFloatLosesSurfacesJustBeforeTheFarPlane) {
     EXPECT_LT(rasterNdc(standard, {0.0, 0.0, -9000.0}), 1.0f);
 }
 
-}  // namespace
+} // namespace

@@ -12,7 +12,8 @@
 
 namespace {
 
-// A square of side `size` in the plane z = 0 of object space, facing +Z, placed by `worldFromObject`.
+// A square of side `size` in the plane z = 0 of object space, facing +Z, placed by
+// `worldFromObject`.
 scenes::Scene planeScene(float size, const glm::mat4& worldFromObject) {
     scenes::Scene scene;
     scene.name = "plane";
@@ -57,7 +58,8 @@ Rendered render(const scenes::Scene& scene, int width, int height) {
 }
 
 TEST(GBufferPass, PlaneFacingTheCamera) {
-    const scenes::Scene scene = planeScene(100.0f, glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -5)));
+    const scenes::Scene scene =
+        planeScene(100.0f, glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -5)));
     const Rendered r = render(scene, 64, 48);
     for (int y = 0; y < 48; ++y)
         for (int x = 0; x < 64; ++x) {
@@ -69,7 +71,8 @@ TEST(GBufferPass, PlaneFacingTheCamera) {
             EXPECT_NEAR(s.albedo.g, 0.5f, 0.0f);
             EXPECT_EQ(s.specularPower, 40.0f);
             EXPECT_NEAR(r.exact.positionView[pixel].z, -5.0, 1e-12);
-            EXPECT_NEAR(glm::length(glm::dvec3(s.positionView) - r.exact.positionView[pixel]), 0.0, 1e-4);
+            EXPECT_NEAR(glm::length(glm::dvec3(s.positionView) - r.exact.positionView[pixel]), 0.0,
+                        1e-4);
         }
 }
 
@@ -79,26 +82,31 @@ TEST(GBufferPass, TiltedPlaneReconstructsExactPositions) {
     worldFromObject = glm::rotate(worldFromObject, glm::radians(-60.0f), glm::vec3(1, 0, 0));
     const scenes::Scene scene = planeScene(200.0f, worldFromObject);
     const Rendered r = render(scene, 96, 64);
-    const glm::dvec3 planeNormal = glm::normalize(glm::dvec3(worldFromObject * glm::vec4(0, 0, 1, 0)));
+    const glm::dvec3 planeNormal =
+        glm::normalize(glm::dvec3(worldFromObject * glm::vec4(0, 0, 1, 0)));
     for (int y = 0; y < 64; ++y)
         for (int x = 0; x < 96; ++x) {
             const size_t pixel = size_t(y) * 96 + x;
-            if (!r.gbuffer->covered(pixel)) continue;
+            if (!r.gbuffer->covered(pixel))
+                continue;
             // The exact position lies on the plane to double precision.
             const glm::dvec3 p = r.exact.positionView[pixel];
-            EXPECT_NEAR(glm::dot(p - glm::dvec3(0, 0, -8), planeNormal), 0.0, 1e-9 * glm::length(p));
+            EXPECT_NEAR(glm::dot(p - glm::dvec3(0, 0, -8), planeNormal), 0.0,
+                        1e-9 * glm::length(p));
             EXPECT_NEAR(glm::distance(r.exact.normalView[pixel], planeNormal), 0.0, 1e-12);
             // The float reconstruction is close in relative terms.
             const glm::vec3 q = r.gbuffer->decode(x, y).positionView;
-            EXPECT_NEAR(glm::distance(glm::dvec3(q), p), 0.0, 2e-5 * glm::length(p)) << x << "," << y;
+            EXPECT_NEAR(glm::distance(glm::dvec3(q), p), 0.0, 2e-5 * glm::length(p))
+                << x << "," << y;
         }
 }
 
 TEST(SceneGeometry, MirroredInstanceKeepsFrontFaces) {
     // A mirroring transform (negative scale) must not turn the plane's front face away.
-    const glm::mat4 mirrored = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -5)), glm::vec3(-1, 1, 1));
+    const glm::mat4 mirrored =
+        glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -5)), glm::vec3(-1, 1, 1));
     const Rendered r = render(planeScene(100.0f, mirrored), 32, 32);
     EXPECT_TRUE(r.gbuffer->covered(16 * 32 + 16));
 }
 
-}  // namespace
+} // namespace

@@ -18,7 +18,8 @@ using gbuffer::AlbedoEncoding;
 using gbuffer::Channel;
 using gbuffer::SpecularEncoding;
 
-const std::vector<Channel> kEverything = {Channel::Depth, Channel::Normal, Channel::Albedo, Channel::Specular};
+const std::vector<Channel> kEverything = {Channel::Depth, Channel::Normal, Channel::Albedo,
+                                          Channel::Specular};
 
 // Two quads side by side, one material each, facing a camera at the origin.
 scenes::Scene twoQuads(scenes::Material left, scenes::Material right) {
@@ -52,16 +53,20 @@ scenes::Material material(glm::vec3 albedo, float intensity, float power) {
 }
 
 TEST(LayoutDerivation, SharedSpecularStoresNoSpecularPlane) {
-    const scenes::Scene scene = twoQuads(material({1, 0, 0}, 0.5f, 20.0f), material({0, 1, 0}, 0.5f, 20.0f));
+    const scenes::Scene scene =
+        twoQuads(material({1, 0, 0}, 0.5f, 20.0f), material({0, 1, 0}, 0.5f, 20.0f));
     const gbuffer::GBufferLayout layout = gbuffer::deriveLayout(scene, kEverything);
     EXPECT_EQ(layout.specular, SpecularEncoding::Constant);
-    for (const gbuffer::PlaneDesc& plane : layout.planes()) EXPECT_NE(plane.channel, "specular") << plane.name;
-    EXPECT_NE(layout.explain().find("every used material has specular intensity"), std::string::npos)
+    for (const gbuffer::PlaneDesc& plane : layout.planes())
+        EXPECT_NE(plane.channel, "specular") << plane.name;
+    EXPECT_NE(layout.explain().find("every used material has specular intensity"),
+              std::string::npos)
         << layout.explain();
 }
 
 TEST(LayoutDerivation, OneColourPerMaterialStoresAMaterialIndexInsteadOfAlbedo) {
-    const scenes::Scene scene = twoQuads(material({1, 0, 0}, 0.5f, 20.0f), material({0, 1, 0}, 0.2f, 60.0f));
+    const scenes::Scene scene =
+        twoQuads(material({1, 0, 0}, 0.5f, 20.0f), material({0, 1, 0}, 0.2f, 60.0f));
     const gbuffer::GBufferLayout layout = gbuffer::deriveLayout(scene, kEverything);
     EXPECT_EQ(layout.albedo, AlbedoEncoding::Material);
     EXPECT_EQ(layout.specular, SpecularEncoding::Material);
@@ -76,14 +81,16 @@ TEST(LayoutDerivation, OneColourPerMaterialStoresAMaterialIndexInsteadOfAlbedo) 
 }
 
 TEST(LayoutDerivation, OneColourForTheWholeSceneIsAConstant) {
-    const scenes::Scene scene = twoQuads(material({0.3f, 0.3f, 0.3f}, 0.5f, 20.0f), material({0.3f, 0.3f, 0.3f}, 0.2f, 60.0f));
+    const scenes::Scene scene = twoQuads(material({0.3f, 0.3f, 0.3f}, 0.5f, 20.0f),
+                                         material({0.3f, 0.3f, 0.3f}, 0.2f, 60.0f));
     const gbuffer::GBufferLayout layout = gbuffer::deriveLayout(scene, kEverything);
     EXPECT_EQ(layout.albedo, AlbedoEncoding::Constant);
     EXPECT_EQ(layout.specular, SpecularEncoding::Material);
 }
 
 TEST(LayoutDerivation, TexturedMaterialsStoreAlbedoPerPixel) {
-    scenes::Scene scene = twoQuads(material({1, 1, 1}, 0.5f, 20.0f), material({0, 1, 0}, 0.5f, 20.0f));
+    scenes::Scene scene =
+        twoQuads(material({1, 1, 1}, 0.5f, 20.0f), material({0, 1, 0}, 0.5f, 20.0f));
     scenes::Texture texture;
     texture.name = "one texel";
     texture.width = texture.height = 1;
@@ -103,21 +110,24 @@ TEST(LayoutDerivation, AStageGetsOnlyTheChannelsItReads) {
         const gbuffer::GBufferLayout layout = gbuffer::makeLayout(scene, reads, info.name, {});
         for (Channel channel : {Channel::Normal, Channel::Albedo, Channel::Specular}) {
             const bool read = std::find(reads.begin(), reads.end(), channel) != reads.end();
-            EXPECT_EQ(layout.provides(channel), read) << info.name << " " << gbuffer::channelName(channel);
+            EXPECT_EQ(layout.provides(channel), read)
+                << info.name << " " << gbuffer::channelName(channel);
         }
     }
     // Forward shading reads no G-buffer channel: depth (coverage) alone, 4 bytes.
-    const gbuffer::GBufferLayout forward =
-        gbuffer::makeLayout(scene, lighting::makeStage("forward")->requirements().channels, "forward", {});
+    const gbuffer::GBufferLayout forward = gbuffer::makeLayout(
+        scene, lighting::makeStage("forward")->requirements().channels, "forward", {});
     EXPECT_DOUBLE_EQ(forward.bytesPerPixel(), 4.0);
-    EXPECT_NE(forward.explain().find("does not read normals"), std::string::npos) << forward.explain();
+    EXPECT_NE(forward.explain().find("does not read normals"), std::string::npos)
+        << forward.explain();
 }
 
 TEST(LayoutDerivation, AnOverrideOfAnUnreadChannelIsReportedNotStored) {
     const scenes::Scene scene = scenes::buildProceduralScene("spheres", {});
     gbuffer::LayoutRequest request;
     request.normals = gbuffer::NormalCodecSpec::parse("octahedral:16");
-    const gbuffer::GBufferLayout layout = gbuffer::makeLayout(scene, {Channel::Depth}, "forward", request);
+    const gbuffer::GBufferLayout layout =
+        gbuffer::makeLayout(scene, {Channel::Depth}, "forward", request);
     EXPECT_FALSE(layout.provides(Channel::Normal));
     ASSERT_FALSE(layout.notes.empty());
     EXPECT_NE(layout.notes.back().find("does not read normals"), std::string::npos);
@@ -144,8 +154,8 @@ TEST(LayoutDerivation, DerivedLayoutIsLossless) {
         scenes::SceneRequest request;
         request.lightCount = 48;
         scenes::Scene scene = scenes::buildProceduralScene("atrium", request);
-        const gbuffer::GBufferLayout used =
-            layout ? gbuffer::deriveLayout(scene, kEverything) : gbuffer::GBufferLayout::reference();
+        const gbuffer::GBufferLayout used = layout ? gbuffer::deriveLayout(scene, kEverything)
+                                                   : gbuffer::GBufferLayout::reference();
         lighting::PreparedFrame frame(std::move(scene), 160, 90, false, used);
         lighting::StageResult result;
         lighting::makeStage("brute")->shade(frame.frame, result);
@@ -157,7 +167,9 @@ TEST(LayoutDerivation, DerivedLayoutIsLossless) {
     EXPECT_LT(derivedBytes, referenceBytes);
     for (int c = 0; c < 3; ++c)
         EXPECT_EQ(std::memcmp(derived.radiance[c].data(), reference.radiance[c].data(),
-                              derived.radiance[c].size() * sizeof(float)), 0) << c;
+                              derived.radiance[c].size() * sizeof(float)),
+                  0)
+            << c;
 }
 
 // Every encoding the G-buffer stores decodes to within its format's step of the lossless value,
@@ -165,7 +177,8 @@ TEST(LayoutDerivation, DerivedLayoutIsLossless) {
 TEST(GBufferStorage, LossyEncodingsDecodeCloseToTheLosslessSurface) {
     scenes::SceneRequest sceneRequest;
     const scenes::Scene scene = scenes::buildProceduralScene("atrium", sceneRequest);
-    lighting::PreparedFrame lossless(scenes::Scene(scene), 160, 90, false, gbuffer::deriveLayout(scene, kEverything));
+    lighting::PreparedFrame lossless(scenes::Scene(scene), 160, 90, false,
+                                     gbuffer::deriveLayout(scene, kEverything));
     for (const char* preset : {"thesis", "killzone2", "bf3", "stalker", "clear-sky", "compact"}) {
         const gbuffer::GBufferLayout layout = gbuffer::presetLayout(preset, scene);
         lighting::PreparedFrame lossy(scenes::Scene(scene), 160, 90, false, layout);
@@ -180,28 +193,34 @@ TEST(GBufferStorage, LossyEncodingsDecodeCloseToTheLosslessSurface) {
                     ++coverageDiffers;
                     continue;
                 }
-                if (!a.covered(pixel)) continue;
+                if (!a.covered(pixel))
+                    continue;
                 const gbuffer::Surface sa = a.decode(x, y), sb = b.decode(x, y);
                 ++covered;
                 // A different surface may win the depth test where depths nearly tie.
-                if (glm::length(sa.positionView - sb.positionView) > 0.01f * -sa.positionView.z) continue;
+                if (glm::length(sa.positionView - sb.positionView) > 0.01f * -sa.positionView.z)
+                    continue;
                 ++compared;
                 worstAlbedo = std::max(worstAlbedo, double(glm::length(sa.albedo - sb.albedo)));
-                worstIntensity = std::max(worstIntensity, double(std::abs(sa.specularIntensity - sb.specularIntensity)));
-                worstPowerRatio = std::max(worstPowerRatio, double(std::abs(sb.specularPower / sa.specularPower - 1)));
-                if (sa.normalView.z > 0.05f)  // xy-z cannot hold back-facing normals: measured elsewhere
-                    worstNormalDot = std::min(worstNormalDot, double(glm::dot(sa.normalView, sb.normalView)));
+                worstIntensity = std::max(
+                    worstIntensity, double(std::abs(sa.specularIntensity - sb.specularIntensity)));
+                worstPowerRatio = std::max(
+                    worstPowerRatio, double(std::abs(sb.specularPower / sa.specularPower - 1)));
+                if (sa.normalView.z >
+                    0.05f) // xy-z cannot hold back-facing normals: measured elsewhere
+                    worstNormalDot =
+                        std::min(worstNormalDot, double(glm::dot(sa.normalView, sb.normalView)));
             }
         EXPECT_EQ(coverageDiffers, 0u) << preset;
         EXPECT_GT(compared, covered * 9 / 10) << preset;
-        EXPECT_LT(worstAlbedo, 0.01) << preset;               // RGB8 sRGB: < 1/255 in sRGB space
+        EXPECT_LT(worstAlbedo, 0.01) << preset;                // RGB8 sRGB: < 1/255 in sRGB space
         EXPECT_LT(worstIntensity, 0.5 / 255 + 1e-6) << preset; // unorm8
-        EXPECT_LT(worstPowerRatio, 0.03) << preset;           // log8 over 2^13: 2^(13/510) - 1 = 1.8%
+        EXPECT_LT(worstPowerRatio, 0.03) << preset; // log8 over 2^13: 2^(13/510) - 1 = 1.8%
         EXPECT_GT(worstNormalDot, std::cos(glm::radians(1.5))) << preset;
     }
 }
 
-}  // namespace
+} // namespace
 
 namespace {
 
@@ -209,7 +228,8 @@ namespace {
 // the hemisphere codecs refuse world space.
 TEST(GBufferStorage, WorldSpaceNormalsDecodeToViewSpace) {
     const scenes::Scene scene = scenes::buildProceduralScene("atrium", {});
-    lighting::PreparedFrame lossless(scenes::Scene(scene), 160, 90, false, gbuffer::deriveLayout(scene, kEverything));
+    lighting::PreparedFrame lossless(scenes::Scene(scene), 160, 90, false,
+                                     gbuffer::deriveLayout(scene, kEverything));
     gbuffer::LayoutRequest request;
     request.normals = gbuffer::NormalCodecSpec::parse("octahedral:24");
     request.normalSpace = gbuffer::NormalSpace::World;
@@ -218,13 +238,15 @@ TEST(GBufferStorage, WorldSpaceNormalsDecodeToViewSpace) {
     double worst = 0.0;
     for (int y = 0; y < 90; ++y)
         for (int x = 0; x < 160; ++x) {
-            if (!lossless.gbuffer->covered(size_t(y) * 160 + x)) continue;
-            worst = std::max(worst, gbuffer::normalAngleRadians(lossless.gbuffer->decode(x, y).normalView,
-                                                                encoded.gbuffer->decode(x, y).normalView));
+            if (!lossless.gbuffer->covered(size_t(y) * 160 + x))
+                continue;
+            worst = std::max(worst,
+                             gbuffer::normalAngleRadians(lossless.gbuffer->decode(x, y).normalView,
+                                                         encoded.gbuffer->decode(x, y).normalView));
         }
-    EXPECT_LT(glm::degrees(worst), 0.1);  // octahedral 2x12 bits: max ~0.06 degrees
+    EXPECT_LT(glm::degrees(worst), 0.1); // octahedral 2x12 bits: max ~0.06 degrees
     request.normals = gbuffer::NormalCodecSpec::parse("xy-z:16");
     EXPECT_THROW(gbuffer::makeLayout(scene, kEverything, "brute", request), std::invalid_argument);
 }
 
-}  // namespace
+} // namespace

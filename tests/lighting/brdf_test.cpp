@@ -13,8 +13,7 @@ using lighting::LightInView;
 using lighting::ShadingPoint;
 using scenes::LightType;
 
-template <class T>
-ShadingPoint<T> matteFloorPoint() {
+template <class T> ShadingPoint<T> matteFloorPoint() {
     ShadingPoint<T> p;
     p.positionView = {T(0), T(0), T(-5)};
     p.normalView = {T(0), T(1), T(0)};
@@ -24,8 +23,7 @@ ShadingPoint<T> matteFloorPoint() {
     return p;
 }
 
-template <class T>
-LightInView<T> pointLightAbove(T height, T range) {
+template <class T> LightInView<T> pointLightAbove(T height, T range) {
     LightInView<T> light;
     light.type = LightType::Point;
     light.positionView = {T(0), height, T(-5)};
@@ -47,9 +45,10 @@ TEST(Brdf, PointLightClosedForm) {
 }
 
 TEST(Brdf, ExactlyZeroAtAndBeyondRange) {
-    for (double range : {0.0, 0.5, 1.0}) {  // light 1 m away: at, and beyond, the range
+    for (double range : {0.0, 0.5, 1.0}) { // light 1 m away: at, and beyond, the range
         const auto p = matteFloorPoint<double>();
-        const glm::dvec3 radiance = evaluateLight(p, glm::dvec3(0, 0, 1), pointLightAbove(1.0, range));
+        const glm::dvec3 radiance =
+            evaluateLight(p, glm::dvec3(0, 0, 1), pointLightAbove(1.0, range));
         EXPECT_EQ(radiance, glm::dvec3(0.0)) << "range " << range;
         EXPECT_FALSE(lighting::contributes(radiance));
     }
@@ -78,7 +77,7 @@ TEST(Brdf, SpotConeAndDirectionalAndAmbient) {
     spot.spotInnerCos = std::cos(0.2);
     spot.spotOuterCos = std::cos(0.3);
     EXPECT_TRUE(lighting::contributes(evaluateLight(p, glm::dvec3(0, 0, 1), spot)));
-    spot.directionView = glm::normalize(glm::dvec3(1, -1, 0));  // 45 degrees off: outside
+    spot.directionView = glm::normalize(glm::dvec3(1, -1, 0)); // 45 degrees off: outside
     EXPECT_EQ(evaluateLight(p, glm::dvec3(0, 0, 1), spot), glm::dvec3(0.0));
 
     LightInView<double> sun;
@@ -98,7 +97,8 @@ TEST(Brdf, FloatMatchesDouble) {
     ShadingPoint<double> pd = matteFloorPoint<double>();
     pd.specularIntensity = 0.5;
     pd.specularPower = 64.0;
-    ShadingPoint<float> pf{glm::vec3(pd.positionView), glm::vec3(pd.normalView), glm::vec3(pd.albedo), 0.5f, 64.0f};
+    ShadingPoint<float> pf{glm::vec3(pd.positionView), glm::vec3(pd.normalView),
+                           glm::vec3(pd.albedo), 0.5f, 64.0f};
     for (int i = 0; i < 100; ++i) {
         const double a = i * 0.0628;
         LightInView<double> ld = pointLightAbove(0.3 + 0.01 * i, 3.0);
@@ -115,4 +115,4 @@ TEST(Brdf, FloatMatchesDouble) {
     }
 }
 
-}  // namespace
+} // namespace

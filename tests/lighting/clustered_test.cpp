@@ -32,7 +32,8 @@ struct ClusterFrame : lighting::PreparedFrame {
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
 
-    explicit ClusterFrame(scenes::Scene scene) : lighting::PreparedFrame(std::move(scene), kWidth, kHeight) {
+    explicit ClusterFrame(scenes::Scene scene)
+        : lighting::PreparedFrame(std::move(scene), kWidth, kHeight) {
         oracle = lighting::countContributingLights(frame);
         lighting::makeStage("brute")->shade(frame, brute);
     }

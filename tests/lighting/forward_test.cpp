@@ -21,7 +21,8 @@
 namespace {
 
 struct TestFrame : lighting::PreparedFrame {
-    TestFrame(scenes::Scene s, int width, int height) : lighting::PreparedFrame(std::move(s), width, height) {}
+    TestFrame(scenes::Scene s, int width, int height)
+        : lighting::PreparedFrame(std::move(s), width, height) {}
 };
 
 lighting::StageResult run(const std::string& stage, const TestFrame& f) {

@@ -32,7 +32,8 @@ struct TestFrame : lighting::PreparedFrame {
     lighting::StageResult brute;
 
     // Renders the G-buffer of `scene`; setLights() replaces the lights and re-runs the oracles.
-    explicit TestFrame(scenes::Scene s, gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed)
+    explicit TestFrame(scenes::Scene s,
+                       gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed)
         : lighting::PreparedFrame(std::move(s), kWidth, kHeight, false, depth) {
         setLights(scene.lights);
     }
@@ -49,7 +50,8 @@ struct TestFrame : lighting::PreparedFrame {
     }
 };
 
-scenes::Scene proceduralScene(const char* name, int lightCount, std::map<std::string, std::string> options = {}) {
+scenes::Scene proceduralScene(const char* name, int lightCount,
+                              std::map<std::string, std::string> options = {}) {
     scenes::SceneRequest request;
     request.lightCount = lightCount;
     request.seed = 7;
@@ -63,18 +65,22 @@ void expectMatchesBrute(const TestFrame& f, const std::string& stage, const std:
     lighting::makeStage(stage)->shade(f.frame, result);
     float peak = 0.0f;
     for (int ch = 0; ch < 3; ++ch)
-        for (float v : f.brute.radiance[ch]) peak = std::max(peak, v);
+        for (float v : f.brute.radiance[ch])
+            peak = std::max(peak, v);
     int imageFailures = 0, dropped = 0;
     for (size_t pixel = 0; pixel < f.oracle.size(); ++pixel) {
         for (int ch = 0; ch < 3; ++ch) {
-            const float difference = std::abs(result.radiance[ch][pixel] - f.brute.radiance[ch][pixel]);
+            const float difference =
+                std::abs(result.radiance[ch][pixel] - f.brute.radiance[ch][pixel]);
             if (!(difference <= 1e-5f * peak) && imageFailures++ < 3)
                 ADD_FAILURE() << stage << " " << where << ": pixel (" << pixel % kWidth << ", "
-                              << pixel / kWidth << ") differs by " << difference << " (peak " << peak << ")";
+                              << pixel / kWidth << ") differs by " << difference << " (peak "
+                              << peak << ")";
         }
         if (result.lightsEvaluated[pixel] < f.oracle[pixel] && dropped++ < 3)
-            ADD_FAILURE() << stage << " " << where << ": pixel (" << pixel % kWidth << ", " << pixel / kWidth
-                          << ") evaluated " << result.lightsEvaluated[pixel] << " < oracle " << f.oracle[pixel];
+            ADD_FAILURE() << stage << " " << where << ": pixel (" << pixel % kWidth << ", "
+                          << pixel / kWidth << ") evaluated " << result.lightsEvaluated[pixel]
+                          << " < oracle " << f.oracle[pixel];
     }
     EXPECT_EQ(imageFailures, 0) << stage << " " << where;
     EXPECT_EQ(dropped, 0) << stage << " " << where;
@@ -99,10 +105,12 @@ TEST(LightVolumes, OptionVariantsMatchBrute) {
         int lights;
         std::map<std::string, std::string> options;
     };
-    const Case cases[] = {{"atrium", 300, {}}, {"wall", 400, {{"behind", "200"}}}, {"spheres", 200, {}}};
+    const Case cases[] = {
+        {"atrium", 300, {}}, {"wall", 400, {{"behind", "200"}}}, {"spheres", 200, {}}};
     for (const Case& c : cases) {
         const TestFrame f(proceduralScene(c.scene, c.lights, c.options));
-        for (const std::string& stage : kVariants) expectMatchesBrute(f, stage, c.scene);
+        for (const std::string& stage : kVariants)
+            expectMatchesBrute(f, stage, c.scene);
     }
 }
 
@@ -114,7 +122,8 @@ TEST(LightVolumes, LightIndexedOverflowIsReportedAndConservative) {
     EXPECT_GT(std::stoull(result.parameters.at("overflow_pixels")), 0u);
     // Overflowed pixels are shaded with their 16x16 tile's conservative list: more than the
     // one-entry capacity, far fewer than every light (exactness: OptionVariantsMatchBrute).
-    const uint32_t most = *std::max_element(result.lightsEvaluated.begin(), result.lightsEvaluated.end());
+    const uint32_t most =
+        *std::max_element(result.lightsEvaluated.begin(), result.lightsEvaluated.end());
     EXPECT_GT(most, 1u);
     EXPECT_LT(most, uint32_t(f.lights.size()) / 2);
 }
@@ -124,29 +133,35 @@ TEST(LightVolumes, ProxyCircumscribesTheUnitSphereAndIsClosed) {
     ASSERT_EQ(proxy.positions.size(), 42u);
     ASSERT_EQ(proxy.indices.size(), 80u * 3);
     std::map<std::pair<uint32_t, uint32_t>, int> directedEdges;
-    std::vector<glm::vec4> planes;  // outward unit normal, distance from the origin
+    std::vector<glm::vec4> planes; // outward unit normal, distance from the origin
     for (size_t t = 0; t < proxy.indices.size(); t += 3) {
         const uint32_t i[3] = {proxy.indices[t], proxy.indices[t + 1], proxy.indices[t + 2]};
-        const glm::dvec3 a(proxy.positions[i[0]]), b(proxy.positions[i[1]]), c(proxy.positions[i[2]]);
+        const glm::dvec3 a(proxy.positions[i[0]]), b(proxy.positions[i[1]]),
+            c(proxy.positions[i[2]]);
         const glm::dvec3 normal = glm::normalize(glm::cross(b - a, c - a));
         const double distance = glm::dot(normal, a);
         EXPECT_GE(distance, 1.0) << "face " << t / 3 << " cuts into the unit sphere";
-        EXPECT_GT(glm::dot(normal, a + b + c), 0.0) << "face " << t / 3 << " is not counter-clockwise outside";
+        EXPECT_GT(glm::dot(normal, a + b + c), 0.0)
+            << "face " << t / 3 << " is not counter-clockwise outside";
         planes.emplace_back(glm::vec3(normal), float(distance));
-        for (int e = 0; e < 3; ++e) ++directedEdges[{i[e], i[(e + 1) % 3]}];
+        for (int e = 0; e < 3; ++e)
+            ++directedEdges[{i[e], i[(e + 1) % 3]}];
     }
     // Closed and consistently wound: every directed edge once, and its reverse once.
     for (const auto& [edge, count] : directedEdges) {
         EXPECT_EQ(count, 1);
         EXPECT_EQ(directedEdges.count({edge.second, edge.first}), 1u);
     }
-    for (const glm::vec3& p : proxy.positions) EXPECT_LE(glm::length(p), proxy.circumradius);
+    for (const glm::vec3& p : proxy.positions)
+        EXPECT_LE(glm::length(p), proxy.circumradius);
     // Random points of the unit sphere are inside every face plane.
     std::mt19937 random(1);
     std::normal_distribution<float> gaussian;
     for (int s = 0; s < 20000; ++s) {
-        const glm::vec3 p = glm::normalize(glm::vec3(gaussian(random), gaussian(random), gaussian(random)));
-        for (const glm::vec4& plane : planes) ASSERT_LE(glm::dot(glm::vec3(plane), p), plane.w);
+        const glm::vec3 p =
+            glm::normalize(glm::vec3(gaussian(random), gaussian(random), gaussian(random)));
+        for (const glm::vec4& plane : planes)
+            ASSERT_LE(glm::dot(glm::vec3(plane), p), plane.w);
     }
 }
 
@@ -165,29 +180,38 @@ std::vector<scenes::Light> hardLights(const TestFrame& f) {
         lights.push_back(light);
     };
     const float nearMetres = f.view.nearMetres;
-    point({0.0f, 0.0f, -0.5f}, 4.0f);                   // camera inside the volume
-    point({0.2f, 0.1f, -nearMetres}, 1.5f);             // centred on the near plane
-    point({-0.3f, 0.0f, 0.05f}, 0.8f);                  // just behind the eye, reaching in front
-    point({0.0f, 0.0f, 3.0f}, 2.0f);                    // wholly behind the camera
-    point({0.0f, 0.0f, 1.0f}, 50.0f);                   // behind, covering everything in view
-    point({0.0f, 0.0f, -20.0f}, 2.0f * f.view.farMetres);  // whole screen, beyond the far plane
+    point({0.0f, 0.0f, -0.5f}, 4.0f);                     // camera inside the volume
+    point({0.2f, 0.1f, -nearMetres}, 1.5f);               // centred on the near plane
+    point({-0.3f, 0.0f, 0.05f}, 0.8f);                    // just behind the eye, reaching in front
+    point({0.0f, 0.0f, 3.0f}, 2.0f);                      // wholly behind the camera
+    point({0.0f, 0.0f, 1.0f}, 50.0f);                     // behind, covering everything in view
+    point({0.0f, 0.0f, -20.0f}, 2.0f * f.view.farMetres); // whole screen, beyond the far plane
     // Surfaces: range zero on a surface, and spheres barely touching or reaching through it.
     int placed = 0;
     for (int y = 5; y < kHeight; y += 23)
         for (int x = 7; x < kWidth; x += 31) {
             const size_t pixel = size_t(y) * kWidth + x;
-            if (!f.gbuffer->covered(pixel)) continue;
+            if (!f.gbuffer->covered(pixel))
+                continue;
             const gbuffer::Surface s = f.gbuffer->decode(x, y);
             const float distance = glm::length(s.positionView);
             const float range = 0.02f * distance + 0.05f;
             switch (placed++ % 4) {
-            case 0: point(s.positionView, 0.0f); break;
-            case 1: point(s.positionView + s.normalView * (range * 0.999f), range); break;
-            case 2: point(s.positionView - s.normalView * (range * 0.999f), range); break;
+            case 0:
+                point(s.positionView, 0.0f);
+                break;
+            case 1:
+                point(s.positionView + s.normalView * (range * 0.999f), range);
+                break;
+            case 2:
+                point(s.positionView - s.normalView * (range * 0.999f), range);
+                break;
             default: {
                 // Grazing: along the surface, slightly above it.
-                const glm::vec3 along = glm::normalize(glm::cross(s.normalView, glm::vec3(0.0f, 1.0f, 0.3f)));
-                point(s.positionView + along * (range * 0.9f) + s.normalView * (range * 0.05f), range);
+                const glm::vec3 along =
+                    glm::normalize(glm::cross(s.normalView, glm::vec3(0.0f, 1.0f, 0.3f)));
+                point(s.positionView + along * (range * 0.9f) + s.normalView * (range * 0.05f),
+                      range);
             }
             }
         }
@@ -205,7 +229,8 @@ TEST(LightVolumes, HardCasesMatchBrute) {
     for (const char* sceneName : {"atrium", "spheres", "wall"}) {
         TestFrame f(proceduralScene(sceneName, 20));
         f.setLights(hardLights(f));
-        for (const std::string& stage : kVariants) expectMatchesBrute(f, stage, std::string("hard ") + sceneName);
+        for (const std::string& stage : kVariants)
+            expectMatchesBrute(f, stage, std::string("hard ") + sceneName);
     }
 }
 
@@ -213,7 +238,8 @@ TEST(LightVolumes, StandardDepthMatchesBrute) {
     TestFrame f(proceduralScene("atrium", 200), gbuffer::DepthConvention::Standard);
     ASSERT_FALSE(f.view.reversedZ());
     f.setLights(hardLights(f));
-    for (const std::string& stage : kVariants) expectMatchesBrute(f, stage, "standard depth");
+    for (const std::string& stage : kVariants)
+        expectMatchesBrute(f, stage, "standard depth");
 }
 
 TEST(LightVolumes, SameResultForOneAndTwoThreads) {
@@ -222,7 +248,8 @@ TEST(LightVolumes, SameResultForOneAndTwoThreads) {
         lighting::StageResult one, two;
         tbb::task_arena(1).execute([&] { lighting::makeStage(stage)->shade(f.frame, one); });
         tbb::task_arena(2).execute([&] { lighting::makeStage(stage)->shade(f.frame, two); });
-        for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(one.radiance[ch], two.radiance[ch]) << stage;
+        for (int ch = 0; ch < 3; ++ch)
+            EXPECT_EQ(one.radiance[ch], two.radiance[ch]) << stage;
         EXPECT_EQ(one.lightsEvaluated, two.lightsEvaluated) << stage;
     }
 }
@@ -233,9 +260,12 @@ TEST(LightVolumes, DeferredCullsOnAtrium) {
         lighting::StageResult result;
         lighting::makeStage(stage)->shade(f.frame, result);
         uint64_t evaluated = 0, brute = 0;
-        for (uint32_t n : result.lightsEvaluated) evaluated += n;
-        for (uint32_t n : f.brute.lightsEvaluated) brute += n;
-        EXPECT_LT(evaluated * 4, brute) << stage << " evaluated " << evaluated << " of brute's " << brute;
+        for (uint32_t n : result.lightsEvaluated)
+            evaluated += n;
+        for (uint32_t n : f.brute.lightsEvaluated)
+            brute += n;
+        EXPECT_LT(evaluated * 4, brute)
+            << stage << " evaluated " << evaluated << " of brute's " << brute;
     }
 }
 
@@ -274,7 +304,7 @@ TEST(LightVolumes, ConeProxyCircumscribesTheLitRegionAndIsClosed) {
             (glm::dvec3(cone->positionsView[0]) + glm::dvec3(cone->positionsView[1]) +
              glm::dvec3(cone->positionsView[1 + lighting::kConeProxySides / 2])) /
             3.0;
-        std::vector<glm::dvec4> planes;  // outward unit normal, offset
+        std::vector<glm::dvec4> planes; // outward unit normal, offset
         for (size_t t = 0; t < indices.size(); t += 3) {
             const glm::dvec3 a(cone->positionsView[indices[t]]),
                 b(cone->positionsView[indices[t + 1]]), c(cone->positionsView[indices[t + 2]]);
@@ -417,7 +447,7 @@ TEST(LightVolumes, ConeProxiesCullMoreThanSpheresForNarrowSpots) {
         const float a = 2.399963f * float(index);
         light.type = scenes::LightType::Spot;
         light.directionWorld = glm::normalize(glm::vec3(std::cos(a), -0.5f, std::sin(a)));
-        const float outer = glm::radians(5.0f + 25.0f * float(index % 6) / 5.0f);  // 5..30 degrees
+        const float outer = glm::radians(5.0f + 25.0f * float(index % 6) / 5.0f); // 5..30 degrees
         light.spotOuterCos = std::cos(outer);
         light.spotInnerCos = std::cos(0.8f * outer);
         light.rangeMetres *= 2.0f;
@@ -481,7 +511,8 @@ TEST(LightVolumes, FrustumCullingAndScreenRectAreConservative) {
                 t = std::clamp(t, tNear, tFar);
                 if (glm::length(ray * t - sphere.centreView) < sphere.radius) {
                     anyInside = true;
-                    ASSERT_TRUE(x >= rect.minX && x <= rect.maxX && y >= rect.minY && y <= rect.maxY)
+                    ASSERT_TRUE(x >= rect.minX && x <= rect.maxX && y >= rect.minY &&
+                                y <= rect.maxY)
                         << "pixel (" << x << ", " << y << ") outside the rectangle of sphere " << s;
                 }
             }
@@ -493,4 +524,4 @@ TEST(LightVolumes, FrustumCullingAndScreenRectAreConservative) {
     EXPECT_GT(visibleCount, 30);
 }
 
-}  // namespace
+} // namespace

@@ -22,7 +22,7 @@ struct SceneCase {
     const char* scene;
     int lights;
     std::map<std::string, std::string> options;
-    bool spots = false;  // turn the generated point lights into spot lights of varied cones
+    bool spots = false; // turn the generated point lights into spot lights of varied cones
 };
 
 // Small images keep the suite fast; light counts are high enough that culling matters.
@@ -42,14 +42,16 @@ const SceneCase kScenes[] = {
 void makeSpots(scenes::Scene& scene) {
     int index = 0;
     for (scenes::Light& light : scene.lights) {
-        if (light.type != scenes::LightType::Point) continue;
-        const float a = 2.399963f * float(index);  // golden angle: spread without clumping
+        if (light.type != scenes::LightType::Point)
+            continue;
+        const float a = 2.399963f * float(index); // golden angle: spread without clumping
         light.type = scenes::LightType::Spot;
-        light.directionWorld = glm::normalize(glm::vec3(std::cos(a), -0.2f - 0.8f * float(index % 5) / 4.0f, std::sin(a)));
+        light.directionWorld = glm::normalize(
+            glm::vec3(std::cos(a), -0.2f - 0.8f * float(index % 5) / 4.0f, std::sin(a)));
         const float outer = glm::radians(5.0f + 95.0f * float(index % 11) / 10.0f);
         light.spotOuterCos = std::cos(outer);
         light.spotInnerCos = std::cos(0.8f * outer);
-        light.rangeMetres *= 1.5f;  // spots reach farther: more pixels to cull correctly
+        light.rangeMetres *= 1.5f; // spots reach farther: more pixels to cull correctly
         ++index;
     }
 }
@@ -64,14 +66,16 @@ struct PreparedCase {
 const PreparedCase& prepared(const SceneCase& c) {
     static std::map<std::string, std::unique_ptr<PreparedCase>> cache;
     auto& slot = cache[c.name];
-    if (slot) return *slot;
+    if (slot)
+        return *slot;
     slot = std::make_unique<PreparedCase>();
     scenes::SceneRequest request;
     request.lightCount = c.lights;
     request.seed = 3;
     request.options = c.options;
     scenes::Scene scene = scenes::buildProceduralScene(c.scene, request);
-    if (c.spots) makeSpots(scene);
+    if (c.spots)
+        makeSpots(scene);
     slot->prepared = std::make_unique<lighting::PreparedFrame>(std::move(scene), kWidth, kHeight);
     slot->oracle = lighting::countContributingLights(slot->prepared->frame);
     lighting::makeStage("brute")->shade(slot->prepared->frame, slot->brute);
@@ -81,7 +85,8 @@ const PreparedCase& prepared(const SceneCase& c) {
 std::vector<std::string> exactStageNames() {
     std::vector<std::string> names;
     for (const lighting::StageInfo& info : lighting::stageInfos())
-        if (info.kind == lighting::StageKind::Exact) names.push_back(info.name);
+        if (info.kind == lighting::StageKind::Exact)
+            names.push_back(info.name);
     return names;
 }
 
@@ -98,7 +103,8 @@ TEST_P(ExactStage, MatchesBruteAndNeverDropsALight) {
 
     float peak = 0.0f;
     for (int ch = 0; ch < 3; ++ch)
-        for (float v : f.brute.radiance[ch]) peak = std::max(peak, v);
+        for (float v : f.brute.radiance[ch])
+            peak = std::max(peak, v);
     ASSERT_GT(peak, 0.0f);
     uint64_t evaluated = 0, oracle = 0;
     int imageFailures = 0, droppedLights = 0;
@@ -106,11 +112,13 @@ TEST_P(ExactStage, MatchesBruteAndNeverDropsALight) {
         evaluated += result.lightsEvaluated[pixel];
         oracle += f.oracle[pixel];
         for (int ch = 0; ch < 3; ++ch) {
-            const float difference = std::abs(result.radiance[ch][pixel] - f.brute.radiance[ch][pixel]);
+            const float difference =
+                std::abs(result.radiance[ch][pixel] - f.brute.radiance[ch][pixel]);
             if (!(difference <= 1e-5f * peak) && imageFailures++ < 5)
-                ADD_FAILURE() << stageName << " on " << c.name << ": pixel (" << pixel % kWidth << ", "
-                              << pixel / kWidth << ") channel " << ch << " differs from brute by "
-                              << difference << " (peak " << peak << ")";
+                ADD_FAILURE() << stageName << " on " << c.name << ": pixel (" << pixel % kWidth
+                              << ", " << pixel / kWidth << ") channel " << ch
+                              << " differs from brute by " << difference << " (peak " << peak
+                              << ")";
         }
         if (result.lightsEvaluated[pixel] < f.oracle[pixel] && droppedLights++ < 5)
             ADD_FAILURE() << stageName << " on " << c.name << ": pixel (" << pixel % kWidth << ", "
@@ -119,17 +127,19 @@ TEST_P(ExactStage, MatchesBruteAndNeverDropsALight) {
     }
     EXPECT_EQ(imageFailures, 0);
     EXPECT_EQ(droppedLights, 0);
-    RecordProperty("culling_efficiency", std::to_string(double(oracle) / std::max<uint64_t>(evaluated, 1)));
+    RecordProperty("culling_efficiency",
+                   std::to_string(double(oracle) / std::max<uint64_t>(evaluated, 1)));
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    AllExactStages, ExactStage,
-    ::testing::Combine(::testing::ValuesIn(exactStageNames()), ::testing::Range(0, int(std::size(kScenes)))),
-    [](const auto& info) {
-        std::string name = std::get<0>(info.param) + "_" + kScenes[std::get<1>(info.param)].name;
-        std::replace(name.begin(), name.end(), '-', '_');
-        return name;
-    });
+INSTANTIATE_TEST_SUITE_P(AllExactStages, ExactStage,
+                         ::testing::Combine(::testing::ValuesIn(exactStageNames()),
+                                            ::testing::Range(0, int(std::size(kScenes)))),
+                         [](const auto& info) {
+                             std::string name = std::get<0>(info.param) + "_" +
+                                                kScenes[std::get<1>(info.param)].name;
+                             std::replace(name.begin(), name.end(), '-', '_');
+                             return name;
+                         });
 
 // The cone bound must cut work: on atrium with spot lights, tiled evaluates markedly fewer lights
 // than it would with the range spheres of point lights at the same places.
@@ -143,7 +153,8 @@ TEST(SpotBounds, ConeBoundsCullMoreThanRangeSpheres) {
     scenes::Scene scene = scenes::buildProceduralScene("atrium", request);
     makeSpots(scene);
     for (scenes::Light& light : scene.lights)
-        if (light.type == scenes::LightType::Spot) light.spotOuterCos = -1.0f;  // whole sphere, same range
+        if (light.type == scenes::LightType::Spot)
+            light.spotOuterCos = -1.0f; // whole sphere, same range
     lighting::PreparedFrame spheres(std::move(scene), kWidth, kHeight);
     lighting::StageResult withSpheres;
     lighting::makeStage("tiled")->shade(spheres.frame, withSpheres);
@@ -177,8 +188,9 @@ TEST(SpotBounds, DeferredConeProxiesEvaluateFewerLightsThanSpheres) {
 
 TEST(StageRegistry, EveryStageRejectsUnknownOptions) {
     for (const lighting::StageInfo& info : lighting::stageInfos())
-        EXPECT_THROW(lighting::makeStage(info.name + ":no_such_option=1"), lighting::StageError) << info.name;
+        EXPECT_THROW(lighting::makeStage(info.name + ":no_such_option=1"), lighting::StageError)
+            << info.name;
     EXPECT_THROW(lighting::makeStage("no-such-stage"), lighting::StageError);
 }
 
-}  // namespace
+} // namespace

@@ -1,9 +1,9 @@
 // `tiled-forward` (Forward+) beyond the shared exactness suite: tile=32, vfc=0 and mask=1 variants
 // are bitwise `brute` on atrium with evaluated >= oracle; it evaluates exactly as many lights per
-// pixel as `tiled` at the same tile size and options (mask=1 included) (its pre-pass depth is the G-buffer's depth, so the tile
-// bounds and hence the tile lists are the same, and the visible surface is the same); the
-// pre-pass tile bounds equal the G-buffer's bitwise; 1 thread and N threads give the same bits;
-// options are parsed, checked and recorded.
+// pixel as `tiled` at the same tile size and options (mask=1 included) (its pre-pass depth is the
+// G-buffer's depth, so the tile bounds and hence the tile lists are the same, and the visible
+// surface is the same); the pre-pass tile bounds equal the G-buffer's bitwise; 1 thread and N
+// threads give the same bits; options are parsed, checked and recorded.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -114,8 +114,8 @@ TEST(TiledForward, BitwiseBruteWithStandardDepth) {
 TEST(TiledForward, EvaluatesExactlyAsManyLightsAsTiled) {
     const std::unique_ptr<TestFrame> wall = makeFrame("wall", 300, 320, 180);
     for (const TestFrame* f : {&atrium(), static_cast<const TestFrame*>(wall.get())}) {
-        for (const std::string options :
-             {"tile=16", "tile=32", "tile=8,vfc=0", "tile=32,vfc=0", "mask=1", "tile=32,mask=1,vfc=0"}) {
+        for (const std::string options : {"tile=16", "tile=32", "tile=8,vfc=0", "tile=32,vfc=0",
+                                          "mask=1", "tile=32,mask=1,vfc=0"}) {
             const lighting::StageResult tiled = run("tiled:" + options, *f);
             const lighting::StageResult forward = run("tiled-forward:" + options, *f);
             EXPECT_EQ(forward.lightsEvaluated, tiled.lightsEvaluated) << options;

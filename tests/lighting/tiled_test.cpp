@@ -33,7 +33,8 @@ struct TestFrame : lighting::PreparedFrame {
 };
 
 // Rasterizes the scene's G-buffer only (lights can be changed afterwards with setLights).
-std::unique_ptr<TestFrame> rasterize(scenes::Scene scene, int width = kWidth, int height = kHeight) {
+std::unique_ptr<TestFrame> rasterize(scenes::Scene scene, int width = kWidth,
+                                     int height = kHeight) {
     return std::make_unique<TestFrame>(std::move(scene), width, height);
 }
 

@@ -1671,8 +1671,9 @@ TEST(RasterCulling, NonFiniteVerticesCullTheirTrianglesOnly) {
                 mesh.indices = {3, 4, 5, 0, 1, 2};
                 std::atomic<uint64_t> fromBad{0}, fromGood{0};
                 Rasterizer rasterizer(width, height);
-                rasterizer.draw(mesh.list(), {CullMode::None, DepthTest::Always, false}, nullptr,
-                                [&](const Fragment& f) { ++(f.triangle == 0 ? fromBad : fromGood); });
+                rasterizer.draw(
+                    mesh.list(), {CullMode::None, DepthTest::Always, false}, nullptr,
+                    [&](const Fragment& f) { ++(f.triangle == 0 ? fromBad : fromGood); });
                 EXPECT_EQ(fromBad.load(), 0u) << value << " in component " << component;
                 EXPECT_GT(fromGood.load(), 0u);
                 EXPECT_EQ(rasterizer.lastStats().trianglesCulled, 1u);
@@ -1840,12 +1841,14 @@ TEST(RasterDeterminism, BarycentricsOffChangesNothingButTheBarycentrics) {
     SoupOutput bare = drawSoup(rasterizer, mesh, without, true, 2);
     size_t written = 0;
     for (size_t i = 0; i < bare.triangle.size(); ++i) {
-        if (bare.triangle[i] == kNoTriangle) continue;
+        if (bare.triangle[i] == kNoTriangle)
+            continue;
         ++written;
-        for (int k = 0; k < 3; ++k) ASSERT_EQ(bare.barycentric[3 * i + k], 0.0f) << "pixel " << i;
+        for (int k = 0; k < 3; ++k)
+            ASSERT_EQ(bare.barycentric[3 * i + k], 0.0f) << "pixel " << i;
     }
     ASSERT_GT(written, 10000u);
-    bare.barycentric = full.barycentric;  // the one output allowed to differ
+    bare.barycentric = full.barycentric; // the one output allowed to differ
     expectIdentical(full, bare, "barycentrics off");
     // And back on, the same object (scratch from a draw without barycentrics) is unchanged.
     expectIdentical(full, drawSoup(rasterizer, mesh, with, true, 2), "barycentrics on again");
@@ -1925,15 +1928,17 @@ TEST_P(RasterViewport, PartlyOffscreenTrianglesMatchOracle) {
     expectCoverageMatchesOracle(mesh, width, height, "offscreen");
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Sizes, RasterViewport,
-    ::testing::Values(glm::ivec2(133, 77), glm::ivec2(1, 1), glm::ivec2(64, 64), glm::ivec2(65, 65),
-                      glm::ivec2(127, 1), glm::ivec2(1, 130), glm::ivec2(200, 129),
-                      glm::ivec2(kTileSize, kTileSize), glm::ivec2(kTileSize + 1, 2 * kTileSize + 1),
-                      glm::ivec2(3 * kTileSize - 1, 1)),
-    [](const ::testing::TestParamInfo<glm::ivec2>& info) {
-        return std::to_string(info.param.x) + "x" + std::to_string(info.param.y);
-    });
+INSTANTIATE_TEST_SUITE_P(Sizes, RasterViewport,
+                         ::testing::Values(glm::ivec2(133, 77), glm::ivec2(1, 1),
+                                           glm::ivec2(64, 64), glm::ivec2(65, 65),
+                                           glm::ivec2(127, 1), glm::ivec2(1, 130),
+                                           glm::ivec2(200, 129), glm::ivec2(kTileSize, kTileSize),
+                                           glm::ivec2(kTileSize + 1, 2 * kTileSize + 1),
+                                           glm::ivec2(3 * kTileSize - 1, 1)),
+                         [](const ::testing::TestParamInfo<glm::ivec2>& info) {
+                             return std::to_string(info.param.x) + "x" +
+                                    std::to_string(info.param.y);
+                         });
 
 } // namespace
 } // namespace raster

@@ -771,7 +771,8 @@ TEST(LoadScene, GltfWithoutLightsGetsGeneratedLights) {
     ASSERT_EQ(scene.lights.size(), 18u);
     EXPECT_EQ(scene.lights[0].type, scenes::LightType::Ambient);
     EXPECT_EQ(scene.lights[1].type, scenes::LightType::Directional);
-    for (size_t i = 2; i < scene.lights.size(); ++i) EXPECT_EQ(scene.lights[i].type, scenes::LightType::Point);
+    for (size_t i = 2; i < scene.lights.size(); ++i)
+        EXPECT_EQ(scene.lights[i].type, scenes::LightType::Point);
     EXPECT_EQ(scene.triangleCount(), 3936u);
     const Scene again = scenes::loadScene(sharedModel("Suzanne/Suzanne.gltf").string(), request);
     ASSERT_EQ(again.lights.size(), 18u);
