@@ -104,12 +104,12 @@ DepthSampler::DepthSampler(const DepthStudyOptions& options, DepthStudyCamera ca
     c.verticalFovRadians = float(options.verticalFovDegrees * kPi / 180.0);
     c.nearMetres = float(camera.nearMetres);
     c.farMetres = float(camera.farMetres);
-    mView = gbuffer::FrameView::fromCamera(c, options.width, options.height, format.convention(),
-                                           format.infiniteFar);
+    mView = gbuffer::CameraView::fromCamera(c, options.width, options.height, format.convention(),
+                                            format.infiniteFar);
     mProjection = gbuffer::DepthProjection::of(mView);
     mRasterClipFromView = glm::dmat4(mView.clipFromView);
     // glm::perspective: [1][1] = 1 / tan(fovY / 2), [0][0] = [1][1] / aspect, from the same
-    // float field of view the FrameView was built from.
+    // float field of view the CameraView was built from.
     const double tanHalf = std::tan(double(c.verticalFovRadians) / 2.0);
     mViewYPerNdc = tanHalf;
     mViewXPerNdc = tanHalf * double(options.width) / double(options.height);

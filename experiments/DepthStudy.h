@@ -8,7 +8,7 @@
 //   1. the exact view-space point p (double) at view depth d on the ray through a pixel centre of
 //      a width x height screen (vertical field of view fovY), camera at the origin looking down -Z;
 //   2. NDC depth as the rasterizer computes it: the FLOAT projection matrix of
-//      FrameView::fromCamera(camera, width, height, format.convention(), format.infiniteFar)
+//      CameraView::fromCamera(camera, width, height, format.convention(), format.infiniteFar)
 //      applied to p, z / w evaluated in double and rounded once to float (the rasterizer
 //      interpolates a double depth plane through float clip-space vertices and rounds to float;
 //      the float rounding of the vertex transform itself, at most ~1 ulp more, is not modelled);
@@ -47,8 +47,8 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "gbuffer/CameraView.h"
 #include "gbuffer/DepthFormat.h"
-#include "gbuffer/FrameView.h"
 
 namespace experiments {
 
@@ -116,14 +116,14 @@ struct DepthStudyResult {
     double studySeconds = 0.0;
 };
 
-// One camera and one format: the FrameView and DepthProjection the G-buffer would use, and the
+// One camera and one format: the CameraView and DepthProjection the G-buffer would use, and the
 // sample model above. Cheap to copy; const methods are thread-safe.
 class DepthSampler {
 public:
     DepthSampler(const DepthStudyOptions& options, DepthStudyCamera camera,
                  gbuffer::DepthFormatSpec format);
 
-    const gbuffer::FrameView& view() const { return mView; }
+    const gbuffer::CameraView& view() const { return mView; }
     const gbuffer::DepthProjection& projection() const { return mProjection; }
     // Exact view-space point at view depth d on the ray through pixel (x, y)'s centre.
     glm::dvec3 exactPointView(int x, int y, double viewDepthMetres) const;
@@ -140,7 +140,7 @@ private:
     bool validCode(uint64_t code) const;
 
     gbuffer::DepthFormatSpec mFormat;
-    gbuffer::FrameView mView;
+    gbuffer::CameraView mView;
     gbuffer::DepthProjection mProjection;
     glm::dmat4 mRasterClipFromView; // the float matrix, widened: what the rasterizer applies
     double mViewXPerNdc = 1.0;      // exact: x_view = ndc.x * d * mViewXPerNdc

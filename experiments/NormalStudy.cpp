@@ -28,7 +28,7 @@
 #include "experiments/PlotScript.h"
 #include "gbuffer/DepthFormat.h"
 #include "gbuffer/NormalCodec.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "scenes/ProceduralScenes.h"
 #include "scenes/SceneLoader.h"
 
@@ -556,9 +556,9 @@ Dataset sceneDataset(const std::string& source, const std::string& label, int wi
     scenes::Scene scene = scenes::loadScene(source, request);
     for (const std::string& warning : scene.warnings)
         warnings.push_back(label + ": " + warning);
-    lighting::PreparedFrame prepared(std::move(scene), width, height);
+    lighting::PreparedScene prepared(std::move(scene), width, height);
     const gbuffer::GBuffer& gb = *prepared.gbuffer;
-    const gbuffer::FrameView& view = prepared.view;
+    const gbuffer::CameraView& view = prepared.view;
     Dataset data{"scene:" + label, {}, {}};
     std::uint64_t negative = 0, backFacing = 0;
     for (int y = 0; y < gb.height(); ++y)

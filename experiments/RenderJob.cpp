@@ -291,9 +291,9 @@ lighting::StageResult renderReference(const RenderOptions& options) {
     lighting::StageResult reference;
     tbb::task_arena arena(effectiveThreads(options.threads));
     arena.execute([&] {
-        lighting::PreparedFrame frame(loadRequestedScene(options), options.width, options.height,
+        lighting::PreparedScene frame(loadRequestedScene(options), options.width, options.height,
                                       true);
-        lighting::makeStage("reference")->shade(frame.frame, reference);
+        lighting::makeStage("reference")->shade(frame.inputs, reference);
     });
     return reference;
 }
@@ -331,9 +331,9 @@ RenderRun runRender(const RenderOptions& options,
 
         step("G-buffer pass");
         const bool needExact = needs.exactSurface || (compare && !givenReference);
-        run.prepared = std::make_unique<lighting::PreparedFrame>(std::move(scene), options.width,
+        run.prepared = std::make_unique<lighting::PreparedScene>(std::move(scene), options.width,
                                                                  options.height, needExact, layout);
-        const lighting::Frame& frame = run.prepared->frame;
+        const lighting::StageInputs& frame = run.prepared->inputs;
         const int runs = options.warmup + options.repetitions;
         for (int i = 0; i < runs; ++i) {
             const bool timed = i >= options.warmup;
@@ -380,7 +380,7 @@ RenderRun runRender(const RenderOptions& options,
                 run.oracleFromLosslessGBuffer = true;
                 const std::unique_ptr<gbuffer::GBuffer> lossless =
                     run.prepared->renderLosslessGBuffer();
-                lighting::Frame losslessFrame = frame;
+                lighting::StageInputs losslessFrame = frame;
                 losslessFrame.gbuffer = lossless.get();
                 run.oracle = lighting::countContributingLights(losslessFrame);
             }

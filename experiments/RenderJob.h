@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "gbuffer/LayoutDerivation.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/ShadingStage.h"
 #include "scenes/Scene.h"
 
@@ -88,7 +88,7 @@ struct PassTiming {
 struct RenderRun {
     RenderOptions options;
     int threads = 0;                                   // effective
-    std::unique_ptr<lighting::PreparedFrame> prepared; // scene, G-buffer, exact surface, lights
+    std::unique_ptr<lighting::PreparedScene> prepared; // scene, G-buffer, exact surface, lights
     lighting::StageResult result;
     std::vector<uint32_t> oracle; // per pixel, from the stage or counted by brute force
     std::vector<PassTiming>

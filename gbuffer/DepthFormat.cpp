@@ -104,7 +104,7 @@ DepthConvention DepthFormatSpec::convention() const {
                : DepthConvention::Standard;
 }
 
-DepthProjection DepthProjection::of(const FrameView& view) {
+DepthProjection DepthProjection::of(const CameraView& view) {
     return {double(view.nearMetres), double(view.farMetres), view.infiniteFar, view.reversedZ()};
 }
 
@@ -227,17 +227,17 @@ PositionMethod parsePositionMethod(const std::string& text) {
                                 "'; valid: inverse-projection, view-ray");
 }
 
-glm::vec3 positionByInverseProjection(const FrameView& view, glm::vec2 ndc, float depthNdc) {
+glm::vec3 positionByInverseProjection(const CameraView& view, glm::vec2 ndc, float depthNdc) {
     const glm::vec4 p = view.viewFromClip * glm::vec4(ndc, depthNdc, 1.0f);
     return glm::vec3(p) / p.w;
 }
 
-glm::vec3 viewRayOfNdc(const FrameView& view, glm::vec2 ndc) {
+glm::vec3 viewRayOfNdc(const CameraView& view, glm::vec2 ndc) {
     // clipFromView[0][0] = 1 / (aspect tan(fov/2)), [1][1] = 1 / tan(fov/2) (symmetric frustum).
     return {ndc.x / view.clipFromView[0][0], ndc.y / view.clipFromView[1][1], -1.0f};
 }
 
-glm::vec3 positionByViewRay(const FrameView& view, glm::vec2 ndc, float viewDepthMetres) {
+glm::vec3 positionByViewRay(const CameraView& view, glm::vec2 ndc, float viewDepthMetres) {
     return viewRayOfNdc(view, ndc) * viewDepthMetres;
 }
 

@@ -26,7 +26,7 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/FrameView.h"
+#include "gbuffer/CameraView.h"
 
 namespace gbuffer {
 
@@ -58,7 +58,7 @@ struct DepthProjection {
     bool infiniteFar = false;
     bool reversed = true;
 
-    static DepthProjection of(const FrameView& view);
+    static DepthProjection of(const CameraView& view);
     double ndcFromViewDepth(double viewDepthMetres) const;
     double viewDepthFromNdc(double depthNdc) const;
     // The same inverse evaluated in float, as a shader reconstructing linear depth would, in the
@@ -88,9 +88,9 @@ enum class PositionMethod {
 const char* positionMethodName(PositionMethod method); // "inverse-projection", "view-ray"
 PositionMethod parsePositionMethod(const std::string& text);
 
-glm::vec3 positionByInverseProjection(const FrameView& view, glm::vec2 ndc, float depthNdc);
-glm::vec3 positionByViewRay(const FrameView& view, glm::vec2 ndc, float viewDepthMetres);
+glm::vec3 positionByInverseProjection(const CameraView& view, glm::vec2 ndc, float depthNdc);
+glm::vec3 positionByViewRay(const CameraView& view, glm::vec2 ndc, float viewDepthMetres);
 // The view ray through `ndc` with z = -1 (also the ray `pixel-view` normals are built on).
-glm::vec3 viewRayOfNdc(const FrameView& view, glm::vec2 ndc);
+glm::vec3 viewRayOfNdc(const CameraView& view, glm::vec2 ndc);
 
 } // namespace gbuffer

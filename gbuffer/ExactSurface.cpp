@@ -16,7 +16,7 @@ void ExactSurface::resize(int w, int h) {
     normalView.assign(n, glm::dvec3(0.0));
 }
 
-void ExactSurface::computeGeometry(const SceneGeometry& geometry, const FrameView& view) {
+void ExactSurface::computeGeometry(const SceneGeometry& geometry, const CameraView& view) {
     const glm::dmat3 normalViewFromWorld(view.viewFromWorldExact);
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {

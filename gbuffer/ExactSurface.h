@@ -11,7 +11,7 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/FrameView.h"
+#include "gbuffer/CameraView.h"
 #include "gbuffer/SceneGeometry.h"
 
 namespace gbuffer {
@@ -31,7 +31,7 @@ struct ExactSurface {
     void resize(int w, int h);
     bool covered(size_t pixel) const { return triangle[pixel] != kNoTriangle; }
     // Fills positionView and normalView from `triangle` (parallel over rows, deterministic).
-    void computeGeometry(const SceneGeometry& geometry, const FrameView& view);
+    void computeGeometry(const SceneGeometry& geometry, const CameraView& view);
 };
 
 } // namespace gbuffer

@@ -39,7 +39,7 @@ uint32_t unorm8(float v) {
 
 } // namespace
 
-GBuffer::GBuffer(const GBufferLayout& layout, const FrameView& view)
+GBuffer::GBuffer(const GBufferLayout& layout, const CameraView& view)
     : mLayout(layout), mView(view), mProjection(DepthProjection::of(view)),
       mClearDepth(view.clearDepth()) {
     if (layout.depth.convention() != view.depthConvention ||

@@ -2,7 +2,7 @@
 // in the encodings of its GBufferLayout, and the decoder every reader goes through.
 //
 // Storage (see GBufferLayout.h for the encodings):
-// - Depth: one float plane of NDC depth in the FrameView's convention (reversed by default),
+// - Depth: one float plane of NDC depth in the CameraView's convention (reversed by default),
 //   cleared to the far plane's value, which marks background. The rasterizer depth-tests in it;
 //   afterwards quantiseDepth() rounds every covered pixel through the layout's depth format, so
 //   every reader (decode, and the culling code that reads depth() directly) sees exactly what the
@@ -23,8 +23,8 @@
 
 #include <glm/glm.hpp>
 
+#include "gbuffer/CameraView.h"
 #include "gbuffer/DepthFormat.h"
-#include "gbuffer/FrameView.h"
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/Plane.h"
 
@@ -43,11 +43,11 @@ struct Surface {
 class GBuffer {
 public:
     // Throws std::invalid_argument when the layout's depth format does not match the view's depth
-    // convention or far plane (FrameView::fromCamera must be called with the format's).
-    GBuffer(const GBufferLayout& layout, const FrameView& view);
+    // convention or far plane (CameraView::fromCamera must be called with the format's).
+    GBuffer(const GBufferLayout& layout, const CameraView& view);
 
     const GBufferLayout& layout() const { return mLayout; }
-    const FrameView& view() const { return mView; }
+    const CameraView& view() const { return mView; }
     int width() const { return mView.width; }
     int height() const { return mView.height; }
     size_t pixelCount() const { return size_t(mView.width) * mView.height; }
@@ -114,7 +114,7 @@ private:
     void writeEncoded(size_t pixel, const Surface& surface);
 
     GBufferLayout mLayout;
-    FrameView mView;
+    CameraView mView;
     DepthProjection mProjection;
     glm::mat3 mWorldFromView{
         1.0f}; // for world-space normal codes (viewFromWorldNormal is a rotation)

@@ -140,7 +140,7 @@ Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& sc
     return surface;
 }
 
-glm::vec3 positionViewOfPixel(const FrameView& view, int x, int y, float depth) {
+glm::vec3 positionViewOfPixel(const CameraView& view, int x, int y, float depth) {
     const glm::vec2 ndc = view.ndcOfPixel(x, y);
     const glm::vec4 p = view.viewFromClip * glm::vec4(ndc, depth, 1.0f);
     return glm::vec3(p) / p.w;
@@ -152,7 +152,7 @@ GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geomet
         throw std::length_error(scene.name + ": too many triangles for the visibility buffer");
 }
 
-void GBufferPass::transformVertices(const FrameView& view) {
+void GBufferPass::transformVertices(const CameraView& view) {
     const size_t count = mGeometry.positionWorld.size();
     mClipPositions.resize(count);
     mNormalView.resize(count);
@@ -167,7 +167,7 @@ void GBufferPass::transformVertices(const FrameView& view) {
 
 void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
     const int width = target.width();
-    const FrameView& view = target.view();
+    const CameraView& view = target.view();
     const GBuffer::Writer sharedWriter = target.writer();
     // ndcOfPixel's x per column, computed once: the same floats, without a division per pixel.
     std::vector<float> ndcXOfColumn(static_cast<size_t>(width));
@@ -212,7 +212,7 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
 GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& target,
                                        ExactSurface* exact) {
     GBufferPassTimings timings;
-    const FrameView& view = target.view();
+    const CameraView& view = target.view();
     auto start = std::chrono::steady_clock::now();
     transformVertices(view);
     timings.transformMs = millisecondsSince(start);

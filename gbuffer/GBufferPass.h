@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
+#include "gbuffer/CameraView.h"
 #include "gbuffer/ExactSurface.h"
-#include "gbuffer/FrameView.h"
 #include "gbuffer/GBuffer.h"
 #include "gbuffer/Plane.h"
 #include "gbuffer/SceneGeometry.h"
@@ -35,7 +35,7 @@ Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& sc
 // View-space position of pixel (x, y) at NDC depth `depth`: the same formula as
 // GBuffer::reconstructPositionView, so a fragment's position equals the one decoded from the
 // G-buffer's stored depth. Pure, thread-safe.
-glm::vec3 positionViewOfPixel(const FrameView& view, int x, int y, float depth);
+glm::vec3 positionViewOfPixel(const CameraView& view, int x, int y, float depth);
 
 struct GBufferPassTimings {
     double transformMs = 0.0;
@@ -60,7 +60,7 @@ public:
     const std::vector<glm::vec3>& normalsView() const { return mNormalView; }
 
 private:
-    void transformVertices(const FrameView& view);
+    void transformVertices(const CameraView& view);
     void resolve(GBuffer& target, ExactSurface* exact) const;
 
     // Visibility buffer: the visible triangle per pixel (kNoTriangle for background, the top bit

@@ -9,16 +9,16 @@
 
 namespace lighting {
 
-void ForwardFrame::prepare(const Frame& frame) {
-    if (!frame.scene || !frame.geometry || !frame.view)
+void ForwardFrame::prepare(const StageInputs& inputs) {
+    if (!inputs.scene || !inputs.geometry || !inputs.view)
         throw std::invalid_argument("forward shading needs the frame's scene, geometry and view");
-    mScene = frame.scene;
-    mGeometry = frame.geometry;
-    mView = frame.view;
-    const gbuffer::SceneGeometry& geometry = *frame.geometry;
-    const gbuffer::FrameView& view = *frame.view;
+    mScene = inputs.scene;
+    mGeometry = inputs.geometry;
+    mView = inputs.view;
+    const gbuffer::SceneGeometry& geometry = *inputs.geometry;
+    const gbuffer::CameraView& view = *inputs.view;
     if (geometry.triangleCount() >= kBackFaceBit)
-        throw std::length_error(frame.scene->name + ": too many triangles for forward shading");
+        throw std::length_error(inputs.scene->name + ": too many triangles for forward shading");
 
     // The same expressions as GBufferPass::transformVertices (and -ffp-contract=off), so clip
     // positions, hence coverage, depth and barycentrics, are bitwise the G-buffer pass's.
@@ -69,7 +69,7 @@ void ForwardFrame::prepare(const Frame& frame) {
 }
 
 void depthPrepass(raster::Rasterizer& rasterizer, const ForwardFrame& forward,
-                  const gbuffer::FrameView& view, std::vector<float>& depth,
+                  const gbuffer::CameraView& view, std::vector<float>& depth,
                   std::vector<uint32_t>& visible) {
     const size_t pixelCount = size_t(view.width) * view.height;
     depth.assign(pixelCount, view.clearDepth());
@@ -87,7 +87,7 @@ void depthPrepass(raster::Rasterizer& rasterizer, const ForwardFrame& forward,
 }
 
 void fitRasterizer(std::unique_ptr<raster::Rasterizer>& rasterizer,
-                   const gbuffer::FrameView& view) {
+                   const gbuffer::CameraView& view) {
     if (!rasterizer || rasterizer->width() != view.width || rasterizer->height() != view.height)
         rasterizer = std::make_unique<raster::Rasterizer>(view.width, view.height);
 }

@@ -10,7 +10,7 @@
 // from the G-buffer (the same triangles through the same rasterizer give the same depth), and
 // evaluating lights in ascending index order gives bitwise brute's radiance.
 //
-// Conventions: view space right-handed, camera down -Z; depth in the FrameView's convention
+// Conventions: view space right-handed, camera down -Z; depth in the CameraView's convention
 // (reversed by default), so "closer" is Greater for reversed Z. Culling is conservative: lights
 // are tested with the widened spheres of LightBounds.h against object boxes padded by
 // kObjectBoxSlack, so rounding only ever adds work.
@@ -59,9 +59,9 @@ inline uint32_t visibilityCode(uint32_t triangle, bool frontFacing) {
 
 class ForwardFrame {
 public:
-    // Transforms vertices, builds the objects and their bounds for frame.view. Requires
-    // frame.scene, frame.geometry, frame.view. Cost O(vertices + triangles), parallel.
-    void prepare(const Frame& frame);
+    // Transforms vertices, builds the objects and their bounds for inputs.view. Requires
+    // inputs.scene, inputs.geometry, inputs.view. Cost O(vertices + triangles), parallel.
+    void prepare(const StageInputs& inputs);
 
     const std::vector<glm::vec4>& clipPositions() const { return mClipPositions; }
     const std::vector<glm::vec3>& normalsView() const { return mNormalsView; }
@@ -81,7 +81,7 @@ public:
 private:
     const scenes::Scene* mScene = nullptr;
     const gbuffer::SceneGeometry* mGeometry = nullptr;
-    const gbuffer::FrameView* mView = nullptr;
+    const gbuffer::CameraView* mView = nullptr;
     std::vector<glm::vec4> mClipPositions;
     std::vector<glm::vec3> mNormalsView;
     std::vector<glm::vec3> mPositionsView; // for the object bounds only
@@ -101,10 +101,10 @@ inline bool sphereTouchesObject(const LightSphere& sphere, const ForwardObject& 
 
 // Depth tests of the frame's convention: strictly closer (first draw / pre-pass) and closer or
 // equal (a draw after a pre-pass, which lets the visible fragment pass again).
-inline raster::DepthTest closerTest(const gbuffer::FrameView& view) {
+inline raster::DepthTest closerTest(const gbuffer::CameraView& view) {
     return view.reversedZ() ? raster::DepthTest::Greater : raster::DepthTest::Less;
 }
-inline raster::DepthTest closerOrEqualTest(const gbuffer::FrameView& view) {
+inline raster::DepthTest closerOrEqualTest(const gbuffer::CameraView& view) {
     return view.reversedZ() ? raster::DepthTest::GreaterEqual : raster::DepthTest::LessEqual;
 }
 
@@ -114,11 +114,12 @@ inline raster::DepthTest closerOrEqualTest(const gbuffer::FrameView& view) {
 // fragments whose code equals visible[pixel] implements an exact "depth equal" test: it shades
 // each pixel's visible fragment once, even where two triangles tie in depth.
 void depthPrepass(raster::Rasterizer& rasterizer, const ForwardFrame& forward,
-                  const gbuffer::FrameView& view, std::vector<float>& depth,
+                  const gbuffer::CameraView& view, std::vector<float>& depth,
                   std::vector<uint32_t>& visible);
 
 // Ensures `rasterizer` matches the view's size (recreated only when it changes).
-void fitRasterizer(std::unique_ptr<raster::Rasterizer>& rasterizer, const gbuffer::FrameView& view);
+void fitRasterizer(std::unique_ptr<raster::Rasterizer>& rasterizer,
+                   const gbuffer::CameraView& view);
 
 inline double forwardElapsedMs(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)

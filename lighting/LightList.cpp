@@ -3,7 +3,7 @@
 namespace lighting {
 
 LightList LightList::build(const std::vector<scenes::Light>& sceneLights,
-                           const gbuffer::FrameView& view) {
+                           const gbuffer::CameraView& view) {
     LightList list;
     list.lights.reserve(sceneLights.size());
     list.lightsExact.reserve(sceneLights.size());

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "gbuffer/FrameView.h"
+#include "gbuffer/CameraView.h"
 #include "lighting/Brdf.h"
 #include "scenes/Scene.h"
 
@@ -15,7 +15,7 @@ struct LightList {
     std::vector<LightInView<double>> lightsExact;
 
     static LightList build(const std::vector<scenes::Light>& sceneLights,
-                           const gbuffer::FrameView& view);
+                           const gbuffer::CameraView& view);
     size_t size() const { return lights.size(); }
 };
 

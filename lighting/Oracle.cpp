@@ -4,12 +4,12 @@
 
 namespace lighting {
 
-std::vector<uint32_t> countContributingLights(const Frame& frame) {
-    const gbuffer::GBuffer& gb = *frame.gbuffer;
+std::vector<uint32_t> countContributingLights(const StageInputs& inputs) {
+    const gbuffer::GBuffer& gb = *inputs.gbuffer;
     StageResult scratch;
     scratch.resize(gb.width(), gb.height(), true);
     shadeWithEveryLight<float>(
-        gb.width(), gb.height(), frame.lights->lights,
+        gb.width(), gb.height(), inputs.lights->lights,
         [&](int x, int y, ShadingPoint<float>& point) { return gbufferSurfaceAt(gb, x, y, point); },
         scratch);
     return std::move(scratch.lightsOracle);

@@ -10,6 +10,6 @@
 
 namespace lighting {
 
-std::vector<uint32_t> countContributingLights(const Frame& frame);
+std::vector<uint32_t> countContributingLights(const StageInputs& inputs);
 
 } // namespace lighting

@@ -13,8 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "gbuffer/CameraView.h"
 #include "gbuffer/ExactSurface.h"
-#include "gbuffer/FrameView.h"
 #include "gbuffer/GBuffer.h"
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/SceneGeometry.h"
@@ -28,11 +28,12 @@ struct StageRequirements {
     bool exactSurface = false;              // reads gbuffer::ExactSurface (the reference)
 };
 
-// Everything a stage may read for one frame. Pointers are null when not required.
-struct Frame {
+// The inputs of a stage for one frame: everything it may read. Pointers are null when not
+// required.
+struct StageInputs {
     const scenes::Scene* scene = nullptr;
     const gbuffer::SceneGeometry* geometry = nullptr;
-    const gbuffer::FrameView* view = nullptr;
+    const gbuffer::CameraView* view = nullptr;
     const gbuffer::GBuffer* gbuffer = nullptr;
     const gbuffer::ExactSurface* exact = nullptr;
     const LightList* lights = nullptr;
@@ -56,7 +57,7 @@ public:
     virtual ~ShadingStage() = default;
     virtual std::string name() const = 0;
     virtual StageRequirements requirements() const = 0;
-    virtual void shade(const Frame& frame, StageResult& result) = 0;
+    virtual void shade(const StageInputs& inputs, StageResult& result) = 0;
 };
 
 } // namespace lighting

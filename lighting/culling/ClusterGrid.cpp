@@ -15,7 +15,7 @@ namespace {
 constexpr size_t kLightsPerBatch = 32;
 
 // x / depth (or -y / depth) of a screen edge, by unprojecting it at the near plane.
-glm::vec3 unprojectNdc(const gbuffer::FrameView& view, float ndcX, float ndcY) {
+glm::vec3 unprojectNdc(const gbuffer::CameraView& view, float ndcX, float ndcY) {
     const float nearNdc = view.reversedZ() ? 1.0f : 0.0f;
     const glm::vec4 p = view.viewFromClip * glm::vec4(ndcX, ndcY, nearNdc, 1.0f);
     return glm::vec3(p) / p.w;
@@ -78,12 +78,12 @@ bool parseClusterGrid(const std::string& text, int& tilesX, int& tilesY, int& sl
     return true;
 }
 
-ClusterGrid::ClusterGrid(const ClusterGridOptions& options, const gbuffer::FrameView& view,
+ClusterGrid::ClusterGrid(const ClusterGridOptions& options, const gbuffer::CameraView& view,
                          float nearDepthMetres, float farDepthMetres) {
     build(options, view, nearDepthMetres, farDepthMetres);
 }
 
-void ClusterGrid::build(const ClusterGridOptions& options, const gbuffer::FrameView& view,
+void ClusterGrid::build(const ClusterGridOptions& options, const gbuffer::CameraView& view,
                         float nearDepthMetres, float farDepthMetres) {
     const int nx = options.tilesX, ny = options.tilesY, nz = options.slices;
     if (nx < 1 || ny < 1 || nz < 1 || nx > kMaxClusterDimension || ny > kMaxClusterDimension ||

@@ -38,7 +38,7 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/FrameView.h"
+#include "gbuffer/CameraView.h"
 #include "lighting/LightBounds.h"
 
 namespace lighting {
@@ -85,11 +85,11 @@ public:
 
     // Builds the cluster geometry for the view's viewport. 0 < nearDepthMetres <= farDepthMetres
     // bound the slices (view depths). Cost: O(cluster count).
-    ClusterGrid(const ClusterGridOptions& options, const gbuffer::FrameView& view,
+    ClusterGrid(const ClusterGridOptions& options, const gbuffer::CameraView& view,
                 float nearDepthMetres, float farDepthMetres);
     // The same, reusing this grid's storage (a stage rebuilds its grid every frame; fresh
     // allocations of megabytes would cost page faults every frame). Clears the light lists.
-    void build(const ClusterGridOptions& options, const gbuffer::FrameView& view,
+    void build(const ClusterGridOptions& options, const gbuffer::CameraView& view,
                float nearDepthMetres, float farDepthMetres);
 
     const ClusterGridOptions& options() const { return mOptions; }

@@ -148,7 +148,7 @@ LightVolumeRasterizer::LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, Vo
                                              bool stencil, SpotProxy spotProxy)
     : mGBuffer(gbuffer), mDepth(gbuffer.depth().data()), mShape(shape), mStencil(stencil),
       mSpotProxy(spotProxy), mRasterizer(gbuffer.width(), gbuffer.height()) {
-    const gbuffer::FrameView& view = gbuffer.view();
+    const gbuffer::CameraView& view = gbuffer.view();
     mReversedZ = view.reversedZ();
     mClearDepth = view.clearDepth();
     mNearMetres = view.nearMetres;

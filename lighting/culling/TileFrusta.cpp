@@ -112,7 +112,7 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
                            });
 }
 
-std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::FrameView& view,
+std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::CameraView& view,
                                                       std::span<const float> depth,
                                                       const TileGrid& grid, bool depthMask) {
     const float clearDepth = view.clearDepth();
@@ -126,7 +126,7 @@ std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::FrameView& 
                            });
 }
 
-TileEdgePlanes TileEdgePlanes::make(const gbuffer::FrameView& view, const TileGrid& grid) {
+TileEdgePlanes TileEdgePlanes::make(const gbuffer::CameraView& view, const TileGrid& grid) {
     TileEdgePlanes edges;
     const int nx = grid.tileCountX + 1, ny = grid.tileCountY + 1;
     auto rayAt = [&](int px, int py) {
@@ -181,7 +181,7 @@ TileBox tileBox(const TileEdgePlanes& edges, const TileGrid& grid, int tx, int t
     return box;
 }
 
-std::vector<uint32_t> lightsInViewFrustum(const gbuffer::FrameView& view, const TileGrid& grid,
+std::vector<uint32_t> lightsInViewFrustum(const gbuffer::CameraView& view, const TileGrid& grid,
                                           const TileEdgePlanes& edges,
                                           const std::vector<LightSphere>& spheres) {
     // Decoded depths may stray from [near, far] by float rounding; widen by far more than that.
@@ -231,7 +231,7 @@ bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
     return axisAngle + bounds.normalHalfAngle + delta + kBackfaceSlackRadians <= kHalfPi;
 }
 
-std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, const TileGrid& grid,
+std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, const TileGrid& grid,
                                             const TileEdgePlanes& edges,
                                             const std::vector<LightSphere>& spheres,
                                             bool frustumCull) {

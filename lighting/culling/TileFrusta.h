@@ -5,7 +5,7 @@
 //
 // Conventions: view space right-handed, camera at the origin looking down -Z; "depth" is the
 // positive view distance -z in metres. Pixel (x, y) covers [x, x+1) x [y, y+1) in pixel units
-// with y down; its sample is the pixel centre, as in FrameView::ndcOfPixel. Tile side planes
+// with y down; its sample is the pixel centre, as in CameraView::ndcOfPixel. Tile side planes
 // pass through pixel EDGES, so every sample of a tile lies half a pixel inside them: float
 // rounding of reconstructed positions (~1e-7 relative) never puts a sample outside its frustum.
 // Depth bounds are the min/max of the decoded positions themselves (bitwise the ones shading
@@ -23,7 +23,7 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/FrameView.h"
+#include "gbuffer/CameraView.h"
 #include "gbuffer/GBuffer.h"
 #include "lighting/LightBounds.h"
 
@@ -69,7 +69,7 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
 // when its depth differs from view.clearDepth(), as GBuffer::covered; positions come from
 // gbuffer::positionViewOfPixel, bitwise the floats GBuffer::decode and forward shading use, so
 // the same depth plane gives bitwise computeTileSurfaceBounds' depth bounds.
-std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::FrameView& view,
+std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::CameraView& view,
                                                       std::span<const float> depth,
                                                       const TileGrid& grid, bool depthMask);
 
@@ -103,7 +103,7 @@ struct TileEdgePlanes {
     std::vector<glm::vec3> rowNormals;    // tileCountY + 1
     std::vector<glm::vec3> cornerRays;    // (tileCountX + 1) * (tileCountY + 1), row-major
 
-    static TileEdgePlanes make(const gbuffer::FrameView& view, const TileGrid& grid);
+    static TileEdgePlanes make(const gbuffer::CameraView& view, const TileGrid& grid);
     const glm::vec3& cornerRay(const TileGrid& grid, int i, int j) const {
         return cornerRays[size_t(j) * (grid.tileCountX + 1) + i];
     }
@@ -139,7 +139,7 @@ inline float distanceSquaredToBox(const glm::vec3& p, const glm::vec3& boxMin,
 
 // Indices (ascending) of the lights whose sphere may touch the camera's view frustum between
 // the near and far planes (slightly widened); unbounded lights are always kept.
-std::vector<uint32_t> lightsInViewFrustum(const gbuffer::FrameView& view, const TileGrid& grid,
+std::vector<uint32_t> lightsInViewFrustum(const gbuffer::CameraView& view, const TileGrid& grid,
                                           const TileEdgePlanes& edges,
                                           const std::vector<LightSphere>& spheres);
 
@@ -156,7 +156,7 @@ struct CandidateLight {
 
 // The candidates in ascending light order: every light, or with `frustumCull` only those
 // lightsInViewFrustum keeps. Parallel over lights.
-std::vector<CandidateLight> candidateLights(const gbuffer::FrameView& view, const TileGrid& grid,
+std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, const TileGrid& grid,
                                             const TileEdgePlanes& edges,
                                             const std::vector<LightSphere>& spheres,
                                             bool frustumCull);

@@ -18,12 +18,12 @@ public:
                  gbuffer::Channel::Specular},
                 false};
     }
-    void shade(const Frame& frame, StageResult& result) override {
-        const gbuffer::GBuffer& gb = *frame.gbuffer;
+    void shade(const StageInputs& inputs, StageResult& result) override {
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
         result.resize(gb.width(), gb.height(), true);
         const auto start = std::chrono::steady_clock::now();
         shadeWithEveryLight<float>(
-            gb.width(), gb.height(), frame.lights->lights,
+            gb.width(), gb.height(), inputs.lights->lights,
             [&](int x, int y, ShadingPoint<float>& point) {
                 return gbufferSurfaceAt(gb, x, y, point);
             },

@@ -48,8 +48,8 @@ public:
                 false};
     }
 
-    void shade(const Frame& frame, StageResult& result) override {
-        const gbuffer::GBuffer& gb = *frame.gbuffer;
+    void shade(const StageInputs& inputs, StageResult& result) override {
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
         const auto assignStart = std::chrono::steady_clock::now();
@@ -86,12 +86,12 @@ public:
             else
                 mGrid->build(mOptions, gb.view(), nearDepth, farDepth);
             ClusterGrid& grid = *mGrid;
-            grid.assign(boundingSpheresView(*frame.lights));
+            grid.assign(boundingSpheresView(*inputs.lights));
             result.timingsMs.emplace_back("assign", millisecondsSince(assignStart));
             pairs = std::to_string(grid.pairCount());
 
             const auto shadingStart = std::chrono::steady_clock::now();
-            const std::vector<LightInView<float>>& lights = frame.lights->lights;
+            const std::vector<LightInView<float>>& lights = inputs.lights->lights;
             std::vector<int> tileXOfPixel(width);
             for (int x = 0; x < width; ++x)
                 tileXOfPixel[x] = grid.tileXOfPixel(x);

@@ -50,14 +50,14 @@ public:
                 false};
     }
 
-    void shade(const Frame& frame, StageResult& result) override {
-        const gbuffer::GBuffer& gb = *frame.gbuffer;
-        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+    void shade(const StageInputs& inputs, StageResult& result) override {
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
+        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
 
         auto start = std::chrono::steady_clock::now();
-        const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
+        const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
         LightVolumeRasterizer volumes(gb, mVolume.shape, mVolume.stencil, mVolume.spotProxy);
         const std::vector<uint32_t> drawn =
             volumes.lightsToDraw(spheres, mVolume.frustumCull); // ascending

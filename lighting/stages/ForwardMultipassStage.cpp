@@ -34,13 +34,13 @@ public:
     std::string name() const override { return "forward-multipass"; }
     StageRequirements requirements() const override { return {{}, false}; }
 
-    void shade(const Frame& frame, StageResult& result) override {
-        const gbuffer::FrameView& view = *frame.view;
+    void shade(const StageInputs& inputs, StageResult& result) override {
+        const gbuffer::CameraView& view = *inputs.view;
         const int width = view.width;
         result.resize(width, view.height, false);
 
         auto start = std::chrono::steady_clock::now();
-        mForward.prepare(frame);
+        mForward.prepare(inputs);
         fitRasterizer(mRasterizer, view);
         result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
 
@@ -49,13 +49,13 @@ public:
         result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
-        buildIlluminationSets(*frame.lights);
+        buildIlluminationSets(*inputs.lights);
         result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
-        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const std::vector<ForwardObject>& objects = mForward.objects();
-        const std::vector<uint32_t>& allIndices = frame.geometry->indices;
+        const std::vector<uint32_t>& allIndices = inputs.geometry->indices;
         raster::RasterState state;
         state.barycentrics = false; // the surface comes from surfaceOfTriangle
         state.cullMode = raster::CullMode::Back;

@@ -12,7 +12,7 @@
 //
 // Exactness: the visible fragment's surface and position are computed by the G-buffer's own
 // functions (ForwardShading.h) and lights are summed in ascending order, so the image is bitwise
-// `brute`'s. Reads no G-buffer channel: it rasterizes the scene itself (frame.scene, .geometry).
+// `brute`'s. Reads no G-buffer channel: it rasterizes the scene itself (inputs.scene, .geometry).
 // Deterministic: one draw, each pixel written only by the thread owning its tile, in submission
 // order.
 #include "lighting/stages/Stages.h"
@@ -34,19 +34,19 @@ public:
     std::string name() const override { return "forward"; }
     StageRequirements requirements() const override { return {{}, false}; }
 
-    void shade(const Frame& frame, StageResult& result) override {
-        const gbuffer::FrameView& view = *frame.view;
+    void shade(const StageInputs& inputs, StageResult& result) override {
+        const gbuffer::CameraView& view = *inputs.view;
         const int width = view.width;
         result.resize(width, view.height, false);
         result.parameters["prepass"] = mPrepass ? "1" : "0";
 
         auto start = std::chrono::steady_clock::now();
-        mForward.prepare(frame);
+        mForward.prepare(inputs);
         fitRasterizer(mRasterizer, view);
         result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
-        buildObjectLightLists(*frame.lights);
+        buildObjectLightLists(*inputs.lights);
         result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
 
         if (mPrepass) {
@@ -58,7 +58,7 @@ public:
         }
 
         start = std::chrono::steady_clock::now();
-        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const bool equalOnly = mPrepass;
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             const size_t pixel = size_t(fragment.y) * width + fragment.x;

@@ -128,15 +128,15 @@ public:
                 false};
     }
 
-    void shade(const Frame& frame, StageResult& result) override {
+    void shade(const StageInputs& inputs, StageResult& result) override {
         using Clock = std::chrono::steady_clock;
-        const gbuffer::GBuffer& gb = *frame.gbuffer;
-        const gbuffer::FrameView& view = gb.view();
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
+        const gbuffer::CameraView& view = gb.view();
         const int width = gb.width(), height = gb.height();
         const int scale = mOptions.scale;
         const int lowWidth = (width + scale - 1) / scale, lowHeight = (height + scale - 1) / scale;
         result.resize(width, height, false);
-        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         auto sampleX = [&](int i) { return std::min(i * scale + scale / 2, width - 1); };
         auto sampleY = [&](int j) { return std::min(j * scale + scale / 2, height - 1); };
 
@@ -144,7 +144,7 @@ public:
         // exactly the samples of low-res tile (tx, ty), since sample i lies in block i.
         const auto cullStart = Clock::now();
         const TileGrid grid = TileGrid::make(width, height, mOptions.tileSizeSamples * scale);
-        const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
+        const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
         std::vector<TileSurfaceBounds> bounds;
         const std::vector<std::vector<uint32_t>> tileLights =
             basicTileLightLists(gb, grid, spheres, bounds);
@@ -181,12 +181,12 @@ public:
 
         // Material pass: second geometry pass, DSF upsampling, combine.
         const auto materialStart = Clock::now();
-        mForward.prepare(frame);
+        mForward.prepare(inputs);
         fitRasterizer(mRasterizer, view);
         depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
         // Object IDs: the scene instance of the visible triangle, for every pixel (looked up on
         // the fly) and for every low-res sample (the pixel the sample read in "lighting").
-        const std::vector<uint32_t>& triangleInstance = frame.geometry->triangleInstance;
+        const std::vector<uint32_t>& triangleInstance = inputs.geometry->triangleInstance;
         auto objectAt = [&](size_t pixel) {
             const uint32_t code = mVisible[pixel];
             return code == kNoVisibleTriangle ? kNoObject : triangleInstance[code & ~kBackFaceBit];
@@ -212,8 +212,9 @@ public:
                 if (code == kNoVisibleTriangle || !gb.covered(pixel))
                     continue;
                 const gbuffer::Surface s = gbuffer::surfaceOfTriangle(
-                    *frame.geometry, *frame.scene, mForward.clipPositions(), mForward.normalsView(),
-                    code & ~kBackFaceBit, (code & kBackFaceBit) != 0, view.ndcOfPixel(x, y));
+                    *inputs.geometry, *inputs.scene, mForward.clipPositions(),
+                    mForward.normalsView(), code & ~kBackFaceBit, (code & kBackFaceBit) != 0,
+                    view.ndcOfPixel(x, y));
                 const gbuffer::Surface here = gb.decode(x, y);
                 const float depth = -here.positionView.z;
                 const uint32_t object = mOptions.objectIds ? objectAt(pixel) : kNoObject;

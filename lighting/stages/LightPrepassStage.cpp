@@ -67,19 +67,19 @@ public:
                 false};
     }
 
-    void shade(const Frame& frame, StageResult& result) override {
+    void shade(const StageInputs& inputs, StageResult& result) override {
         using Clock = std::chrono::steady_clock;
-        const gbuffer::GBuffer& gb = *frame.gbuffer;
-        const gbuffer::FrameView& view = gb.view();
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
+        const gbuffer::CameraView& view = gb.view();
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
-        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
         const auto cullStart = Clock::now();
         const TileGrid grid = TileGrid::make(width, height, mTileSizePixels);
         std::vector<TileSurfaceBounds> bounds;
         const std::vector<std::vector<uint32_t>> tileLights =
-            basicTileLightLists(gb, grid, boundingSpheresView(*frame.lights), bounds);
+            basicTileLightLists(gb, grid, boundingSpheresView(*inputs.lights), bounds);
         const double cullMs = forwardElapsedMs(cullStart);
 
         // Light buffer: diffuse RGB + monochromatic specular, per pixel.
@@ -107,7 +107,7 @@ public:
 
         // Material pass: second geometry pass into a visibility buffer, then combine.
         const auto materialStart = Clock::now();
-        mForward.prepare(frame);
+        mForward.prepare(inputs);
         fitRasterizer(mRasterizer, view);
         depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
         tbb::parallel_for(0, height, [&](int y) {
@@ -117,8 +117,9 @@ public:
                 if (code == kNoVisibleTriangle || !gb.covered(pixel))
                     continue;
                 const gbuffer::Surface s = gbuffer::surfaceOfTriangle(
-                    *frame.geometry, *frame.scene, mForward.clipPositions(), mForward.normalsView(),
-                    code & ~kBackFaceBit, (code & kBackFaceBit) != 0, view.ndcOfPixel(x, y));
+                    *inputs.geometry, *inputs.scene, mForward.clipPositions(),
+                    mForward.normalsView(), code & ~kBackFaceBit, (code & kBackFaceBit) != 0,
+                    view.ndcOfPixel(x, y));
                 const glm::vec3& diffuse = mDiffuse[pixel];
                 glm::vec3 specularColour(1.0f);
                 if (mChroma) {

@@ -15,12 +15,12 @@ class ReferenceStage final : public ShadingStage {
 public:
     std::string name() const override { return "reference"; }
     StageRequirements requirements() const override { return {{gbuffer::Channel::Depth}, true}; }
-    void shade(const Frame& frame, StageResult& result) override {
-        const gbuffer::ExactSurface& exact = *frame.exact;
+    void shade(const StageInputs& inputs, StageResult& result) override {
+        const gbuffer::ExactSurface& exact = *inputs.exact;
         result.resize(exact.width, exact.height, true);
         const auto start = std::chrono::steady_clock::now();
         shadeWithEveryLight<double>(
-            exact.width, exact.height, frame.lights->lightsExact,
+            exact.width, exact.height, inputs.lights->lightsExact,
             [&](int x, int y, ShadingPoint<double>& point) {
                 const size_t pixel = size_t(y) * exact.width + x;
                 if (!exact.covered(pixel))

@@ -55,16 +55,16 @@ public:
     explicit TiledForwardStage(const TiledForwardOptions& options) : mOptions(options) {}
 
     std::string name() const override { return "tiled-forward"; }
-    // Reads no G-buffer channel: it rasterizes the scene itself (frame.scene, .geometry).
+    // Reads no G-buffer channel: it rasterizes the scene itself (inputs.scene, .geometry).
     StageRequirements requirements() const override { return {{}, false}; }
 
-    void shade(const Frame& frame, StageResult& result) override {
-        const gbuffer::FrameView& view = *frame.view;
+    void shade(const StageInputs& inputs, StageResult& result) override {
+        const gbuffer::CameraView& view = *inputs.view;
         const int width = view.width;
         result.resize(width, view.height, false);
 
         auto start = std::chrono::steady_clock::now();
-        mForward.prepare(frame);
+        mForward.prepare(inputs);
         fitRasterizer(mRasterizer, view);
         result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
 
@@ -74,11 +74,11 @@ public:
 
         start = std::chrono::steady_clock::now();
         const TileGrid grid = TileGrid::make(width, view.height, mOptions.tileSizePixels);
-        const size_t lightsAfterVfc = buildTileLightLists(view, grid, *frame.lights);
+        const size_t lightsAfterVfc = buildTileLightLists(view, grid, *inputs.lights);
         result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
-        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             const size_t pixel = size_t(fragment.y) * width + fragment.x;
@@ -112,14 +112,14 @@ public:
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
         result.parameters["lights_after_vfc"] = std::to_string(lightsAfterVfc);
         result.parameters["vfc_culled"] =
-            std::to_string(frame.lights->lights.size() - lightsAfterVfc);
+            std::to_string(inputs.lights->lights.size() - lightsAfterVfc);
         result.parameters["tile_light_pairs"] = std::to_string(pairs);
     }
 
 private:
     // Fills mTileLights from the pre-pass depth (mDepth); returns the number of lights kept by
     // view-frustum culling. The same tests (appendTileLights) as `tiled` with the same options.
-    size_t buildTileLightLists(const gbuffer::FrameView& view, const TileGrid& grid,
+    size_t buildTileLightLists(const gbuffer::CameraView& view, const TileGrid& grid,
                                const LightList& lightList) {
         const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
         const std::vector<LightSphere> spheres = boundingSpheresView(lightList);

@@ -57,16 +57,16 @@ public:
                 false};
     }
 
-    void shade(const Frame& frame, StageResult& result) override {
+    void shade(const StageInputs& inputs, StageResult& result) override {
         using Clock = std::chrono::steady_clock;
-        const gbuffer::GBuffer& gb = *frame.gbuffer;
-        const gbuffer::FrameView& view = gb.view();
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
+        const gbuffer::CameraView& view = gb.view();
         result.resize(gb.width(), gb.height(), false);
         const auto cullStart = Clock::now();
 
         const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
         const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
-        const std::vector<LightSphere> spheres = boundingSpheresView(*frame.lights);
+        const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
         const std::vector<CandidateLight> candidates =
             candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
 
@@ -89,7 +89,7 @@ public:
             std::chrono::duration<double, std::milli>(Clock::now() - cullStart).count();
 
         const auto shadeStart = Clock::now();
-        const std::vector<LightInView<float>>& lights = frame.lights->lights;
+        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
             const std::vector<uint32_t>& list = tileLights[size_t(tile)];
             if (!bounds[size_t(tile)].covered)

@@ -1,11 +1,11 @@
 // Shared set-up for the benchmarks: every benchmark renders its frame through
-// lighting::PreparedFrame at 1280x720 with seed 1, so their figures compare like for like.
+// lighting::PreparedScene at 1280x720 with seed 1, so their figures compare like for like.
 #pragma once
 
 #include <map>
 #include <string>
 
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "scenes/ProceduralScenes.h"
 
 namespace bench {
@@ -23,10 +23,10 @@ inline scenes::Scene proceduralScene(const std::string& name, int lightCount,
 }
 
 // A benchmark frame: the prepared frame of a built-in scene at 1280x720.
-struct BenchFrame : lighting::PreparedFrame {
-    BenchFrame(const std::string& name, int lightCount,
+struct BenchScene : lighting::PreparedScene {
+    BenchScene(const std::string& name, int lightCount,
                std::map<std::string, std::string> options = {})
-        : lighting::PreparedFrame(proceduralScene(name, lightCount, std::move(options)), kWidth,
+        : lighting::PreparedScene(proceduralScene(name, lightCount, std::move(options)), kWidth,
                                   kHeight) {}
 };
 

@@ -15,8 +15,8 @@
 
 namespace {
 
-const bench::BenchFrame& atrium() {
-    static const bench::BenchFrame frame("atrium", 256);
+const bench::BenchScene& atrium() {
+    static const bench::BenchScene frame("atrium", 256);
     return frame;
 }
 
@@ -24,7 +24,7 @@ const bench::BenchFrame& atrium() {
 // 1 = the layout `testbed render` derives for `brute` on atrium (gbuffer/LayoutDerivation.h:
 // float normals, material index, 17 bytes per pixel; the same image bit for bit).
 void gbufferPass(benchmark::State& state) {
-    const bench::BenchFrame& f = atrium();
+    const bench::BenchScene& f = atrium();
     tbb::task_arena arena(int(state.range(0)));
     const gbuffer::GBufferLayout layout =
         state.range(1) == 0
@@ -69,7 +69,7 @@ BENCHMARK(gbufferPass)
     ->MinTime(2.0);
 
 void bruteShading(benchmark::State& state) {
-    const bench::BenchFrame& f = atrium();
+    const bench::BenchScene& f = atrium();
     tbb::task_arena arena(int(state.range(0)));
     auto stage = lighting::makeStage("brute");
     lighting::StageResult result;
@@ -77,7 +77,7 @@ void bruteShading(benchmark::State& state) {
     double seconds = 0.0;
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
-        arena.execute([&] { stage->shade(f.frame, result); });
+        arena.execute([&] { stage->shade(f.inputs, result); });
         const double elapsed =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         state.SetIterationTime(elapsed);

@@ -25,20 +25,20 @@
 namespace {
 
 // One prepared frame per light count: scene, G-buffer, lights and the oracle, built once.
-struct ClusteredBenchFrame : bench::BenchFrame {
+struct ClusteredBenchScene : bench::BenchScene {
     uint64_t oracleSamples = 0;
 
-    explicit ClusteredBenchFrame(int lightCount) : bench::BenchFrame("atrium", lightCount) {
-        for (uint32_t n : lighting::countContributingLights(frame))
+    explicit ClusteredBenchScene(int lightCount) : bench::BenchScene("atrium", lightCount) {
+        for (uint32_t n : lighting::countContributingLights(inputs))
             oracleSamples += n;
     }
 };
 
-const ClusteredBenchFrame& benchFrame(int lightCount) {
-    static std::map<int, std::unique_ptr<ClusteredBenchFrame>> frames;
+const ClusteredBenchScene& benchScene(int lightCount) {
+    static std::map<int, std::unique_ptr<ClusteredBenchScene>> frames;
     auto& slot = frames[lightCount];
     if (!slot)
-        slot = std::make_unique<ClusteredBenchFrame>(lightCount);
+        slot = std::make_unique<ClusteredBenchScene>(lightCount);
     return *slot;
 }
 
@@ -52,13 +52,13 @@ double processCpuSeconds() {
 }
 
 void runStage(benchmark::State& state, const std::string& spec, int lightCount) {
-    const ClusteredBenchFrame& f = benchFrame(lightCount);
+    const ClusteredBenchScene& f = benchScene(lightCount);
     auto stage = lighting::makeStage(spec);
     lighting::StageResult result;
     std::map<std::string, double> passMs;
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
-        stage->shade(f.frame, result);
+        stage->shade(f.inputs, result);
         state.SetIterationTime(
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         for (const auto& [pass, ms] : result.timingsMs)
@@ -127,7 +127,7 @@ void clusteredVsBrute(benchmark::State& state) {
                                          "clustered:grid=24x12x64,test=frustum"};
     const char* spec = kSpecs[state.range(1)];
     state.SetLabel(spec);
-    const ClusteredBenchFrame& f = benchFrame(int(state.range(0)));
+    const ClusteredBenchScene& f = benchScene(int(state.range(0)));
     auto brute = lighting::makeStage("brute");
     auto clustered = lighting::makeStage(spec);
     lighting::StageResult bruteResult, result;
@@ -135,13 +135,13 @@ void clusteredVsBrute(benchmark::State& state) {
     for (auto _ : state) {
         double cpu = processCpuSeconds();
         auto start = std::chrono::steady_clock::now();
-        brute->shade(f.frame, bruteResult);
+        brute->shade(f.inputs, bruteResult);
         bruteSeconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         bruteCpu += processCpuSeconds() - cpu;
         cpu = processCpuSeconds();
         start = std::chrono::steady_clock::now();
-        clustered->shade(f.frame, result);
+        clustered->shade(f.inputs, result);
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         clusteredCpu += processCpuSeconds() - cpu;
@@ -169,7 +169,7 @@ BENCHMARK(clusteredVsBrute)
 // that contribute there (lists precomputed outside the timer, so culling is free and perfect,
 // efficiency 1). brute / this = the largest speed-up an exact stage could reach on this frame.
 void clusteredPerfectCullingCeiling(benchmark::State& state) {
-    const ClusteredBenchFrame& f = benchFrame(int(state.range(0)));
+    const ClusteredBenchScene& f = benchScene(int(state.range(0)));
     const gbuffer::GBuffer& gb = *f.gbuffer;
     const auto& lights = f.lights.lights;
     const size_t pixelCount = gb.pixelCount();
@@ -194,7 +194,7 @@ void clusteredPerfectCullingCeiling(benchmark::State& state) {
     lighting::StageResult bruteResult;
     for (auto _ : state) {
         double cpu = processCpuSeconds();
-        brute->shade(f.frame, bruteResult);
+        brute->shade(f.inputs, bruteResult);
         bruteCpu += processCpuSeconds() - cpu;
         cpu = processCpuSeconds();
         const auto start = std::chrono::steady_clock::now();

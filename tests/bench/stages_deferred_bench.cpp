@@ -21,7 +21,7 @@
 
 namespace {
 
-using VolumeFixture = bench::BenchFrame;
+using VolumeFixture = bench::BenchScene;
 
 const VolumeFixture& wallFixture() {
     static const VolumeFixture fixture("wall", 2500, {{"behind", "1000"}});
@@ -39,7 +39,7 @@ void shadeStage(benchmark::State& state, const VolumeFixture& f, const std::stri
     uint64_t samples = 0;
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
-        arena.execute([&] { stage->shade(f.frame, result); });
+        arena.execute([&] { stage->shade(f.inputs, result); });
         state.SetIterationTime(
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         samples = 0;

@@ -17,26 +17,26 @@
 
 namespace {
 
-struct ForwardBenchFrame : bench::BenchFrame {
-    explicit ForwardBenchFrame(int lightCount) : bench::BenchFrame("atrium", lightCount) {}
+struct ForwardBenchScene : bench::BenchScene {
+    explicit ForwardBenchScene(int lightCount) : bench::BenchScene("atrium", lightCount) {}
 };
 
-const ForwardBenchFrame& forwardBenchFrame(int lightCount) {
-    static std::map<int, std::unique_ptr<ForwardBenchFrame>> frames;
+const ForwardBenchScene& forwardBenchFrame(int lightCount) {
+    static std::map<int, std::unique_ptr<ForwardBenchScene>> frames;
     auto& slot = frames[lightCount];
     if (!slot)
-        slot = std::make_unique<ForwardBenchFrame>(lightCount);
+        slot = std::make_unique<ForwardBenchScene>(lightCount);
     return *slot;
 }
 
 void runStage(benchmark::State& state, const char* stageName) {
-    const ForwardBenchFrame& f = forwardBenchFrame(int(state.range(0)));
+    const ForwardBenchScene& f = forwardBenchFrame(int(state.range(0)));
     auto stage = lighting::makeStage(stageName);
     lighting::StageResult result;
-    stage->shade(f.frame, result); // warm-up: scratch buffers allocated outside the timing
+    stage->shade(f.inputs, result); // warm-up: scratch buffers allocated outside the timing
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
-        stage->shade(f.frame, result);
+        stage->shade(f.inputs, result);
         state.SetIterationTime(
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }

@@ -22,20 +22,20 @@
 namespace {
 
 // wall takes its lights-behind count as a scene option; other scenes take none.
-struct PreparedFrame : bench::BenchFrame {
-    PreparedFrame(const std::string& sceneName, int lightCount, int behind)
-        : bench::BenchFrame(
+struct TiledBenchScene : bench::BenchScene {
+    TiledBenchScene(const std::string& sceneName, int lightCount, int behind)
+        : bench::BenchScene(
               sceneName, lightCount,
               sceneName == "wall"
                   ? std::map<std::string, std::string>{{"behind", std::to_string(behind)}}
                   : std::map<std::string, std::string>{}) {}
 };
 
-const PreparedFrame& prepared(const std::string& sceneName, int lightCount, int behind) {
-    static std::map<std::string, std::unique_ptr<PreparedFrame>> cache;
+const TiledBenchScene& prepared(const std::string& sceneName, int lightCount, int behind) {
+    static std::map<std::string, std::unique_ptr<TiledBenchScene>> cache;
     auto& slot = cache[sceneName + "/" + std::to_string(lightCount) + "/" + std::to_string(behind)];
     if (!slot)
-        slot = std::make_unique<PreparedFrame>(sceneName, lightCount, behind);
+        slot = std::make_unique<TiledBenchScene>(sceneName, lightCount, behind);
     return *slot;
 }
 
@@ -48,12 +48,12 @@ double timing(const lighting::StageResult& result, const char* pass) {
 
 void shadeStage(benchmark::State& state, const char* sceneName, int lightCount, int behind,
                 const char* spec) {
-    const PreparedFrame& f = prepared(sceneName, lightCount, behind);
+    const TiledBenchScene& f = prepared(sceneName, lightCount, behind);
     auto stage = lighting::makeStage(spec);
     lighting::StageResult result;
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
-        stage->shade(f.frame, result);
+        stage->shade(f.inputs, result);
         state.SetIterationTime(
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }

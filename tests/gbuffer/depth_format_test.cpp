@@ -1,5 +1,5 @@
 // DepthFormat and position reconstruction against closed forms: names, the projection's depth
-// mapping and its inverse, FrameView's matrices, exact code round trips, the "covered never reads
+// mapping and its inverse, CameraView's matrices, exact code round trips, the "covered never reads
 // as background" rule, decoded view depth within each format's analytic bound, the two
 // reconstruction methods against the exact position, and the issue's reversed-Z test.
 //
@@ -21,8 +21,8 @@
 
 #include <Imath/half.h>
 
+#include "gbuffer/CameraView.h"
 #include "gbuffer/DepthFormat.h"
-#include "gbuffer/FrameView.h"
 #include "scenes/Scene.h"
 
 namespace gbuffer {
@@ -33,11 +33,11 @@ void PrintTo(const DepthFormatSpec& spec, std::ostream* os) {
 
 namespace {
 
+using gbuffer::CameraView;
 using gbuffer::DepthConvention;
 using gbuffer::DepthFormatKind;
 using gbuffer::DepthFormatSpec;
 using gbuffer::DepthProjection;
-using gbuffer::FrameView;
 using gbuffer::PositionMethod;
 
 constexpr double kEps = 0x1.0p-24;
@@ -55,15 +55,15 @@ struct Planes {
 constexpr Planes kCameras[] = {
     {0.01f, 100.0f}, {0.1f, 1000.0f}, {0.1f, 10000.0f}, {1.0f, 10000.0f}};
 
-FrameView viewOf(Planes planes, DepthConvention convention, bool infinite) {
+CameraView viewOf(Planes planes, DepthConvention convention, bool infinite) {
     scenes::Camera camera; // origin, looking down -Z
     camera.verticalFovRadians = float(kFovYRadians);
     camera.nearMetres = planes.nearMetres;
     camera.farMetres = planes.farMetres;
-    return FrameView::fromCamera(camera, kWidth, kHeight, convention, infinite);
+    return CameraView::fromCamera(camera, kWidth, kHeight, convention, infinite);
 }
 
-FrameView viewOf(Planes planes, const DepthFormatSpec& format) {
+CameraView viewOf(Planes planes, const DepthFormatSpec& format) {
     return viewOf(planes, format.convention(), format.infiniteFar);
 }
 
@@ -85,7 +85,7 @@ glm::dvec3 exactPoint(int x, int y, double d) {
     return {ndcX * d * tanHalf * kWidth / kHeight, ndcY * d * tanHalf, -d};
 }
 
-float rasterNdc(const FrameView& view, const glm::dvec3& p) {
+float rasterNdc(const CameraView& view, const glm::dvec3& p) {
     const glm::dvec4 clip = glm::dmat4(view.clipFromView) * glm::dvec4(p, 1.0);
     return float(clip.z / clip.w);
 }
@@ -98,7 +98,7 @@ std::vector<glm::ivec2> pixelGrid() { // 9 x 5 pixels, corners included
     return pixels;
 }
 
-glm::vec3 reconstruct(const DepthFormatSpec& format, const FrameView& view, PositionMethod method,
+glm::vec3 reconstruct(const DepthFormatSpec& format, const CameraView& view, PositionMethod method,
                       glm::ivec2 pixel, float depthNdc) {
     const DepthProjection projection = DepthProjection::of(view);
     const uint32_t code = gbuffer::encodeDepth(format, projection, depthNdc);
@@ -117,7 +117,7 @@ struct ErrorStats {
 
 ErrorStats positionError(const DepthFormatSpec& format, Planes planes, PositionMethod method,
                          const std::vector<double>& distances) {
-    const FrameView view = viewOf(planes, format);
+    const CameraView view = viewOf(planes, format);
     ErrorStats stats;
     for (double d : distances)
         for (glm::ivec2 pixel : pixelGrid()) {
@@ -249,7 +249,7 @@ TEST(DepthProjection, FloatInverseIsAccurateToAFewRoundingsEverywhere) {
 TEST(FrameViewDepth, MatricesAgreeWithDepthProjection) {
     for (const Planes& planes : kCameras)
         for (const ProjectionCase& c : kProjections) {
-            const FrameView view =
+            const CameraView view =
                 viewOf(planes, c.reversed ? DepthConvention::Reversed : DepthConvention::Standard,
                        c.infinite);
             const DepthProjection projection = DepthProjection::of(view);
@@ -433,7 +433,7 @@ TEST(DepthAccuracy, DecodedViewDepthIsWithinEachFormatsAnalyticBound) {
     for (const DepthFormatSpec& format : gbuffer::allDepthFormatSpecs()) {
         double worstRatio = 0.0, worstError = 0.0;
         for (const Planes& planes : kCameras) {
-            const FrameView view = viewOf(planes, format);
+            const CameraView view = viewOf(planes, format);
             const DepthProjection projection = DepthProjection::of(view);
             for (double d : logDistances(planes.nearMetres, planes.farMetres, 2000)) {
                 if (format.kind == DepthFormatKind::F16Linear && d > 65504.0)
@@ -501,8 +501,8 @@ TEST(DepthAccuracy, ReversedFloatBeatsStandardFloatTenfoldAtTheFarPlane) {
 // keeps every one of those depths distinct from its clear value.
 TEST(DepthAccuracy, StandardFloatLosesSurfacesJustBeforeTheFarPlane) {
     const Planes planes{0.1f, 10000.0f};
-    const FrameView standard = viewOf(planes, DepthConvention::Standard, false);
-    const FrameView reversed = viewOf(planes, DepthConvention::Reversed, false);
+    const CameraView standard = viewOf(planes, DepthConvention::Standard, false);
+    const CameraView reversed = viewOf(planes, DepthConvention::Reversed, false);
     for (double d : {9990.0, 9999.0, 9999.9}) {
         EXPECT_EQ(rasterNdc(standard, {0.0, 0.0, -d}), 1.0f) << d;
         EXPECT_GT(rasterNdc(reversed, {0.0, 0.0, -d}), 0.0f) << d;

@@ -48,7 +48,8 @@ struct Rendered {
 
 Rendered render(const scenes::Scene& scene, int width, int height) {
     const gbuffer::SceneGeometry geometry = gbuffer::SceneGeometry::build(scene);
-    const gbuffer::FrameView view = gbuffer::FrameView::fromCamera(scene.cameras[0], width, height);
+    const gbuffer::CameraView view =
+        gbuffer::CameraView::fromCamera(scene.cameras[0], width, height);
     Rendered r;
     r.gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer::GBufferLayout::reference(), view);
     raster::Rasterizer rasterizer(width, height);

@@ -6,7 +6,7 @@
 #include <cstring>
 
 #include "gbuffer/LayoutDerivation.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
 #include "scenes/SceneRequest.h"
@@ -156,9 +156,9 @@ TEST(LayoutDerivation, DerivedLayoutIsLossless) {
         scenes::Scene scene = scenes::buildProceduralScene("atrium", request);
         const gbuffer::GBufferLayout used = layout ? gbuffer::deriveLayout(scene, kEverything)
                                                    : gbuffer::GBufferLayout::reference();
-        lighting::PreparedFrame frame(std::move(scene), 160, 90, false, used);
+        lighting::PreparedScene frame(std::move(scene), 160, 90, false, used);
         lighting::StageResult result;
-        lighting::makeStage("brute")->shade(frame.frame, result);
+        lighting::makeStage("brute")->shade(frame.inputs, result);
         return std::make_pair(result, frame.gbuffer->layout().bytesPerPixel());
     };
     const gbuffer::GBufferLayout marker;
@@ -177,11 +177,11 @@ TEST(LayoutDerivation, DerivedLayoutIsLossless) {
 TEST(GBufferStorage, LossyEncodingsDecodeCloseToTheLosslessSurface) {
     scenes::SceneRequest sceneRequest;
     const scenes::Scene scene = scenes::buildProceduralScene("atrium", sceneRequest);
-    lighting::PreparedFrame lossless(scenes::Scene(scene), 160, 90, false,
+    lighting::PreparedScene lossless(scenes::Scene(scene), 160, 90, false,
                                      gbuffer::deriveLayout(scene, kEverything));
     for (const char* preset : {"thesis", "killzone2", "bf3", "stalker", "clear-sky", "compact"}) {
         const gbuffer::GBufferLayout layout = gbuffer::presetLayout(preset, scene);
-        lighting::PreparedFrame lossy(scenes::Scene(scene), 160, 90, false, layout);
+        lighting::PreparedScene lossy(scenes::Scene(scene), 160, 90, false, layout);
         const gbuffer::GBuffer& a = *lossless.gbuffer;
         const gbuffer::GBuffer& b = *lossy.gbuffer;
         size_t coverageDiffers = 0, covered = 0, compared = 0;
@@ -228,13 +228,13 @@ namespace {
 // the hemisphere codecs refuse world space.
 TEST(GBufferStorage, WorldSpaceNormalsDecodeToViewSpace) {
     const scenes::Scene scene = scenes::buildProceduralScene("atrium", {});
-    lighting::PreparedFrame lossless(scenes::Scene(scene), 160, 90, false,
+    lighting::PreparedScene lossless(scenes::Scene(scene), 160, 90, false,
                                      gbuffer::deriveLayout(scene, kEverything));
     gbuffer::LayoutRequest request;
     request.normals = gbuffer::NormalCodecSpec::parse("octahedral:24");
     request.normalSpace = gbuffer::NormalSpace::World;
     const gbuffer::GBufferLayout world = gbuffer::makeLayout(scene, kEverything, "brute", request);
-    lighting::PreparedFrame encoded(scenes::Scene(scene), 160, 90, false, world);
+    lighting::PreparedScene encoded(scenes::Scene(scene), 160, 90, false, world);
     double worst = 0.0;
     for (int y = 0; y < 90; ++y)
         for (int x = 0; x < 160; ++x) {

@@ -17,7 +17,7 @@
 
 #include <tbb/task_arena.h>
 
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
 
@@ -43,7 +43,7 @@ constexpr double kApproximationFloor = 1e-2;
 constexpr double kPanelIdGain = 0.5;
 
 struct Case {
-    std::unique_ptr<lighting::PreparedFrame> prepared;
+    std::unique_ptr<lighting::PreparedScene> prepared;
     lighting::StageResult reference;
     lighting::StageResult brute;
 };
@@ -62,9 +62,9 @@ const Case& spheres(bool whiteLights) {
         for (scenes::Light& light : scene.lights)
             light.color = glm::vec3(1.0f);
     slot->prepared =
-        std::make_unique<lighting::PreparedFrame>(std::move(scene), kWidth, kHeight, true);
-    lighting::makeStage("reference")->shade(slot->prepared->frame, slot->reference);
-    lighting::makeStage("brute")->shade(slot->prepared->frame, slot->brute);
+        std::make_unique<lighting::PreparedScene>(std::move(scene), kWidth, kHeight, true);
+    lighting::makeStage("reference")->shade(slot->prepared->inputs, slot->reference);
+    lighting::makeStage("brute")->shade(slot->prepared->inputs, slot->brute);
     return *slot;
 }
 
@@ -82,7 +82,7 @@ double relativeRmse(const lighting::StageResult& image, const lighting::StageRes
 
 lighting::StageResult run(const std::string& spec, const Case& c) {
     lighting::StageResult result;
-    lighting::makeStage(spec)->shade(c.prepared->frame, result);
+    lighting::makeStage(spec)->shade(c.prepared->inputs, result);
     EXPECT_EQ(result.width, kWidth);
     EXPECT_EQ(result.height, kHeight);
     return result;
@@ -182,12 +182,12 @@ scenes::Scene panelBeforeWallScene() {
 }
 
 TEST(Inferred, ObjectIdsSeparateTouchingSurfaces) {
-    lighting::PreparedFrame prepared(panelBeforeWallScene(), kWidth, kHeight, true);
+    lighting::PreparedScene prepared(panelBeforeWallScene(), kWidth, kHeight, true);
     Case c;
-    lighting::makeStage("reference")->shade(prepared.frame, c.reference);
+    lighting::makeStage("reference")->shade(prepared.inputs, c.reference);
     const auto error = [&](const std::string& spec) {
         lighting::StageResult result;
-        lighting::makeStage(spec)->shade(prepared.frame, result);
+        lighting::makeStage(spec)->shade(prepared.inputs, result);
         EXPECT_EQ(result.parameters["ids"], spec.ends_with("ids=0") ? "0" : "1") << spec;
         const double e = relativeRmse(result, c.reference);
         std::cout << "[measured] panel-before-wall " << spec << " relative RMSE = " << e << "\n";

@@ -13,7 +13,7 @@
 
 #include "gbuffer/GBufferPass.h"
 #include "lighting/Oracle.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/ClusterGrid.h"
 #include "scenes/ProceduralScenes.h"
@@ -28,31 +28,31 @@ constexpr int kWidth = 160;
 constexpr int kHeight = 96;
 
 // A prepared frame plus its oracle and brute's image.
-struct ClusterFrame : lighting::PreparedFrame {
+struct ClusterScene : lighting::PreparedScene {
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
 
-    explicit ClusterFrame(scenes::Scene scene)
-        : lighting::PreparedFrame(std::move(scene), kWidth, kHeight) {
-        oracle = lighting::countContributingLights(frame);
-        lighting::makeStage("brute")->shade(frame, brute);
+    explicit ClusterScene(scenes::Scene scene)
+        : lighting::PreparedScene(std::move(scene), kWidth, kHeight) {
+        oracle = lighting::countContributingLights(inputs);
+        lighting::makeStage("brute")->shade(inputs, brute);
     }
 };
 
-const ClusterFrame& prepared(const std::string& sceneName, int lightCount) {
-    static std::map<std::string, std::unique_ptr<ClusterFrame>> cache;
+const ClusterScene& prepared(const std::string& sceneName, int lightCount) {
+    static std::map<std::string, std::unique_ptr<ClusterScene>> cache;
     auto& slot = cache[sceneName + std::to_string(lightCount)];
     if (!slot) {
         scenes::SceneRequest request;
         request.lightCount = lightCount;
         request.seed = 5;
-        slot = std::make_unique<ClusterFrame>(scenes::buildProceduralScene(sceneName, request));
+        slot = std::make_unique<ClusterScene>(scenes::buildProceduralScene(sceneName, request));
     }
     return *slot;
 }
 
 // Image within 1e-5 of peak of brute, and never fewer lights evaluated than contribute.
-void expectExact(const ClusterFrame& f, const lighting::StageResult& result,
+void expectExact(const ClusterScene& f, const lighting::StageResult& result,
                  const std::string& what) {
     float peak = 0.0f;
     for (int ch = 0; ch < 3; ++ch)
@@ -74,15 +74,15 @@ void expectExact(const ClusterFrame& f, const lighting::StageResult& result,
 
 TEST(ClusteredStage, EveryOptionCombinationMatchesBrute) {
     for (const char* scene : {"spheres", "atrium"}) {
-        const ClusterFrame& f = prepared(scene, 120);
+        const ClusterScene& f = prepared(scene, 120);
         for (const char* grid : {"1x1x1", "24x12x32", "64x32x64", "7x5x3"})
             for (const char* slices : {"exp", "uniform"})
                 for (const char* test : {"aabb", "frustum"}) {
                     lighting::StageResult walk, binary;
                     const std::string base = std::string("clustered:grid=") + grid +
                                              ",slices=" + slices + ",test=" + test;
-                    lighting::makeStage(base + ",assign=walk")->shade(f.frame, walk);
-                    lighting::makeStage(base + ",assign=binary")->shade(f.frame, binary);
+                    lighting::makeStage(base + ",assign=walk")->shade(f.inputs, walk);
+                    lighting::makeStage(base + ",assign=binary")->shade(f.inputs, binary);
                     expectExact(f, walk, std::string(scene) + " " + base + ",assign=walk");
                     // Identical lists give bitwise identical images and counts.
                     for (int ch = 0; ch < 3; ++ch)
@@ -99,10 +99,10 @@ TEST(ClusteredStage, EveryOptionCombinationMatchesBrute) {
 }
 
 TEST(ClusteredStage, IndependentOfThreadCountAndRecordsPasses) {
-    const ClusterFrame& f = prepared("atrium", 120);
+    const ClusterScene& f = prepared("atrium", 120);
     lighting::StageResult one, many;
-    tbb::task_arena(1).execute([&] { lighting::makeStage("clustered")->shade(f.frame, one); });
-    lighting::makeStage("clustered")->shade(f.frame, many);
+    tbb::task_arena(1).execute([&] { lighting::makeStage("clustered")->shade(f.inputs, one); });
+    lighting::makeStage("clustered")->shade(f.inputs, many);
     for (int ch = 0; ch < 3; ++ch)
         EXPECT_EQ(one.radiance[ch], many.radiance[ch]);
     EXPECT_EQ(one.lightsEvaluated, many.lightsEvaluated);
@@ -117,14 +117,14 @@ TEST(ClusteredStage, IndependentOfThreadCountAndRecordsPasses) {
 }
 
 TEST(ClusteredStage, ReusedAcrossFramesEqualsFresh) {
-    const ClusterFrame& atrium = prepared("atrium", 120);
-    const ClusterFrame& spheres = prepared("spheres", 120);
+    const ClusterScene& atrium = prepared("atrium", 120);
+    const ClusterScene& spheres = prepared("spheres", 120);
     auto reused = lighting::makeStage("clustered:grid=64x32x64");
     lighting::StageResult first, second, third, fresh;
-    reused->shade(atrium.frame, first);
-    reused->shade(spheres.frame, second);
-    reused->shade(atrium.frame, third);
-    lighting::makeStage("clustered:grid=64x32x64")->shade(spheres.frame, fresh);
+    reused->shade(atrium.inputs, first);
+    reused->shade(spheres.inputs, second);
+    reused->shade(atrium.inputs, third);
+    lighting::makeStage("clustered:grid=64x32x64")->shade(spheres.inputs, fresh);
     for (int ch = 0; ch < 3; ++ch) {
         EXPECT_EQ(first.radiance[ch], third.radiance[ch]);
         EXPECT_EQ(second.radiance[ch], fresh.radiance[ch]);
@@ -149,12 +149,12 @@ TEST(ClusteredStage, RejectsBadOptions) {
 
 // ---- ClusterGrid alone ------------------------------------------------------------------------
 
-gbuffer::FrameView testView() {
+gbuffer::CameraView testView() {
     scenes::Camera camera;
     camera.verticalFovRadians = 0.9f;
     camera.nearMetres = 0.1f;
     camera.farMetres = 50.0f;
-    return gbuffer::FrameView::fromCamera(camera, 320, 180);
+    return gbuffer::CameraView::fromCamera(camera, 320, 180);
 }
 
 bool listed(const ClusterGrid& grid, size_t cluster, uint32_t light) {
@@ -254,7 +254,7 @@ std::vector<LightSphere> hardSpheres(const ClusterGrid& grid) {
 }
 
 TEST(ClusterGrid, AssignmentIsASupersetOfTouchedClustersAndMethodsAgree) {
-    const gbuffer::FrameView view = testView();
+    const gbuffer::CameraView view = testView();
     for (const char* gridText : {"24x12x32", "1x1x1", "7x5x9", "64x32x64"})
         for (auto spacing : {lighting::SliceSpacing::Exponential, lighting::SliceSpacing::Uniform})
             for (auto test : {lighting::ClusterTest::Aabb, lighting::ClusterTest::Frustum}) {
@@ -294,7 +294,7 @@ TEST(ClusterGrid, AssignmentIsASupersetOfTouchedClustersAndMethodsAgree) {
 }
 
 TEST(ClusterGrid, PixelsFallInClustersThatContainThem) {
-    const gbuffer::FrameView view = testView();
+    const gbuffer::CameraView view = testView();
     ClusterGridOptions o;
     ClusterGrid grid(o, view, 0.5f, 25.0f);
     // Slices: a depth exactly on a boundary belongs to the slice that starts there.
@@ -325,7 +325,7 @@ TEST(ClusterGrid, PixelsFallInClustersThatContainThem) {
 }
 
 TEST(ClusterGrid, SliceSearchMatchesCountingBoundaries) {
-    const gbuffer::FrameView view = testView();
+    const gbuffer::CameraView view = testView();
     std::mt19937 random(3);
     std::uniform_real_distribution<float> depth(0.0f, 30.0f);
     for (int slices : {1, 2, 3, 7, 16, 31, 32, 33, 64, 1000}) {
@@ -343,7 +343,7 @@ TEST(ClusterGrid, SliceSearchMatchesCountingBoundaries) {
 }
 
 TEST(ClusterGrid, ListsIndependentOfThreadCount) {
-    const gbuffer::FrameView view = testView();
+    const gbuffer::CameraView view = testView();
     ClusterGridOptions o;
     ClusterGrid one(o, view, 0.5f, 25.0f), many(o, view, 0.5f, 25.0f);
     const std::vector<LightSphere> spheres = randomSpheres(500, 7);

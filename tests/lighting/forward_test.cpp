@@ -13,21 +13,21 @@
 
 #include "gbuffer/GBufferPass.h"
 #include "lighting/ForwardShading.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/MeshBuilder.h"
 #include "scenes/ProceduralScenes.h"
 
 namespace {
 
-struct TestFrame : lighting::PreparedFrame {
-    TestFrame(scenes::Scene s, int width, int height)
-        : lighting::PreparedFrame(std::move(s), width, height) {}
+struct TestScene : lighting::PreparedScene {
+    TestScene(scenes::Scene s, int width, int height)
+        : lighting::PreparedScene(std::move(s), width, height) {}
 };
 
-lighting::StageResult run(const std::string& stage, const TestFrame& f) {
+lighting::StageResult run(const std::string& stage, const TestScene& f) {
     lighting::StageResult result;
-    lighting::makeStage(stage)->shade(f.frame, result);
+    lighting::makeStage(stage)->shade(f.inputs, result);
     return result;
 }
 
@@ -42,12 +42,12 @@ uint64_t total(const std::vector<uint32_t>& counts) {
     return sum;
 }
 
-const TestFrame& atrium() {
-    static const TestFrame frame = [] {
+const TestScene& atrium() {
+    static const TestScene frame = [] {
         scenes::SceneRequest request;
         request.lightCount = 200;
         request.seed = 5;
-        return TestFrame(scenes::buildProceduralScene("atrium", request), 192, 108);
+        return TestScene(scenes::buildProceduralScene("atrium", request), 192, 108);
     }();
     return frame;
 }
@@ -55,8 +55,8 @@ const TestFrame& atrium() {
 // Three unit boxes in front of a camera at the origin looking down -Z: A (left) lit by a small
 // light in front of it, B (right) lit only by a light BEHIND the camera (view z > 0), and C
 // (below) out of reach of both.
-const TestFrame& threeBoxes() {
-    static const TestFrame frame = [] {
+const TestScene& threeBoxes() {
+    static const TestScene frame = [] {
         scenes::Scene scene;
         scene.name = "three-boxes";
         scene.materials.push_back({});
@@ -78,7 +78,7 @@ const TestFrame& threeBoxes() {
         behindCamera.intensity = 50.0f;
         scene.lights = {nearA, behindCamera};
         scenes::validate(scene);
-        return TestFrame(std::move(scene), 128, 96);
+        return TestScene(std::move(scene), 128, 96);
     }();
     return frame;
 }
@@ -98,7 +98,7 @@ void expectBitwiseEqual(const lighting::StageResult& result, const lighting::Sta
 }
 
 TEST(Forward, EveryVariantIsBitwiseBrute) {
-    for (const TestFrame* f : {&atrium(), &threeBoxes()}) {
+    for (const TestScene* f : {&atrium(), &threeBoxes()}) {
         const lighting::StageResult brute = run("brute", *f);
         for (const char* stage : {"forward", "forward:prepass=1", "forward-multipass"})
             expectBitwiseEqual(run(stage, *f), brute, std::string(stage) + " on " + f->scene.name);
@@ -106,7 +106,7 @@ TEST(Forward, EveryVariantIsBitwiseBrute) {
 }
 
 TEST(Forward, PrepassShadesEachPixelOnceAndOverdrawIsCounted) {
-    const TestFrame& f = atrium();
+    const TestScene& f = atrium();
     const lighting::StageResult single = run("forward", f);
     const lighting::StageResult prepass = run("forward:prepass=1", f);
     EXPECT_EQ(single.parameters.at("prepass"), "0");
@@ -131,7 +131,7 @@ TEST(Forward, MultipassEvaluatesOnlyVisibleFragments) {
     // With the pre-pass's equal test, multipass never evaluates more lights at a pixel than the
     // single-pass stage does for that pixel's visible object (the same culling), and nothing on
     // the background.
-    const TestFrame& f = atrium();
+    const TestScene& f = atrium();
     const lighting::StageResult multipass = run("forward-multipass", f);
     const lighting::StageResult prepass = run("forward:prepass=1", f);
     for (size_t pixel = 0; pixel < multipass.lightsEvaluated.size(); ++pixel)
@@ -139,9 +139,9 @@ TEST(Forward, MultipassEvaluatesOnlyVisibleFragments) {
 }
 
 TEST(Forward, UnlitObjectsCostNothingAndALightBehindTheCameraStillLights) {
-    const TestFrame& f = threeBoxes();
+    const TestScene& f = threeBoxes();
     lighting::ForwardFrame forward;
-    forward.prepare(f.frame);
+    forward.prepare(f.inputs);
     ASSERT_EQ(forward.objects().size(), 3u);
     raster::Rasterizer rasterizer(f.view.width, f.view.height);
     std::vector<float> depth;
@@ -176,7 +176,7 @@ TEST(Forward, UnlitObjectsCostNothingAndALightBehindTheCameraStillLights) {
 }
 
 TEST(Forward, SameResultForAnyThreadCount) {
-    const TestFrame& f = atrium();
+    const TestScene& f = atrium();
     for (const char* stage : {"forward", "forward:prepass=1", "forward-multipass"}) {
         lighting::StageResult one, two;
         tbb::task_arena(1).execute([&] { one = run(stage, f); });
@@ -190,9 +190,9 @@ TEST(Forward, SharedSurfaceFunctionReproducesTheGBuffer) {
     // The refactored GBufferPass::resolve and the forward stages share surfaceOfTriangle and
     // positionViewOfPixel: at every covered pixel, the G-buffer's decoded surface must equal,
     // bit for bit, the forward frame's surface of the pre-pass's visible fragment.
-    for (const TestFrame* f : {&atrium(), &threeBoxes()}) {
+    for (const TestScene* f : {&atrium(), &threeBoxes()}) {
         lighting::ForwardFrame forward;
-        forward.prepare(f->frame);
+        forward.prepare(f->inputs);
         raster::Rasterizer rasterizer(f->view.width, f->view.height);
         std::vector<float> depth;
         std::vector<uint32_t> visible;

@@ -16,7 +16,7 @@
 #include "gbuffer/GBufferPass.h"
 #include "lighting/LightBounds.h"
 #include "lighting/Oracle.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/LightVolumes.h"
 #include "scenes/ProceduralScenes.h"
@@ -27,20 +27,20 @@ constexpr int kWidth = 256;
 constexpr int kHeight = 144;
 
 // A prepared frame plus the oracle and brute's image for its current lights.
-struct TestFrame : lighting::PreparedFrame {
+struct TestScene : lighting::PreparedScene {
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
 
     // Renders the G-buffer of `scene`; setLights() replaces the lights and re-runs the oracles.
-    explicit TestFrame(scenes::Scene s,
+    explicit TestScene(scenes::Scene s,
                        gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed)
-        : lighting::PreparedFrame(std::move(s), kWidth, kHeight, false, depth) {
+        : lighting::PreparedScene(std::move(s), kWidth, kHeight, false, depth) {
         setLights(scene.lights);
     }
     void setLights(const std::vector<scenes::Light>& sceneLights) {
-        lighting::PreparedFrame::setLights(sceneLights);
-        oracle = lighting::countContributingLights(frame);
-        lighting::makeStage("brute")->shade(frame, brute);
+        lighting::PreparedScene::setLights(sceneLights);
+        oracle = lighting::countContributingLights(inputs);
+        lighting::makeStage("brute")->shade(inputs, brute);
     }
     glm::vec3 worldFromView(const glm::vec3& p) const {
         return glm::vec3(glm::inverse(view.viewFromWorld) * glm::vec4(p, 1.0f));
@@ -60,9 +60,9 @@ scenes::Scene proceduralScene(const char* name, int lightCount,
 }
 
 // Shades with `stage` and checks the image against brute and the counts against the oracle.
-void expectMatchesBrute(const TestFrame& f, const std::string& stage, const std::string& where) {
+void expectMatchesBrute(const TestScene& f, const std::string& stage, const std::string& where) {
     lighting::StageResult result;
-    lighting::makeStage(stage)->shade(f.frame, result);
+    lighting::makeStage(stage)->shade(f.inputs, result);
     float peak = 0.0f;
     for (int ch = 0; ch < 3; ++ch)
         for (float v : f.brute.radiance[ch])
@@ -108,16 +108,16 @@ TEST(LightVolumes, OptionVariantsMatchBrute) {
     const Case cases[] = {
         {"atrium", 300, {}}, {"wall", 400, {{"behind", "200"}}}, {"spheres", 200, {}}};
     for (const Case& c : cases) {
-        const TestFrame f(proceduralScene(c.scene, c.lights, c.options));
+        const TestScene f(proceduralScene(c.scene, c.lights, c.options));
         for (const std::string& stage : kVariants)
             expectMatchesBrute(f, stage, c.scene);
     }
 }
 
 TEST(LightVolumes, LightIndexedOverflowIsReportedAndConservative) {
-    const TestFrame f(proceduralScene("atrium", 300));
+    const TestScene f(proceduralScene("atrium", 300));
     lighting::StageResult result;
-    lighting::makeStage("light-indexed:max=1")->shade(f.frame, result);
+    lighting::makeStage("light-indexed:max=1")->shade(f.inputs, result);
     ASSERT_TRUE(result.parameters.count("overflow_pixels"));
     EXPECT_GT(std::stoull(result.parameters.at("overflow_pixels")), 0u);
     // Overflowed pixels are shaded with their 16x16 tile's conservative list: more than the
@@ -168,7 +168,7 @@ TEST(LightVolumes, ProxyCircumscribesTheUnitSphereAndIsClosed) {
 // Adds hard lights to `f`'s scene in view space: camera inside a volume, a volume crossing the
 // near plane, range zero, a volume covering the whole screen and crossing the far plane, lights
 // behind the camera, and lights just touching (or just reaching through) visible surfaces.
-std::vector<scenes::Light> hardLights(const TestFrame& f) {
+std::vector<scenes::Light> hardLights(const TestScene& f) {
     std::vector<scenes::Light> lights = f.scene.lights;
     auto point = [&](glm::vec3 positionView, float range, glm::vec3 color = glm::vec3(1.0f)) {
         scenes::Light light;
@@ -227,7 +227,7 @@ std::vector<scenes::Light> hardLights(const TestFrame& f) {
 
 TEST(LightVolumes, HardCasesMatchBrute) {
     for (const char* sceneName : {"atrium", "spheres", "wall"}) {
-        TestFrame f(proceduralScene(sceneName, 20));
+        TestScene f(proceduralScene(sceneName, 20));
         f.setLights(hardLights(f));
         for (const std::string& stage : kVariants)
             expectMatchesBrute(f, stage, std::string("hard ") + sceneName);
@@ -235,7 +235,7 @@ TEST(LightVolumes, HardCasesMatchBrute) {
 }
 
 TEST(LightVolumes, StandardDepthMatchesBrute) {
-    TestFrame f(proceduralScene("atrium", 200), gbuffer::DepthConvention::Standard);
+    TestScene f(proceduralScene("atrium", 200), gbuffer::DepthConvention::Standard);
     ASSERT_FALSE(f.view.reversedZ());
     f.setLights(hardLights(f));
     for (const std::string& stage : kVariants)
@@ -243,11 +243,11 @@ TEST(LightVolumes, StandardDepthMatchesBrute) {
 }
 
 TEST(LightVolumes, SameResultForOneAndTwoThreads) {
-    const TestFrame f(proceduralScene("atrium", 300));
+    const TestScene f(proceduralScene("atrium", 300));
     for (const char* stage : {"deferred", "deferred:stencil=1", "light-indexed:max=2"}) {
         lighting::StageResult one, two;
-        tbb::task_arena(1).execute([&] { lighting::makeStage(stage)->shade(f.frame, one); });
-        tbb::task_arena(2).execute([&] { lighting::makeStage(stage)->shade(f.frame, two); });
+        tbb::task_arena(1).execute([&] { lighting::makeStage(stage)->shade(f.inputs, one); });
+        tbb::task_arena(2).execute([&] { lighting::makeStage(stage)->shade(f.inputs, two); });
         for (int ch = 0; ch < 3; ++ch)
             EXPECT_EQ(one.radiance[ch], two.radiance[ch]) << stage;
         EXPECT_EQ(one.lightsEvaluated, two.lightsEvaluated) << stage;
@@ -255,10 +255,10 @@ TEST(LightVolumes, SameResultForOneAndTwoThreads) {
 }
 
 TEST(LightVolumes, DeferredCullsOnAtrium) {
-    const TestFrame f(proceduralScene("atrium", 300));
+    const TestScene f(proceduralScene("atrium", 300));
     for (const char* stage : {"deferred", "deferred:stencil=1", "light-indexed"}) {
         lighting::StageResult result;
-        lighting::makeStage(stage)->shade(f.frame, result);
+        lighting::makeStage(stage)->shade(f.inputs, result);
         uint64_t evaluated = 0, brute = 0;
         for (uint32_t n : result.lightsEvaluated)
             evaluated += n;
@@ -349,7 +349,7 @@ TEST(LightVolumes, ConeProxyCircumscribesTheLitRegionAndIsClosed) {
 // behind the near plane, a spot pointing at the camera, narrow (0.5 to 5 degrees) and wide
 // (75 degrees) cones into the scene, and surfaces grazed by the cone's edge just inside and just
 // outside, or touched by the rim at the range.
-std::vector<scenes::Light> hardSpots(const TestFrame& f) {
+std::vector<scenes::Light> hardSpots(const TestScene& f) {
     std::vector<scenes::Light> lights = f.scene.lights;
     auto spot = [&](glm::vec3 positionView, glm::vec3 axisView, float range, float outerDegrees) {
         scenes::Light light;
@@ -422,7 +422,7 @@ TEST(LightVolumes, HardSpotsMatchBrute) {
     for (const gbuffer::DepthConvention depth :
          {gbuffer::DepthConvention::Reversed, gbuffer::DepthConvention::Standard})
         for (const char* sceneName : {"atrium", "spheres", "wall"}) {
-            TestFrame f(proceduralScene(sceneName, 20), depth);
+            TestScene f(proceduralScene(sceneName, 20), depth);
             f.setLights(hardSpots(f));
             const std::string where =
                 std::string("hard spots ") + sceneName +
@@ -431,7 +431,7 @@ TEST(LightVolumes, HardSpotsMatchBrute) {
                 expectMatchesBrute(f, stage, where);
             // The cone path is the one under test.
             lighting::StageResult result;
-            lighting::makeStage("deferred:stencil=1")->shade(f.frame, result);
+            lighting::makeStage("deferred:stencil=1")->shade(f.inputs, result);
             EXPECT_GT(std::stoull(result.parameters.at("cone_proxies")), 20u) << where;
         }
 }
@@ -453,14 +453,14 @@ TEST(LightVolumes, ConeProxiesCullMoreThanSpheresForNarrowSpots) {
         light.rangeMetres *= 2.0f;
         ++index;
     }
-    const TestFrame f(std::move(scene));
+    const TestScene f(std::move(scene));
     for (const char* stencil : {"0", "1"}) {
         uint64_t evaluated[2] = {0, 0};
         const char* proxies[2] = {"cone", "sphere"};
         for (int k = 0; k < 2; ++k) {
             lighting::StageResult result;
             lighting::makeStage(std::string("deferred:stencil=") + stencil + ",spot=" + proxies[k])
-                ->shade(f.frame, result);
+                ->shade(f.inputs, result);
             EXPECT_EQ(result.parameters.at("spot"), proxies[k]);
             for (uint32_t n : result.lightsEvaluated)
                 evaluated[k] += n;
@@ -487,7 +487,7 @@ TEST(LightVolumes, SpotOptionIsForSphereVolumesOnly) {
 }
 
 TEST(LightVolumes, FrustumCullingAndScreenRectAreConservative) {
-    const TestFrame f(proceduralScene("atrium", 8));
+    const TestScene f(proceduralScene("atrium", 8));
     lighting::LightVolumeRasterizer volumes(*f.gbuffer, lighting::VolumeShape::Rect, false,
                                             lighting::SpotProxy::Cone);
     std::mt19937 random(5);

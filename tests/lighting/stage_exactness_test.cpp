@@ -11,7 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include "lighting/Oracle.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
 
@@ -58,7 +58,7 @@ void makeSpots(scenes::Scene& scene) {
 
 // One frame per scene case, its oracle and brute's image, shared by every stage's test.
 struct PreparedCase {
-    std::unique_ptr<lighting::PreparedFrame> prepared;
+    std::unique_ptr<lighting::PreparedScene> prepared;
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
 };
@@ -76,9 +76,9 @@ const PreparedCase& prepared(const SceneCase& c) {
     scenes::Scene scene = scenes::buildProceduralScene(c.scene, request);
     if (c.spots)
         makeSpots(scene);
-    slot->prepared = std::make_unique<lighting::PreparedFrame>(std::move(scene), kWidth, kHeight);
-    slot->oracle = lighting::countContributingLights(slot->prepared->frame);
-    lighting::makeStage("brute")->shade(slot->prepared->frame, slot->brute);
+    slot->prepared = std::make_unique<lighting::PreparedScene>(std::move(scene), kWidth, kHeight);
+    slot->oracle = lighting::countContributingLights(slot->prepared->inputs);
+    lighting::makeStage("brute")->shade(slot->prepared->inputs, slot->brute);
     return *slot;
 }
 
@@ -97,7 +97,7 @@ TEST_P(ExactStage, MatchesBruteAndNeverDropsALight) {
     const SceneCase& c = kScenes[sceneIndex];
     const PreparedCase& f = prepared(c);
     lighting::StageResult result;
-    lighting::makeStage(stageName)->shade(f.prepared->frame, result);
+    lighting::makeStage(stageName)->shade(f.prepared->inputs, result);
     ASSERT_EQ(result.width, kWidth);
     ASSERT_EQ(result.height, kHeight);
 
@@ -146,7 +146,7 @@ INSTANTIATE_TEST_SUITE_P(AllExactStages, ExactStage,
 TEST(SpotBounds, ConeBoundsCullMoreThanRangeSpheres) {
     const PreparedCase& spots = prepared(kScenes[3]);
     lighting::StageResult withCones;
-    lighting::makeStage("tiled")->shade(spots.prepared->frame, withCones);
+    lighting::makeStage("tiled")->shade(spots.prepared->inputs, withCones);
     scenes::SceneRequest request;
     request.lightCount = kScenes[3].lights;
     request.seed = 3;
@@ -155,9 +155,9 @@ TEST(SpotBounds, ConeBoundsCullMoreThanRangeSpheres) {
     for (scenes::Light& light : scene.lights)
         if (light.type == scenes::LightType::Spot)
             light.spotOuterCos = -1.0f; // whole sphere, same range
-    lighting::PreparedFrame spheres(std::move(scene), kWidth, kHeight);
+    lighting::PreparedScene spheres(std::move(scene), kWidth, kHeight);
     lighting::StageResult withSpheres;
-    lighting::makeStage("tiled")->shade(spheres.frame, withSpheres);
+    lighting::makeStage("tiled")->shade(spheres.inputs, withSpheres);
     uint64_t cones = 0, rangeSpheres = 0;
     for (size_t pixel = 0; pixel < withCones.lightsEvaluated.size(); ++pixel) {
         cones += withCones.lightsEvaluated[pixel];
@@ -174,7 +174,7 @@ TEST(SpotBounds, DeferredConeProxiesEvaluateFewerLightsThanSpheres) {
     const char* stages[2] = {"deferred:spot=cone", "deferred:spot=sphere"};
     for (int k = 0; k < 2; ++k) {
         lighting::StageResult result;
-        lighting::makeStage(stages[k])->shade(spots.prepared->frame, result);
+        lighting::makeStage(stages[k])->shade(spots.prepared->inputs, result);
         int dropped = 0;
         for (size_t pixel = 0; pixel < result.lightsEvaluated.size(); ++pixel) {
             evaluated[k] += result.lightsEvaluated[pixel];

@@ -15,42 +15,42 @@
 
 #include "gbuffer/GBufferPass.h"
 #include "lighting/Oracle.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/TileFrusta.h"
 #include "scenes/ProceduralScenes.h"
 
 namespace {
 
-// A PreparedFrame (the runner's own frame construction) plus brute's result and the oracle.
-struct TestFrame {
-    std::unique_ptr<lighting::PreparedFrame> prepared;
-    lighting::Frame frame;
-    gbuffer::FrameView view;
+// A PreparedScene (the runner's own frame construction) plus brute's result and the oracle.
+struct TestScene {
+    std::unique_ptr<lighting::PreparedScene> prepared;
+    lighting::StageInputs inputs;
+    gbuffer::CameraView view;
     const gbuffer::GBuffer* gbuffer = nullptr;
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
 };
 
-std::unique_ptr<TestFrame>
-makeFrame(const std::string& sceneName, int lightCount, int width, int height,
-          gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed) {
-    auto f = std::make_unique<TestFrame>();
+std::unique_ptr<TestScene>
+makeTestScene(const std::string& sceneName, int lightCount, int width, int height,
+              gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed) {
+    auto f = std::make_unique<TestScene>();
     scenes::SceneRequest request;
     request.lightCount = lightCount;
     request.seed = 5;
-    f->prepared = std::make_unique<lighting::PreparedFrame>(
+    f->prepared = std::make_unique<lighting::PreparedScene>(
         scenes::buildProceduralScene(sceneName, request), width, height, false, depth);
-    f->frame = f->prepared->frame;
+    f->inputs = f->prepared->inputs;
     f->view = f->prepared->view;
     f->gbuffer = f->prepared->gbuffer.get();
-    f->oracle = lighting::countContributingLights(f->frame);
-    lighting::makeStage("brute")->shade(f->frame, f->brute);
+    f->oracle = lighting::countContributingLights(f->inputs);
+    lighting::makeStage("brute")->shade(f->inputs, f->brute);
     return f;
 }
 
-const TestFrame& atrium() {
-    static const std::unique_ptr<TestFrame> frame = makeFrame("atrium", 200, 320, 180);
+const TestScene& atrium() {
+    static const std::unique_ptr<TestScene> frame = makeTestScene("atrium", 200, 320, 180);
     return *frame;
 }
 
@@ -58,14 +58,14 @@ bool sameBits(float a, float b) {
     return std::memcmp(&a, &b, sizeof a) == 0;
 }
 
-lighting::StageResult run(const std::string& spec, const TestFrame& f) {
+lighting::StageResult run(const std::string& spec, const TestScene& f) {
     lighting::StageResult result;
-    lighting::makeStage(spec)->shade(f.frame, result);
+    lighting::makeStage(spec)->shade(f.inputs, result);
     return result;
 }
 
 // Bitwise brute's image and evaluated >= oracle at every pixel; returns the result.
-lighting::StageResult expectExact(const TestFrame& f, const std::string& spec) {
+lighting::StageResult expectExact(const TestScene& f, const std::string& spec) {
     const lighting::StageResult result = run(spec, f);
     EXPECT_EQ(result.width, f.view.width);
     EXPECT_EQ(result.height, f.view.height);
@@ -97,8 +97,8 @@ TEST(TiledForward, VariantsAreBitwiseBruteOnAtrium) {
 
 // Standard Z (near=0, far=1): the pre-pass and the tile bounds follow the view's convention.
 TEST(TiledForward, BitwiseBruteWithStandardDepth) {
-    const std::unique_ptr<TestFrame> f =
-        makeFrame("atrium", 200, 320, 180, gbuffer::DepthConvention::Standard);
+    const std::unique_ptr<TestScene> f =
+        makeTestScene("atrium", 200, 320, 180, gbuffer::DepthConvention::Standard);
     expectExact(*f, "tiled-forward");
     expectExact(*f, "tiled-forward:tile=32,vfc=0");
     expectExact(*f, "tiled-forward:mask=1");
@@ -112,8 +112,8 @@ TEST(TiledForward, BitwiseBruteWithStandardDepth) {
 // (float depth in the reference layout), its tile bounds are bitwise `tiled`'s, and the list
 // tests are the same. Holds exactly, so this checks equality, not just >= oracle.
 TEST(TiledForward, EvaluatesExactlyAsManyLightsAsTiled) {
-    const std::unique_ptr<TestFrame> wall = makeFrame("wall", 300, 320, 180);
-    for (const TestFrame* f : {&atrium(), static_cast<const TestFrame*>(wall.get())}) {
+    const std::unique_ptr<TestScene> wall = makeTestScene("wall", 300, 320, 180);
+    for (const TestScene* f : {&atrium(), static_cast<const TestScene*>(wall.get())}) {
         for (const std::string options : {"tile=16", "tile=32", "tile=8,vfc=0", "tile=32,vfc=0",
                                           "mask=1", "tile=32,mask=1,vfc=0"}) {
             const lighting::StageResult tiled = run("tiled:" + options, *f);
@@ -130,7 +130,7 @@ TEST(TiledForward, EvaluatesExactlyAsManyLightsAsTiled) {
 }
 
 TEST(TiledForward, PrepassTileBoundsEqualGBufferBounds) {
-    const TestFrame& f = atrium();
+    const TestScene& f = atrium();
     for (int tileSize : {4, 16, 37}) {
         const lighting::TileGrid grid =
             lighting::TileGrid::make(f.view.width, f.view.height, tileSize);
@@ -155,11 +155,11 @@ TEST(TiledForward, PrepassTileBoundsEqualGBufferBounds) {
 }
 
 TEST(TiledForward, SameResultForAnyThreadCount) {
-    const std::unique_ptr<TestFrame> f = makeFrame("wall", 300, 320, 180);
+    const std::unique_ptr<TestScene> f = makeTestScene("wall", 300, 320, 180);
     for (const char* spec : {"tiled-forward", "tiled-forward:tile=8,vfc=0"}) {
         lighting::StageResult one, many;
-        tbb::task_arena(1).execute([&] { lighting::makeStage(spec)->shade(f->frame, one); });
-        lighting::makeStage(spec)->shade(f->frame, many);
+        tbb::task_arena(1).execute([&] { lighting::makeStage(spec)->shade(f->inputs, one); });
+        lighting::makeStage(spec)->shade(f->inputs, many);
         for (int ch = 0; ch < 3; ++ch)
             EXPECT_EQ(one.radiance[ch], many.radiance[ch]) << spec;
         EXPECT_EQ(one.lightsEvaluated, many.lightsEvaluated) << spec;
@@ -170,11 +170,11 @@ TEST(TiledForward, SameResultForAnyThreadCount) {
 TEST(TiledForward, StageReusedAcrossFramesGivesSameResult) {
     // The stage keeps its rasterizer, depth and lists between frames; a second frame of another
     // size must not see stale data.
-    const std::unique_ptr<TestFrame> small = makeFrame("spheres", 100, 160, 90);
+    const std::unique_ptr<TestScene> small = makeTestScene("spheres", 100, 160, 90);
     std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage("tiled-forward:tile=16");
     lighting::StageResult first, second;
-    stage->shade(atrium().frame, first);
-    stage->shade(small->frame, second);
+    stage->shade(atrium().inputs, first);
+    stage->shade(small->inputs, second);
     const lighting::StageResult fresh = run("tiled-forward:tile=16", *small);
     for (int ch = 0; ch < 3; ++ch)
         EXPECT_EQ(second.radiance[ch], fresh.radiance[ch]);

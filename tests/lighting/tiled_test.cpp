@@ -14,7 +14,7 @@
 
 #include "gbuffer/GBufferPass.h"
 #include "lighting/Oracle.h"
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/TileFrusta.h"
 #include "scenes/ProceduralScenes.h"
@@ -25,31 +25,31 @@ constexpr int kWidth = 320;
 constexpr int kHeight = 180;
 
 // A prepared frame plus the oracle and brute's image for its current lights.
-struct TestFrame : lighting::PreparedFrame {
+struct TestScene : lighting::PreparedScene {
     std::vector<uint32_t> oracle;
     lighting::StageResult brute;
-    TestFrame(scenes::Scene scene, int width, int height)
-        : lighting::PreparedFrame(std::move(scene), width, height) {}
+    TestScene(scenes::Scene scene, int width, int height)
+        : lighting::PreparedScene(std::move(scene), width, height) {}
 };
 
 // Rasterizes the scene's G-buffer only (lights can be changed afterwards with setLights).
-std::unique_ptr<TestFrame> rasterize(scenes::Scene scene, int width = kWidth,
+std::unique_ptr<TestScene> rasterize(scenes::Scene scene, int width = kWidth,
                                      int height = kHeight) {
-    return std::make_unique<TestFrame>(std::move(scene), width, height);
+    return std::make_unique<TestScene>(std::move(scene), width, height);
 }
 
-void setLights(TestFrame& f, const std::vector<scenes::Light>& lights) {
+void setLights(TestScene& f, const std::vector<scenes::Light>& lights) {
     f.setLights(lights);
-    f.oracle = lighting::countContributingLights(f.frame);
-    lighting::makeStage("brute")->shade(f.frame, f.brute);
+    f.oracle = lighting::countContributingLights(f.inputs);
+    lighting::makeStage("brute")->shade(f.inputs, f.brute);
 }
 
 // Runs `spec` on the frame and checks it against brute: bitwise image, evaluated >= oracle.
 // Returns the result for further checks.
-lighting::StageResult expectExact(const TestFrame& f, const std::string& spec,
+lighting::StageResult expectExact(const TestScene& f, const std::string& spec,
                                   const std::string& what) {
     lighting::StageResult result;
-    lighting::makeStage(spec)->shade(f.frame, result);
+    lighting::makeStage(spec)->shade(f.inputs, result);
     EXPECT_EQ(result.width, f.view.width);
     EXPECT_EQ(result.height, f.view.height);
     int imageFailures = 0, dropped = 0;
@@ -75,7 +75,7 @@ const char* const kSpecs[] = {
     "tiled-backface", "tiled-backface:mask=1", "tiled-backface:tile=32,vfc=0",
     "tiled:tile=7"};
 
-void expectAllExact(const TestFrame& f, const std::string& what) {
+void expectAllExact(const TestScene& f, const std::string& what) {
     uint64_t oracleTotal = 0;
     for (uint32_t n : f.oracle)
         oracleTotal += n;
@@ -100,12 +100,12 @@ scenes::Light pointLight(const glm::vec3& positionWorld, float rangeMetres) {
     return light;
 }
 
-glm::vec3 worldFromView(const gbuffer::FrameView& view, const glm::vec3& pView) {
+glm::vec3 worldFromView(const gbuffer::CameraView& view, const glm::vec3& pView) {
     return glm::vec3(glm::inverse(view.viewFromWorld) * glm::vec4(pView, 1.0f));
 }
 
 // The wall scene without generated lights: its frame plus its camera's view.
-std::unique_ptr<TestFrame> wallFrame() {
+std::unique_ptr<TestScene> wallScene() {
     scenes::SceneRequest request;
     request.lightCount = 0;
     return rasterize(scenes::buildProceduralScene("wall", request));
@@ -141,8 +141,8 @@ scenes::Scene twoPlaneScene() {
 }
 
 TEST(TiledStage, LightsCentredOnTileCorners) {
-    auto f = wallFrame();
-    const gbuffer::FrameView& view = f->view;
+    auto f = wallScene();
+    const gbuffer::CameraView& view = f->view;
     const auto& depth = f->gbuffer->depth();
     std::vector<scenes::Light> lights;
     for (int tile : {8, 16, 32})
@@ -165,8 +165,8 @@ TEST(TiledStage, LightsCentredOnTileCorners) {
 }
 
 TEST(TiledStage, LightsAtNearPlaneAroundAndBehindCamera) {
-    auto f = wallFrame();
-    const gbuffer::FrameView& view = f->view;
+    auto f = wallScene();
+    const gbuffer::CameraView& view = f->view;
     std::vector<scenes::Light> lights = {
         pointLight(worldFromView(view, {0.0f, 0.0f, -view.nearMetres}), 6.0f), // crosses near
         pointLight(worldFromView(view, {0.3f, -0.2f, -0.05f}), 4.0f),          // eye inside
@@ -180,8 +180,8 @@ TEST(TiledStage, LightsAtNearPlaneAroundAndBehindCamera) {
 }
 
 TEST(TiledStage, ZeroRangeAndScreenCoveringLights) {
-    auto f = wallFrame();
-    const gbuffer::FrameView& view = f->view;
+    auto f = wallScene();
+    const gbuffer::CameraView& view = f->view;
     std::vector<scenes::Light> lights;
     lights.push_back(pointLight(worldFromView(view, {0.0f, 0.0f, -9.0f}), 0.0f));
     lights.push_back(pointLight({0.0f, 2.0f, 0.5f}, 0.0f));   // on the wall's face, zero range
@@ -252,8 +252,8 @@ TEST(TiledStage, SameResultForAnyThreadCount) {
     setLights(*f, lights);
     for (const char* spec : {"tiled:mask=1", "tiled-backface"}) {
         lighting::StageResult one, many;
-        tbb::task_arena(1).execute([&] { lighting::makeStage(spec)->shade(f->frame, one); });
-        lighting::makeStage(spec)->shade(f->frame, many);
+        tbb::task_arena(1).execute([&] { lighting::makeStage(spec)->shade(f->inputs, one); });
+        lighting::makeStage(spec)->shade(f->inputs, many);
         for (int ch = 0; ch < 3; ++ch)
             EXPECT_EQ(one.radiance[ch], many.radiance[ch]) << spec;
         EXPECT_EQ(one.lightsEvaluated, many.lightsEvaluated) << spec;

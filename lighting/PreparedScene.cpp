@@ -1,4 +1,4 @@
-#include "lighting/PreparedFrame.h"
+#include "lighting/PreparedScene.h"
 
 namespace lighting {
 
@@ -11,12 +11,12 @@ gbuffer::GBufferLayout losslessLayout(gbuffer::DepthConvention depth, bool infin
     return layout;
 }
 
-PreparedFrame::PreparedFrame(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
+PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
                              const gbuffer::GBufferLayout& layout)
     : scene(std::move(sceneIn)) {
     geometry = gbuffer::SceneGeometry::build(scene);
-    view = gbuffer::FrameView::fromCamera(scene.cameras.front(), width, height,
-                                          layout.depth.convention(), layout.depth.infiniteFar);
+    view = gbuffer::CameraView::fromCamera(scene.cameras.front(), width, height,
+                                           layout.depth.convention(), layout.depth.infiniteFar);
     gbuffer = std::make_unique<gbuffer::GBuffer>(layout, view);
     if (withExactSurface)
         exact = std::make_unique<gbuffer::ExactSurface>();
@@ -24,31 +24,31 @@ PreparedFrame::PreparedFrame(scenes::Scene sceneIn, int width, int height, bool 
     mPass = std::make_unique<gbuffer::GBufferPass>(scene, geometry);
     renderGBuffer();
     setLights(scene.lights);
-    frame.scene = &scene;
-    frame.geometry = &geometry;
-    frame.view = &view;
-    frame.gbuffer = gbuffer.get();
-    frame.exact = exact.get();
-    frame.lights = &lights;
+    inputs.scene = &scene;
+    inputs.geometry = &geometry;
+    inputs.view = &view;
+    inputs.gbuffer = gbuffer.get();
+    inputs.exact = exact.get();
+    inputs.lights = &lights;
 }
 
-PreparedFrame::PreparedFrame(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
+PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
                              gbuffer::DepthConvention depth)
-    : PreparedFrame(std::move(sceneIn), width, height, withExactSurface, losslessLayout(depth)) {}
+    : PreparedScene(std::move(sceneIn), width, height, withExactSurface, losslessLayout(depth)) {}
 
-void PreparedFrame::renderGBuffer() {
+void PreparedScene::renderGBuffer() {
     gbufferTimings = mPass->render(*mRasterizer, *gbuffer, exact.get());
     rasterStats = mRasterizer->lastStats();
 }
 
-std::unique_ptr<gbuffer::GBuffer> PreparedFrame::renderLosslessGBuffer() {
+std::unique_ptr<gbuffer::GBuffer> PreparedScene::renderLosslessGBuffer() {
     auto lossless = std::make_unique<gbuffer::GBuffer>(
         losslessLayout(view.depthConvention, view.infiniteFar), view);
     mPass->render(*mRasterizer, *lossless, nullptr);
     return lossless;
 }
 
-void PreparedFrame::setLights(const std::vector<scenes::Light>& sceneLights) {
+void PreparedScene::setLights(const std::vector<scenes::Light>& sceneLights) {
     if (&sceneLights != &scene.lights)
         scene.lights = sceneLights;
     lights = LightList::build(scene.lights, view);

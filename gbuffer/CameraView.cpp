@@ -1,12 +1,12 @@
-#include "gbuffer/FrameView.h"
+#include "gbuffer/CameraView.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
 namespace gbuffer {
 
-FrameView FrameView::fromCamera(const scenes::Camera& camera, int width, int height,
-                                DepthConvention convention, bool infiniteFar) {
-    FrameView view;
+CameraView CameraView::fromCamera(const scenes::Camera& camera, int width, int height,
+                                  DepthConvention convention, bool infiniteFar) {
+    CameraView view;
     view.infiniteFar = infiniteFar;
     view.depthConvention = convention;
     view.width = width;

@@ -1,4 +1,5 @@
-// FrameView: the camera of one frame as matrices, for a given viewport. Depth is "zero to one"
+// CameraView: the camera of one frame as matrices (view, projection, their inverses), for a given
+// viewport. Depth is "zero to one"
 // (0 <= z <= w in clip space). With standard Z, 0 is the near plane and 1 the far plane; with
 // reversed Z (the default), 1 is the near plane and 0 the far plane, which spreads float32
 // precision evenly over distance (standard float depth loses ~1e-4 relative position accuracy
@@ -14,7 +15,7 @@ namespace gbuffer {
 
 enum class DepthConvention { Standard, Reversed };
 
-struct FrameView {
+struct CameraView {
     int width = 0;
     int height = 0;
     float nearMetres = 0.1f;
@@ -28,9 +29,9 @@ struct FrameView {
     glm::dmat4 viewFromWorldExact{1.0};
     glm::dmat4 viewFromClipExact{1.0};
 
-    static FrameView fromCamera(const scenes::Camera& camera, int width, int height,
-                                DepthConvention convention = DepthConvention::Reversed,
-                                bool infiniteFar = false);
+    static CameraView fromCamera(const scenes::Camera& camera, int width, int height,
+                                 DepthConvention convention = DepthConvention::Reversed,
+                                 bool infiniteFar = false);
 
     bool reversedZ() const { return depthConvention == DepthConvention::Reversed; }
     // Depth of "nothing here": the far plane's value.

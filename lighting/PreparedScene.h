@@ -1,15 +1,16 @@
-// PreparedFrame: everything a shading stage reads for one frame, owned in one place: the scene,
-// its flattened geometry, the camera matrices, the rasterized G-buffer in a given layout (and, on
-// request, the exact surface for the reference) and the view-space lights. The runner, the tests
-// and the benchmarks all build frames this way, so a stage sees the same inputs everywhere.
-// Construction rasterizes the G-buffer (parallel, under the caller's tbb::task_arena); the
-// object is immovable because `frame` points into it.
+// PreparedScene: a scene prepared for the shading stages at one camera and size, everything a
+// stage reads owned in one place: the scene, its flattened geometry, the camera matrices, the
+// rasterized G-buffer in a given layout (and, on request, the exact surface for the reference)
+// and the view-space lights, with `inputs` (the StageInputs a stage's shade() takes) pointing
+// into them. The runner, the tests and the benchmarks all prepare scenes this way, so a stage
+// sees the same inputs everywhere. Construction rasterizes the G-buffer (parallel, under the
+// caller's tbb::task_arena); the object is immovable because `inputs` points into it.
 #pragma once
 
 #include <memory>
 
+#include "gbuffer/CameraView.h"
 #include "gbuffer/ExactSurface.h"
-#include "gbuffer/FrameView.h"
 #include "gbuffer/GBuffer.h"
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/GBufferPass.h"
@@ -21,23 +22,23 @@
 
 namespace lighting {
 
-struct PreparedFrame {
+struct PreparedScene {
     scenes::Scene scene;
     gbuffer::SceneGeometry geometry;
-    gbuffer::FrameView view;
+    gbuffer::CameraView view;
     std::unique_ptr<gbuffer::GBuffer> gbuffer;
     std::unique_ptr<gbuffer::ExactSurface> exact; // null unless asked for
     LightList lights;
-    Frame frame;
+    StageInputs inputs;
     raster::RasterStats rasterStats;
     gbuffer::GBufferPassTimings gbufferTimings;
 
     // Renders `scene` from its first camera at width x height into `layout`; the view's depth
     // convention and far plane follow the layout's depth format.
-    PreparedFrame(scenes::Scene scene, int width, int height, bool withExactSurface,
+    PreparedScene(scenes::Scene scene, int width, int height, bool withExactSurface,
                   const gbuffer::GBufferLayout& layout);
     // The reference layout (float32 everything), with standard or reversed float depth.
-    PreparedFrame(scenes::Scene scene, int width, int height, bool withExactSurface = false,
+    PreparedScene(scenes::Scene scene, int width, int height, bool withExactSurface = false,
                   gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed);
 
     // Rasterizes the G-buffer (and the exact surface, if any) again: for timing repetitions.
@@ -52,8 +53,8 @@ struct PreparedFrame {
     // lights by hand after seeing the geometry.
     void setLights(const std::vector<scenes::Light>& sceneLights);
 
-    PreparedFrame(const PreparedFrame&) = delete;
-    PreparedFrame& operator=(const PreparedFrame&) = delete;
+    PreparedScene(const PreparedScene&) = delete;
+    PreparedScene& operator=(const PreparedScene&) = delete;
 
 private:
     std::unique_ptr<raster::Rasterizer> mRasterizer;
