@@ -13,6 +13,7 @@
 
 #include "gbuffer/CameraView.h"
 #include "gbuffer/SceneGeometry.h"
+#include "gbuffer/Surface.h"
 
 namespace gbuffer {
 
@@ -30,6 +31,16 @@ struct ExactSurface {
 
     void resize(int w, int h);
     bool covered(size_t pixel) const { return triangle[pixel] != kNoTriangle; }
+    // The exact surface at a covered pixel, in double (material index left 0).
+    BasicSurface<double> surface(size_t pixel) const {
+        BasicSurface<double> s;
+        s.positionView = positionView[pixel];
+        s.normalView = normalView[pixel];
+        s.albedo = glm::dvec3(albedo[pixel]);
+        s.specularIntensity = double(specular[pixel].x);
+        s.specularPower = double(specular[pixel].y);
+        return s;
+    }
     // Fills positionView and normalView from `triangle` (parallel over rows, deterministic).
     void computeGeometry(const SceneGeometry& geometry, const CameraView& view);
 };

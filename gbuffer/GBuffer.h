@@ -27,18 +27,9 @@
 #include "gbuffer/DepthFormat.h"
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/Plane.h"
+#include "gbuffer/Surface.h"
 
 namespace gbuffer {
-
-// What a lighting stage needs at one pixel, decoded.
-struct Surface {
-    glm::vec3 positionView{0.0f};
-    glm::vec3 normalView{0.0f, 0.0f, 1.0f};
-    glm::vec3 albedo{0.0f};
-    float specularIntensity = 0.0f;
-    float specularPower = 1.0f;
-    uint32_t material = 0; // index into the scene's materials (written, not always stored)
-};
 
 class GBuffer {
 public:

@@ -15,19 +15,12 @@
 
 #include <glm/glm.hpp>
 
+#include "gbuffer/Surface.h"
 #include "scenes/Scene.h"
 
 namespace lighting {
 
 template <class T> using Vec3 = glm::vec<3, T, glm::defaultp>;
-
-template <class T> struct ShadingPoint {
-    Vec3<T> positionView{T(0)};
-    Vec3<T> normalView{T(0), T(0), T(1)}; // unit
-    Vec3<T> albedo{T(0)};
-    T specularIntensity = T(0);
-    T specularPower = T(1);
-};
 
 // A scene light in view space, with its colour and intensity folded into one radiance.
 template <class T> struct LightInView {
@@ -45,7 +38,7 @@ inline constexpr double kPi = 3.14159265358979323846;
 // Radiance towards the camera from one light at one surface point. Zero (exactly) when the point
 // is at or beyond the light's range, outside a spot cone, or facing away from the light.
 template <class T>
-inline Vec3<T> evaluateLight(const ShadingPoint<T>& s, const Vec3<T>& toViewer,
+inline Vec3<T> evaluateLight(const gbuffer::BasicSurface<T>& s, const Vec3<T>& toViewer,
                              const LightInView<T>& light) {
     using scenes::LightType;
     if (light.type == LightType::Ambient)

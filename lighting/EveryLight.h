@@ -1,7 +1,7 @@
 // shadeWithEveryLight: the brute-force loop shared by the `brute` and `reference` stages and
 // the oracle: every light at every covered pixel, in light order, rows in parallel (each pixel
 // written by one task only, so the result is independent of the thread count).
-// surfaceAt(x, y, point) fills a ShadingPoint<T> and returns false for background pixels.
+// surfaceAt(x, y, point) fills a gbuffer::BasicSurface<T> and returns false for background pixels.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +20,7 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
     const bool countOracle = !result.lightsOracle.empty();
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {
-            ShadingPoint<T> point;
+            gbuffer::BasicSurface<T> point;
             if (!surfaceAt(x, y, point))
                 continue;
             const size_t pixel = size_t(y) * width + x;
@@ -42,12 +42,11 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
     });
 }
 
-// The G-buffer's surface at (x, y) as a float ShadingPoint; false for background.
-inline bool gbufferSurfaceAt(const gbuffer::GBuffer& gb, int x, int y, ShadingPoint<float>& point) {
+// The G-buffer's decoded surface at (x, y); false for background.
+inline bool gbufferSurfaceAt(const gbuffer::GBuffer& gb, int x, int y, gbuffer::Surface& point) {
     if (!gb.covered(size_t(y) * gb.width() + x))
         return false;
-    const gbuffer::Surface s = gb.decode(x, y);
-    point = {s.positionView, s.normalView, s.albedo, s.specularIntensity, s.specularPower};
+    point = gb.decode(x, y);
     return true;
 }
 

@@ -6,7 +6,7 @@
 // objects (runs of consecutive triangles of one scenes::Instance) and bounds each object with a
 // view-space AABB. A fragment's surface comes from gbuffer::surfaceOfTriangle and its position
 // from gbuffer::positionViewOfPixel on the fragment's depth, the functions the G-buffer pass and
-// GBuffer::decode use, so the visible fragment's ShadingPoint is bitwise the one `brute` reads
+// GBuffer::decode use, so the visible fragment's Surface is bitwise the one `brute` reads
 // from the G-buffer (the same triangles through the same rasterizer give the same depth), and
 // evaluating lights in ascending index order gives bitwise brute's radiance.
 //
@@ -70,12 +70,13 @@ public:
     raster::TriangleList triangles() const { return {mClipPositions, mGeometry->indices}; }
 
     // The fragment's surface as `brute` sees it in the G-buffer (see the file comment).
-    ShadingPoint<float> surfaceAt(const raster::Fragment& fragment, uint32_t triangle) const {
-        const gbuffer::Surface s = gbuffer::surfaceOfTriangle(
+    gbuffer::Surface surfaceAt(const raster::Fragment& fragment, uint32_t triangle) const {
+        gbuffer::Surface s = gbuffer::surfaceOfTriangle(
             *mGeometry, *mScene, mClipPositions, mNormalsView, triangle, !fragment.frontFacing,
             mView->ndcOfPixel(fragment.x, fragment.y));
-        return {gbuffer::positionViewOfPixel(*mView, fragment.x, fragment.y, fragment.depth),
-                s.normalView, s.albedo, s.specularIntensity, s.specularPower};
+        s.positionView =
+            gbuffer::positionViewOfPixel(*mView, fragment.x, fragment.y, fragment.depth);
+        return s;
     }
 
 private:

@@ -20,7 +20,7 @@ inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
                                const std::vector<LightInView<float>>& lights,
                                std::span<const uint32_t> lightIndices, StageResult& result) {
     const size_t pixel = size_t(y) * gb.width() + x;
-    ShadingPoint<float> point;
+    gbuffer::Surface point;
     if (!gbufferSurfaceAt(gb, x, y, point))
         return;
     const glm::vec3 toViewer = glm::normalize(-point.positionView);
@@ -42,11 +42,11 @@ struct SplitLighting {
     glm::vec3 specular{0.0f};
 };
 
-inline SplitLighting splitLighting(const ShadingPoint<float>& point,
+inline SplitLighting splitLighting(const gbuffer::Surface& point,
                                    const std::vector<LightInView<float>>& lights,
                                    std::span<const uint32_t> lightIndices) {
     const glm::vec3 toViewer = glm::normalize(-point.positionView);
-    ShadingPoint<float> diffusePoint = point, specularPoint = point;
+    gbuffer::Surface diffusePoint = point, specularPoint = point;
     diffusePoint.albedo = glm::vec3(1.0f);
     diffusePoint.specularIntensity = 0.0f;
     specularPoint.albedo = glm::vec3(0.0f);

@@ -10,7 +10,7 @@ std::vector<uint32_t> countContributingLights(const StageInputs& inputs) {
     scratch.resize(gb.width(), gb.height(), true);
     shadeWithEveryLight<float>(
         gb.width(), gb.height(), inputs.lights->lights,
-        [&](int x, int y, ShadingPoint<float>& point) { return gbufferSurfaceAt(gb, x, y, point); },
+        [&](int x, int y, gbuffer::Surface& point) { return gbufferSurfaceAt(gb, x, y, point); },
         scratch);
     return std::move(scratch.lightsOracle);
 }

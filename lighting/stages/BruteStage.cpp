@@ -24,7 +24,7 @@ public:
         const auto start = std::chrono::steady_clock::now();
         shadeWithEveryLight<float>(
             gb.width(), gb.height(), inputs.lights->lights,
-            [&](int x, int y, ShadingPoint<float>& point) {
+            [&](int x, int y, gbuffer::Surface& point) {
                 return gbufferSurfaceAt(gb, x, y, point);
             },
             result);

@@ -70,7 +70,7 @@ public:
         uint32_t* evaluated = result.lightsEvaluated.data();
         // Adds one light at one pixel; the pixel belongs to the calling task alone.
         auto addLight = [&](int x, int y, size_t pixel, const LightInView<float>& light) {
-            ShadingPoint<float> point;
+            gbuffer::Surface point;
             if (!gbufferSurfaceAt(gb, x, y, point))
                 return;
             const glm::vec3 value =

@@ -90,7 +90,7 @@ public:
                     globalTriangle ? globalTriangle[fragment.triangle] : fragment.triangle;
                 if (mVisible[pixel] != visibilityCode(triangle, fragment.frontFacing))
                     return;
-                const ShadingPoint<float> point = mForward.surfaceAt(fragment, triangle);
+                const gbuffer::Surface point = mForward.surfaceAt(fragment, triangle);
                 const glm::vec3 radiance =
                     evaluateLight(point, glm::normalize(-point.positionView), light);
                 result.radiance[0][pixel] += radiance.x;

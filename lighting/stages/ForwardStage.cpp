@@ -68,7 +68,7 @@ public:
             const uint32_t object = mForward.objectOfTriangle(fragment.triangle);
             const uint32_t* index = mLightIndices.data() + mLightOffsets[object];
             const uint32_t* end = mLightIndices.data() + mLightOffsets[object + 1];
-            const ShadingPoint<float> point = mForward.surfaceAt(fragment, fragment.triangle);
+            const gbuffer::Surface point = mForward.surfaceAt(fragment, fragment.triangle);
             const glm::vec3 toViewer = glm::normalize(-point.positionView);
             glm::vec3 sum(0.0f);
             for (; index != end; ++index)

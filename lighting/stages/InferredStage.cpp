@@ -164,7 +164,7 @@ public:
             for (int j = ty * tileSamples; j < j1; ++j)
                 for (int i = tx * tileSamples; i < i1; ++i) {
                     const int x = sampleX(i), y = sampleY(j);
-                    ShadingPoint<float> point;
+                    gbuffer::Surface point;
                     if (!gbufferSurfaceAt(gb, x, y, point))
                         continue;
                     LightSample& sample = mSamples[size_t(j) * lowWidth + i];

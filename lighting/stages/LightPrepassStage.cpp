@@ -94,7 +94,7 @@ public:
             for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
                 for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
                     const size_t pixel = size_t(y) * width + x;
-                    ShadingPoint<float> point;
+                    gbuffer::Surface point;
                     if (!gbufferSurfaceAt(gb, x, y, point))
                         continue;
                     const SplitLighting lighting = splitLighting(point, lights, list);

@@ -21,13 +21,11 @@ public:
         const auto start = std::chrono::steady_clock::now();
         shadeWithEveryLight<double>(
             exact.width, exact.height, inputs.lights->lightsExact,
-            [&](int x, int y, ShadingPoint<double>& point) {
+            [&](int x, int y, gbuffer::BasicSurface<double>& point) {
                 const size_t pixel = size_t(y) * exact.width + x;
                 if (!exact.covered(pixel))
                     return false;
-                point = {exact.positionView[pixel], exact.normalView[pixel],
-                         glm::dvec3(exact.albedo[pixel]), double(exact.specular[pixel].x),
-                         double(exact.specular[pixel].y)};
+                point = exact.surface(pixel);
                 return true;
             },
             result);

@@ -86,7 +86,7 @@ public:
                 return;
             const std::vector<uint32_t>& list =
                 mTileLights[size_t(fragment.y / tileSize) * tileCountX + fragment.x / tileSize];
-            const ShadingPoint<float> point = mForward.surfaceAt(fragment, fragment.triangle);
+            const gbuffer::Surface point = mForward.surfaceAt(fragment, fragment.triangle);
             const glm::vec3 toViewer = glm::normalize(-point.positionView);
             glm::vec3 sum(0.0f);
             for (uint32_t index : list)

@@ -178,7 +178,7 @@ void clusteredPerfectCullingCeiling(benchmark::State& state) {
     tbb::parallel_for(0, gb.height(), [&](int y) {
         rowOffsets[y].push_back(0);
         for (int x = 0; x < gb.width(); ++x) {
-            lighting::ShadingPoint<float> point;
+            gbuffer::Surface point;
             if (lighting::gbufferSurfaceAt(gb, x, y, point)) {
                 const glm::vec3 toViewer = glm::normalize(-point.positionView);
                 for (uint32_t i = 0; i < lights.size(); ++i)

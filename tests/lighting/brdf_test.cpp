@@ -10,11 +10,10 @@ namespace {
 
 using lighting::evaluateLight;
 using lighting::LightInView;
-using lighting::ShadingPoint;
 using scenes::LightType;
 
-template <class T> ShadingPoint<T> matteFloorPoint() {
-    ShadingPoint<T> p;
+template <class T> gbuffer::BasicSurface<T> matteFloorPoint() {
+    gbuffer::BasicSurface<T> p;
     p.positionView = {T(0), T(0), T(-5)};
     p.normalView = {T(0), T(1), T(0)};
     p.albedo = {T(0.5), T(0.5), T(0.5)};
@@ -94,11 +93,15 @@ TEST(Brdf, SpotConeAndDirectionalAndAmbient) {
 
 TEST(Brdf, FloatMatchesDouble) {
     // Same formula in both precisions: relative agreement to float rounding.
-    ShadingPoint<double> pd = matteFloorPoint<double>();
+    gbuffer::BasicSurface<double> pd = matteFloorPoint<double>();
     pd.specularIntensity = 0.5;
     pd.specularPower = 64.0;
-    ShadingPoint<float> pf{glm::vec3(pd.positionView), glm::vec3(pd.normalView),
-                           glm::vec3(pd.albedo), 0.5f, 64.0f};
+    gbuffer::Surface pf;
+    pf.positionView = glm::vec3(pd.positionView);
+    pf.normalView = glm::vec3(pd.normalView);
+    pf.albedo = glm::vec3(pd.albedo);
+    pf.specularIntensity = 0.5f;
+    pf.specularPower = 64.0f;
     for (int i = 0; i < 100; ++i) {
         const double a = i * 0.0628;
         LightInView<double> ld = pointLightAbove(0.3 + 0.01 * i, 3.0);

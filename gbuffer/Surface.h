@@ -1,0 +1,31 @@
+// Surface: the shading inputs at one surface point, the one struct the G-buffer stores and
+// decodes, the visibility pass resolves, the exact surface gives the reference and the BRDF
+// (lighting/Brdf.h) shades. Templated on the scalar type: float everywhere, double for the
+// reference (BasicSurface<double>, from gbuffer::ExactSurface).
+//
+// Conventions: view space right-handed, camera at the origin looking down -Z, metres. The
+// defaults are what background pixels hold in every plane (GBuffer::Writer::writeBackground):
+// zero position and albedo, normal +Z, no specular.
+// A channel a G-buffer layout does not provide decodes to its default (GBuffer::decode). New
+// material parameters (e.g. roughness, metallic, emissive) are new fields with a default here,
+// a channel in GBufferLayout.h, and a line in the resolve (TriangleCorners.h) and the decoder.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+namespace gbuffer {
+
+template <class T> struct BasicSurface {
+    glm::vec<3, T> positionView{T(0)};
+    glm::vec<3, T> normalView{T(0), T(0), T(1)}; // unit
+    glm::vec<3, T> albedo{T(0)};                 // linear RGB, times the base colour texture
+    T specularIntensity = T(0);
+    T specularPower = T(1); // Blinn-Phong exponent
+    uint32_t material = 0;  // index into the scene's materials (written, not always stored)
+};
+
+using Surface = BasicSurface<float>;
+
+} // namespace gbuffer
