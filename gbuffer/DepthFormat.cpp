@@ -241,4 +241,29 @@ glm::vec3 positionByViewRay(const CameraView& view, glm::vec2 ndc, float viewDep
     return viewRayOfNdc(view, ndc) * viewDepthMetres;
 }
 
+DepthDecoder::DepthDecoder(const DepthFormatSpec& format, PositionMethod method,
+                           const CameraView& view)
+    : mFormat(format), mMethod(method), mView(view), mProjection(DepthProjection::of(view)) {}
+
+bool DepthDecoder::lossless() const {
+    return mFormat.kind == DepthFormatKind::F32 || mFormat.kind == DepthFormatKind::F32Reversed;
+}
+
+float DepthDecoder::storedDepthNdc(float depthNdc) const {
+    const float clear = mProjection.clearDepthNdc();
+    if (lossless() || depthNdc == clear)
+        return depthNdc;
+    const float stored =
+        decodeDepthNdc(mFormat, mProjection, encodeDepth(mFormat, mProjection, depthNdc));
+    const bool covered = mProjection.reversed ? stored > clear : stored < clear;
+    return covered ? stored : std::nextafter(clear, mProjection.reversed ? 1.0f : 0.0f);
+}
+
+glm::vec3 DepthDecoder::positionView(int x, int y, float storedDepthNdc) const {
+    const glm::vec2 ndc = mView.ndcOfPixel(x, y);
+    if (mMethod == PositionMethod::InverseProjection)
+        return positionByInverseProjection(mView, ndc, storedDepthNdc);
+    return positionByViewRay(mView, ndc, mProjection.viewDepthFromNdcFloat(storedDepthNdc));
+}
+
 } // namespace gbuffer

@@ -17,7 +17,7 @@
 //   plane's value) means "no surface"; a covered pixel never encodes to it (clamped one step
 //   nearer), so quantisation cannot turn geometry into background.
 // - Every function is pure and thread-safe; parse() throws std::invalid_argument listing the
-//   valid names.
+//   valid names. Readers of a depth plane go through DepthDecoder (below), which composes them.
 #pragma once
 
 #include <cstdint>
@@ -92,5 +92,48 @@ glm::vec3 positionByInverseProjection(const CameraView& view, glm::vec2 ndc, flo
 glm::vec3 positionByViewRay(const CameraView& view, glm::vec2 ndc, float viewDepthMetres);
 // The view ray through `ndc` with z = -1 (also the ray `pixel-view` normals are built on).
 glm::vec3 viewRayOfNdc(const CameraView& view, glm::vec2 ndc);
+
+// DepthDecoder: a layout's depth as every reader sees it, and the one implementation of position
+// from depth (GBuffer::decode, the tile and cluster bounds of the culling stages, forward
+// shading's fragments). Built from a layout's depth format and position method
+// (GBufferLayout::depthDecoder) and the frame's view.
+// A depth plane holds the rasterizer's float NDC depth rounded through the format
+// (storedDepthNdc: what GBuffer::quantiseDepth writes), so reading needs no decoding of codes;
+// position comes from that value by the layout's method:
+//   inverse-projection  positionByInverseProjection(view, ndc, depth)
+//   view-ray            positionByViewRay(view, ndc, projection.viewDepthFromNdcFloat(depth))
+// Forward stages keep no G-buffer: their depth is the rasterizer's own float depth, i.e. the
+// lossless layout's (GBufferLayout::lossless), and they read it with that layout's decoder, so a
+// fragment's position is bitwise what GBuffer::decode gives on the lossless layout.
+// Cheap to copy (holds a copy of the view); const and thread-safe.
+class DepthDecoder {
+public:
+    DepthDecoder(const DepthFormatSpec& format, PositionMethod method, const CameraView& view);
+
+    const DepthFormatSpec& format() const { return mFormat; }
+    PositionMethod method() const { return mMethod; }
+    const CameraView& view() const { return mView; }
+    const DepthProjection& projection() const { return mProjection; }
+    // True when the format keeps the rasterizer's float depth unchanged (f32, f32-reversed).
+    bool lossless() const;
+
+    // What the format keeps of the rasterizer's NDC depth `depthNdc` of a covered pixel: its code
+    // decoded, one float step nearer than the clear value when the rounding would make it read as
+    // background (e.g. f16-linear rounding past the far plane). The clear value itself is kept.
+    float storedDepthNdc(float depthNdc) const;
+    // View-space position of pixel (x, y) whose depth plane holds `storedDepthNdc` (covered), by
+    // the layout's method.
+    glm::vec3 positionView(int x, int y, float storedDepthNdc) const;
+    // Positive view depth -positionView(x, y, storedDepthNdc).z, metres.
+    float viewDepthMetres(int x, int y, float storedDepthNdc) const {
+        return -positionView(x, y, storedDepthNdc).z;
+    }
+
+private:
+    DepthFormatSpec mFormat;
+    PositionMethod mMethod;
+    CameraView mView;
+    DepthProjection mProjection;
+};
 
 } // namespace gbuffer

@@ -40,8 +40,7 @@ uint32_t unorm8(float v) {
 } // namespace
 
 GBuffer::GBuffer(const GBufferLayout& layout, const CameraView& view)
-    : mLayout(layout), mView(view), mProjection(DepthProjection::of(view)),
-      mClearDepth(view.clearDepth()) {
+    : mLayout(layout), mDepthDecoder(layout.depthDecoder(view)), mClearDepth(view.clearDepth()) {
     if (layout.depth.convention() != view.depthConvention ||
         layout.depth.infiniteFar != view.infiniteFar)
         throw std::invalid_argument(
@@ -77,35 +76,22 @@ GBuffer::GBuffer(const GBufferLayout& layout, const CameraView& view)
         mMaterial.assign(n, 0);
 }
 
-void GBuffer::clearDepth() {
-    std::fill(mDepth.begin(), mDepth.end(), mClearDepth);
-}
-
 void GBuffer::quantiseDepth() {
-    const DepthFormatKind kind = mLayout.depth.kind;
-    if (kind == DepthFormatKind::F32 || kind == DepthFormatKind::F32Reversed)
-        return; // lossless
-    const bool reversed = mView.reversedZ();
-    // One float step nearer than the clear value: where a covered pixel goes if its rounded depth
-    // would read as background (e.g. f16-linear rounding past the far plane).
-    const float nearestCovered = std::nextafter(mClearDepth, reversed ? 1.0f : 0.0f);
+    if (mDepthDecoder.lossless())
+        return;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, mDepth.size(), 16384), [&](const auto& range) {
         for (size_t pixel = range.begin(); pixel != range.end(); ++pixel) {
             const float z = mDepth[pixel];
-            if (z == mClearDepth)
-                continue;
-            float q = decodeDepthNdc(mLayout.depth, mProjection,
-                                     encodeDepth(mLayout.depth, mProjection, z));
-            if (reversed ? !(q > mClearDepth) : !(q < mClearDepth))
-                q = nearestCovered;
-            mDepth[pixel] = q;
+            if (z != mClearDepth)
+                mDepth[pixel] = mDepthDecoder.storedDepthNdc(z);
         }
     });
 }
 
 glm::vec3 GBuffer::viewRayOfPixel(size_t pixel) const {
-    const int x = int(pixel % size_t(mView.width)), y = int(pixel / size_t(mView.width));
-    return viewRayOfNdc(mView, mView.ndcOfPixel(x, y));
+    const CameraView& v = view();
+    const int x = int(pixel % size_t(v.width)), y = int(pixel / size_t(v.width));
+    return viewRayOfNdc(v, v.ndcOfPixel(x, y));
 }
 
 GBuffer::Writer::Writer(GBuffer& target) {
@@ -152,26 +138,20 @@ void GBuffer::writeEncoded(size_t pixel, const Surface& s) {
     }
 }
 
-glm::vec3 GBuffer::reconstructPositionView(int x, int y, float depthNdc) const {
-    const glm::vec2 ndc = mView.ndcOfPixel(x, y);
-    if (mLayout.position == PositionMethod::InverseProjection)
-        return positionByInverseProjection(mView, ndc, depthNdc);
-    return positionByViewRay(mView, ndc, mProjection.viewDepthFromNdcFloat(depthNdc));
-}
-
 Surface GBuffer::decode(int x, int y) const {
-    const size_t pixel = size_t(y) * mView.width + x;
+    const CameraView& view = mDepthDecoder.view();
+    const size_t pixel = size_t(y) * view.width + x;
     Surface s;
-    s.positionView = reconstructPositionView(x, y, mDepth[pixel]);
+    s.positionView = mDepthDecoder.positionView(x, y, mDepth[pixel]);
     if (!mNormal[0].empty()) {
         s.normalView = glm::vec3(mNormal[0][pixel], mNormal[1][pixel], mNormal[2][pixel]);
     } else if (!mNormalCode32.empty() || !mNormalCode64.empty()) {
         NormalCode code;
         code.low = !mNormalCode32.empty() ? mNormalCode32[pixel] : mNormalCode64[pixel];
         s.normalView =
-            decodeNormal(mLayout.normals, code, viewRayOfNdc(mView, mView.ndcOfPixel(x, y)));
+            decodeNormal(mLayout.normals, code, viewRayOfNdc(view, view.ndcOfPixel(x, y)));
         if (mLayout.normalSpace == NormalSpace::World)
-            s.normalView = mView.viewFromWorldNormal * s.normalView;
+            s.normalView = view.viewFromWorldNormal * s.normalView;
     }
     if (!mMaterial.empty())
         s.material = mMaterial[pixel];

@@ -13,9 +13,9 @@
 // - Albedo: three float planes (f32), one packed RGB8 sRGB word, or nothing (material index,
 //   constant, none). Specular: two float planes, one packed word, or nothing. Material index:
 //   one 16-bit array when albedo or specular decode from the material table.
-// View-space position is reconstructed from depth by the layout's method (inverse projection or
-// view ray). Decoding is const and thread-safe; writing a pixel is safe concurrently with writing
-// other pixels.
+// View-space position is reconstructed from depth by the layout's DepthDecoder (DepthFormat.h:
+// inverse projection or view ray). Decoding is const and thread-safe; writing a pixel is safe
+// concurrently with writing other pixels.
 #pragma once
 
 #include <cstdint>
@@ -38,14 +38,12 @@ public:
     GBuffer(const GBufferLayout& layout, const CameraView& view);
 
     const GBufferLayout& layout() const { return mLayout; }
-    const CameraView& view() const { return mView; }
-    int width() const { return mView.width; }
-    int height() const { return mView.height; }
-    size_t pixelCount() const { return size_t(mView.width) * mView.height; }
-
-    // Resets depth to the far plane's value. Other planes are written for every pixel by the
-    // G-buffer pass (zero for background), so clearing them too would only cost bandwidth.
-    void clearDepth();
+    const CameraView& view() const { return mDepthDecoder.view(); }
+    // The layout's depth decoder on this view: how depth() reads back as view-space position.
+    const DepthDecoder& depthDecoder() const { return mDepthDecoder; }
+    int width() const { return view().width; }
+    int height() const { return view().height; }
+    size_t pixelCount() const { return size_t(view().width) * view().height; }
     // Rounds every covered pixel's depth through the layout's format (no-op for the float format
     // of the view's own convention). Parallel (TBB). A covered pixel stays covered.
     void quantiseDepth();
@@ -90,12 +88,13 @@ public:
     Writer writer() { return Writer(*this); }
 
     bool covered(size_t pixel) const { return mDepth[pixel] != mClearDepth; }
-    // Reconstructs view-space position from depth and decodes the other channels; channels the
-    // layout does not provide are left at Surface's defaults.
+    // Reconstructs view-space position from depth (depthDecoder()) and decodes the other channels;
+    // channels the layout does not provide are left at Surface's defaults.
     Surface decode(int x, int y) const;
-    glm::vec3 reconstructPositionView(int x, int y, float depthNdc) const;
 
-    float* depthPlane() { return mDepth.data(); }
+    // The working depth plane the G-buffer pass draws into: NDC depth in the view's convention,
+    // the far plane's value where nothing was drawn.
+    std::span<float> depthPlane() { return mDepth; }
     std::span<const float> depth() const { return mDepth; }
 
 private:
@@ -105,8 +104,7 @@ private:
     void writeEncoded(size_t pixel, const Surface& surface);
 
     GBufferLayout mLayout;
-    CameraView mView;
-    DepthProjection mProjection;
+    DepthDecoder mDepthDecoder;
     glm::mat3 mWorldFromView{
         1.0f}; // for world-space normal codes (viewFromWorldNormal is a rotation)
     float mClearDepth;

@@ -244,4 +244,12 @@ GBufferLayout GBufferLayout::reference() {
     return layout;
 }
 
+GBufferLayout GBufferLayout::lossless(DepthConvention depth, bool infiniteFar) {
+    GBufferLayout layout = reference();
+    layout.depth.kind =
+        depth == DepthConvention::Reversed ? DepthFormatKind::F32Reversed : DepthFormatKind::F32;
+    layout.depth.infiniteFar = infiniteFar;
+    return layout;
+}
+
 } // namespace gbuffer

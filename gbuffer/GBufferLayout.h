@@ -100,9 +100,15 @@ struct GBufferLayout {
     // One line per plane with its format, bits and the reason it is there, then the notes.
     std::string explain() const;
 
+    // How readers get depth and position back from this layout's depth plane.
+    DepthDecoder depthDecoder(const CameraView& view) const { return {depth, position, view}; }
+
     // float32 reversed-Z depth, float32 view-space normal, float32 albedo RGB, float32 specular
     // (intensity, power): lossless with respect to what the rasterizer computes.
     static GBufferLayout reference();
+    // The reference layout with float depth in the given convention and far plane: what the
+    // rasterizer computes, kept as is (the surface forward stages shade).
+    static GBufferLayout lossless(DepthConvention depth, bool infiniteFar = false);
 };
 
 } // namespace gbuffer

@@ -1,5 +1,6 @@
 #include "gbuffer/GBufferPass.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -140,12 +141,6 @@ Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& sc
     return surface;
 }
 
-glm::vec3 positionViewOfPixel(const CameraView& view, int x, int y, float depth) {
-    const glm::vec2 ndc = view.ndcOfPixel(x, y);
-    const glm::vec4 p = view.viewFromClip * glm::vec4(ndc, depth, 1.0f);
-    return glm::vec3(p) / p.w;
-}
-
 GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geometry)
     : mScene(scene), mGeometry(geometry) {
     if (geometry.triangleCount() >= kBackFaceBit)
@@ -218,7 +213,8 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     timings.transformMs = millisecondsSince(start);
 
     start = std::chrono::steady_clock::now();
-    target.clearDepth();
+    const std::span<float> depth = target.depthPlane();
+    std::fill(depth.begin(), depth.end(), view.clearDepth());
     mVisibleTriangle.assign(target.pixelCount(), kNoTriangle);
     const int width = view.width;
     // Only the triangle is recorded: its barycentrics are computed once per pixel in resolve()
@@ -232,8 +228,8 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     state.cullMode = raster::CullMode::Back;
     state.barycentrics = false;
     state.depthTest = view.reversedZ() ? raster::DepthTest::Greater : raster::DepthTest::Less;
-    rasterizer.draw(raster::TriangleList{mClipPositions, mGeometry.indices}, state,
-                    target.depthPlane(), recordVisible);
+    rasterizer.draw(raster::TriangleList{mClipPositions, mGeometry.indices}, state, depth.data(),
+                    recordVisible);
     timings.rasterMs = millisecondsSince(start);
 
     start = std::chrono::steady_clock::now();

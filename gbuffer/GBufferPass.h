@@ -23,7 +23,7 @@ namespace gbuffer {
 // from the triangle's clip-space vertices, the interpolated, normalised view-space normal (negated
 // when the back face is visible: two-sided draws light the visible side), and the material's
 // albedo (times the base colour texture) and specular. positionView is left zero: it comes from
-// depth (positionViewOfPixel). This is the one definition of the G-buffer's surface: the G-buffer
+// depth (DepthDecoder). This is the one definition of the G-buffer's surface: the G-buffer
 // pass and the forward stages both call it, so forward shading sees bitwise the same floats as a
 // stage reading the G-buffer. clipPositions / normalsView are per vertex of `geometry`, as made
 // by GBufferPass (or the identical transform of another pass). Pure, thread-safe.
@@ -31,11 +31,6 @@ Surface surfaceOfTriangle(const SceneGeometry& geometry, const scenes::Scene& sc
                           std::span<const glm::vec4> clipPositions,
                           std::span<const glm::vec3> normalsView, uint32_t triangle, bool backFace,
                           glm::vec2 ndc);
-
-// View-space position of pixel (x, y) at NDC depth `depth`: the same formula as
-// GBuffer::reconstructPositionView, so a fragment's position equals the one decoded from the
-// G-buffer's stored depth. Pure, thread-safe.
-glm::vec3 positionViewOfPixel(const CameraView& view, int x, int y, float depth);
 
 struct GBufferPassTimings {
     double transformMs = 0.0;

@@ -15,6 +15,9 @@ void ForwardFrame::prepare(const StageInputs& inputs) {
     mScene = inputs.scene;
     mGeometry = inputs.geometry;
     mView = inputs.view;
+    mDepthDecoder =
+        gbuffer::GBufferLayout::lossless(inputs.view->depthConvention, inputs.view->infiniteFar)
+            .depthDecoder(*inputs.view);
     const gbuffer::SceneGeometry& geometry = *inputs.geometry;
     const gbuffer::CameraView& view = *inputs.view;
     if (geometry.triangleCount() >= kBackFaceBit)

@@ -5,10 +5,10 @@
 // view space with the SAME expressions as gbuffer::GBufferPass, splits the triangle list into
 // objects (runs of consecutive triangles of one scenes::Instance) and bounds each object with a
 // view-space AABB. A fragment's surface comes from gbuffer::surfaceOfTriangle and its position
-// from gbuffer::positionViewOfPixel on the fragment's depth, the functions the G-buffer pass and
-// GBuffer::decode use, so the visible fragment's Surface is bitwise the one `brute` reads
-// from the G-buffer (the same triangles through the same rasterizer give the same depth), and
-// evaluating lights in ascending index order gives bitwise brute's radiance.
+// from the fragment's depth through the lossless layout's gbuffer::DepthDecoder, the functions
+// the G-buffer pass and GBuffer::decode use, so the visible fragment's Surface is bitwise the one
+// `brute` reads from the G-buffer (the same triangles through the same rasterizer give the same
+// depth), and evaluating lights in ascending index order gives bitwise brute's radiance.
 //
 // Conventions: view space right-handed, camera down -Z; depth in the CameraView's convention
 // (reversed by default), so "closer" is Greater for reversed Z. Culling is conservative: lights
@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -74,15 +75,19 @@ public:
         gbuffer::Surface s = gbuffer::surfaceOfTriangle(
             *mGeometry, *mScene, mClipPositions, mNormalsView, triangle, !fragment.frontFacing,
             mView->ndcOfPixel(fragment.x, fragment.y));
-        s.positionView =
-            gbuffer::positionViewOfPixel(*mView, fragment.x, fragment.y, fragment.depth);
+        s.positionView = mDepthDecoder->positionView(fragment.x, fragment.y, fragment.depth);
         return s;
     }
+    // How the forward stages read their own depth planes: the decoder of the lossless layout
+    // (their depth is the rasterizer's float depth, kept as is), so positions are bitwise those
+    // GBuffer::decode gives on that layout.
+    const gbuffer::DepthDecoder& depthDecoder() const { return *mDepthDecoder; }
 
 private:
     const scenes::Scene* mScene = nullptr;
     const gbuffer::SceneGeometry* mGeometry = nullptr;
     const gbuffer::CameraView* mView = nullptr;
+    std::optional<gbuffer::DepthDecoder> mDepthDecoder;
     std::vector<glm::vec4> mClipPositions;
     std::vector<glm::vec3> mNormalsView;
     std::vector<glm::vec3> mPositionsView; // for the object bounds only

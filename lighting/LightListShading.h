@@ -14,15 +14,11 @@
 
 namespace lighting {
 
-// Shades pixel (x, y) of the G-buffer with `lightIndices`; writes result.radiance and
-// result.lightsEvaluated at that pixel. Background pixels get zero and no evaluations.
-inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
+// Shades `point`, the surface at `pixel`, with `lightIndices`; writes result.radiance and
+// result.lightsEvaluated at that pixel.
+inline void shadeWithLightList(const gbuffer::Surface& point, size_t pixel,
                                const std::vector<LightInView<float>>& lights,
                                std::span<const uint32_t> lightIndices, StageResult& result) {
-    const size_t pixel = size_t(y) * gb.width() + x;
-    gbuffer::Surface point;
-    if (!gbufferSurfaceAt(gb, x, y, point))
-        return;
     const glm::vec3 toViewer = glm::normalize(-point.positionView);
     glm::vec3 sum(0.0f);
     for (uint32_t index : lightIndices)
@@ -31,6 +27,16 @@ inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
     result.radiance[1][pixel] = sum.y;
     result.radiance[2][pixel] = sum.z;
     result.lightsEvaluated[pixel] = uint32_t(lightIndices.size());
+}
+
+// Shades pixel (x, y) of the G-buffer with `lightIndices`. Background pixels are left alone (zero
+// radiance, no evaluations).
+inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
+                               const std::vector<LightInView<float>>& lights,
+                               std::span<const uint32_t> lightIndices, StageResult& result) {
+    gbuffer::Surface point;
+    if (gbufferSurfaceAt(gb, x, y, point))
+        shadeWithLightList(point, size_t(y) * gb.width() + x, lights, lightIndices, result);
 }
 
 // The lighting at one point split the way light buffers store it (light pre-pass, inferred

@@ -2,15 +2,6 @@
 
 namespace lighting {
 
-gbuffer::GBufferLayout losslessLayout(gbuffer::DepthConvention depth, bool infiniteFar) {
-    gbuffer::GBufferLayout layout = gbuffer::GBufferLayout::reference();
-    layout.depth.kind = depth == gbuffer::DepthConvention::Reversed
-                            ? gbuffer::DepthFormatKind::F32Reversed
-                            : gbuffer::DepthFormatKind::F32;
-    layout.depth.infiniteFar = infiniteFar;
-    return layout;
-}
-
 PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
                              const gbuffer::GBufferLayout& layout)
     : scene(std::move(sceneIn)) {
@@ -34,7 +25,8 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
 
 PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
                              gbuffer::DepthConvention depth)
-    : PreparedScene(std::move(sceneIn), width, height, withExactSurface, losslessLayout(depth)) {}
+    : PreparedScene(std::move(sceneIn), width, height, withExactSurface,
+                    gbuffer::GBufferLayout::lossless(depth)) {}
 
 void PreparedScene::renderGBuffer() {
     gbufferTimings = mPass->render(*mRasterizer, *gbuffer, exact.get());
@@ -43,7 +35,7 @@ void PreparedScene::renderGBuffer() {
 
 std::unique_ptr<gbuffer::GBuffer> PreparedScene::renderLosslessGBuffer() {
     auto lossless = std::make_unique<gbuffer::GBuffer>(
-        losslessLayout(view.depthConvention, view.infiniteFar), view);
+        gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar), view);
     mPass->render(*mRasterizer, *lossless, nullptr);
     return lossless;
 }

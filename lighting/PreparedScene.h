@@ -61,7 +61,4 @@ private:
     std::unique_ptr<gbuffer::GBufferPass> mPass;
 };
 
-// The reference layout for a view with the given float depth convention and far plane.
-gbuffer::GBufferLayout losslessLayout(gbuffer::DepthConvention depth, bool infiniteFar = false);
-
 } // namespace lighting

@@ -6,8 +6,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "gbuffer/GBufferPass.h"
-
 namespace lighting {
 
 TileGrid TileGrid::make(int widthPixels, int heightPixels, int tileSizePixels) {
@@ -112,16 +110,16 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
                            });
 }
 
-std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::CameraView& view,
+std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::DepthDecoder& decoder,
                                                       std::span<const float> depth,
                                                       const TileGrid& grid, bool depthMask) {
-    const float clearDepth = view.clearDepth();
+    const float clearDepth = decoder.view().clearDepth();
     return boundsOfSamples(grid, {depthMask, false},
                            [&](int x, int y, float& depthMetres, glm::vec3&) {
                                const float d = depth[size_t(y) * grid.widthPixels + x];
                                if (d == clearDepth)
                                    return false;
-                               depthMetres = -gbuffer::positionViewOfPixel(view, x, y, d).z;
+                               depthMetres = decoder.viewDepthMetres(x, y, d);
                                return true;
                            });
 }

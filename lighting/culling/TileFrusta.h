@@ -66,10 +66,10 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
 
 // Depth bounds (and optionally the depth mask; no normal cone) from a depth plane in the view's
 // convention, for stages without a G-buffer (tiled forward's depth pre-pass). A pixel is covered
-// when its depth differs from view.clearDepth(), as GBuffer::covered; positions come from
-// gbuffer::positionViewOfPixel, bitwise the floats GBuffer::decode and forward shading use, so
-// the same depth plane gives bitwise computeTileSurfaceBounds' depth bounds.
-std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::CameraView& view,
+// when its depth differs from the view's clear depth, as GBuffer::covered; positions come from
+// `decoder` (the decoder of the layout the plane is in), so the same depth plane in a G-buffer
+// of that layout gives bitwise computeTileSurfaceBounds' depth bounds.
+std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::DepthDecoder& decoder,
                                                       std::span<const float> depth,
                                                       const TileGrid& grid, bool depthMask);
 

@@ -75,10 +75,9 @@ public:
         if (ndcRange.first <= ndcRange.second) {
             // View depths of the extremes (depth along -Z does not depend on the pixel for a
             // pinhole), widened so that rounding in the per-pixel reconstruction stays inside.
-            const float depthA =
-                -gb.reconstructPositionView(width / 2, height / 2, ndcRange.first).z;
-            const float depthB =
-                -gb.reconstructPositionView(width / 2, height / 2, ndcRange.second).z;
+            const gbuffer::DepthDecoder& decoder = gb.depthDecoder();
+            const float depthA = decoder.viewDepthMetres(width / 2, height / 2, ndcRange.first);
+            const float depthB = decoder.viewDepthMetres(width / 2, height / 2, ndcRange.second);
             const float nearDepth = std::max(std::min(depthA, depthB) * (1.0f - 1e-5f), 1e-6f);
             const float farDepth = std::max(std::max(depthA, depthB) * (1.0f + 1e-5f), nearDepth);
             if (!mGrid)
@@ -95,24 +94,18 @@ public:
             std::vector<int> tileXOfPixel(width);
             for (int x = 0; x < width; ++x)
                 tileXOfPixel[x] = grid.tileXOfPixel(x);
-            // View depth of a pixel: the z and w rows of GBuffer::reconstructPositionView (the
-            // same position shading decodes; any rounding difference is inside the slack).
-            const glm::mat4& viewFromClip = gb.view().viewFromClip;
+            // A pixel's cluster comes from the view depth of the position it is shaded at (the
+            // layout's decoder, decoded once), so it lies in its cluster up to the slack.
             tbb::parallel_for(0, height, [&](int y) {
                 const int tileY = grid.tileYOfPixel(y);
                 for (int x = 0; x < width; ++x) {
-                    const size_t pixel = size_t(y) * width + x;
-                    if (depth[pixel] == clear)
+                    gbuffer::Surface point;
+                    if (!gbufferSurfaceAt(gb, x, y, point))
                         continue;
-                    const glm::vec2 ndc = gb.view().ndcOfPixel(x, y);
-                    const float z = viewFromClip[0][2] * ndc.x + viewFromClip[1][2] * ndc.y +
-                                    viewFromClip[2][2] * depth[pixel] + viewFromClip[3][2];
-                    const float w = viewFromClip[0][3] * ndc.x + viewFromClip[1][3] * ndc.y +
-                                    viewFromClip[2][3] * depth[pixel] + viewFromClip[3][3];
-                    const float depthMetres = -z / w;
-                    const size_t cluster =
-                        grid.clusterIndex(tileXOfPixel[x], tileY, grid.sliceOfDepth(depthMetres));
-                    shadeWithLightList(gb, x, y, lights, grid.lightsOf(cluster), result);
+                    const size_t cluster = grid.clusterIndex(
+                        tileXOfPixel[x], tileY, grid.sliceOfDepth(-point.positionView.z));
+                    shadeWithLightList(point, size_t(y) * width + x, lights, grid.lightsOf(cluster),
+                                       result);
                 }
             });
             result.timingsMs.emplace_back("shading", millisecondsSince(shadingStart));

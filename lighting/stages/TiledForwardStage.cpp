@@ -126,8 +126,8 @@ private:
         const std::vector<CandidateLight> candidates =
             candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
 
-        const std::vector<TileSurfaceBounds> bounds =
-            computeTileDepthBounds(view, std::span<const float>(mDepth), grid, mOptions.depthMask);
+        const std::vector<TileSurfaceBounds> bounds = computeTileDepthBounds(
+            mForward.depthDecoder(), std::span<const float>(mDepth), grid, mOptions.depthMask);
 
         mTileLights.resize(size_t(grid.tileCount()));
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {

@@ -134,11 +134,15 @@ TEST(TiledForward, PrepassTileBoundsEqualGBufferBounds) {
     for (int tileSize : {4, 16, 37}) {
         const lighting::TileGrid grid =
             lighting::TileGrid::make(f.view.width, f.view.height, tileSize);
+        // The decoder the forward stages read their pre-pass depth with (ForwardShading.h).
+        const gbuffer::DepthDecoder forwardDecoder =
+            gbuffer::GBufferLayout::lossless(f.view.depthConvention, f.view.infiniteFar)
+                .depthDecoder(f.view);
         for (bool mask : {false, true}) {
             const auto fromGBuffer =
                 lighting::computeTileSurfaceBounds(*f.gbuffer, grid, {mask, false});
             const auto fromDepth = lighting::computeTileDepthBounds(
-                f.view, std::span<const float>(f.gbuffer->depth()), grid, mask);
+                forwardDecoder, std::span<const float>(f.gbuffer->depth()), grid, mask);
             ASSERT_EQ(fromGBuffer.size(), fromDepth.size());
             for (size_t tile = 0; tile < fromDepth.size(); ++tile) {
                 EXPECT_EQ(fromDepth[tile].covered, fromGBuffer[tile].covered) << tile;
