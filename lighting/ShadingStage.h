@@ -7,6 +7,7 @@
 // and must be deterministic: the same frame gives bitwise the same result for any thread count.
 #pragma once
 
+#include <chrono>
 #include <map>
 #include <memory>
 #include <string>
@@ -51,6 +52,12 @@ struct StageResult {
 
     void resize(int w, int h, bool withOracle);
 };
+
+// Milliseconds since `start` on the steady clock: how stages time their passes.
+inline double millisecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+}
 
 class ShadingStage {
 public:

@@ -33,11 +33,6 @@ namespace lighting {
 
 namespace {
 
-double millisecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
-}
-
 class ClusteredStage final : public ShadingStage {
 public:
     explicit ClusteredStage(const ClusterGridOptions& options) : mOptions(options) {}

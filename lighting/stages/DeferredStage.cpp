@@ -34,11 +34,6 @@ namespace lighting {
 
 namespace {
 
-double millisecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
-}
-
 class DeferredStage final : public ShadingStage {
 public:
     explicit DeferredStage(const VolumeStageOptions& volume) : mVolume(volume) {}

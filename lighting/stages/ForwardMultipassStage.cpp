@@ -9,9 +9,9 @@
 //
 // Why the pre-pass is mandatory: additive passes without an equal test would add the light once
 // per overdrawn fragment. The equal test is closer-or-equal plus the pre-pass's visible triangle
-// (ForwardShading.h depthPrepass), so exact depth ties never add a light twice.
+// (gbuffer/VisibilityPass.h redrawState), so exact depth ties never add a light twice.
 //
-// Exactness: the fragment's surface and position are the G-buffer's own (ForwardShading.h), and
+// Exactness: the fragment's surface and position are the G-buffer's own (ForwardGeometry.h), and
 // per pixel the lights are added in ascending order starting from zero, the same sequence of
 // float additions as `brute` minus lights that add exactly zero, so the image is bitwise
 // brute's. lightsEvaluated counts one per (light, visible fragment) drawn. Reads no G-buffer
@@ -23,7 +23,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/ForwardShading.h"
+#include "lighting/ForwardGeometry.h"
 
 namespace lighting {
 
@@ -42,25 +42,23 @@ public:
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
         fitRasterizer(mRasterizer, view);
-        result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
+        result.timingsMs.emplace_back("transform", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
-        depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
-        result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
+        gbuffer::VisibilityPass& visibility = mForward.visibility();
+        mDepth.resize(size_t(width) * view.height);
+        visibility.draw(*mRasterizer, mDepth);
+        result.timingsMs.emplace_back("prepass", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         buildIlluminationSets(*inputs.lights);
-        result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
+        result.timingsMs.emplace_back("cull", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const std::vector<ForwardObject>& objects = mForward.objects();
         const std::vector<uint32_t>& allIndices = inputs.geometry->indices;
-        raster::RasterState state;
-        state.barycentrics = false; // the surface comes from surfaceOfTriangle
-        state.cullMode = raster::CullMode::Back;
-        state.depthTest = closerOrEqualTest(view);
-        state.depthWrite = false;
+        const raster::RasterState state = visibility.redrawState();
         for (uint32_t l = 0; l < lights.size(); ++l) {
             const std::vector<uint32_t>& set = mSets[l];
             if (set.empty())
@@ -88,7 +86,7 @@ public:
                 const size_t pixel = size_t(fragment.y) * width + fragment.x;
                 const uint32_t triangle =
                     globalTriangle ? globalTriangle[fragment.triangle] : fragment.triangle;
-                if (mVisible[pixel] != visibilityCode(triangle, fragment.frontFacing))
+                if (!visibility.isVisible(fragment, triangle))
                     return;
                 const gbuffer::Surface point = mForward.surfaceAt(fragment, triangle);
                 const glm::vec3 radiance =
@@ -98,10 +96,10 @@ public:
                 result.radiance[2][pixel] += radiance.z;
                 ++result.lightsEvaluated[pixel];
             };
-            mRasterizer->draw(raster::TriangleList{mForward.clipPositions(), indices}, state,
+            mRasterizer->draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
                               mDepth.data(), addLight);
         }
-        result.timingsMs.emplace_back("shading", forwardElapsedMs(start));
+        result.timingsMs.emplace_back("shading", millisecondsSince(start));
     }
 
 private:
@@ -120,10 +118,9 @@ private:
         });
     }
 
-    ForwardFrame mForward;
+    ForwardGeometry mForward;
     std::unique_ptr<raster::Rasterizer> mRasterizer;
     std::vector<float> mDepth;
-    std::vector<uint32_t> mVisible;
     std::vector<std::vector<uint32_t>> mSets;
     std::vector<uint32_t> mSetIndices;
     std::vector<uint32_t> mSetTriangles;

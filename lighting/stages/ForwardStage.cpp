@@ -6,12 +6,13 @@
 // it is at least the visible fragment's count.
 //
 // Options:
-//   prepass=0|1 (default 0): 1 draws a depth-only pre-pass first ("prepass"), then shades with a
-//     depth-equal test (closer-or-equal plus the pre-pass's visible triangle, see
-//     ForwardShading.h depthPrepass), so each pixel is shaded once and overdraw disappears.
+//   prepass=0|1 (default 0): 1 draws a depth-only pre-pass first ("prepass": the visibility draw,
+//     gbuffer/VisibilityPass.h), then shades with a depth-equal test (closer-or-equal plus the
+//     pre-pass's visible triangle, VisibilityPass::redrawState), so each pixel is shaded once and
+//     overdraw disappears.
 //
 // Exactness: the visible fragment's surface and position are computed by the G-buffer's own
-// functions (ForwardShading.h) and lights are summed in ascending order, so the image is bitwise
+// functions (ForwardGeometry.h) and lights are summed in ascending order, so the image is bitwise
 // `brute`'s. Reads no G-buffer channel: it rasterizes the scene itself (inputs.scene, .geometry).
 // Deterministic: one draw, each pixel written only by the thread owning its tile, in submission
 // order.
@@ -21,7 +22,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/ForwardShading.h"
+#include "lighting/ForwardGeometry.h"
 
 namespace lighting {
 
@@ -43,16 +44,18 @@ public:
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
         fitRasterizer(mRasterizer, view);
-        result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
+        result.timingsMs.emplace_back("transform", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         buildObjectLightLists(*inputs.lights);
-        result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
+        result.timingsMs.emplace_back("cull", millisecondsSince(start));
 
+        const gbuffer::VisibilityPass& visibility = mForward.visibility();
         if (mPrepass) {
             start = std::chrono::steady_clock::now();
-            depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
-            result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
+            mDepth.resize(size_t(width) * view.height);
+            mForward.visibility().draw(*mRasterizer, mDepth);
+            result.timingsMs.emplace_back("prepass", millisecondsSince(start));
         } else {
             mDepth.assign(size_t(width) * view.height, view.clearDepth());
         }
@@ -62,8 +65,7 @@ public:
         const bool equalOnly = mPrepass;
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             const size_t pixel = size_t(fragment.y) * width + fragment.x;
-            if (equalOnly &&
-                mVisible[pixel] != visibilityCode(fragment.triangle, fragment.frontFacing))
+            if (equalOnly && !visibility.isVisible(fragment, fragment.triangle))
                 return;
             const uint32_t object = mForward.objectOfTriangle(fragment.triangle);
             const uint32_t* index = mLightIndices.data() + mLightOffsets[object];
@@ -78,13 +80,12 @@ public:
             result.radiance[2][pixel] = sum.z;
             result.lightsEvaluated[pixel] += mLightOffsets[object + 1] - mLightOffsets[object];
         };
-        raster::RasterState state;
-        state.barycentrics = false; // the surface comes from surfaceOfTriangle
-        state.cullMode = raster::CullMode::Back;
-        state.depthTest = mPrepass ? closerOrEqualTest(view) : closerTest(view);
-        state.depthWrite = !mPrepass;
-        mRasterizer->draw(mForward.triangles(), state, mDepth.data(), shadeFragment);
-        result.timingsMs.emplace_back("shading", forwardElapsedMs(start));
+        // Without a pre-pass, the visibility draw's own state (every fragment that passes the
+        // closer test is shaded); with one, the redraw that passes each visible fragment once.
+        mRasterizer->draw(visibility.triangles(),
+                          mPrepass ? visibility.redrawState() : visibility.drawState(),
+                          mDepth.data(), shadeFragment);
+        result.timingsMs.emplace_back("shading", millisecondsSince(start));
     }
 
 private:
@@ -112,10 +113,9 @@ private:
     }
 
     bool mPrepass;
-    ForwardFrame mForward;
+    ForwardGeometry mForward;
     std::unique_ptr<raster::Rasterizer> mRasterizer;
     std::vector<float> mDepth;
-    std::vector<uint32_t> mVisible;
     std::vector<std::vector<uint32_t>> mPerObject;
     std::vector<uint32_t> mLightOffsets;
     std::vector<uint32_t> mLightIndices;

@@ -18,11 +18,11 @@
 //               that this stage's error is the resolution alone; `light-prepass` measures the
 //               monochromatic-specular approximation separately. With scale=1 the image equals
 //               brute's up to float summation order.
-//   "material"  the second geometry pass: the scene is rasterized again into a visibility
-//               buffer (lighting/ForwardShading.h depthPrepass, the G-buffer pass's culling and
-//               depth test) and each fragment's albedo and specular intensity come from
-//               gbuffer::surfaceOfTriangle. Object IDs (ids=1): a pixel's ID is the scene
-//               instance of its visible triangle (SceneGeometry::triangleInstance); a sample's is
+//   "material"  the second geometry pass (lighting/MaterialPass.h): the scene is rasterized
+//               again with the G-buffer pass's visibility draw, and each visible pixel's albedo
+//               and specular intensity come from its triangle's surface. Object IDs (ids=1): a
+//               pixel's ID is the scene instance of its visible triangle
+//               (SceneGeometry::triangleInstance, MaterialPass::instanceAt); a sample's is
 //               the ID of the full-res pixel it read, taken from the same visibility buffer (what
 //               the technique writes into its DSF buffer in the geometry pass; ours are 32-bit,
 //               so they never wrap as its 8-bit IDs do). The instance is the finest "object" a
@@ -68,9 +68,9 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/EveryLight.h"
-#include "lighting/ForwardShading.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
+#include "lighting/MaterialPass.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
@@ -86,7 +86,7 @@ struct InferredOptions {
 };
 
 // Object ID of background (no triangle): never equal to a surface's ID.
-constexpr uint32_t kNoObject = UINT32_MAX;
+constexpr uint32_t kNoObject = MaterialPass::kNoInstance;
 
 // One L-buffer sample: the full-res pixel it reads, its surface for DSF, and its light.
 struct LightSample {
@@ -131,7 +131,6 @@ public:
     void shade(const StageInputs& inputs, StageResult& result) override {
         using Clock = std::chrono::steady_clock;
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        const gbuffer::CameraView& view = gb.view();
         const int width = gb.width(), height = gb.height();
         const int scale = mOptions.scale;
         const int lowWidth = (width + scale - 1) / scale, lowHeight = (height + scale - 1) / scale;
@@ -148,7 +147,7 @@ public:
         std::vector<TileSurfaceBounds> bounds;
         const std::vector<std::vector<uint32_t>> tileLights =
             basicTileLightLists(gb, grid, spheres, bounds);
-        const double cullMs = forwardElapsedMs(cullStart);
+        const double cullMs = millisecondsSince(cullStart);
 
         // L-buffer at low resolution.
         const auto lightingStart = Clock::now();
@@ -177,108 +176,90 @@ public:
                     result.lightsEvaluated[size_t(y) * width + x] = uint32_t(list.size());
                 }
         });
-        const double lightingMs = forwardElapsedMs(lightingStart);
+        const double lightingMs = millisecondsSince(lightingStart);
 
         // Material pass: second geometry pass, DSF upsampling, combine.
         const auto materialStart = Clock::now();
-        mForward.prepare(inputs);
-        fitRasterizer(mRasterizer, view);
-        depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
+        mMaterials.draw(inputs);
         // Object IDs: the scene instance of the visible triangle, for every pixel (looked up on
         // the fly) and for every low-res sample (the pixel the sample read in "lighting").
-        const std::vector<uint32_t>& triangleInstance = inputs.geometry->triangleInstance;
-        auto objectAt = [&](size_t pixel) {
-            const uint32_t code = mVisible[pixel];
-            return code == kNoVisibleTriangle ? kNoObject : triangleInstance[code & ~kBackFaceBit];
-        };
         mSampleObjects.assign(size_t(lowWidth) * lowHeight, kNoObject);
         if (mOptions.objectIds)
             for (int j = 0; j < lowHeight; ++j)
                 for (int i = 0; i < lowWidth; ++i)
                     mSampleObjects[size_t(j) * lowWidth + i] =
-                        objectAt(size_t(sampleY(j)) * width + sampleX(i));
+                        mMaterials.instanceAt(size_t(sampleY(j)) * width + sampleX(i));
+        // Per row, so that each task counts into its own slot.
         std::vector<uint32_t> rowFallbacks(size_t(height), 0), rowIdFallbacks(size_t(height), 0);
         const float halfScale = float(scale / 2);
-        tbb::parallel_for(0, height, [&](int y) {
+        mMaterials.forEachSurface(gb, [&](int x, int y, size_t pixel, const gbuffer::Surface& s) {
             const float v = (float(y) - halfScale) / float(scale);
             const int j0 = int(std::floor(v));
             const float fy = v - float(j0);
             const int ja = std::clamp(j0, 0, lowHeight - 1),
                       jb = std::clamp(j0 + 1, 0, lowHeight - 1);
-            uint32_t fallbacks = 0, idFallbacks = 0;
-            for (int x = 0; x < width; ++x) {
-                const size_t pixel = size_t(y) * width + x;
-                const uint32_t code = mVisible[pixel];
-                if (code == kNoVisibleTriangle || !gb.covered(pixel))
-                    continue;
-                const gbuffer::Surface s = gbuffer::surfaceOfTriangle(
-                    *inputs.geometry, *inputs.scene, mForward.clipPositions(),
-                    mForward.normalsView(), code & ~kBackFaceBit, (code & kBackFaceBit) != 0,
-                    view.ndcOfPixel(x, y));
-                const gbuffer::Surface here = gb.decode(x, y);
-                const float depth = -here.positionView.z;
-                const uint32_t object = mOptions.objectIds ? objectAt(pixel) : kNoObject;
+            uint32_t& fallbacks = rowFallbacks[size_t(y)];
+            uint32_t& idFallbacks = rowIdFallbacks[size_t(y)];
+            const gbuffer::Surface here = gb.decode(x, y);
+            const float depth = -here.positionView.z;
+            const uint32_t object = mOptions.objectIds ? mMaterials.instanceAt(pixel) : kNoObject;
 
-                const float u = (float(x) - halfScale) / float(scale);
-                const int i0 = int(std::floor(u));
-                const float fx = u - float(i0);
-                const int ia = std::clamp(i0, 0, lowWidth - 1),
-                          ib = std::clamp(i0 + 1, 0, lowWidth - 1);
-                const size_t tapIndex[4] = {size_t(ja) * lowWidth + ia, size_t(ja) * lowWidth + ib,
-                                            size_t(jb) * lowWidth + ia, size_t(jb) * lowWidth + ib};
-                const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy,
-                                           fx * fy};
-                // Two filters at once: `same` applies the ID, depth and normal tests, `surface` the
-                // depth and normal tests only (with ids=0 they coincide).
-                glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f);
-                glm::vec3 surfaceDiffuse(0.0f), surfaceSpecular(0.0f);
-                float sameWeight = 0.0f, surfaceWeight = 0.0f;
-                int nearest = -1;
-                float nearestWeight = -1.0f;
-                for (int k = 0; k < 4; ++k) {
-                    const LightSample& t = mSamples[tapIndex[k]];
-                    if (!t.covered)
-                        continue;
-                    if (bilinear[k] > nearestWeight) {
-                        nearestWeight = bilinear[k];
-                        nearest = k;
-                    }
-                    if (std::abs(t.depthMetres - depth) > mOptions.depthThreshold * depth ||
-                        glm::dot(t.normalView, here.normalView) < mOptions.normalThreshold)
-                        continue;
-                    surfaceDiffuse += bilinear[k] * t.diffuse;
-                    surfaceSpecular += bilinear[k] * t.specular;
-                    surfaceWeight += bilinear[k];
-                    if (mSampleObjects[tapIndex[k]] != object)
-                        continue;
-                    sameDiffuse += bilinear[k] * t.diffuse;
-                    sameSpecular += bilinear[k] * t.specular;
-                    sameWeight += bilinear[k];
+            const float u = (float(x) - halfScale) / float(scale);
+            const int i0 = int(std::floor(u));
+            const float fx = u - float(i0);
+            const int ia = std::clamp(i0, 0, lowWidth - 1),
+                      ib = std::clamp(i0 + 1, 0, lowWidth - 1);
+            const size_t tapIndex[4] = {size_t(ja) * lowWidth + ia, size_t(ja) * lowWidth + ib,
+                                        size_t(jb) * lowWidth + ia, size_t(jb) * lowWidth + ib};
+            const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+            // Two filters at once: `same` applies the ID, depth and normal tests, `surface` the
+            // depth and normal tests only (with ids=0 they coincide).
+            glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f);
+            glm::vec3 surfaceDiffuse(0.0f), surfaceSpecular(0.0f);
+            float sameWeight = 0.0f, surfaceWeight = 0.0f;
+            int nearest = -1;
+            float nearestWeight = -1.0f;
+            for (int k = 0; k < 4; ++k) {
+                const LightSample& t = mSamples[tapIndex[k]];
+                if (!t.covered)
+                    continue;
+                if (bilinear[k] > nearestWeight) {
+                    nearestWeight = bilinear[k];
+                    nearest = k;
                 }
-                glm::vec3 diffuse(0.0f), specular(0.0f);
-                if (sameWeight > 0.0f) {
-                    diffuse = sameDiffuse / sameWeight;
-                    specular = sameSpecular / sameWeight;
-                } else if (surfaceWeight > 0.0f) {
-                    diffuse = surfaceDiffuse / surfaceWeight;
-                    specular = surfaceSpecular / surfaceWeight;
-                    ++idFallbacks;
-                } else if (nearest >= 0) {
-                    diffuse = mSamples[tapIndex[nearest]].diffuse;
-                    specular = mSamples[tapIndex[nearest]].specular;
-                    ++fallbacks;
-                } else {
-                    ++fallbacks;
-                }
-                const glm::vec3 radiance = s.albedo * diffuse + s.specularIntensity * specular;
-                result.radiance[0][pixel] = radiance.r;
-                result.radiance[1][pixel] = radiance.g;
-                result.radiance[2][pixel] = radiance.b;
+                if (std::abs(t.depthMetres - depth) > mOptions.depthThreshold * depth ||
+                    glm::dot(t.normalView, here.normalView) < mOptions.normalThreshold)
+                    continue;
+                surfaceDiffuse += bilinear[k] * t.diffuse;
+                surfaceSpecular += bilinear[k] * t.specular;
+                surfaceWeight += bilinear[k];
+                if (mSampleObjects[tapIndex[k]] != object)
+                    continue;
+                sameDiffuse += bilinear[k] * t.diffuse;
+                sameSpecular += bilinear[k] * t.specular;
+                sameWeight += bilinear[k];
             }
-            rowFallbacks[size_t(y)] = fallbacks;
-            rowIdFallbacks[size_t(y)] = idFallbacks;
+            glm::vec3 diffuse(0.0f), specular(0.0f);
+            if (sameWeight > 0.0f) {
+                diffuse = sameDiffuse / sameWeight;
+                specular = sameSpecular / sameWeight;
+            } else if (surfaceWeight > 0.0f) {
+                diffuse = surfaceDiffuse / surfaceWeight;
+                specular = surfaceSpecular / surfaceWeight;
+                ++idFallbacks;
+            } else if (nearest >= 0) {
+                diffuse = mSamples[tapIndex[nearest]].diffuse;
+                specular = mSamples[tapIndex[nearest]].specular;
+                ++fallbacks;
+            } else {
+                ++fallbacks;
+            }
+            const glm::vec3 radiance = s.albedo * diffuse + s.specularIntensity * specular;
+            result.radiance[0][pixel] = radiance.r;
+            result.radiance[1][pixel] = radiance.g;
+            result.radiance[2][pixel] = radiance.b;
         });
-        const double materialMs = forwardElapsedMs(materialStart);
+        const double materialMs = millisecondsSince(materialStart);
 
         uint64_t pairs = 0, fallbacks = 0, idFallbacks = 0;
         for (const auto& list : tileLights)
@@ -306,10 +287,7 @@ private:
     // Per-frame scratch, kept to avoid reallocation between repetitions.
     std::vector<LightSample> mSamples;
     std::vector<uint32_t> mSampleObjects; // object ID per low-res sample; all kNoObject with ids=0
-    ForwardFrame mForward;
-    std::unique_ptr<raster::Rasterizer> mRasterizer;
-    std::vector<float> mDepth;
-    std::vector<uint32_t> mVisible;
+    MaterialPass mMaterials;
 };
 
 } // namespace

@@ -37,11 +37,6 @@ namespace lighting {
 
 namespace {
 
-double millisecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
-}
-
 // Marks an overflowed pixel in the count plane (counts never exceed 255).
 constexpr uint16_t kOverflowed = 0xFFFF;
 // Tile size of the overflow fallback's lists: `tiled`'s default.

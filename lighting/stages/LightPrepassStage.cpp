@@ -14,11 +14,11 @@
 //               specular intensity 0 for the diffuse part and albedo 0, intensity 1 for the
 //               specular part (the second call only for lights whose diffuse part is non-zero:
 //               a light with zero diffuse there has zero att * n.l, so zero specular too).
-//   "material"  the second geometry pass: the scene is rasterized again (back faces culled,
-//               closer test, as the G-buffer pass: lighting/ForwardShading.h depthPrepass) into a
-//               visibility buffer, and each visible fragment's material comes from
-//               gbuffer::surfaceOfTriangle -- albedo and specular intensity are never read from
-//               the G-buffer. Then radiance = albedo * diffuse + intensity * specular * colour.
+//   "material"  the second geometry pass (lighting/MaterialPass.h): the scene is rasterized
+//               again with the G-buffer pass's visibility draw, and each visible pixel's material
+//               comes from its triangle's surface -- albedo and specular intensity are never read
+//               from the G-buffer. Then radiance = albedo * diffuse + intensity * specular *
+//               colour.
 // Options:
 //   spec=grey   colour of the monochromatic specular: `grey` (white: the classic approximation,
 //               coloured specular turns grey) or `chroma` (Engel's variant: the chromaticity of the
@@ -43,9 +43,9 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/EveryLight.h"
-#include "lighting/ForwardShading.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
+#include "lighting/MaterialPass.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
@@ -70,7 +70,6 @@ public:
     void shade(const StageInputs& inputs, StageResult& result) override {
         using Clock = std::chrono::steady_clock;
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        const gbuffer::CameraView& view = gb.view();
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
@@ -80,7 +79,7 @@ public:
         std::vector<TileSurfaceBounds> bounds;
         const std::vector<std::vector<uint32_t>> tileLights =
             basicTileLightLists(gb, grid, boundingSpheresView(*inputs.lights), bounds);
-        const double cullMs = forwardElapsedMs(cullStart);
+        const double cullMs = millisecondsSince(cullStart);
 
         // Light buffer: diffuse RGB + monochromatic specular, per pixel.
         const auto lightingStart = Clock::now();
@@ -103,38 +102,26 @@ public:
                     result.lightsEvaluated[pixel] = uint32_t(list.size());
                 }
         });
-        const double lightingMs = forwardElapsedMs(lightingStart);
+        const double lightingMs = millisecondsSince(lightingStart);
 
         // Material pass: second geometry pass into a visibility buffer, then combine.
         const auto materialStart = Clock::now();
-        mForward.prepare(inputs);
-        fitRasterizer(mRasterizer, view);
-        depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
-        tbb::parallel_for(0, height, [&](int y) {
-            for (int x = 0; x < width; ++x) {
-                const size_t pixel = size_t(y) * width + x;
-                const uint32_t code = mVisible[pixel];
-                if (code == kNoVisibleTriangle || !gb.covered(pixel))
-                    continue;
-                const gbuffer::Surface s = gbuffer::surfaceOfTriangle(
-                    *inputs.geometry, *inputs.scene, mForward.clipPositions(),
-                    mForward.normalsView(), code & ~kBackFaceBit, (code & kBackFaceBit) != 0,
-                    view.ndcOfPixel(x, y));
-                const glm::vec3& diffuse = mDiffuse[pixel];
-                glm::vec3 specularColour(1.0f);
-                if (mChroma) {
-                    const float lum = luminance(diffuse);
-                    if (lum > 0.0f)
-                        specularColour = diffuse / lum;
-                }
-                const glm::vec3 radiance =
-                    s.albedo * diffuse + (s.specularIntensity * mSpecular[pixel]) * specularColour;
-                result.radiance[0][pixel] = radiance.r;
-                result.radiance[1][pixel] = radiance.g;
-                result.radiance[2][pixel] = radiance.b;
+        mMaterials.draw(inputs);
+        mMaterials.forEachSurface(gb, [&](int, int, size_t pixel, const gbuffer::Surface& s) {
+            const glm::vec3& diffuse = mDiffuse[pixel];
+            glm::vec3 specularColour(1.0f);
+            if (mChroma) {
+                const float lum = luminance(diffuse);
+                if (lum > 0.0f)
+                    specularColour = diffuse / lum;
             }
+            const glm::vec3 radiance =
+                s.albedo * diffuse + (s.specularIntensity * mSpecular[pixel]) * specularColour;
+            result.radiance[0][pixel] = radiance.r;
+            result.radiance[1][pixel] = radiance.g;
+            result.radiance[2][pixel] = radiance.b;
         });
-        const double materialMs = forwardElapsedMs(materialStart);
+        const double materialMs = millisecondsSince(materialStart);
 
         uint64_t pairs = 0;
         for (const auto& list : tileLights)
@@ -153,10 +140,7 @@ private:
     // Per-frame scratch, kept to avoid reallocation between repetitions.
     std::vector<glm::vec3> mDiffuse;
     std::vector<float> mSpecular;
-    ForwardFrame mForward;
-    std::unique_ptr<raster::Rasterizer> mRasterizer;
-    std::vector<float> mDepth;
-    std::vector<uint32_t> mVisible;
+    MaterialPass mMaterials;
 };
 
 } // namespace

@@ -1,7 +1,7 @@
 // `tiled-forward`: tile-based forward shading, "Forward+" (Ishmukhametov 2013, section 2.4.2,
 // after Harada et al. 2012). Three passes over the scene's own geometry, no G-buffer:
-//   1. "prepass": depth-only pre-pass (ForwardShading.h depthPrepass), which also records each
-//      pixel's visible triangle;
+//   1. "prepass": depth-only pre-pass (the visibility draw, gbuffer/VisibilityPass.h), which also
+//      records each pixel's visible triangle;
 //   2. "cull": the screen is split into square tiles; the pre-pass depths bound each tile's
 //      frustum (computeTileDepthBounds in culling/TileFrusta.h: min/max view depth of the
 //      covered pixels' reconstructed positions) and every light whose conservative sphere
@@ -20,7 +20,7 @@
 // Parameters record the options and lights_after_vfc, vfc_culled and tile_light_pairs.
 //
 // Exactness: the visible fragment's surface and position are computed by the G-buffer's own
-// functions (ForwardFrame::surfaceAt) and each pixel sums its tile's lights in ascending order,
+// functions (ForwardGeometry::surfaceAt) and each pixel sums its tile's lights in ascending order,
 // so the image is bitwise `brute`'s. Per pixel, lightsEvaluated is the list length of its one
 // shaded fragment (0 for background); with the G-buffer's depth equal to the pre-pass depth this
 // equals `tiled`'s count at the same tile size.
@@ -36,7 +36,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/ForwardShading.h"
+#include "lighting/ForwardGeometry.h"
 #include "lighting/LightBounds.h"
 #include "lighting/culling/TileFrusta.h"
 
@@ -66,23 +66,25 @@ public:
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
         fitRasterizer(mRasterizer, view);
-        result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
+        result.timingsMs.emplace_back("transform", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
-        depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
-        result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
+        gbuffer::VisibilityPass& visibility = mForward.visibility();
+        mDepth.resize(size_t(width) * view.height);
+        visibility.draw(*mRasterizer, mDepth);
+        result.timingsMs.emplace_back("prepass", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         const TileGrid grid = TileGrid::make(width, view.height, mOptions.tileSizePixels);
         const size_t lightsAfterVfc = buildTileLightLists(view, grid, *inputs.lights);
-        result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
+        result.timingsMs.emplace_back("cull", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             const size_t pixel = size_t(fragment.y) * width + fragment.x;
-            if (mVisible[pixel] != visibilityCode(fragment.triangle, fragment.frontFacing))
+            if (!visibility.isVisible(fragment, fragment.triangle))
                 return;
             const std::vector<uint32_t>& list =
                 mTileLights[size_t(fragment.y / tileSize) * tileCountX + fragment.x / tileSize];
@@ -96,13 +98,9 @@ public:
             result.radiance[2][pixel] = sum.z;
             result.lightsEvaluated[pixel] = uint32_t(list.size());
         };
-        raster::RasterState state;
-        state.barycentrics = false; // the surface comes from surfaceOfTriangle
-        state.cullMode = raster::CullMode::Back;
-        state.depthTest = closerOrEqualTest(view);
-        state.depthWrite = false;
-        mRasterizer->draw(mForward.triangles(), state, mDepth.data(), shadeFragment);
-        result.timingsMs.emplace_back("shading", forwardElapsedMs(start));
+        mRasterizer->draw(visibility.triangles(), visibility.redrawState(), mDepth.data(),
+                          shadeFragment);
+        result.timingsMs.emplace_back("shading", millisecondsSince(start));
 
         uint64_t pairs = 0;
         for (const std::vector<uint32_t>& list : mTileLights)
@@ -144,10 +142,9 @@ private:
     }
 
     TiledForwardOptions mOptions;
-    ForwardFrame mForward;
+    ForwardGeometry mForward;
     std::unique_ptr<raster::Rasterizer> mRasterizer;
     std::vector<float> mDepth;                      // pre-pass depth, the frame's convention
-    std::vector<uint32_t> mVisible;                 // pre-pass visibility codes
     std::vector<std::vector<uint32_t>> mTileLights; // per tile, ascending light indices
 };
 

@@ -7,12 +7,13 @@
 
 #include <cstring>
 #include <memory>
+#include <span>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <tbb/task_arena.h>
 
 #include "gbuffer/GBufferPass.h"
-#include "lighting/ForwardShading.h"
+#include "lighting/ForwardGeometry.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/MeshBuilder.h"
@@ -140,25 +141,25 @@ TEST(Forward, MultipassEvaluatesOnlyVisibleFragments) {
 
 TEST(Forward, UnlitObjectsCostNothingAndALightBehindTheCameraStillLights) {
     const TestScene& f = threeBoxes();
-    lighting::ForwardFrame forward;
+    lighting::ForwardGeometry forward;
     forward.prepare(f.inputs);
     ASSERT_EQ(forward.objects().size(), 3u);
     raster::Rasterizer rasterizer(f.view.width, f.view.height);
-    std::vector<float> depth;
-    std::vector<uint32_t> visible;
-    lighting::depthPrepass(rasterizer, forward, f.view, depth, visible);
+    std::vector<float> depth(f.gbuffer->pixelCount());
+    forward.visibility().draw(rasterizer, depth);
+    const std::span<const uint32_t> visible = forward.visibility().codes();
 
     for (const char* stage : {"forward", "forward:prepass=1", "forward-multipass"}) {
         const lighting::StageResult result = run(stage, f);
         int pixelsOfObject[3] = {0, 0, 0};
         int litPixelsOfObject[3] = {0, 0, 0};
         for (size_t pixel = 0; pixel < visible.size(); ++pixel) {
-            if (visible[pixel] == lighting::kNoVisibleTriangle) {
+            if (visible[pixel] == gbuffer::VisibilityPass::kNoTriangle) {
                 EXPECT_EQ(result.lightsEvaluated[pixel], 0u) << stage;
                 continue;
             }
             const uint32_t object =
-                forward.objectOfTriangle(visible[pixel] & ~lighting::kBackFaceBit);
+                forward.objectOfTriangle(gbuffer::VisibilityPass::triangleOf(visible[pixel]));
             ++pixelsOfObject[object];
             litPixelsOfObject[object] += result.radiance[0][pixel] > 0.0f ? 1 : 0;
             // A and B each have exactly one light in reach; C none.
@@ -187,33 +188,34 @@ TEST(Forward, SameResultForAnyThreadCount) {
 }
 
 TEST(Forward, SharedSurfaceFunctionReproducesTheGBuffer) {
-    // The refactored GBufferPass::resolve and the forward stages share surfaceOfTriangle and
-    // positionViewOfPixel: at every covered pixel, the G-buffer's decoded surface must equal,
-    // bit for bit, the forward frame's surface of the pre-pass's visible fragment.
+    // The G-buffer pass and the forward stages share the visibility pass (transform, draw,
+    // surface) and the lossless layout's depth decoder: at every covered pixel, the G-buffer's
+    // decoded surface must equal, bit for bit, the forward geometry's surface of the pre-pass's
+    // visible fragment.
     for (const TestScene* f : {&atrium(), &threeBoxes()}) {
-        lighting::ForwardFrame forward;
+        lighting::ForwardGeometry forward;
         forward.prepare(f->inputs);
         raster::Rasterizer rasterizer(f->view.width, f->view.height);
-        std::vector<float> depth;
-        std::vector<uint32_t> visible;
-        lighting::depthPrepass(rasterizer, forward, f->view, depth, visible);
+        std::vector<float> depth(f->gbuffer->pixelCount());
+        forward.visibility().draw(rasterizer, depth);
+        const std::span<const uint32_t> visible = forward.visibility().codes();
         int covered = 0, failures = 0;
         for (int y = 0; y < f->view.height; ++y)
             for (int x = 0; x < f->view.width; ++x) {
                 const size_t pixel = size_t(y) * f->view.width + x;
                 ASSERT_TRUE(sameBits(depth[pixel], f->gbuffer->depth()[pixel])) << pixel;
-                ASSERT_EQ(visible[pixel] != lighting::kNoVisibleTriangle,
+                ASSERT_EQ(visible[pixel] != gbuffer::VisibilityPass::kNoTriangle,
                           f->gbuffer->covered(pixel));
-                if (visible[pixel] == lighting::kNoVisibleTriangle)
+                if (visible[pixel] == gbuffer::VisibilityPass::kNoTriangle)
                     continue;
                 ++covered;
                 raster::Fragment fragment;
                 fragment.x = x;
                 fragment.y = y;
                 fragment.depth = depth[pixel];
-                fragment.frontFacing = (visible[pixel] & lighting::kBackFaceBit) == 0;
-                const auto point =
-                    forward.surfaceAt(fragment, visible[pixel] & ~lighting::kBackFaceBit);
+                fragment.frontFacing = !gbuffer::VisibilityPass::backFaceOf(visible[pixel]);
+                const auto point = forward.surfaceAt(
+                    fragment, gbuffer::VisibilityPass::triangleOf(visible[pixel]));
                 const gbuffer::Surface decoded = f->gbuffer->decode(x, y);
                 bool same = sameBits(point.specularIntensity, decoded.specularIntensity) &&
                             sameBits(point.specularPower, decoded.specularPower);

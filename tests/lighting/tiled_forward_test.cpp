@@ -134,7 +134,7 @@ TEST(TiledForward, PrepassTileBoundsEqualGBufferBounds) {
     for (int tileSize : {4, 16, 37}) {
         const lighting::TileGrid grid =
             lighting::TileGrid::make(f.view.width, f.view.height, tileSize);
-        // The decoder the forward stages read their pre-pass depth with (ForwardShading.h).
+        // The decoder the forward stages read their pre-pass depth with (ForwardGeometry.h).
         const gbuffer::DepthDecoder forwardDecoder =
             gbuffer::GBufferLayout::lossless(f.view.depthConvention, f.view.infiniteFar)
                 .depthDecoder(f.view);

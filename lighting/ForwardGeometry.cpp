@@ -1,4 +1,4 @@
-#include "lighting/ForwardShading.h"
+#include "lighting/ForwardGeometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,37 +7,18 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "gbuffer/GBufferLayout.h"
+
 namespace lighting {
 
-void ForwardFrame::prepare(const StageInputs& inputs) {
+void ForwardGeometry::prepare(const StageInputs& inputs) {
     if (!inputs.scene || !inputs.geometry || !inputs.view)
         throw std::invalid_argument("forward shading needs the frame's scene, geometry and view");
-    mScene = inputs.scene;
-    mGeometry = inputs.geometry;
-    mView = inputs.view;
-    mDepthDecoder =
-        gbuffer::GBufferLayout::lossless(inputs.view->depthConvention, inputs.view->infiniteFar)
-            .depthDecoder(*inputs.view);
     const gbuffer::SceneGeometry& geometry = *inputs.geometry;
     const gbuffer::CameraView& view = *inputs.view;
-    if (geometry.triangleCount() >= kBackFaceBit)
-        throw std::length_error(inputs.scene->name + ": too many triangles for forward shading");
-
-    // The same expressions as GBufferPass::transformVertices (and -ffp-contract=off), so clip
-    // positions, hence coverage, depth and barycentrics, are bitwise the G-buffer pass's.
-    const size_t vertexCount = geometry.positionWorld.size();
-    mClipPositions.resize(vertexCount);
-    mNormalsView.resize(vertexCount);
-    mPositionsView.resize(vertexCount);
-    const glm::mat4 clipFromWorld = view.clipFromWorld();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexCount, 4096), [&](const auto& range) {
-        for (size_t v = range.begin(); v != range.end(); ++v) {
-            const glm::vec4 world(geometry.positionWorld[v], 1.0f);
-            mClipPositions[v] = clipFromWorld * world;
-            mNormalsView[v] = view.viewFromWorldNormal * geometry.normalWorld[v];
-            mPositionsView[v] = glm::vec3(view.viewFromWorld * world);
-        }
-    });
+    mVisibility.transform(*inputs.scene, geometry, view);
+    mDepthDecoder =
+        gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar).depthDecoder(view);
 
     // Objects: maximal runs of one instance (SceneGeometry appends instances one after another,
     // so this is one object per instance).
@@ -54,6 +35,13 @@ void ForwardFrame::prepare(const StageInputs& inputs) {
 
     // Bounds over the objects' vertices in view space: every surface point of a triangle lies in
     // the box of its corners.
+    const size_t vertexCount = geometry.positionWorld.size();
+    mPositionsView.resize(vertexCount);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexCount, 4096), [&](const auto& range) {
+        for (size_t v = range.begin(); v != range.end(); ++v)
+            mPositionsView[v] =
+                glm::vec3(view.viewFromWorld * glm::vec4(geometry.positionWorld[v], 1.0f));
+    });
     tbb::parallel_for(size_t(0), mObjects.size(), [&](size_t o) {
         ForwardObject& object = mObjects[o];
         glm::vec3 lo(INFINITY), hi(-INFINITY);
@@ -69,24 +57,6 @@ void ForwardFrame::prepare(const StageInputs& inputs) {
         object.minView = lo - glm::vec3(pad);
         object.maxView = hi + glm::vec3(pad);
     });
-}
-
-void depthPrepass(raster::Rasterizer& rasterizer, const ForwardFrame& forward,
-                  const gbuffer::CameraView& view, std::vector<float>& depth,
-                  std::vector<uint32_t>& visible) {
-    const size_t pixelCount = size_t(view.width) * view.height;
-    depth.assign(pixelCount, view.clearDepth());
-    visible.assign(pixelCount, kNoVisibleTriangle);
-    const int width = view.width;
-    raster::RasterState state;
-    state.barycentrics = false; // the surface comes from surfaceOfTriangle
-    state.cullMode = raster::CullMode::Back;
-    state.depthTest = closerTest(view);
-    rasterizer.draw(forward.triangles(), state, depth.data(),
-                    [&](const raster::Fragment& fragment) {
-                        visible[size_t(fragment.y) * width + fragment.x] =
-                            visibilityCode(fragment.triangle, fragment.frontFacing);
-                    });
 }
 
 void fitRasterizer(std::unique_ptr<raster::Rasterizer>& rasterizer,

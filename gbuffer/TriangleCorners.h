@@ -1,0 +1,137 @@
+// TriangleCorners: how the surface of a triangle at a pixel centre is computed, inline because the
+// G-buffer resolve runs it at every pixel (VisibilityPass::RowSurfaces is its one user; read
+// VisibilityPass.h first).
+//
+// A triangle's corners (clip-space x, y, w, view-space normals, uvs, material) are loaded once;
+// along a pixel row the perspective-correct barycentric weights are affine in the pixel's NDC x
+// (RowWeights), so a run of pixels showing the same triangle costs three multiply-adds per pixel
+// plus the normal's normalisation. Homogeneous: valid for triangles crossing the near plane.
+// Extending the surface (tangents for normal mapping, more material parameters) means loading
+// the new per-vertex or per-material data in load() and interpolating it in updateSurfaceAt().
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "gbuffer/SceneGeometry.h"
+#include "gbuffer/Surface.h"
+#include "raster/Rasterizer.h"
+#include "scenes/Scene.h"
+
+namespace gbuffer {
+
+struct TriangleCorners {
+    // Clip-space x, y and w of the three vertices (z is not needed: depth comes from the
+    // rasterizer).
+    glm::vec3 clipX, clipY, clipW;
+    glm::vec3 normalView[3];
+    // Flat triangles (the three normals bitwise equal: floors, walls) have one normal direction;
+    // it is normalised here once, and per pixel only the sign of the weight sum is needed.
+    bool flat;
+    bool flatNormalIsZero;    // flat with zero-length normals: the (0, 0, +-1) fallback
+    glm::vec3 flatNormalView; // unit, valid when flat and not zero
+    glm::vec2 uv[3];          // loaded only for textured materials
+    uint32_t materialIndex;
+    const scenes::Material* material;
+    const scenes::Texture* baseColorTexture; // null when untextured
+
+    static TriangleCorners load(const SceneGeometry& geometry, const scenes::Scene& scene,
+                                std::span<const glm::vec4> clipPositions,
+                                std::span<const glm::vec3> normalsView, uint32_t triangle) {
+        const uint32_t* index = geometry.indices.data() + 3 * size_t(triangle);
+        TriangleCorners corners;
+        corners.materialIndex = geometry.triangleMaterial[triangle];
+        corners.material = &scene.materials[corners.materialIndex];
+        corners.baseColorTexture = corners.material->baseColorTexture >= 0
+                                       ? &scene.textures[size_t(corners.material->baseColorTexture)]
+                                       : nullptr;
+        for (int i = 0; i < 3; ++i) {
+            const glm::vec4& clip = clipPositions[index[i]];
+            corners.clipX[i] = clip.x;
+            corners.clipY[i] = clip.y;
+            corners.clipW[i] = clip.w;
+            corners.normalView[i] = normalsView[index[i]];
+            corners.uv[i] = corners.baseColorTexture ? geometry.uv[index[i]] : glm::vec2(0.0f);
+        }
+        corners.flat = corners.normalView[0] == corners.normalView[1] &&
+                       corners.normalView[0] == corners.normalView[2];
+        const float length2 = glm::dot(corners.normalView[0], corners.normalView[0]);
+        corners.flatNormalIsZero = !(length2 > 0.0f);
+        corners.flatNormalView = corners.flatNormalIsZero
+                                     ? glm::vec3(0.0f)
+                                     : corners.normalView[0] * (1.0f / std::sqrt(length2));
+        return corners;
+    }
+};
+
+// Perspective-correct barycentrics along one pixel row. The point sum(b_i c_i) of the triangle
+// with clip-space vertices c_i projects onto the pixel centre (ndcX, ndcY) when
+// sum b_i (x_i - ndcX w_i) = 0 and sum b_i (y_i - ndcY w_i) = 0, so b is the cross product of
+// those two rows, up to scale (the barycentrics are b / sum b). The second row is fixed along a
+// pixel row, so b = cross(x, rowY) - ndcX cross(w, rowY) is affine in ndcX: two cross products per
+// run of pixels, then three multiply-adds per pixel.
+struct RowWeights {
+    glm::vec3 constant;
+    glm::vec3 slope;
+
+    static RowWeights of(const TriangleCorners& corners, float ndcY) {
+        const glm::vec3 rowY = corners.clipY - ndcY * corners.clipW;
+        return {glm::cross(corners.clipX, rowY), glm::cross(corners.clipW, rowY)};
+    }
+};
+
+// The parts of a triangle's surface that do not vary over it: material index, albedo factor
+// (the whole albedo when untextured) and specular. Normal and textured albedo come per pixel from
+// updateSurfaceAt. positionView stays zero: it comes from depth (DepthDecoder).
+inline Surface triangleSurface(const TriangleCorners& corners) {
+    const scenes::Material& material = *corners.material;
+    Surface surface;
+    surface.material = corners.materialIndex;
+    surface.albedo = glm::vec3(material.baseColorFactor);
+    surface.specularIntensity = material.specularIntensity;
+    surface.specularPower = material.specularPower;
+    return surface;
+}
+
+// Sets the pixel-varying parts of `surface` (from triangleSurface of the same corners) at the
+// pixel centre ndcX of the row `row` describes: the interpolated, normalised view-space normal
+// (negated when the back face is visible: two-sided draws light the visible side) and the albedo
+// times the base colour texture.
+[[gnu::always_inline]] inline void updateSurfaceAt(Surface& surface, const TriangleCorners& corners,
+                                                   const RowWeights& row, bool backFace,
+                                                   float ndcX) {
+    // Unnormalised weights: the normal is renormalised anyway, so only the sign of the scale
+    // matters there, and the division stays off the per-pixel path unless a texture needs the
+    // true weights. sum = 0 (pixel ray parallel to the plane) gives equal weights.
+    glm::vec3 b = row.constant - ndcX * row.slope;
+    float sum = b.x + b.y + b.z;
+    if (sum == 0.0f) {
+        b = glm::vec3(1.0f);
+        sum = 3.0f;
+    }
+    // Two-sided draws light the visible side; a negative weight sum flips the interpolated sum.
+    const float sign = (sum < 0.0f) != backFace ? -1.0f : 1.0f;
+    // Zero-length normals (degenerate input) face the viewer.
+    const glm::vec3 zeroNormalFallback(0.0f, 0.0f, backFace ? -1.0f : 1.0f);
+    if (corners.flat) {
+        surface.normalView =
+            corners.flatNormalIsZero ? zeroNormalFallback : corners.flatNormalView * sign;
+    } else {
+        const glm::vec3 normal = raster::interpolate(corners.normalView[0], corners.normalView[1],
+                                                     corners.normalView[2], b);
+        const float length2 = glm::dot(normal, normal);
+        surface.normalView =
+            length2 > 0.0f ? normal * (sign / std::sqrt(length2)) : zeroNormalFallback;
+    }
+    if (corners.baseColorTexture) {
+        const glm::vec2 uv =
+            raster::interpolate(corners.uv[0], corners.uv[1], corners.uv[2], b * (1.0f / sum));
+        surface.albedo = glm::vec3(corners.material->baseColorFactor) *
+                         glm::vec3(corners.baseColorTexture->sample(uv));
+    }
+}
+
+} // namespace gbuffer

@@ -1,0 +1,76 @@
+#include "gbuffer/VisibilityPass.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace gbuffer {
+
+void VisibilityPass::checkTriangleCount(const scenes::Scene& scene, const SceneGeometry& geometry) {
+    if (geometry.triangleCount() >= kBackFaceBit)
+        throw std::length_error(scene.name + ": too many triangles for the visibility buffer");
+}
+
+void VisibilityPass::transform(const scenes::Scene& scene, const SceneGeometry& geometry,
+                               const CameraView& view) {
+    checkTriangleCount(scene, geometry);
+    mScene = &scene;
+    mGeometry = &geometry;
+    mView = view;
+    const size_t count = geometry.positionWorld.size();
+    mClipPositions.resize(count);
+    mNormalsView.resize(count);
+    const glm::mat4 clipFromWorld = view.clipFromWorld();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 4096), [&](const auto& range) {
+        for (size_t v = range.begin(); v != range.end(); ++v) {
+            mClipPositions[v] = clipFromWorld * glm::vec4(geometry.positionWorld[v], 1.0f);
+            mNormalsView[v] = view.viewFromWorldNormal * geometry.normalWorld[v];
+        }
+    });
+    mNdcXOfColumn.resize(size_t(view.width));
+    for (int x = 0; x < view.width; ++x)
+        mNdcXOfColumn[size_t(x)] = view.ndcOfPixel(x, 0).x;
+}
+
+raster::RasterState VisibilityPass::drawState() const {
+    raster::RasterState state;
+    state.cullMode = raster::CullMode::Back;
+    state.barycentrics = false;
+    state.depthTest = mView.reversedZ() ? raster::DepthTest::Greater : raster::DepthTest::Less;
+    state.depthWrite = true;
+    return state;
+}
+
+raster::RasterState VisibilityPass::redrawState() const {
+    raster::RasterState state = drawState();
+    state.depthTest =
+        mView.reversedZ() ? raster::DepthTest::GreaterEqual : raster::DepthTest::LessEqual;
+    state.depthWrite = false;
+    return state;
+}
+
+void VisibilityPass::draw(raster::Rasterizer& rasterizer, std::span<float> depth) {
+    const size_t pixelCount = size_t(mView.width) * size_t(mView.height);
+    if (depth.size() != pixelCount)
+        throw std::invalid_argument("visibility draw: the depth plane has " +
+                                    std::to_string(depth.size()) + " pixels, the view " +
+                                    std::to_string(pixelCount));
+    std::fill(depth.begin(), depth.end(), mView.clearDepth());
+    mCodes.assign(pixelCount, kNoTriangle);
+    const size_t width = size_t(mView.width);
+    uint32_t* codes = mCodes.data();
+    rasterizer.draw(triangles(), drawState(), depth.data(), [&](const raster::Fragment& fragment) {
+        codes[size_t(fragment.y) * width + size_t(fragment.x)] =
+            code(fragment.triangle, fragment.frontFacing);
+    });
+}
+
+Surface VisibilityPass::surfaceAt(uint32_t code, int x, int y) const {
+    RowSurfaces row(*this, y);
+    return row.at(code, x);
+}
+
+} // namespace gbuffer

@@ -1,0 +1,97 @@
+// ForwardGeometry: the per-frame geometry of the forward stages (`forward`, `forward-multipass`,
+// `tiled-forward`), which shade while rasterizing instead of reading a G-buffer.
+//
+// Per frame, prepare() runs the G-buffer pass's own transform (gbuffer::VisibilityPass: vertices
+// to clip space, normals to view space), splits the triangle list into objects (runs of
+// consecutive triangles of one scenes::Instance) and bounds each object with a view-space AABB.
+// A fragment's surface is the visibility pass's surface of its triangle at its pixel, and its
+// position comes from the fragment's depth through the lossless layout's gbuffer::DepthDecoder
+// (a forward stage's depth is the rasterizer's float depth, kept as is). So the visible
+// fragment's Surface is bitwise the one `brute` decodes from a G-buffer of the lossless layout
+// (the same triangles through the same rasterizer give the same depth), and evaluating lights in
+// ascending index order gives bitwise brute's radiance there.
+//
+// Conventions: view space right-handed, camera down -Z; depth in the CameraView's convention
+// (reversed by default). Culling is conservative: lights are tested with the widened spheres of
+// LightBounds.h against object boxes padded by kObjectBoxSlack, so rounding only ever adds work.
+//
+// Thread safety: prepare() is parallel inside and not reentrant per object; the const queries
+// are thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gbuffer/DepthFormat.h"
+#include "gbuffer/Surface.h"
+#include "gbuffer/VisibilityPass.h"
+#include "lighting/LightBounds.h"
+#include "lighting/ShadingStage.h"
+#include "raster/Rasterizer.h"
+
+namespace lighting {
+
+// Relative padding of object boxes (times the largest view-space coordinate magnitude of the
+// box): positions reconstructed from float depth stray from the float-transformed vertices by a
+// few ulps of the distance to the camera; 1e-5 is ~100x that and only ever adds lights.
+inline constexpr float kObjectBoxSlack = 1e-5f;
+
+// A run of consecutive triangles of one instance, drawn as one unit, and its view-space bounds.
+struct ForwardObject {
+    uint32_t firstTriangle = 0;
+    uint32_t triangleCount = 0;
+    uint32_t instance = 0;
+    glm::vec3 minView{0.0f};
+    glm::vec3 maxView{0.0f};
+};
+
+class ForwardGeometry {
+public:
+    // Transforms the scene, builds the objects and their bounds for inputs.view. Requires
+    // inputs.scene, inputs.geometry, inputs.view. Cost O(vertices + triangles), parallel.
+    void prepare(const StageInputs& inputs);
+
+    // The transformed scene: draws (triangles(), drawState(), redrawState()), the depth pre-pass
+    // (draw(): depth and the visibility buffer) and surfaces.
+    gbuffer::VisibilityPass& visibility() { return mVisibility; }
+    const gbuffer::VisibilityPass& visibility() const { return mVisibility; }
+    const std::vector<ForwardObject>& objects() const { return mObjects; }
+    uint32_t objectOfTriangle(uint32_t triangle) const { return mObjectOfTriangle[triangle]; }
+
+    // The fragment's surface as `brute` sees it in the G-buffer (see the file comment).
+    gbuffer::Surface surfaceAt(const raster::Fragment& fragment, uint32_t triangle) const {
+        gbuffer::Surface s = mVisibility.surfaceAt(
+            gbuffer::VisibilityPass::code(triangle, fragment.frontFacing), fragment.x, fragment.y);
+        s.positionView = mDepthDecoder->positionView(fragment.x, fragment.y, fragment.depth);
+        return s;
+    }
+    // How the forward stages read their own depth planes: the lossless layout's decoder.
+    const gbuffer::DepthDecoder& depthDecoder() const { return *mDepthDecoder; }
+
+private:
+    gbuffer::VisibilityPass mVisibility;
+    std::optional<gbuffer::DepthDecoder> mDepthDecoder;
+    std::vector<glm::vec3> mPositionsView; // for the object bounds only
+    std::vector<ForwardObject> mObjects;
+    std::vector<uint32_t> mObjectOfTriangle;
+};
+
+// True when the (widened) light sphere may touch the object's box; unbounded lights always do.
+inline bool sphereTouchesObject(const LightSphere& sphere, const ForwardObject& object) {
+    if (sphere.unbounded)
+        return true;
+    const glm::vec3 outside =
+        glm::max(glm::max(object.minView - sphere.centreView, sphere.centreView - object.maxView),
+                 glm::vec3(0.0f));
+    return glm::dot(outside, outside) <= sphere.radius * sphere.radius;
+}
+
+// Ensures `rasterizer` matches the view's size (recreated only when it changes).
+void fitRasterizer(std::unique_ptr<raster::Rasterizer>& rasterizer,
+                   const gbuffer::CameraView& view);
+
+} // namespace lighting

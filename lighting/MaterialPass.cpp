@@ -1,0 +1,19 @@
+#include "lighting/MaterialPass.h"
+
+#include <stdexcept>
+
+#include "lighting/ForwardGeometry.h"
+
+namespace lighting {
+
+void MaterialPass::draw(const StageInputs& inputs) {
+    if (!inputs.scene || !inputs.geometry || !inputs.view)
+        throw std::invalid_argument("the material pass needs the frame's scene, geometry and view");
+    const gbuffer::CameraView& view = *inputs.view;
+    mVisibility.transform(*inputs.scene, *inputs.geometry, view);
+    fitRasterizer(mRasterizer, view);
+    mDepth.resize(size_t(view.width) * view.height);
+    mVisibility.draw(*mRasterizer, mDepth);
+}
+
+} // namespace lighting
