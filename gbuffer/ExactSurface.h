@@ -31,15 +31,18 @@ struct ExactSurface {
 
     void resize(int w, int h);
     bool covered(size_t pixel) const { return triangle[pixel] != kNoTriangle; }
-    // The exact surface at a covered pixel, in double (material index left 0).
-    BasicSurface<double> surface(size_t pixel) const {
-        BasicSurface<double> s;
+    // The exact surface at pixel (x, y), in double (material index left 0); false for
+    // background.
+    bool surfaceAt(int x, int y, BasicSurface<double>& s) const {
+        const size_t pixel = size_t(y) * width + x;
+        if (!covered(pixel))
+            return false;
         s.positionView = positionView[pixel];
         s.normalView = normalView[pixel];
         s.albedo = glm::dvec3(albedo[pixel]);
         s.specularIntensity = double(specular[pixel].x);
         s.specularPower = double(specular[pixel].y);
-        return s;
+        return true;
     }
     // Fills positionView and normalView from `triangle` (parallel over rows, deterministic).
     void computeGeometry(const SceneGeometry& geometry, const CameraView& view);

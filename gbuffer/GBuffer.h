@@ -91,6 +91,13 @@ public:
     // Reconstructs view-space position from depth (depthDecoder()) and decodes the other channels;
     // channels the layout does not provide are left at Surface's defaults.
     Surface decode(int x, int y) const;
+    // decode(x, y) into `s` when the pixel is covered; false (and `s` untouched) for background.
+    bool surfaceAt(int x, int y, Surface& s) const {
+        if (!covered(size_t(y) * size_t(width()) + size_t(x)))
+            return false;
+        s = decode(x, y);
+        return true;
+    }
 
     // The working depth plane the G-buffer pass draws into: NDC depth in the view's convention,
     // the far plane's value where nothing was drawn.

@@ -1,23 +1,31 @@
-// shadeWithEveryLight: the brute-force loop shared by the `brute` and `reference` stages and
-// the oracle: every light at every covered pixel, in light order, rows in parallel (each pixel
-// written by one task only, so the result is independent of the thread count).
-// surfaceAt(x, y, point) fills a gbuffer::BasicSurface<T> and returns false for background pixels.
+// shadeWithEveryLight: the brute-force loop of the `brute` and `reference` stages and the oracle,
+// written once: every light at every covered pixel, in light order, rows in parallel (each pixel
+// written by one task only, so the result is independent of the thread count). The stages differ
+// only in where the surface comes from and in the scalar type: surfaceAt(x, y, surface) fills a
+// gbuffer::BasicSurface<T> and returns false for background pixels (GBuffer::surfaceAt for the
+// G-buffer in float, gbuffer::ExactSurface::surfaceAt for the exact surface in double).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
 #include <tbb/parallel_for.h>
 
+#include "gbuffer/Surface.h"
 #include "lighting/Brdf.h"
 #include "lighting/ShadingStage.h"
 
 namespace lighting {
 
+// Resizes `result` to width x height with the oracle plane, shades, and records the loop as the
+// pass "shading". Per covered pixel: radiance summed over `lights` in order, lightsEvaluated =
+// every light, lightsOracle = the lights that contribute.
 template <class T, class SurfaceAt>
 void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>>& lights,
-                         SurfaceAt&& surfaceAt, StageResult& result) {
-    const bool countOracle = !result.lightsOracle.empty();
+                         const SurfaceAt& surfaceAt, StageResult& result) {
+    result.resize(width, height, true);
+    const auto start = std::chrono::steady_clock::now();
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             gbuffer::BasicSurface<T> point;
@@ -36,18 +44,10 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
             result.radiance[1][pixel] = float(sum.y);
             result.radiance[2][pixel] = float(sum.z);
             result.lightsEvaluated[pixel] = uint32_t(lights.size());
-            if (countOracle)
-                result.lightsOracle[pixel] = contributing;
+            result.lightsOracle[pixel] = contributing;
         }
     });
-}
-
-// The G-buffer's decoded surface at (x, y); false for background.
-inline bool gbufferSurfaceAt(const gbuffer::GBuffer& gb, int x, int y, gbuffer::Surface& point) {
-    if (!gb.covered(size_t(y) * gb.width() + x))
-        return false;
-    point = gb.decode(x, y);
-    return true;
+    result.timingsMs.emplace_back("shading", millisecondsSince(start));
 }
 
 } // namespace lighting

@@ -9,7 +9,6 @@
 #include <span>
 
 #include "lighting/Brdf.h"
-#include "lighting/EveryLight.h"
 #include "lighting/ShadingStage.h"
 
 namespace lighting {
@@ -35,7 +34,7 @@ inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
                                const std::vector<LightInView<float>>& lights,
                                std::span<const uint32_t> lightIndices, StageResult& result) {
     gbuffer::Surface point;
-    if (gbufferSurfaceAt(gb, x, y, point))
+    if (gb.surfaceAt(x, y, point))
         shadeWithLightList(point, size_t(y) * gb.width() + x, lights, lightIndices, result);
 }
 

@@ -7,11 +7,9 @@ namespace lighting {
 std::vector<uint32_t> countContributingLights(const StageInputs& inputs) {
     const gbuffer::GBuffer& gb = *inputs.gbuffer;
     StageResult scratch;
-    scratch.resize(gb.width(), gb.height(), true);
-    shadeWithEveryLight<float>(
+    shadeWithEveryLight(
         gb.width(), gb.height(), inputs.lights->lights,
-        [&](int x, int y, gbuffer::Surface& point) { return gbufferSurfaceAt(gb, x, y, point); },
-        scratch);
+        [&gb](int x, int y, gbuffer::Surface& s) { return gb.surfaceAt(x, y, s); }, scratch);
     return std::move(scratch.lightsOracle);
 }
 

@@ -1,10 +1,54 @@
 // ShadingStage: the interface every lighting pipeline implements (one stage per file under
-// lighting/stages/, registered by name in StageRegistry.cpp).
+// lighting/stages/, registered by name in StageRegistry.cpp), and what it reads and writes.
 //
-// Declare, then run: requirements() says what the stage reads (G-buffer channels, the exact
-// surface); it is cheap and may be called any number of times. shade() runs the stage on one
-// frame and fills a StageResult. Stages are parallel inside (TBB, under the caller's task_arena)
-// and must be deterministic: the same frame gives bitwise the same result for any thread count.
+// Declare, then run. The runner (experiments/RenderJob, the tests and the benchmarks through
+// PreparedScene) first asks requirements(), derives the G-buffer layout from it and the scene
+// (gbuffer/LayoutDerivation.h), renders the G-buffer, then calls shade() once per frame (several
+// times for timing repetitions, on the same inputs).
+//
+// The contract of each method:
+//
+// name()          The registry name (`brute`, `tiled-backface`...). Pure.
+//
+// requirements()  What shade() reads: the G-buffer channels (the layout provides at least these,
+//                 or layout derivation fails naming the stage and the channel) and whether it
+//                 needs the exact surface. Cheap, pure, the same for the life of the object;
+//                 called any number of times, before and between shade() calls; thread-safe.
+//
+// shade(inputs, result)
+//   May assume:
+//   - inputs.scene, .geometry, .view, .gbuffer and .lights are set; .exact is set when
+//     requirements().exactSurface (it may be set otherwise: ignore it). .view is the G-buffer's
+//     view (*inputs.view == inputs.gbuffer->view()); width and height are the view's.
+//   - The G-buffer may be lossy and in any layout that provides the declared channels: read it
+//     only through GBuffer::decode / surfaceAt / covered / depth() and its depthDecoder() (never
+//     the planes, never a format); channels not declared may be absent (decoded as defaults).
+//   - The lights are LightList's (view space; float for stages, double in lightsExact).
+//   - The call runs inside the caller's tbb::task_arena: parallelise with TBB (it sets the
+//     thread count), start no threads of your own.
+//   - The inputs live for the duration of the call only: keep no pointer into them afterwards.
+//     Scratch storage may be kept in the stage object between calls (it is reused across
+//     repetitions), and successive calls may bring other scenes, sizes and layouts.
+//   Must fill:
+//   - result.resize(width, height, withOracle) first (it clears every plane, the timings and
+//     the parameters; a result object is reused across calls).
+//   - radiance: linear HDR R, G, B of every covered pixel; background pixels (not covered in the
+//     G-buffer, or with no visible fragment for stages that rasterize the scene) stay zero.
+//   - lightsEvaluated: per pixel, the light evaluations the stage actually did there (a forward
+//     stage's overdrawn fragments included; zero on background). An exact stage evaluates at
+//     least the contributing lights at every pixel (StageKind::Exact, StageRegistry.h).
+//   - lightsOracle: either left empty (resize(..., false): the runner counts the contributing
+//     lights itself, lighting/Oracle.h) or, when the stage evaluates every light anyway, the
+//     number of lights with non-zero radiance at every pixel.
+//   - timingsMs: one entry per pass the stage runs, in execution order, with short lowercase
+//     names ("cull", "shading"...), measured with millisecondsSince; not the G-buffer pass (the
+//     runner adds "gbuffer" and "total").
+//   - parameters: the effective value of every option that applies (defaults included) under its
+//     option key, and the stage's counters (e.g. tile_light_pairs), as strings.
+//   Thread safety and determinism: not reentrant per object (one shade() at a time; separate
+//   objects are independent). The same inputs give bitwise the same result for any thread count
+//   and on every repetition: no atomics or scheduling-dependent sums in per-pixel work, light
+//   sums in ascending light order.
 #pragma once
 
 #include <chrono>
@@ -29,8 +73,8 @@ struct StageRequirements {
     bool exactSurface = false;              // reads gbuffer::ExactSurface (the reference)
 };
 
-// The inputs of a stage for one frame: everything it may read. Pointers are null when not
-// required.
+// The inputs of a stage for one frame: everything it may read (see shade() above for which
+// pointers are set).
 struct StageInputs {
     const scenes::Scene* scene = nullptr;
     const gbuffer::SceneGeometry* geometry = nullptr;
@@ -40,6 +84,7 @@ struct StageInputs {
     const LightList* lights = nullptr;
 };
 
+// What shade() fills (see the file comment for each field's contract).
 struct StageResult {
     int width = 0;
     int height = 0;
@@ -50,6 +95,8 @@ struct StageResult {
     std::vector<std::pair<std::string, double>> timingsMs; // per pass, in execution order
     std::map<std::string, std::string> parameters;         // the stage's effective options
 
+    // Sizes every plane to w x h, zero-filled (lightsOracle empty unless withOracle), and clears
+    // timingsMs and parameters.
     void resize(int w, int h, bool withOracle);
 };
 
@@ -62,6 +109,7 @@ inline double millisecondsSince(std::chrono::steady_clock::time_point start) {
 class ShadingStage {
 public:
     virtual ~ShadingStage() = default;
+    // Each method's contract is in the file comment above.
     virtual std::string name() const = 0;
     virtual StageRequirements requirements() const = 0;
     virtual void shade(const StageInputs& inputs, StageResult& result) = 0;

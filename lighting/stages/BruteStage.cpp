@@ -1,8 +1,7 @@
 // `brute`: every light at every pixel, in float, from the G-buffer. The baseline every culling
-// stage must match (up to summation order) and the source of the per-pixel oracle count.
+// stage must match (up to summation order) and the source of the per-pixel oracle count. The
+// loop is shadeWithEveryLight (EveryLight.h), shared with `reference` and the oracle.
 #include "lighting/stages/Stages.h"
-
-#include <chrono>
 
 #include "lighting/EveryLight.h"
 
@@ -20,17 +19,9 @@ public:
     }
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        result.resize(gb.width(), gb.height(), true);
-        const auto start = std::chrono::steady_clock::now();
-        shadeWithEveryLight<float>(
+        shadeWithEveryLight(
             gb.width(), gb.height(), inputs.lights->lights,
-            [&](int x, int y, gbuffer::Surface& point) {
-                return gbufferSurfaceAt(gb, x, y, point);
-            },
-            result);
-        result.timingsMs.emplace_back("shading", std::chrono::duration<double, std::milli>(
-                                                     std::chrono::steady_clock::now() - start)
-                                                     .count());
+            [&gb](int x, int y, gbuffer::Surface& s) { return gb.surfaceAt(x, y, s); }, result);
     }
 };
 

@@ -95,7 +95,7 @@ public:
                 const int tileY = grid.tileYOfPixel(y);
                 for (int x = 0; x < width; ++x) {
                     gbuffer::Surface point;
-                    if (!gbufferSurfaceAt(gb, x, y, point))
+                    if (!gb.surfaceAt(x, y, point))
                         continue;
                     const size_t cluster = grid.clusterIndex(
                         tileXOfPixel[x], tileY, grid.sliceOfDepth(-point.positionView.z));

@@ -25,7 +25,6 @@
 
 #include <chrono>
 
-#include "lighting/EveryLight.h"
 #include "lighting/LightBounds.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/stages/VolumeStageOptions.h"
@@ -66,7 +65,7 @@ public:
         // Adds one light at one pixel; the pixel belongs to the calling task alone.
         auto addLight = [&](int x, int y, size_t pixel, const LightInView<float>& light) {
             gbuffer::Surface point;
-            if (!gbufferSurfaceAt(gb, x, y, point))
+            if (!gb.surfaceAt(x, y, point))
                 return;
             const glm::vec3 value =
                 evaluateLight(point, glm::normalize(-point.positionView), light);

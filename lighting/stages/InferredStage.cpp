@@ -67,7 +67,6 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/EveryLight.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
@@ -164,7 +163,7 @@ public:
                 for (int i = tx * tileSamples; i < i1; ++i) {
                     const int x = sampleX(i), y = sampleY(j);
                     gbuffer::Surface point;
-                    if (!gbufferSurfaceAt(gb, x, y, point))
+                    if (!gb.surfaceAt(x, y, point))
                         continue;
                     LightSample& sample = mSamples[size_t(j) * lowWidth + i];
                     sample.covered = true;

@@ -42,7 +42,6 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/EveryLight.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
@@ -94,7 +93,7 @@ public:
                 for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
                     const size_t pixel = size_t(y) * width + x;
                     gbuffer::Surface point;
-                    if (!gbufferSurfaceAt(gb, x, y, point))
+                    if (!gb.surfaceAt(x, y, point))
                         continue;
                     const SplitLighting lighting = splitLighting(point, lights, list);
                     mDiffuse[pixel] = lighting.diffuse;

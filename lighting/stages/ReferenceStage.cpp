@@ -1,9 +1,7 @@
 // `reference`: every light at every pixel in double precision, from the exact surface (position
 // and normal recomputed in double from the unrounded geometry, materials unencoded). Every other
-// image is compared with it.
+// image is compared with it. The loop is shadeWithEveryLight (EveryLight.h), shared with `brute`.
 #include "lighting/stages/Stages.h"
-
-#include <chrono>
 
 #include "lighting/EveryLight.h"
 
@@ -17,21 +15,12 @@ public:
     StageRequirements requirements() const override { return {{gbuffer::Channel::Depth}, true}; }
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::ExactSurface& exact = *inputs.exact;
-        result.resize(exact.width, exact.height, true);
-        const auto start = std::chrono::steady_clock::now();
-        shadeWithEveryLight<double>(
+        shadeWithEveryLight(
             exact.width, exact.height, inputs.lights->lightsExact,
-            [&](int x, int y, gbuffer::BasicSurface<double>& point) {
-                const size_t pixel = size_t(y) * exact.width + x;
-                if (!exact.covered(pixel))
-                    return false;
-                point = exact.surface(pixel);
-                return true;
+            [&exact](int x, int y, gbuffer::BasicSurface<double>& s) {
+                return exact.surfaceAt(x, y, s);
             },
             result);
-        result.timingsMs.emplace_back("shading", std::chrono::duration<double, std::milli>(
-                                                     std::chrono::steady_clock::now() - start)
-                                                     .count());
     }
 };
 

@@ -179,7 +179,7 @@ void clusteredPerfectCullingCeiling(benchmark::State& state) {
         rowOffsets[y].push_back(0);
         for (int x = 0; x < gb.width(); ++x) {
             gbuffer::Surface point;
-            if (lighting::gbufferSurfaceAt(gb, x, y, point)) {
+            if (gb.surfaceAt(x, y, point)) {
                 const glm::vec3 toViewer = glm::normalize(-point.positionView);
                 for (uint32_t i = 0; i < lights.size(); ++i)
                     if (lighting::contributes(lighting::evaluateLight(point, toViewer, lights[i])))
