@@ -19,6 +19,8 @@ void ForwardGeometry::prepare(const StageInputs& inputs) {
     mVisibility.transform(*inputs.scene, geometry, view);
     mDepthDecoder =
         gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar).depthDecoder(view);
+    fitRasterizer(mRasterizer, view);
+    mDepth.resize(size_t(view.width) * view.height);
 
     // Objects: maximal runs of one instance (SceneGeometry appends instances one after another,
     // so this is one object per instance).

@@ -19,9 +19,11 @@
 // are thread-safe.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -51,13 +53,27 @@ struct ForwardObject {
 
 class ForwardGeometry {
 public:
-    // Transforms the scene, builds the objects and their bounds for inputs.view. Requires
-    // inputs.scene, inputs.geometry, inputs.view. Cost O(vertices + triangles), parallel.
+    // Transforms the scene, builds the objects and their bounds for inputs.view and sizes the
+    // rasterizer. Requires inputs.scene, inputs.geometry, inputs.view. Cost O(vertices +
+    // triangles), parallel.
     void prepare(const StageInputs& inputs);
 
-    // The transformed scene: draws (triangles(), drawState(), redrawState()), the depth pre-pass
-    // (draw(): depth and the visibility buffer) and surfaces.
-    gbuffer::VisibilityPass& visibility() { return mVisibility; }
+    // The depth pre-pass: the visibility draw into depth() and visibility().codes().
+    void drawDepthPrepass() { mVisibility.draw(*mRasterizer, mDepth); }
+    // Clears depth() to the view's far value, for a first draw without a pre-pass.
+    void clearDepth() { std::fill(mDepth.begin(), mDepth.end(), mVisibility.view().clearDepth()); }
+    // Draws `triangles` (visibility().triangles(), or a subset indexing its clip positions) with
+    // `state` over depth(), calling fragmentFn per fragment (raster::Rasterizer::draw).
+    template <class FragmentFn>
+    void draw(const raster::TriangleList& triangles, const raster::RasterState& state,
+              FragmentFn&& fragmentFn) {
+        mRasterizer->draw(triangles, state, mDepth.data(), fragmentFn);
+    }
+    // The forward stages' depth plane (the frame's convention), as the last draws left it.
+    std::span<const float> depth() const { return mDepth; }
+
+    // The transformed scene: triangles(), drawState(), redrawState(), the visibility buffer of
+    // the pre-pass (codes(), isVisible()) and surfaces.
     const gbuffer::VisibilityPass& visibility() const { return mVisibility; }
     const std::vector<ForwardObject>& objects() const { return mObjects; }
     uint32_t objectOfTriangle(uint32_t triangle) const { return mObjectOfTriangle[triangle]; }
@@ -75,6 +91,8 @@ public:
 private:
     gbuffer::VisibilityPass mVisibility;
     std::optional<gbuffer::DepthDecoder> mDepthDecoder;
+    std::unique_ptr<raster::Rasterizer> mRasterizer;
+    std::vector<float> mDepth;
     std::vector<glm::vec3> mPositionsView; // for the object bounds only
     std::vector<ForwardObject> mObjects;
     std::vector<uint32_t> mObjectOfTriangle;

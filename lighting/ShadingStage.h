@@ -71,6 +71,14 @@ namespace lighting {
 struct StageRequirements {
     std::vector<gbuffer::Channel> channels; // G-buffer channels the stage reads
     bool exactSurface = false;              // reads gbuffer::ExactSurface (the reference)
+
+    // Every channel the BRDF reads (depth, normal, albedo, specular): what a stage that shades
+    // from the G-buffer declares.
+    static StageRequirements wholeSurface() {
+        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
+                 gbuffer::Channel::Specular},
+                false};
+    }
 };
 
 // The inputs of a stage for one frame: everything it may read (see shade() above for which

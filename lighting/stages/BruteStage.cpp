@@ -12,11 +12,7 @@ namespace {
 class BruteStage final : public ShadingStage {
 public:
     std::string name() const override { return "brute"; }
-    StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
-                 gbuffer::Channel::Specular},
-                false};
-    }
+    StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         shadeWithEveryLight(

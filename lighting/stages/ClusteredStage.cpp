@@ -37,11 +37,7 @@ class ClusteredStage final : public ShadingStage {
 public:
     explicit ClusteredStage(const ClusterGridOptions& options) : mOptions(options) {}
     std::string name() const override { return "clustered"; }
-    StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
-                 gbuffer::Channel::Specular},
-                false};
-    }
+    StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;

@@ -38,11 +38,7 @@ public:
     explicit DeferredStage(const VolumeStageOptions& volume) : mVolume(volume) {}
 
     std::string name() const override { return "deferred"; }
-    StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
-                 gbuffer::Channel::Specular},
-                false};
-    }
+    StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;

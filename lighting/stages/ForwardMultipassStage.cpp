@@ -41,13 +41,10 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
-        fitRasterizer(mRasterizer, view);
         result.timingsMs.emplace_back("transform", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
-        gbuffer::VisibilityPass& visibility = mForward.visibility();
-        mDepth.resize(size_t(width) * view.height);
-        visibility.draw(*mRasterizer, mDepth);
+        mForward.drawDepthPrepass();
         result.timingsMs.emplace_back("prepass", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
@@ -58,6 +55,7 @@ public:
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const std::vector<ForwardObject>& objects = mForward.objects();
         const std::vector<uint32_t>& allIndices = inputs.geometry->indices;
+        const gbuffer::VisibilityPass& visibility = mForward.visibility();
         const raster::RasterState state = visibility.redrawState();
         for (uint32_t l = 0; l < lights.size(); ++l) {
             const std::vector<uint32_t>& set = mSets[l];
@@ -96,8 +94,8 @@ public:
                 result.radiance[2][pixel] += radiance.z;
                 ++result.lightsEvaluated[pixel];
             };
-            mRasterizer->draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
-                              mDepth.data(), addLight);
+            mForward.draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
+                          addLight);
         }
         result.timingsMs.emplace_back("shading", millisecondsSince(start));
     }
@@ -119,8 +117,6 @@ private:
     }
 
     ForwardGeometry mForward;
-    std::unique_ptr<raster::Rasterizer> mRasterizer;
-    std::vector<float> mDepth;
     std::vector<std::vector<uint32_t>> mSets;
     std::vector<uint32_t> mSetIndices;
     std::vector<uint32_t> mSetTriangles;

@@ -43,7 +43,6 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
-        fitRasterizer(mRasterizer, view);
         result.timingsMs.emplace_back("transform", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
@@ -53,11 +52,10 @@ public:
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
         if (mPrepass) {
             start = std::chrono::steady_clock::now();
-            mDepth.resize(size_t(width) * view.height);
-            mForward.visibility().draw(*mRasterizer, mDepth);
+            mForward.drawDepthPrepass();
             result.timingsMs.emplace_back("prepass", millisecondsSince(start));
         } else {
-            mDepth.assign(size_t(width) * view.height, view.clearDepth());
+            mForward.clearDepth();
         }
 
         start = std::chrono::steady_clock::now();
@@ -82,9 +80,8 @@ public:
         };
         // Without a pre-pass, the visibility draw's own state (every fragment that passes the
         // closer test is shaded); with one, the redraw that passes each visible fragment once.
-        mRasterizer->draw(visibility.triangles(),
-                          mPrepass ? visibility.redrawState() : visibility.drawState(),
-                          mDepth.data(), shadeFragment);
+        mForward.draw(visibility.triangles(),
+                      mPrepass ? visibility.redrawState() : visibility.drawState(), shadeFragment);
         result.timingsMs.emplace_back("shading", millisecondsSince(start));
     }
 
@@ -114,8 +111,6 @@ private:
 
     bool mPrepass;
     ForwardGeometry mForward;
-    std::unique_ptr<raster::Rasterizer> mRasterizer;
-    std::vector<float> mDepth;
     std::vector<std::vector<uint32_t>> mPerObject;
     std::vector<uint32_t> mLightOffsets;
     std::vector<uint32_t> mLightIndices;

@@ -48,11 +48,7 @@ public:
         : mMaxLights(maxLights), mVolume(volume) {}
 
     std::string name() const override { return "light-indexed"; }
-    StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
-                 gbuffer::Channel::Specular},
-                false};
-    }
+    StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;

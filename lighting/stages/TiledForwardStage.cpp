@@ -38,6 +38,7 @@
 
 #include "lighting/ForwardGeometry.h"
 #include "lighting/LightBounds.h"
+#include "lighting/LightListShading.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
@@ -65,13 +66,10 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
-        fitRasterizer(mRasterizer, view);
         result.timingsMs.emplace_back("transform", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
-        gbuffer::VisibilityPass& visibility = mForward.visibility();
-        mDepth.resize(size_t(width) * view.height);
-        visibility.draw(*mRasterizer, mDepth);
+        mForward.drawDepthPrepass();
         result.timingsMs.emplace_back("prepass", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
@@ -82,24 +80,16 @@ public:
         start = std::chrono::steady_clock::now();
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
+        const gbuffer::VisibilityPass& visibility = mForward.visibility();
         auto shadeFragment = [&](const raster::Fragment& fragment) {
-            const size_t pixel = size_t(fragment.y) * width + fragment.x;
             if (!visibility.isVisible(fragment, fragment.triangle))
                 return;
             const std::vector<uint32_t>& list =
                 mTileLights[size_t(fragment.y / tileSize) * tileCountX + fragment.x / tileSize];
-            const gbuffer::Surface point = mForward.surfaceAt(fragment, fragment.triangle);
-            const glm::vec3 toViewer = glm::normalize(-point.positionView);
-            glm::vec3 sum(0.0f);
-            for (uint32_t index : list)
-                sum += evaluateLight(point, toViewer, lights[index]);
-            result.radiance[0][pixel] = sum.x;
-            result.radiance[1][pixel] = sum.y;
-            result.radiance[2][pixel] = sum.z;
-            result.lightsEvaluated[pixel] = uint32_t(list.size());
+            shadeWithLightList(mForward.surfaceAt(fragment, fragment.triangle),
+                               size_t(fragment.y) * width + fragment.x, lights, list, result);
         };
-        mRasterizer->draw(visibility.triangles(), visibility.redrawState(), mDepth.data(),
-                          shadeFragment);
+        mForward.draw(visibility.triangles(), visibility.redrawState(), shadeFragment);
         result.timingsMs.emplace_back("shading", millisecondsSince(start));
 
         uint64_t pairs = 0;
@@ -115,8 +105,9 @@ public:
     }
 
 private:
-    // Fills mTileLights from the pre-pass depth (mDepth); returns the number of lights kept by
-    // view-frustum culling. The same tests (appendTileLights) as `tiled` with the same options.
+    // Fills mTileLights from the pre-pass depth (mForward.depth()); returns the number of lights
+    // kept by view-frustum culling. The same tests (appendTileLights) as `tiled` with the same
+    // options.
     size_t buildTileLightLists(const gbuffer::CameraView& view, const TileGrid& grid,
                                const LightList& lightList) {
         const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
@@ -125,7 +116,7 @@ private:
             candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
 
         const std::vector<TileSurfaceBounds> bounds = computeTileDepthBounds(
-            mForward.depthDecoder(), std::span<const float>(mDepth), grid, mOptions.depthMask);
+            mForward.depthDecoder(), mForward.depth(), grid, mOptions.depthMask);
 
         mTileLights.resize(size_t(grid.tileCount()));
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
@@ -143,8 +134,6 @@ private:
 
     TiledForwardOptions mOptions;
     ForwardGeometry mForward;
-    std::unique_ptr<raster::Rasterizer> mRasterizer;
-    std::vector<float> mDepth;                      // pre-pass depth, the frame's convention
     std::vector<std::vector<uint32_t>> mTileLights; // per tile, ascending light indices
 };
 

@@ -51,11 +51,7 @@ public:
     explicit TiledStage(const TiledOptions& options) : mOptions(options) {}
 
     std::string name() const override { return mOptions.backface ? "tiled-backface" : "tiled"; }
-    StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
-                 gbuffer::Channel::Specular},
-                false};
-    }
+    StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         using Clock = std::chrono::steady_clock;

@@ -144,9 +144,7 @@ TEST(Forward, UnlitObjectsCostNothingAndALightBehindTheCameraStillLights) {
     lighting::ForwardGeometry forward;
     forward.prepare(f.inputs);
     ASSERT_EQ(forward.objects().size(), 3u);
-    raster::Rasterizer rasterizer(f.view.width, f.view.height);
-    std::vector<float> depth(f.gbuffer->pixelCount());
-    forward.visibility().draw(rasterizer, depth);
+    forward.drawDepthPrepass();
     const std::span<const uint32_t> visible = forward.visibility().codes();
 
     for (const char* stage : {"forward", "forward:prepass=1", "forward-multipass"}) {
@@ -195,9 +193,8 @@ TEST(Forward, SharedSurfaceFunctionReproducesTheGBuffer) {
     for (const TestScene* f : {&atrium(), &threeBoxes()}) {
         lighting::ForwardGeometry forward;
         forward.prepare(f->inputs);
-        raster::Rasterizer rasterizer(f->view.width, f->view.height);
-        std::vector<float> depth(f->gbuffer->pixelCount());
-        forward.visibility().draw(rasterizer, depth);
+        forward.drawDepthPrepass();
+        const std::span<const float> depth = forward.depth();
         const std::span<const uint32_t> visible = forward.visibility().codes();
         int covered = 0, failures = 0;
         for (int y = 0; y < f->view.height; ++y)
