@@ -25,6 +25,14 @@ namespace lighting {
 
 class MaterialPass {
 public:
+    // What the stages with a material pass read from the G-buffer: depth, normal and specular
+    // (only its power is used: the layout has no power-only channel). Albedo and specular
+    // intensity come from the material pass.
+    static StageRequirements gbufferRequirements() {
+        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Specular},
+                false};
+    }
+
     // Object ID of background (no triangle): never equal to a scene instance.
     static constexpr uint32_t kNoInstance = UINT32_MAX;
 

@@ -46,15 +46,8 @@ public:
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
 
-        auto start = std::chrono::steady_clock::now();
-        const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
-        LightVolumeRasterizer volumes(gb, mVolume.shape, mVolume.stencil, mVolume.spotProxy);
-        const std::vector<uint32_t> drawn =
-            volumes.lightsToDraw(spheres, mVolume.frustumCull); // ascending
-        const size_t culled = spheres.size() - drawn.size();
-        result.timingsMs.emplace_back("cull", millisecondsSince(start));
-
-        start = std::chrono::steady_clock::now();
+        VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
+        const auto start = std::chrono::steady_clock::now();
         float* radiance[3] = {result.radiance[0].data(), result.radiance[1].data(),
                               result.radiance[2].data()};
         uint32_t* evaluated = result.lightsEvaluated.data();
@@ -70,12 +63,13 @@ public:
             radiance[2][pixel] += value.z;
             ++evaluated[pixel];
         };
-        volumes.draw(spheres, drawn, [&](uint32_t light, int x, int y, size_t pixel) {
-            addLight(x, y, pixel, lights[light]);
-        });
+        cull.volumes.draw(cull.spheres, cull.drawn,
+                          [&](uint32_t light, int x, int y, size_t pixel) {
+                              addLight(x, y, pixel, lights[light]);
+                          });
         result.timingsMs.emplace_back("shading", millisecondsSince(start));
 
-        recordVolumeParameters(mVolume, culled, volumes.stats(), result.parameters);
+        recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
     }
 
 private:

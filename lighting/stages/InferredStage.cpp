@@ -122,10 +122,7 @@ public:
     explicit InferredStage(const InferredOptions& options) : mOptions(options) {}
 
     std::string name() const override { return "inferred"; }
-    StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Specular},
-                false};
-    }
+    StageRequirements requirements() const override { return MaterialPass::gbufferRequirements(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         using Clock = std::chrono::steady_clock;

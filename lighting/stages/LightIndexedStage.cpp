@@ -57,15 +57,8 @@ public:
         const size_t capacity = size_t(mMaxLights);
         result.resize(width, height, false);
 
+        VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
         auto start = std::chrono::steady_clock::now();
-        const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
-        LightVolumeRasterizer volumes(gb, mVolume.shape, mVolume.stencil, mVolume.spotProxy);
-        const std::vector<uint32_t> drawn =
-            volumes.lightsToDraw(spheres, mVolume.frustumCull); // ascending
-        const size_t culled = spheres.size() - drawn.size();
-        result.timingsMs.emplace_back("cull", millisecondsSince(start));
-
-        start = std::chrono::steady_clock::now();
         mCounts.assign(gb.pixelCount(), 0);
         mLists.resize(gb.pixelCount() * capacity);
         uint16_t* counts = mCounts.data();
@@ -80,8 +73,8 @@ public:
             }
             lists[pixel * capacity + count++] = light;
         };
-        volumes.draw(spheres, drawn,
-                     [&](uint32_t light, int, int, size_t pixel) { append(pixel, light); });
+        cull.volumes.draw(cull.spheres, cull.drawn,
+                          [&](uint32_t light, int, int, size_t pixel) { append(pixel, light); });
         result.timingsMs.emplace_back("index", millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
@@ -91,7 +84,7 @@ public:
         std::vector<std::vector<uint32_t>> overflowLists;
         if (anyOverflow) {
             std::vector<TileSurfaceBounds> bounds;
-            overflowLists = basicTileLightLists(gb, overflowGrid, spheres, bounds);
+            overflowLists = basicTileLightLists(gb, overflowGrid, cull.spheres, bounds);
         }
         std::vector<uint32_t> overflowPerRow(size_t(height), 0);
         tbb::parallel_for(0, height, [&](int y) {
@@ -117,7 +110,7 @@ public:
         for (uint32_t n : overflowPerRow)
             overflowPixels += n;
         result.parameters["max"] = std::to_string(mMaxLights);
-        recordVolumeParameters(mVolume, culled, volumes.stats(), result.parameters);
+        recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
         result.parameters["overflow_pixels"] = std::to_string(overflowPixels);
     }
 

@@ -61,10 +61,7 @@ public:
         : mChroma(chroma), mTileSizePixels(tileSizePixels) {}
 
     std::string name() const override { return "light-prepass"; }
-    StageRequirements requirements() const override {
-        return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Specular},
-                false};
-    }
+    StageRequirements requirements() const override { return MaterialPass::gbufferRequirements(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         using Clock = std::chrono::steady_clock;

@@ -1,5 +1,7 @@
 #include "lighting/stages/VolumeStageOptions.h"
 
+#include <chrono>
+
 #include "lighting/stages/Stages.h"
 
 namespace lighting {
@@ -17,6 +19,17 @@ VolumeStageOptions parseVolumeStageOptions(const StageSpec& spec) {
     options.stencil = boolOption(spec, "stencil", false);
     options.frustumCull = boolOption(spec, "vfc", true);
     return options;
+}
+
+VolumeCull cullLightVolumes(const gbuffer::GBuffer& gb, const LightList& lights,
+                            const VolumeStageOptions& options, StageResult& result) {
+    const auto start = std::chrono::steady_clock::now();
+    VolumeCull cull{boundingSpheresView(lights),
+                    LightVolumeRasterizer(gb, options.shape, options.stencil, options.spotProxy),
+                    {}};
+    cull.drawn = cull.volumes.lightsToDraw(cull.spheres, options.frustumCull);
+    result.timingsMs.emplace_back("cull", millisecondsSince(start));
+    return cull;
 }
 
 void recordVolumeParameters(const VolumeStageOptions& options, size_t culled,

@@ -6,7 +6,12 @@
 #include <cstddef>
 #include <map>
 #include <string>
+#include <vector>
 
+#include "gbuffer/GBuffer.h"
+#include "lighting/LightBounds.h"
+#include "lighting/LightList.h"
+#include "lighting/ShadingStage.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/LightVolumes.h"
 
@@ -22,6 +27,19 @@ struct VolumeStageOptions {
 // Reads the four options (the caller rejects unknown keys); a StageError when malformed or when
 // `spot` is given with volume=rect.
 VolumeStageOptions parseVolumeStageOptions(const StageSpec& spec);
+
+// The "cull" pass both volume stages start with: the lights' conservative spheres, the volume
+// rasterizer over the G-buffer, and the lights to draw (ascending; only those whose sphere may
+// touch the view frustum with vfc=1).
+struct VolumeCull {
+    std::vector<LightSphere> spheres;
+    LightVolumeRasterizer volumes;
+    std::vector<uint32_t> drawn;
+    size_t culled() const { return spheres.size() - drawn.size(); } // by view-frustum culling
+};
+// Runs the pass and records its time in result.timingsMs as "cull".
+VolumeCull cullLightVolumes(const gbuffer::GBuffer& gb, const LightList& lights,
+                            const VolumeStageOptions& options, StageResult& result);
 
 // Records the options and the volume draw's statistics (`culled`: lights removed by view-frustum
 // culling) in a stage's parameters.
