@@ -110,10 +110,7 @@ class DepthDecoder {
 public:
     DepthDecoder(const DepthFormatSpec& format, PositionMethod method, const CameraView& view);
 
-    const DepthFormatSpec& format() const { return mFormat; }
-    PositionMethod method() const { return mMethod; }
     const CameraView& view() const { return mView; }
-    const DepthProjection& projection() const { return mProjection; }
     // True when the format keeps the rasterizer's float depth unchanged (f32, f32-reversed).
     bool lossless() const;
 

@@ -81,26 +81,6 @@ const char* specularEncodingName(SpecularEncoding encoding) {
     return "?";
 }
 
-AlbedoEncoding parseAlbedoEncoding(const std::string& text) {
-    std::string valid;
-    for (const AlbedoInfo& info : kAlbedoEncodings) {
-        if (text == info.name)
-            return info.encoding;
-        valid += std::string(valid.empty() ? "" : ", ") + info.name;
-    }
-    throw std::invalid_argument("unknown albedo encoding '" + text + "'; valid: " + valid);
-}
-
-SpecularEncoding parseSpecularEncoding(const std::string& text) {
-    std::string valid;
-    for (const SpecularInfo& info : kSpecularEncodings) {
-        if (text == info.name)
-            return info.encoding;
-        valid += std::string(valid.empty() ? "" : ", ") + info.name;
-    }
-    throw std::invalid_argument("unknown specular encoding '" + text + "'; valid: " + valid);
-}
-
 bool GBufferLayout::provides(Channel channel) const {
     switch (channel) {
     case Channel::Depth:

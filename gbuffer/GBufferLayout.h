@@ -48,8 +48,6 @@ enum class AlbedoEncoding { None, Constant, Material, Rgb8Srgb, Float32 };
 enum class SpecularEncoding { None, Constant, Material, Unorm8Log8, Unorm8Half, Float32 };
 const char* albedoEncodingName(AlbedoEncoding encoding); // "none", "constant", ...
 const char* specularEncodingName(SpecularEncoding encoding);
-AlbedoEncoding parseAlbedoEncoding(const std::string& text); // throws std::invalid_argument
-SpecularEncoding parseSpecularEncoding(const std::string& text);
 
 // Per-material values the `material` and `constant` encodings decode from.
 struct MaterialConstants {
