@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "lighting/EveryLight.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -28,9 +29,9 @@ public:
                 return gbufferSurfaceAt(gb, x, y, point);
             },
             result);
-        result.timingsMs.emplace_back("shading", std::chrono::duration<double, std::milli>(
-                                                     std::chrono::steady_clock::now() - start)
-                                                     .count());
+        result.timingsMs.emplace_back(pass::kShading, std::chrono::duration<double, std::milli>(
+                                                          std::chrono::steady_clock::now() - start)
+                                                          .count());
     }
 };
 

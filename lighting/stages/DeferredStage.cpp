@@ -27,6 +27,7 @@
 
 #include "lighting/EveryLight.h"
 #include "lighting/LightBounds.h"
+#include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/stages/VolumeStageOptions.h"
 
@@ -62,7 +63,7 @@ public:
         const std::vector<uint32_t> drawn =
             volumes.lightsToDraw(spheres, mVolume.frustumCull); // ascending
         const size_t culled = spheres.size() - drawn.size();
-        result.timingsMs.emplace_back("cull", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         float* radiance[3] = {result.radiance[0].data(), result.radiance[1].data(),
@@ -83,7 +84,7 @@ public:
         volumes.draw(spheres, drawn, [&](uint32_t light, int x, int y, size_t pixel) {
             addLight(x, y, pixel, lights[light]);
         });
-        result.timingsMs.emplace_back("shading", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
 
         recordVolumeParameters(mVolume, culled, volumes.stats(), result.parameters);
     }

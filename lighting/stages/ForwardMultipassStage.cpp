@@ -24,6 +24,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardShading.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -42,15 +43,15 @@ public:
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(frame);
         fitRasterizer(mRasterizer, view);
-        result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kTransform, forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
         depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
-        result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kPrepass, forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
         buildIlluminationSets(*frame.lights);
-        result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kCull, forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
         const std::vector<LightInView<float>>& lights = frame.lights->lights;
@@ -101,7 +102,7 @@ public:
             mRasterizer->draw(raster::TriangleList{mForward.clipPositions(), indices}, state,
                               mDepth.data(), addLight);
         }
-        result.timingsMs.emplace_back("shading", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kShading, forwardElapsedMs(start));
     }
 
 private:

@@ -22,6 +22,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardShading.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -43,16 +44,16 @@ public:
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(frame);
         fitRasterizer(mRasterizer, view);
-        result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kTransform, forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
         buildObjectLightLists(*frame.lights);
-        result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kCull, forwardElapsedMs(start));
 
         if (mPrepass) {
             start = std::chrono::steady_clock::now();
             depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
-            result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
+            result.timingsMs.emplace_back(pass::kPrepass, forwardElapsedMs(start));
         } else {
             mDepth.assign(size_t(width) * view.height, view.clearDepth());
         }
@@ -84,7 +85,7 @@ public:
         state.depthTest = mPrepass ? closerOrEqualTest(view) : closerTest(view);
         state.depthWrite = !mPrepass;
         mRasterizer->draw(mForward.triangles(), state, mDepth.data(), shadeFragment);
-        result.timingsMs.emplace_back("shading", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kShading, forwardElapsedMs(start));
     }
 
 private:

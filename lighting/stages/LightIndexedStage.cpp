@@ -29,6 +29,7 @@
 
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
+#include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/culling/TileFrusta.h"
 #include "lighting/stages/VolumeStageOptions.h"
@@ -72,7 +73,7 @@ public:
         const std::vector<uint32_t> drawn =
             volumes.lightsToDraw(spheres, mVolume.frustumCull); // ascending
         const size_t culled = spheres.size() - drawn.size();
-        result.timingsMs.emplace_back("cull", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         mCounts.assign(gb.pixelCount(), 0);
@@ -91,7 +92,7 @@ public:
         };
         volumes.draw(spheres, drawn,
                      [&](uint32_t light, int, int, size_t pixel) { append(pixel, light); });
-        result.timingsMs.emplace_back("index", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kIndex, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         const bool anyOverflow =
@@ -120,7 +121,7 @@ public:
             }
             overflowPerRow[size_t(y)] = overflowed;
         });
-        result.timingsMs.emplace_back("shading", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
 
         uint64_t overflowPixels = 0;
         for (uint32_t n : overflowPerRow)

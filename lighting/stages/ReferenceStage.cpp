@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "lighting/EveryLight.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -31,9 +32,9 @@ public:
                 return true;
             },
             result);
-        result.timingsMs.emplace_back("shading", std::chrono::duration<double, std::milli>(
-                                                     std::chrono::steady_clock::now() - start)
-                                                     .count());
+        result.timingsMs.emplace_back(pass::kShading, std::chrono::duration<double, std::milli>(
+                                                          std::chrono::steady_clock::now() - start)
+                                                          .count());
     }
 };
 

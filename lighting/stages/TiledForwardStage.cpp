@@ -38,6 +38,7 @@
 
 #include "lighting/ForwardShading.h"
 #include "lighting/LightBounds.h"
+#include "lighting/PassNames.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
@@ -66,16 +67,16 @@ public:
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(frame);
         fitRasterizer(mRasterizer, view);
-        result.timingsMs.emplace_back("transform", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kTransform, forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
         depthPrepass(*mRasterizer, mForward, view, mDepth, mVisible);
-        result.timingsMs.emplace_back("prepass", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kPrepass, forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
         const TileGrid grid = TileGrid::make(width, view.height, mOptions.tileSizePixels);
         const size_t lightsAfterVfc = buildTileLightLists(view, grid, *frame.lights);
-        result.timingsMs.emplace_back("cull", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kCull, forwardElapsedMs(start));
 
         start = std::chrono::steady_clock::now();
         const std::vector<LightInView<float>>& lights = frame.lights->lights;
@@ -102,7 +103,7 @@ public:
         state.depthTest = closerOrEqualTest(view);
         state.depthWrite = false;
         mRasterizer->draw(mForward.triangles(), state, mDepth.data(), shadeFragment);
-        result.timingsMs.emplace_back("shading", forwardElapsedMs(start));
+        result.timingsMs.emplace_back(pass::kShading, forwardElapsedMs(start));
 
         uint64_t pairs = 0;
         for (const std::vector<uint32_t>& list : mTileLights)
