@@ -14,13 +14,13 @@
 #include <CLI/CLI.hpp>
 
 #include "experiments/CommandErrors.h"
-#include "experiments/DepthStudy.h"
 #include "experiments/DiffCommand.h"
-#include "experiments/NormalStudy.h"
 #include "experiments/RenderCommand.h"
 #include "experiments/ReportCommand.h"
 #include "experiments/SweepFile.h"
 #include "experiments/SweepRunner.h"
+#include "experiments/studies/DepthStudy.h"
+#include "experiments/studies/NormalStudy.h"
 #include "gbuffer/NormalCodec.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots of the depth/position study (`testbed depth`, experiments/DepthStudy.h), matplotlib.
+"""Plots of the depth/position study (`testbed depth`, experiments/studies/DepthStudy.h), matplotlib.
 
 Called by the C++ command, not by hand (but it can be):
 

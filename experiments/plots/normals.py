@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots of the normal-encoding precision study (`testbed normals`, experiments/NormalStudy.h).
+"""Plots of the normal-encoding precision study (`testbed normals`, experiments/studies/NormalStudy.h).
 
 Called by the C++ command after it has written DIR/normals.json and the error grids
 DIR/maps/<codec>-<bits>.f32 (it can also be run by hand):
