@@ -90,6 +90,17 @@ def panels(cameras, title):
     return fig, list(axes.flat)
 
 
+def style_panel(axis, near, far, y_label):
+    """Log-log axes of one camera's panel, against view depth."""
+    axis.set_xscale("log")
+    axis.set_yscale("log")
+    axis.set_title(f"near {near:g} m, far {far:g} m")
+    axis.set_xlabel("view depth d (m)")
+    axis.set_ylabel(y_label)
+    axis.grid(True, which="major", alpha=0.3)
+    axis.minorticks_off()  # hundreds of log-axis minor ticks cost most of the drawing time
+
+
 def plot_errors(data, out):
     rows = data["rows"]
     cameras = cameras_of(rows)
@@ -113,13 +124,7 @@ def plot_errors(data, out):
                 if lost:  # the surface reads as background there: drawn as error 1 (100%)
                     axis.plot(lost, [1.0] * len(lost), "x", color=COLOURS.get(fmt), markersize=5)
         axis.axhline(1e-3, color="grey", linewidth=0.8, linestyle=(0, (1, 3)))
-        axis.set_xscale("log")
-        axis.set_yscale("log")
-        axis.set_title(f"near {near:g} m, far {far:g} m")
-        axis.set_xlabel("view depth d (m)")
-        axis.set_ylabel("max relative error")
-        axis.grid(True, which="major", alpha=0.3)
-        axis.minorticks_off()  # hundreds of log-axis minor ticks cost most of the drawing time
+        style_panel(axis, near, far, "max relative error")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     fig.subplots_adjust(left=0.07, right=0.98, top=0.89, bottom=0.2, hspace=0.3, wspace=0.18)
@@ -146,13 +151,7 @@ def plot_steps(data, out):
         if distances:
             axis.plot(distances, [d * 1e-3 for d in distances], color="grey", linewidth=0.8,
                       linestyle=(0, (1, 3)))
-        axis.set_xscale("log")
-        axis.set_yscale("log")
-        axis.set_title(f"near {near:g} m, far {far:g} m")
-        axis.set_xlabel("view depth d (m)")
-        axis.set_ylabel("depth step (m)")
-        axis.grid(True, which="major", alpha=0.3)
-        axis.minorticks_off()  # hundreds of log-axis minor ticks cost most of the drawing time
+        style_panel(axis, near, far, "depth step (m)")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=5, fontsize=8, frameon=False)
     fig.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.13, hspace=0.3, wspace=0.18)
