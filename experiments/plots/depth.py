@@ -12,22 +12,16 @@ and OUTDIR/depth_step_vs_distance.png (metres between neighbouring depth codes a
 panel per camera, one line per format x far plane, with d * 1e-3 as a guide). Samples lost to
 background (null errors / steps) are gaps in the lines. Each PNG is written to a temporary name
 in OUTDIR and renamed (os.replace), so an interrupted run leaves no partial file.
-Exit status 0 on success, 2 on bad arguments or input, 3 when matplotlib is missing.
+Exit status 0 on success, 2 on bad arguments or input, 3 when matplotlib is missing (plotfiles.py).
 """
 import json
 import math
 import os
 import sys
 
-try:
-    import matplotlib
+from plotfiles import pyplot, save_png
 
-    matplotlib.use("Agg")  # no display; must precede pyplot
-    import matplotlib.pyplot as plt
-except ImportError:
-    print("depth.py: matplotlib is not installed (Debian: apt-get install python3-matplotlib)",
-          file=sys.stderr)
-    sys.exit(3)
+plt = pyplot("depth.py")
 
 DPI = 100
 # Drawing order: f32 last, on top of unorm24, which it equals wherever NDC depth >= 1/2 (there the
@@ -68,15 +62,7 @@ def grid(count):
 
 
 def save(fig, path):
-    root, ext = os.path.splitext(path)
-    temp = f"{os.path.dirname(path)}/.{os.path.basename(root)}.tmp-{os.getpid()}{ext}"
-    try:
-        fig.savefig(temp, dpi=DPI)
-        os.replace(temp, path)
-    finally:
-        if os.path.exists(temp):
-            os.remove(temp)
-        plt.close(fig)
+    save_png(fig, path, dpi=DPI)
 
 
 def panels(cameras, title):
