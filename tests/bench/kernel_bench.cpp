@@ -2,6 +2,8 @@
 //   kernelBruteShading/<isa>     atrium 1280x720, 256 point lights + ambient + sun, every light
 //                                for every packet (brute force), packets decoded beforehand;
 //                                ns per covered pixel-light, one thread
+//   kernelBruteSpeedup/<isa>     the same, scalar and <isa> timed alternately on the same packets:
+//                                the median ratio (the target: >= 8)
 //   kernelBruteFrame/<isa>/<t>   the same with the decode inside the timer, on t threads: what a
 //                                brute stage on the kernel would cost (compare bruteShading)
 //   kernelContributing/<isa>     synthetic packets where every lane receives every light (the
@@ -14,11 +16,12 @@
 //   machinePeak                  the measured clock and FMA instructions per cycle
 // Single-threaded benchmarks time the thread's CPU time (the machine is shared: time spent
 // descheduled is not the kernel's); kernelBruteFrame times wall clock, as a frame is.
-// Flops of one evaluation as the kernel executes it (see README.md for the count): 100 for a point
-// light, 112 for a spot, 82 for a directional light, 6 for an ambient one; fused multiply-adds
-// count 2, square roots and divisions 1, comparisons and selections 0, and pow the 45 flops of
-// Highway's Log and Exp. Peak = lanes x 2 FMA pipes x 2 flops x measured clock, with lanes the
-// ISA's floats per vector (1 for the scalar path).
+// Flops of one evaluation as the kernel executes it (lighting/kernel/README.md counts them): 99
+// for a point light, 111 for a spot, 81 for a directional light, 6 for an ambient one; additions,
+// multiplications, divisions and square roots count 1, fused multiply-adds 2, comparisons,
+// selections, conversions and integer operations 0, and pow the 44 flops Highway's Log (20), the
+// product y log x (1) and Exp (23) execute. Peak = lanes x 2 FMA pipes x 2 flops x measured clock,
+// with lanes the ISA's floats per vector (1 for the scalar path).
 //   build/bin/testbed_bench --benchmark_counters_tabular=true
 //       --benchmark_filter='kernel|packetDecode|gbufferDecode|machinePeak'
 #include <benchmark/benchmark.h>
@@ -50,11 +53,11 @@ constexpr int kFmaPipes = 2; // Zen 5 (MachinePeak.h); machinePeak reports the m
 double flopsPerEvaluation(scenes::LightType type) {
     switch (type) {
     case scenes::LightType::Point:
-        return 100;
+        return 99;
     case scenes::LightType::Spot:
-        return 112;
+        return 111;
     case scenes::LightType::Directional:
-        return 82;
+        return 81;
     case scenes::LightType::Ambient:
         return 6;
     }
@@ -163,6 +166,46 @@ void kernelBruteShading(benchmark::State& state, const KernelIsa& isa) {
     state.counters["ns/pixel-light_median"] = times.median() * 1e9 / pixelLights;
     state.counters["shaded_fraction"] = double(shaded) / double(total);
     state.SetLabel(isa.name());
+}
+
+// The ratio, measured so that load on the shared machine hits both sides alike: each
+// iteration times the scalar path and then `isa` on the same packets (every 8th packet of the
+// frame, brute force, with the oracle count), and the ratio of the two times is kept; the median
+// ratio over the iterations is reported.
+void kernelBruteSpeedup(benchmark::State& state, const KernelIsa& isa) {
+    const AtriumKernelFrame& f = atriumKernelFrame();
+    PacketAccumulator accumulator;
+    auto shadeEighth = [&](const KernelIsa& which) {
+        const double start = bench::threadCpuSeconds();
+        for (size_t p = 0; p < f.packets.size(); p += 8) {
+            accumulator.clear();
+            lighting::kernel::shadePacket(which, f.packets[p], lighting::kernel::kAllLanes,
+                                          *f.lights, f.everyLight, accumulator, true);
+        }
+        benchmark::DoNotOptimize(accumulator);
+        return bench::threadCpuSeconds() - start;
+    };
+    double pixelLights = 0;
+    for (size_t p = 0; p < f.packets.size(); p += 8)
+        pixelLights += double(__builtin_popcount(f.packets[p].laneMask)) * f.everyLight.size();
+    std::vector<double> ratios, scalarTimes, vectorTimes;
+    for (auto _ : state) {
+        const double scalar = shadeEighth(KernelIsa::scalar());
+        const double vector = shadeEighth(isa);
+        state.SetIterationTime(scalar + vector);
+        ratios.push_back(scalar / vector);
+        scalarTimes.push_back(scalar);
+        vectorTimes.push_back(vector);
+    }
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        return v[v.size() / 2];
+    };
+    state.counters["speedup_median"] = median(ratios);
+    state.counters["speedup_min"] = *std::min_element(ratios.begin(), ratios.end());
+    state.counters["scalar_ns/pixel-light"] = median(scalarTimes) * 1e9 / pixelLights;
+    state.counters["vector_ns/pixel-light"] = median(vectorTimes) * 1e9 / pixelLights;
+    state.SetLabel(isa.name() + " vs scalar");
 }
 
 void kernelBruteFrame(benchmark::State& state, const KernelIsa& isa) {
@@ -407,6 +450,14 @@ BENCHMARK(machinePeak)->Iterations(1);
 const bool kRegistered = [] {
     registerPerIsa("kernelBruteShading", kernelBruteShading);
     registerPerIsa("kernelBruteFrame", kernelBruteFrame, {1, 2});
+    for (const KernelIsa& isa : KernelIsa::available())
+        if (!isa.isScalar())
+            benchmark::RegisterBenchmark(
+                ("kernelBruteSpeedup/" + isa.name()).c_str(),
+                [isa](benchmark::State& state) { kernelBruteSpeedup(state, isa); })
+                ->UseManualTime()
+                ->MinTime(4.0)
+                ->Unit(benchmark::kMillisecond);
     registerPerIsa("kernelContributing", kernelContributing);
     registerPerIsa("kernelIdealAtrium", kernelIdealAtrium);
     registerPerIsa("packetDecode", packetDecode);
