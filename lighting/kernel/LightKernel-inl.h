@@ -103,11 +103,10 @@ HWY_INLINE void accumulate(const FloatVec radiance[3], ChunkSums& sums) {
         hn::Sub(sums.contributing, hn::VecFromMask(di, hn::RebindMask(di, contributes)));
 }
 
-// Phase 3 for one chunk: the halfway vector, the specular lobe and the radiance, added to the
-// sums, with evaluateLight's operations except pow.
-template <bool kCountContributing>
-HWY_INLINE void shadeChunk(const KernelLight& light, const ChunkSurface& s, const ChunkLight& l,
-                           ChunkSums& sums) {
+// Phase 3 for one chunk: the halfway vector, the specular lobe and the radiance, with
+// evaluateLight's operations except pow.
+HWY_INLINE void shadedRadiance(const KernelLight& light, const ChunkSurface& s, const ChunkLight& l,
+                               FloatVec radiance[3]) {
     const FloatTag d;
     const FloatVec one = hn::Set(d, 1.0f);
     FloatVec halfway[3];
@@ -124,11 +123,17 @@ HWY_INLINE void shadeChunk(const KernelLight& light, const ChunkSurface& s, cons
         dot3(s.normal[0], s.normal[1], s.normal[2], halfway[0], halfway[1], halfway[2]);
     const FloatVec specular = hn::Mul(s.specularScale, powNonNegative(d, nDotH, s.specularPower));
     const FloatVec scale = hn::Mul(l.attenuation, l.nDotL);
-    FloatVec radiance[3];
     for (int k = 0; k < 3; ++k)
         radiance[k] =
             hn::IfThenElseZero(l.pass, hn::Mul(hn::Mul(hn::Set(d, light.radiance[k]), scale),
                                                hn::Add(s.diffuse[k], specular)));
+}
+
+template <bool kCountContributing>
+HWY_INLINE void shadeAndAdd(const KernelLight& light, const ChunkSurface& s, const ChunkLight& l,
+                            ChunkSums& sums) {
+    FloatVec radiance[3];
+    shadedRadiance(light, s, l, radiance);
     accumulate<kCountContributing>(radiance, sums);
 }
 
@@ -238,11 +243,25 @@ template <bool kCountContributing> void shadeLights(const ShadeArgs& args) {
         sums[c].contributing = hn::Zero(di);
     }
 
+    // With one vector per packet (AVX-512), a light's shading is one long dependency chain (two
+    // square roots, three divisions, Log, Exp: ~200 cycles) and the core overlaps too few of
+    // them; so a light to shade waits for the next one and the two are shaded side by side,
+    // then added in list order. Measured on Zen 5: 6% less time per shaded light with AVX-512
+    // (median of 6 alternating runs, 105.6 against 112.3 cycles); with 2 or 4 vectors per
+    // packet, which already have independent chains, pairing was slower.
+    constexpr bool kPairLights = kChunks == 1;
     ChunkLight chunkLight[kChunks];
+    ChunkLight pendingLight[kChunks];
+    const KernelLight* pending = nullptr;
     for (size_t i = 0; i < args.count; ++i) {
         const KernelLight& light = args.lights[args.indices[i]];
         const auto type = scenes::LightType(light.type);
         if (type == scenes::LightType::Ambient) {
+            if (pending) {
+                for (size_t c = 0; c < kChunks; ++c)
+                    shadeAndAdd<kCountContributing>(*pending, surface[c], pendingLight[c], sums[c]);
+                pending = nullptr;
+            }
             for (size_t c = 0; c < kChunks; ++c) {
                 FloatVec radiance[3];
                 for (int k = 0; k < 3; ++k)
@@ -278,10 +297,28 @@ template <bool kCountContributing> void shadeLights(const ShadeArgs& args) {
             ++accumulator.lightsSkippedAtConeOrFacing;
             continue;
         }
-        for (size_t c = 0; c < kChunks; ++c)
-            shadeChunk<kCountContributing>(light, surface[c], chunkLight[c], sums[c]);
         ++accumulator.lightsShaded;
+        if (!kPairLights) {
+            for (size_t c = 0; c < kChunks; ++c)
+                shadeAndAdd<kCountContributing>(light, surface[c], chunkLight[c], sums[c]);
+        } else if (!pending) {
+            pending = &light;
+            for (size_t c = 0; c < kChunks; ++c)
+                pendingLight[c] = chunkLight[c];
+        } else {
+            for (size_t c = 0; c < kChunks; ++c) {
+                FloatVec first[3], second[3];
+                shadedRadiance(*pending, surface[c], pendingLight[c], first);
+                shadedRadiance(light, surface[c], chunkLight[c], second);
+                accumulate<kCountContributing>(first, sums[c]);
+                accumulate<kCountContributing>(second, sums[c]);
+            }
+            pending = nullptr;
+        }
     }
+    if (pending)
+        for (size_t c = 0; c < kChunks; ++c)
+            shadeAndAdd<kCountContributing>(*pending, surface[c], pendingLight[c], sums[c]);
 
     for (size_t c = 0; c < kChunks; ++c) {
         const size_t first = c * kLanesPerVector;
