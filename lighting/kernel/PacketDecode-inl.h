@@ -6,8 +6,8 @@
 // one unaligned 128-bit load per float plane (64-bit for the 16-bit material index), joined with
 // Combine. Then, per lane and with GBuffer::decode's operations in its order (no fused
 // multiply-add): the pixel centre's NDC, the position (inverse projection or view ray), the
-// material lookups (GatherIndex into the table's columns, the index clamped to the sentinel
-// entry that stands for "out of range"), and coverage (depth != the clear value).
+// material lookups (a permutation when the table fits in a vector, else GatherIndex), and
+// coverage (depth != the clear value).
 #include "lighting/kernel/PacketDecoder.h"
 #include "lighting/kernel/VectorTargets.h"
 
@@ -82,6 +82,40 @@ HWY_INLINE hn::Vec<DI> loadMaterialRows(DI di, const uint16_t* row0, size_t stri
 alignas(64) constexpr float kLaneX[kPacketLanes] = {0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3};
 alignas(64) constexpr float kLaneY[kPacketLanes] = {0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3};
 
+// A material table column per lane. When the table fits in one vector (most scenes: atrium has 8
+// materials) the lookup is one permutation of the column loaded as a vector, else a gather.
+// Indices past the table read the sentinel entry at materialCount (GBuffer::decode's values for
+// an index out of range), by selection or by clamping.
+struct MaterialLookup {
+    bool byPermutation = false;
+    LaneMask inRange = hn::FirstN(FloatTag(), 0);
+    decltype(hn::IndicesFromVec(FloatTag(), hn::Zero(IntTag()))) indices =
+        hn::IndicesFromVec(FloatTag(), hn::Zero(IntTag()));
+    IntVec clamped = hn::Zero(IntTag());
+
+    MaterialLookup() = default;
+    MaterialLookup(const PacketDecodeTables& t, IntVec index) {
+        const IntTag di;
+        byPermutation = t.materialCount > 0 && t.materialCount <= kLanes;
+        if (byPermutation) {
+            inRange =
+                hn::RebindMask(FloatTag(), hn::Lt(index, hn::Set(di, int32_t(t.materialCount))));
+            indices = hn::IndicesFromVec(FloatTag(),
+                                         hn::Min(index, hn::Set(di, int32_t(t.materialCount) - 1)));
+        } else {
+            clamped = hn::Min(index, hn::Set(di, int32_t(t.materialCount)));
+        }
+    }
+    // `column` has materialCount + 1 entries and is padded to at least 16 floats.
+    FloatVec column(const float* values, uint32_t materialCount) const {
+        const FloatTag d;
+        if (!byPermutation)
+            return hn::GatherIndex(d, values, clamped);
+        return hn::IfThenElse(inRange, hn::TableLookupLanes(hn::LoadU(d, values), indices),
+                              hn::Set(d, values[materialCount]));
+    }
+};
+
 } // namespace decode
 
 void decodePacketVector(const DecodeArgs& args) {
@@ -141,16 +175,15 @@ void decodePacketVector(const DecodeArgs& args) {
             hn::Store(loadRows(d, t.normal[k] + pixel0, stride), d, packet.normalView[k] + first);
         }
 
-        IntVec material = hn::Zero(IntTag());
+        MaterialLookup material;
         if (t.albedoSource == DecodeSource::Material || t.specularSource == DecodeSource::Material)
-            material = hn::Min(loadMaterialRows(IntTag(), t.material + pixel0, stride),
-                               hn::Set(IntTag(), int32_t(t.materialCount)));
+            material = MaterialLookup(t, loadMaterialRows(IntTag(), t.material + pixel0, stride));
         for (int k = 0; k < 3; ++k) {
             FloatVec albedo = hn::Zero(d);
             if (t.albedoSource == DecodeSource::Plane)
                 albedo = loadRows(d, t.albedoPlane[k] + pixel0, stride);
             else if (t.albedoSource == DecodeSource::Material)
-                albedo = hn::GatherIndex(d, t.materialAlbedo[k], material);
+                albedo = material.column(t.materialAlbedo[k], t.materialCount);
             else if (t.albedoSource == DecodeSource::Constant)
                 albedo = hn::Set(d, t.constantAlbedo[k]);
             hn::Store(albedo, d, packet.albedo[k] + first);
@@ -162,7 +195,7 @@ void decodePacketVector(const DecodeArgs& args) {
             if (t.specularSource == DecodeSource::Plane)
                 specular = loadRows(d, t.specularPlane[k] + pixel0, stride);
             else if (t.specularSource == DecodeSource::Material)
-                specular = hn::GatherIndex(d, t.materialSpecular[k], material);
+                specular = material.column(t.materialSpecular[k], t.materialCount);
             else if (t.specularSource == DecodeSource::Constant)
                 specular = hn::Set(d, t.constantSpecular[k]);
             hn::Store(specular, d, specularTargets[k]);

@@ -101,17 +101,17 @@ PacketDecoder::PacketDecoder(const gbuffer::GBufferLayout& layout, const gbuffer
     }
     // The material table as columns plus the "index out of range" entry GBuffer::decode implies.
     t.materialCount = uint32_t(layout.materials.size());
-    for (auto& column : mMaterialColumns)
-        column.reserve(layout.materials.size() + 1);
     for (const gbuffer::MaterialConstants& m : layout.materials) {
         for (int k = 0; k < 3; ++k)
             mMaterialColumns[k].push_back(m.albedo[k]);
         mMaterialColumns[3].push_back(m.specularIntensity);
         mMaterialColumns[4].push_back(m.specularPower);
     }
+    // The sentinel, repeated up to 16 entries so a vector decoder can load a whole column as one
+    // vector of up to 16 lanes.
     const float sentinel[5] = {0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
     for (int k = 0; k < 5; ++k)
-        mMaterialColumns[k].push_back(sentinel[k]);
+        mMaterialColumns[k].resize(std::max<size_t>(layout.materials.size() + 1, 16), sentinel[k]);
     for (int k = 0; k < 3; ++k)
         t.materialAlbedo[k] = mMaterialColumns[k].data();
     t.materialSpecular[0] = mMaterialColumns[3].data();

@@ -64,7 +64,8 @@ struct PacketDecodeTables {
     float constantAlbedo[3] = {};
     float constantSpecular[2] = {0.0f, 1.0f};
     // The layout's material table as columns, with one more entry at index materialCount holding
-    // what GBuffer::decode gives for an index out of range (albedo 0, specular (0, 1)).
+    // what GBuffer::decode gives for an index out of range (albedo 0, specular (0, 1)), repeated
+    // to at least 16 entries.
     const float* materialAlbedo[3] = {};
     const float* materialSpecular[2] = {};
     uint32_t materialCount = 0;

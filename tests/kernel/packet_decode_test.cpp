@@ -135,6 +135,57 @@ TEST(PacketDecoder, ConstantAlbedoAndSpecular) {
     expectDecodesLikeGBuffer(frame);
 }
 
+// The material lookup's two paths (a permutation when the table fits in a vector, a gather when
+// not) and indices past the table, which GBuffer::decode reads as albedo 0, specular (0, 1).
+// The G-buffer pass never writes such indices, so they are planted in a copy of the planes.
+TEST(PacketDecoder, MaterialLookupPathsAndIndicesPastTheTable) {
+    scenes::Scene scene = atrium();
+    const gbuffer::GBufferLayout layout = gbuffer::deriveLayout(scene, kBruteReads);
+    const lighting::PreparedFrame frame(std::move(scene), 64, 36, false, layout);
+    const gbuffer::GBuffer& gb = *frame.gbuffer;
+    for (size_t extra : {size_t(0), size_t(20)}) {
+        // With 20 more (unused) materials the table fits no vector: every target gathers.
+        gbuffer::GBufferLayout table = layout;
+        for (size_t i = 0; i < extra; ++i)
+            table.materials.push_back({{0.1f * float(i % 10), 0.5f, 0.25f}, 0.5f, float(i + 2)});
+        kerneltest::GBufferPlaneCopy copy(gb);
+        const uint16_t pastTheTable[3] = {uint16_t(table.materials.size()),
+                                          uint16_t(table.materials.size() + 5), 65535};
+        for (size_t pixel = 0; pixel < copy.material.size(); pixel += 7)
+            copy.material[pixel] = pastTheTable[pixel % 3];
+        const PacketDecoder decoder(table, frame.view, copy.planes());
+        for (int y0 = 0; y0 < gb.height(); y0 += 4)
+            for (int x0 = 0; x0 < gb.width(); x0 += 4) {
+                ShadingPacket expected = kerneltest::poisonedPacket();
+                decoder.decodeScalar(x0, y0, expected);
+                for (const KernelIsa& isa : KernelIsa::available()) {
+                    ShadingPacket packet = kerneltest::poisonedPacket();
+                    decoder.decode(isa, x0, y0, packet);
+                    ASSERT_EQ(packet.laneMask, expected.laneMask);
+                    for (int lane = 0; lane < lighting::kernel::kPacketLanes; ++lane) {
+                        if (!(packet.laneMask >> lane & 1u))
+                            continue;
+                        const size_t pixel =
+                            size_t(y0 + lighting::kernel::laneY(lane)) * gb.width() +
+                            size_t(x0 + lighting::kernel::laneX(lane));
+                        const bool past = copy.material[pixel] >= table.materials.size();
+                        const gbuffer::Surface s = gb.decode(x0 + lighting::kernel::laneX(lane),
+                                                             y0 + lighting::kernel::laneY(lane));
+                        for (int k = 0; k < 3; ++k) {
+                            EXPECT_TRUE(same(packet.albedo[k][lane], expected.albedo[k][lane]));
+                            EXPECT_TRUE(same(packet.albedo[k][lane], past ? 0.0f : s.albedo[k]))
+                                << isa.name() << " extra " << extra << " pixel " << pixel;
+                        }
+                        EXPECT_TRUE(same(packet.specularIntensity[lane],
+                                         past ? 0.0f : s.specularIntensity));
+                        EXPECT_TRUE(
+                            same(packet.specularPower[lane], past ? 1.0f : s.specularPower));
+                    }
+                }
+            }
+    }
+}
+
 TEST(PacketDecoder, RefusesLayoutsItCannotDecode) {
     scenes::Scene scene = atrium();
     gbuffer::LayoutRequest request;
