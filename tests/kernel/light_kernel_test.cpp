@@ -279,6 +279,33 @@ TEST_P(LightKernelTest, HardCases) {
     }
 }
 
+// An analytic value, independent of lighting/Brdf.h: a sun straight above a floor seen along
+// +Z (l = +Y, v = +Z, so h = (0, 1, 1) / sqrt 2 and n.h = 1 / sqrt 2), radiance 2:
+// 2 * (albedo / pi + intensity (power + 8) / (8 pi) * (1 / sqrt 2)^power).
+TEST_P(LightKernelTest, ClosedFormSun) {
+    const KernelIsa isa = GetParam();
+    for (float power : {1.0f, 16.0f, 100.0f}) {
+        Surface floor;
+        floor.position = {0.0f, 0.0f, -5.0f};
+        floor.normal = {0.0f, 1.0f, 0.0f};
+        floor.albedo = glm::vec3(0.5f);
+        floor.specularIntensity = 0.25f;
+        floor.specularPower = power;
+        ShadingPacket packet = poisonedPacket();
+        setLane(packet, 9, floor);
+        LightInView<float> sun;
+        sun.type = LightType::Directional;
+        sun.directionView = {0.0f, -1.0f, 0.0f};
+        sun.radiance = glm::vec3(2.0f);
+        const KernelLights lights({sun});
+        const PacketAccumulator result = shade(isa, packet, kAllLanes, lights, {0});
+        const double pi = 3.14159265358979323846;
+        const double expected = 2.0 * (0.5 / pi + 0.25 * (double(power) + 8.0) / (8.0 * pi) *
+                                                      std::pow(std::sqrt(0.5), double(power)));
+        EXPECT_NEAR(result.radiance[0][9], expected, 1e-6 * expected) << "power " << power;
+    }
+}
+
 // A pixel's sum depends on its own surface and the list only: the same surface in different
 // lanes, with different neighbours (some background with NaN data), gives bitwise the same sum.
 TEST_P(LightKernelTest, LaneIndependence) {
