@@ -12,7 +12,7 @@ case "$mode" in main|test) ;; *) echo "usage: $0 main|test" >&2; exit 2 ;; esac
 packages=(
     g++ cmake make git pkg-config clang-format
     libglm-dev libtbb-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
-    libtinygltf-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev
+    libtinygltf-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev libhwy-dev
     fonts-dejavu-core
     libtomlplusplus-dev
     python3-matplotlib chromium

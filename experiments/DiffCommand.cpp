@@ -15,9 +15,10 @@
 #include <OpenImageIO/imagebufalgo.h>
 
 #include "experiments/AtomicFile.h"
+#include "experiments/CommandErrors.h"
 #include "experiments/ImageOutput.h"
-#include "experiments/RenderJob.h"
 #include "experiments/ReportCommand.h"
+#include "experiments/RunMetrics.h"
 
 namespace experiments {
 
@@ -82,21 +83,11 @@ json numberOrText(double value) {
 }
 
 std::string formatNumber(double value) {
-    if (std::isnan(value))
-        return "NaN";
-    if (std::isinf(value))
-        return value > 0 ? "inf" : "-inf";
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%.6g", value);
-    return buffer;
+    return displayNumber(value, 6);
 }
 
 void writeDiffPlot(const DiffCommandOptions& options, const ImageDiff& diff, const fs::path& png) {
-    const fs::path script =
-        options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
-    if (!fs::is_regular_file(script))
-        throw std::runtime_error("plot script " + script.string() +
-                                 " not found (use --plots-script)");
+    const fs::path script = requirePlotScript(options.plotsScript, "report.py");
     const std::string python = requirePythonWithMatplotlib(options.python);
     // The plot script reads raw float32; the temporary file is removed whatever happens.
     const fs::path raw = options.out / (".absdiff.tmp-" + std::to_string(getpid()) + ".f32");
@@ -228,14 +219,8 @@ ImageDiff diffImageFiles(const fs::path& aPath, const fs::path& bPath) {
     // Beauty metrics: the same comparison as the sweep's error against the reference.
     const OIIO::ImageBuf rgbA = selectChannels(a, beautyA), rgbB = selectChannels(b, beautyB);
     lighting::StageResult resultA = beautyAsStageResult(rgbA), resultB = beautyAsStageResult(rgbB);
-    const ErrorMetrics error = compareImages(resultA, resultB);
     DiffMetrics& m = diff.metrics;
-    m.rmse = error.rmse;
-    m.relativeRmse = error.relativeRmse;
-    m.maxAbs = error.maxAbs;
-    m.psnr = error.psnr;
-    m.relativeMean = error.relativeMean;
-    m.p99Abs = error.p99Abs;
+    static_cast<ErrorMetrics&>(m) = compareImages(resultA, resultB);
     OIIO::ImageBuf absRgb;
     if (!OIIO::ImageBufAlgo::absdiff(absRgb, rgbA, rgbB))
         throw std::runtime_error("cannot compute |A - B|: " + absRgb.geterror());
@@ -357,8 +342,7 @@ int runDiffCommand(const DiffCommandOptions& options) {
                   << "\n  report: " << (options.out / "index.html").string() << "\n";
         return 0;
     } catch (const std::exception& e) {
-        std::cerr << "testbed: error: " << e.what() << "\n";
-        return 1;
+        return reportError(e);
     }
 }
 

@@ -34,6 +34,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/RunMetrics.h"
+
 namespace experiments {
 
 struct DiffCommandOptions {
@@ -45,14 +47,9 @@ struct DiffCommandOptions {
     float exposure = 1.0f;             // linear factor applied before tone mapping
 };
 
-struct DiffMetrics {
-    double rmse = 0.0;
-    double relativeRmse = 0.0;
-    double maxAbs = 0.0;
-    double psnr = 0.0;
-    double meanAbs = 0.0;
-    double relativeMean = 0.0;
-    double p99Abs = 0.0;
+// The sweep's error metrics (RunMetrics.h) plus the mean absolute difference.
+struct DiffMetrics : ErrorMetrics {
+    double meanAbs = 0.0; // mean |A - B| over the R, G, B samples
 };
 
 struct ChannelStatistics {

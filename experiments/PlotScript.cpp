@@ -28,6 +28,15 @@ std::filesystem::path plotScriptPath(const std::string& fileName) {
     return std::filesystem::path(TESTBED_SOURCE_DIR) / "experiments" / "plots" / fileName;
 }
 
+std::filesystem::path requirePlotScript(const std::filesystem::path& requested,
+                                        const std::string& fileName) {
+    const std::filesystem::path script = requested.empty() ? plotScriptPath(fileName) : requested;
+    if (!std::filesystem::is_regular_file(script))
+        throw std::invalid_argument("plot script " + script.string() +
+                                    " not found (--plots-script PATH)");
+    return script;
+}
+
 int runProcess(const std::vector<std::string>& argv, bool quiet) {
     if (argv.empty())
         return 127;

@@ -14,6 +14,11 @@ namespace experiments {
 
 // experiments/plots/<fileName> of the source tree this binary was built from.
 std::filesystem::path plotScriptPath(const std::string& fileName);
+// The script a command runs: `requested` (--plots-script) when not empty, else
+// plotScriptPath(fileName). Throws std::invalid_argument("plot script <path> not found
+// (--plots-script PATH)") when it is no file, so that commands check it before any work.
+std::filesystem::path requirePlotScript(const std::filesystem::path& requested,
+                                        const std::string& fileName);
 
 // Runs argv[0] (searched on PATH) with the arguments, waits, and returns its exit status (127
 // when it cannot be started, 128 + signal when killed). Its stdout and stderr are this process'.

@@ -17,8 +17,9 @@
 #include <unistd.h>
 
 #include "experiments/AtomicFile.h"
+#include "experiments/CommandErrors.h"
 #include "experiments/ImageOutput.h"
-#include "lighting/StageRegistry.h"
+#include "lighting/PassNames.h"
 #include "scenes/Scene.h"
 
 namespace experiments {
@@ -72,7 +73,7 @@ std::vector<float> toFloat(const std::vector<uint32_t>& counts) {
 // |image - reference| per channel, through ImageBufAlgo; empty planes without a reference.
 std::array<std::vector<float>, 3> errorPlanes(const RenderRun& run) {
     std::array<std::vector<float>, 3> planes;
-    if (!run.error)
+    if (!run.metrics.error)
         return planes;
     const int w = run.result.width, h = run.result.height;
     auto toBuffer = [&](const lighting::StageResult& image) {
@@ -113,6 +114,24 @@ void writeErrorPng(const std::filesystem::path& path, int w, int h,
         if (!coloured.write(temp.string(), OIIO::TypeDesc::UINT8))
             throw std::runtime_error("cannot write " + path.string() + ": " + coloured.geterror());
     });
+}
+
+// What `testbed render` prints when done: the run, its pass medians, the error, the files.
+void printSummary(const RenderRun& run, const std::filesystem::path& out) {
+    std::cout << "testbed: " << run.options.stage << " on " << run.scene().name << " ("
+              << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
+              << " lights) at " << run.options.width << "x" << run.options.height << ", "
+              << run.threads << " threads\n";
+    for (const PassTiming& timing : run.metrics.passes)
+        std::cout << "  " << timing.pass << ": " << std::fixed << std::setprecision(2)
+                  << timing.medianMs() << " ms\n";
+    if (const std::optional<ErrorMetrics>& error = run.metrics.error)
+        std::cout << "  error vs reference: rmse " << std::scientific << error->rmse << ", max_abs "
+                  << error->maxAbs << ", relative rmse " << error->relativeRmse << "\n";
+    std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
+    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
+        if (std::filesystem::exists(out / file))
+            std::cout << "  " << (out / file).string() << "\n";
 }
 
 } // namespace
@@ -159,12 +178,85 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
     writePreviewPng(dir / "preview.png", w, h, run.result.radiance[0].data(),
                     run.result.radiance[1].data(), run.result.radiance[2].data());
     writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(), heatmapMax);
-    if (run.error)
+    if (run.metrics.error)
         writeErrorPng(dir / "error.png", w, h, error);
     writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
 }
 
+namespace {
+
+nlohmann::json layoutJson(const gbuffer::GBufferLayout& layout, const RunMetrics& metrics) {
+    nlohmann::json planes = nlohmann::json::array();
+    for (const gbuffer::PlaneDesc& plane : layout.planes())
+        planes.push_back({{"name", plane.name},
+                          {"channel", plane.channel},
+                          {"format", plane.format},
+                          {"bits", plane.bits},
+                          {"allocated", !plane.unmodelled}});
+    nlohmann::json reasons = nlohmann::json::object();
+    for (const auto& [channel, reason] : layout.reasons)
+        reasons[gbuffer::channelName(channel)] = reason;
+    return {{"name", layout.name},
+            {"depth", layout.depth.text()},
+            {"position", gbuffer::positionMethodName(layout.position)},
+            {"normals", layout.hasNormals ? layout.normals.text() : "none"},
+            {"normal_space", gbuffer::normalSpaceName(layout.normalSpace)},
+            {"albedo", gbuffer::albedoEncodingName(layout.albedo)},
+            {"specular", gbuffer::specularEncodingName(layout.specular)},
+            {"planes", planes},
+            {"reasons", reasons},
+            {"notes", layout.notes},
+            {metric::kBytesPerPixel, metrics.bytesPerPixel},
+            {metric::kAllocatedBytesPerPixel, metrics.allocatedBytesPerPixel}};
+}
+
+// timings_ms (the medians) and timings (warm-up, repetitions, every pass's spread and samples).
+void addTimings(nlohmann::json& stats, const RenderRun& run) {
+    nlohmann::json medians = nlohmann::json::object();
+    nlohmann::json spread = nlohmann::json::object();
+    for (const PassTiming& timing : run.metrics.passes) {
+        medians[timing.pass] = timing.medianMs();
+        spread[timing.pass] = {{"median", timing.medianMs()},
+                               {"min", timing.minMs()},
+                               {"max", timing.maxMs()},
+                               {"samples", timing.samplesMs}};
+    }
+    stats["timings_ms"] = medians;
+    stats["timings"] = {{"warmup", run.options.warmup},
+                        {"repetitions", run.options.repetitions},
+                        {"passes_ms", spread}};
+    const gbuffer::GBufferPassTimings& steps = run.prepared->gbufferTimings;
+    stats["gbuffer_steps_ms"] = {{"transform", steps.transformMs},
+                                 {"raster", steps.rasterMs},
+                                 {"resolve", steps.resolveMs},
+                                 {lighting::pass::kExactSurface, steps.exactMs}};
+    stats["measurement_ms"] = {{"oracle", run.metrics.oracleMs},
+                               {"reference", run.metrics.referenceMs}};
+}
+
+// The error figures; psnr is +inf for identical images, written as "inf" (JSON has no infinity).
+nlohmann::json errorJson(const RunMetrics& metrics) {
+    nlohmann::json error = {{"reference", "reference"}};
+    for (const NamedFigure& figure : metrics.errorFigures())
+        error[figure.name] = std::isinf(figure.value) && figure.value > 0
+                                 ? nlohmann::json("inf")
+                                 : nlohmann::json(figure.value);
+    return error;
+}
+
+nlohmann::json rasterJson(const raster::RasterStats& raster) {
+    return {{"triangles_in", raster.trianglesIn},
+            {"triangles_culled", raster.trianglesCulled},
+            {"triangles_clipped", raster.trianglesClipped},
+            {"triangles_set_up", raster.trianglesSetUp},
+            {"samples_covered", raster.samplesCovered},
+            {"samples_passed", raster.samplesPassed}};
+}
+
+} // namespace
+
 nlohmann::json statsJson(const RenderRun& run) {
+    const RunMetrics& metrics = run.metrics;
     nlohmann::json stats;
     stats["scene"] = run.scene().name;
     stats["scene_source"] = run.options.scene;
@@ -180,84 +272,24 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["lights"] = run.scene().lights.size();
     stats["generated_lights"] = run.options.lights;
     stats["seed"] = run.options.seed;
-    const gbuffer::GBufferLayout& layout = run.gbuffer().layout();
-    nlohmann::json planes = nlohmann::json::array();
-    for (const gbuffer::PlaneDesc& plane : layout.planes())
-        planes.push_back({{"name", plane.name},
-                          {"channel", plane.channel},
-                          {"format", plane.format},
-                          {"bits", plane.bits},
-                          {"allocated", !plane.unmodelled}});
-    nlohmann::json reasons = nlohmann::json::object();
-    for (const auto& [channel, reason] : layout.reasons)
-        reasons[gbuffer::channelName(channel)] = reason;
-    stats["layout"] = {{"name", layout.name},
-                       {"depth", layout.depth.text()},
-                       {"position", gbuffer::positionMethodName(layout.position)},
-                       {"normals", layout.hasNormals ? layout.normals.text() : "none"},
-                       {"normal_space", gbuffer::normalSpaceName(layout.normalSpace)},
-                       {"albedo", gbuffer::albedoEncodingName(layout.albedo)},
-                       {"specular", gbuffer::specularEncodingName(layout.specular)},
-                       {"planes", planes},
-                       {"reasons", reasons},
-                       {"notes", layout.notes},
-                       {"bytes_per_pixel", layout.bytesPerPixel()},
-                       {"allocated_bytes_per_pixel", layout.allocatedBytesPerPixel()}};
-    stats["bytes_per_pixel"] = layout.bytesPerPixel();
-    nlohmann::json timings = nlohmann::json::object();
-    for (const auto& [pass, ms] : run.timingsMs)
-        timings[pass] = ms;
-    stats["timings_ms"] = timings; // medians over the repetitions
-    nlohmann::json spread = nlohmann::json::object();
-    for (const PassTiming& timing : run.passTimings)
-        spread[timing.pass] = {{"median", timing.medianMs()},
-                               {"min", timing.minMs()},
-                               {"max", timing.maxMs()},
-                               {"samples", timing.samplesMs}};
-    stats["timings"] = {{"warmup", run.options.warmup},
-                        {"repetitions", run.options.repetitions},
-                        {"passes_ms", spread}};
+    stats["layout"] = layoutJson(run.gbuffer().layout(), metrics);
+    stats[metric::kBytesPerPixel] = metrics.bytesPerPixel;
+    addTimings(stats, run);
     stats["oracle_surface"] = run.oracleFromLosslessGBuffer
                                   ? "lossless G-buffer (the layout lacks BRDF channels)"
                                   : "the stage's G-buffer";
-    stats["gbuffer_steps_ms"] = {{"transform", run.prepared->gbufferTimings.transformMs},
-                                 {"raster", run.prepared->gbufferTimings.rasterMs},
-                                 {"resolve", run.prepared->gbufferTimings.resolveMs},
-                                 {"exact_surface", run.prepared->gbufferTimings.exactMs}};
-    stats["measurement_ms"] = {{"oracle", run.oracleMs}, {"reference", run.referenceMs}};
-    const uint64_t evaluations = run.lightEvaluations(), oracle = run.oracleLightEvaluations();
-    stats["light_evaluations"] = evaluations;
-    stats["oracle_light_evaluations"] = oracle;
-    stats["culling_efficiency"] = evaluations > 0 ? double(oracle) / double(evaluations) : 1.0;
-    stats["raster"] = {{"triangles_in", run.prepared->rasterStats.trianglesIn},
-                       {"triangles_culled", run.prepared->rasterStats.trianglesCulled},
-                       {"triangles_clipped", run.prepared->rasterStats.trianglesClipped},
-                       {"triangles_set_up", run.prepared->rasterStats.trianglesSetUp},
-                       {"samples_covered", run.prepared->rasterStats.samplesCovered},
-                       {"samples_passed", run.prepared->rasterStats.samplesPassed}};
-    if (run.error) {
-        stats["error"] = {{"reference", "reference"},
-                          {"rmse", run.error->rmse},
-                          {"relative_rmse", run.error->relativeRmse},
-                          {"max_abs", run.error->maxAbs},
-                          {"psnr", std::isfinite(run.error->psnr) ? nlohmann::json(run.error->psnr)
-                                                                  : nlohmann::json("inf")},
-                          {"relative_mean", run.error->relativeMean},
-                          {"p99_abs", run.error->p99Abs}};
-    }
+    stats[metric::kLightEvaluations] = metrics.lightEvaluations;
+    stats[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
+    stats[metric::kCullingEfficiency] = metrics.cullingEfficiency;
+    stats["raster"] = rasterJson(run.prepared->rasterStats);
+    if (metrics.error)
+        stats["error"] = errorJson(metrics);
     stats["warnings"] = run.scene().warnings;
     return stats;
 }
 
 int runRenderCommand(const RenderCommandOptions& options) {
     try {
-        validate(options.render);
-        if (options.explainLayout) {
-            std::cout << "stage " << options.render.stage << " on " << options.render.scene << ":\n"
-                      << renderLayout(options.render).explain();
-            return 0;
-        }
-        ensureWritableDirectory(options.out);
         const bool terminal = isatty(STDERR_FILENO);
         const auto start = std::chrono::steady_clock::now();
         auto progress = [&](const std::string& step) {
@@ -268,29 +300,21 @@ int runRenderCommand(const RenderCommandOptions& options) {
             std::cerr << "[" << std::fixed << std::setprecision(1) << seconds << " s] " << step
                       << "\n";
         };
-        const RenderRun run = runRender(options.render, progress);
+        progress("loading scene " + options.render.scene);
+        RenderPlan plan = planRender(options.render); // every input error stops here
+        if (options.explainLayout) {
+            std::cout << "stage " << options.render.stage << " on " << options.render.scene << ":\n"
+                      << plan.layout.explain();
+            return 0;
+        }
+        ensureWritableDirectory(options.out); // before the G-buffer pass and the stage
+        const RenderRun run = runRender(std::move(plan), progress);
         progress("writing outputs");
         writeRenderOutputs(run, options.out, options.heatmapMax);
-        std::cout << "testbed: " << run.options.stage << " on " << run.scene().name << " ("
-                  << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
-                  << " lights) at " << run.options.width << "x" << run.options.height << ", "
-                  << run.threads << " threads\n";
-        for (const auto& [pass, ms] : run.timingsMs)
-            std::cout << "  " << pass << ": " << std::fixed << std::setprecision(2) << ms
-                      << " ms\n";
-        if (run.error)
-            std::cout << "  error vs reference: rmse " << std::scientific << run.error->rmse
-                      << ", max_abs " << run.error->maxAbs << ", relative rmse "
-                      << run.error->relativeRmse << "\n";
-        std::cout << "outputs in " << std::filesystem::absolute(options.out).string() << ":\n";
-        for (const char* file :
-             {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
-            if (std::filesystem::exists(options.out / file))
-                std::cout << "  " << (options.out / file).string() << "\n";
+        printSummary(run, options.out);
         return 0;
     } catch (const std::exception& e) {
-        std::cerr << "testbed: error: " << e.what() << "\n";
-        return 1;
+        return reportError(e);
     }
 }
 

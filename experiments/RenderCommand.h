@@ -5,8 +5,9 @@
 //   preview.png  tone-mapped beauty
 //   heatmap.png  lights evaluated per pixel, false colour with a legend
 //   stats.json   configuration, machine, commit, timings, light counts, error metrics
-// Every file is written under a temporary name and renamed, so a failed run leaves no partial
-// output. The output folder is checked for writability before any work.
+// The command plans the render (RenderPlan.h: options validated once, scene loaded, layout
+// derived), checks the output folder for writability, then runs the plan (RenderJob.h). Every
+// file is written under a temporary name and renamed, so a failed run leaves no partial output.
 #pragma once
 
 #include <cstdint>
@@ -25,6 +26,8 @@ struct RenderCommandOptions {
     bool explainLayout = false; // print the derived layout and its reasons instead of rendering
 };
 
+// stats.json: the run's configuration, layout and machine, and its RunMetrics (RunMetrics.h
+// names the figures).
 nlohmann::json statsJson(const RenderRun& run);
 
 // Writes render.exr (with error.R,G,B when the run was compared with a reference), preview.png,
@@ -33,8 +36,8 @@ nlohmann::json statsJson(const RenderRun& run);
 void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
                         uint32_t heatmapMax);
 
-// Validates, renders, writes; returns the process exit code (0 on success). Errors are
-// reported on stderr as one line starting with "testbed: error:".
+// Plans, renders, writes; returns the process exit code (0 on success). Errors are reported on
+// stderr as one line starting with "testbed: error:" (CommandErrors.h) before any file is written.
 int runRenderCommand(const RenderCommandOptions& options);
 
 } // namespace experiments

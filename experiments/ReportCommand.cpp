@@ -20,10 +20,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 
 #include "experiments/AtomicFile.h"
-
-#ifndef TESTBED_SOURCE_DIR
-#define TESTBED_SOURCE_DIR "."
-#endif
+#include "experiments/CommandErrors.h"
 
 namespace experiments {
 
@@ -67,16 +64,7 @@ std::string urlPath(const std::string& path) {
 
 // Integers without a fraction, everything else with 4 significant digits.
 std::string formatNumber(double value) {
-    if (std::isnan(value))
-        return "NaN";
-    if (std::isinf(value))
-        return value > 0 ? "inf" : "-inf";
-    char buffer[64];
-    if (value == std::floor(value) && std::fabs(value) < 1e15)
-        std::snprintf(buffer, sizeof buffer, "%.0f", value);
-    else
-        std::snprintf(buffer, sizeof buffer, "%.4g", value);
-    return buffer;
+    return displayNumber(value, 4, true);
 }
 
 std::string formatCell(const json& value) {
@@ -516,6 +504,19 @@ json comparePublished(const json& published, const json& jobs) {
     return table;
 }
 
+std::string displayNumber(double value, int significantDigits, bool wholeIntegers) {
+    if (std::isnan(value))
+        return "NaN";
+    if (std::isinf(value))
+        return value > 0 ? "inf" : "-inf";
+    char buffer[64];
+    if (wholeIntegers && value == std::floor(value) && std::fabs(value) < 1e15)
+        std::snprintf(buffer, sizeof buffer, "%.0f", value);
+    else
+        std::snprintf(buffer, sizeof buffer, "%.*g", significantDigits, value);
+    return buffer;
+}
+
 fs::path defaultPlotsScript() {
     return plotScriptPath("report.py");
 }
@@ -544,11 +545,7 @@ int runReportCommand(const ReportCommandOptions& options) {
         }
         writeTextAtomically(reportDir / "published.json", publishedTables.dump(2) + "\n");
 
-        const fs::path script =
-            options.plotsScript.empty() ? defaultPlotsScript() : options.plotsScript;
-        if (!fs::is_regular_file(script))
-            throw std::runtime_error("plot script " + script.string() +
-                                     " not found (use --plots-script)");
+        const fs::path script = requirePlotScript(options.plotsScript, "report.py");
         const std::string python = requirePythonWithMatplotlib(options.python);
         const int status = runProcess(
             {python, script.string(), "results", "--results", (dir / "results.json").string(),
@@ -609,8 +606,7 @@ int runReportCommand(const ReportCommandOptions& options) {
         std::cout << "testbed: report written to " << (dir / "report.html").string() << "\n";
         return 0;
     } catch (const std::exception& e) {
-        std::cerr << "testbed: error: " << e.what() << "\n";
-        return 1;
+        return reportError(e);
     }
 }
 

@@ -80,6 +80,10 @@ int runReportCommand(const ReportCommandOptions& options);
 // The default plot script (the source tree's experiments/plots/report.py, fixed at build time).
 std::filesystem::path defaultPlotsScript();
 
+// A number as the report and diff pages show it: `significantDigits` (%g), integers whole when
+// wholeIntegers (below 1e15), "NaN", "inf", "-inf".
+std::string displayNumber(double value, int significantDigits, bool wholeIntegers = false);
+
 // HTML pieces shared by the report and the diff pages.
 std::string htmlEscape(const std::string& text);
 // An inline <script> for <head> that, once the page has loaded, writes "PAGE-CHECK: OK (N images)"

@@ -8,7 +8,10 @@
 #include <system_error>
 
 #include "experiments/AtomicFile.h"
+#include "experiments/CsvTable.h"
+#include "experiments/RunMetrics.h"
 #include "experiments/SweepFile.h"
+#include "lighting/PassNames.h"
 
 namespace experiments {
 
@@ -20,38 +23,25 @@ namespace {
 const std::string kTimePrefix = "time_";
 const std::string kMedianSuffix = "_median_ms";
 
-// Pipeline order of the passes stages report; anything else goes after them by name.
-const std::vector<std::string> kPassOrder = {"gbuffer",  "exact_surface", "transform", "prepass",
-                                             "cull",     "assign",        "index",     "shading",
-                                             "lighting", "material",      "stage"};
-const std::vector<std::string> kMetricColumns = {"light_evaluations",
-                                                 "oracle_evaluations",
-                                                 "culling_efficiency",
-                                                 "bytes_per_pixel",
-                                                 "rmse",
-                                                 "relative_rmse",
-                                                 "psnr",
-                                                 "max_abs",
-                                                 "relative_mean",
-                                                 "p99_abs"};
+// Pipeline order of the passes stages report, then the stage's sum; anything else goes after
+// them by name, and the total last.
+std::vector<std::string> passOrder() {
+    std::vector<std::string> order(lighting::pass::kPipelineOrder.begin(),
+                                   lighting::pass::kPipelineOrder.end());
+    order.push_back(pass::kStage);
+    return order;
+}
 
 bool endsWith(const std::string& text, const std::string& suffix) {
     return text.size() >= suffix.size() &&
            text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-std::string csvField(const Json& value) {
+// A JSON value as a CSV cell: null empty, strings as they are, numbers as JSON writes them.
+std::string cellText(const Json& value) {
     if (value.is_null())
         return "";
-    std::string text = value.is_string() ? value.get<std::string>() : value.dump();
-    const bool quote = text.find_first_of(",\"\r\n") != std::string::npos ||
-                       (!text.empty() && (text.front() == ' ' || text.back() == ' '));
-    if (!quote)
-        return text;
-    std::string quoted = "\"";
-    for (char c : text)
-        quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return quoted + "\"";
+    return value.is_string() ? value.get<std::string>() : value.dump();
 }
 
 std::string readText(const fs::path& path) {
@@ -86,21 +76,22 @@ std::vector<std::string> metricColumns(const std::vector<Json>& rows) {
             if (!value.is_null() && key.rfind(kTimePrefix, 0) == 0 && endsWith(key, kMedianSuffix))
                 passes.insert(key.substr(kTimePrefix.size(),
                                          key.size() - kTimePrefix.size() - kMedianSuffix.size()));
+    const std::vector<std::string> order = passOrder();
     std::vector<std::string> ordered;
-    for (const std::string& pass : kPassOrder)
-        if (passes.count(pass))
-            ordered.push_back(pass);
-    for (const std::string& pass : passes) // std::set: by name
-        if (std::find(kPassOrder.begin(), kPassOrder.end(), pass) == kPassOrder.end() &&
-            pass != "total")
-            ordered.push_back(pass);
-    if (passes.count("total"))
-        ordered.push_back("total");
+    for (const std::string& name : order)
+        if (passes.count(name))
+            ordered.push_back(name);
+    for (const std::string& name : passes) // std::set: by name
+        if (std::find(order.begin(), order.end(), name) == order.end() && name != pass::kTotal)
+            ordered.push_back(name);
+    if (passes.count(pass::kTotal))
+        ordered.push_back(pass::kTotal);
     std::vector<std::string> columns;
-    for (const std::string& pass : ordered)
+    for (const std::string& name : ordered)
         for (const char* statistic : {"median", "min", "max"})
-            columns.push_back(kTimePrefix + pass + "_" + statistic + "_ms");
-    columns.insert(columns.end(), kMetricColumns.begin(), kMetricColumns.end());
+            columns.push_back(kTimePrefix + name + "_" + statistic + "_ms");
+    const std::vector<std::string> figures = runFigureColumns();
+    columns.insert(columns.end(), figures.begin(), figures.end());
     return columns;
 }
 
@@ -131,24 +122,17 @@ Json resultsJson(const Json& sweep, const std::string& sweepFile, bool quick,
 }
 
 std::string resultsCsv(const Json& results) {
-    std::string csv;
-    const Json& columns = results.at("columns");
-    for (size_t c = 0; c < columns.size(); ++c) {
-        if (c)
-            csv += ',';
-        csv += csvField(columns[c]);
-    }
-    csv += "\n";
+    std::vector<std::string> columns;
+    for (const Json& column : results.at("columns"))
+        columns.push_back(cellText(column));
+    CsvTable table(columns);
     for (const Json& job : results.at("jobs")) {
-        for (size_t c = 0; c < columns.size(); ++c) {
-            const std::string name = columns[c].get<std::string>();
-            if (c)
-                csv += ',';
-            csv += csvField(job.contains(name) ? job[name] : Json(nullptr));
-        }
-        csv += "\n";
+        std::vector<std::string> cells;
+        for (const std::string& name : columns)
+            cells.push_back(cellText(job.contains(name) ? job[name] : Json(nullptr)));
+        table.addRow(std::move(cells));
     }
-    return csv;
+    return table.text();
 }
 
 void writeResults(const fs::path& dir, const Json& results) {

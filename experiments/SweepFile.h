@@ -36,7 +36,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/RenderJob.h"
+#include "experiments/RenderOptions.h"
 
 namespace experiments {
 

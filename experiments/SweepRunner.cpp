@@ -12,10 +12,12 @@
 #include <OpenImageIO/imagebuf.h>
 
 #include "experiments/AtomicFile.h"
+#include "experiments/CommandErrors.h"
 #include "experiments/ImageOutput.h"
 #include "experiments/RenderCommand.h"
 #include "experiments/RenderJob.h"
 #include "experiments/ResultsTable.h"
+#include "experiments/RunMetrics.h"
 #include "experiments/SweepFile.h"
 
 namespace experiments {
@@ -95,47 +97,23 @@ Json baseRow(const SweepJob& job, const std::vector<std::string>& axisColumns) {
     return row;
 }
 
-// The stage's own time per repetition: every pass but the G-buffer's (and total), i.e. what
-// papers that exclude the G-buffer pass report (Örtegren's "Total" = assignment + shading).
-PassTiming stageTiming(const std::vector<PassTiming>& passes) {
-    PassTiming stage;
-    stage.pass = "stage";
-    for (const PassTiming& timing : passes) {
-        if (timing.pass == "gbuffer" || timing.pass == "exact_surface" || timing.pass == "total")
-            continue;
-        if (stage.samplesMs.size() < timing.samplesMs.size())
-            stage.samplesMs.resize(timing.samplesMs.size(), 0.0);
-        for (size_t r = 0; r < timing.samplesMs.size(); ++r)
-            stage.samplesMs[r] += timing.samplesMs[r];
-    }
-    return stage;
-}
-
-void addMetrics(Json& row, const RenderRun& run) {
-    std::vector<PassTiming> passes = run.passTimings;
-    if (const PassTiming stage = stageTiming(passes); !stage.samplesMs.empty())
-        passes.push_back(stage);
+// The run's metrics as result columns: time_<pass>_{median,min,max}_ms for every pass and the
+// stage's sum, then RunMetrics' figures (runFigureColumns() order); non-finite values are null.
+void addMetrics(Json& row, const RunMetrics& metrics) {
+    std::vector<PassTiming> passes = metrics.passes;
+    if (!metrics.stage.samplesMs.empty())
+        passes.push_back(metrics.stage);
     for (const PassTiming& timing : passes) {
         row["time_" + timing.pass + "_median_ms"] = number(timing.medianMs());
         row["time_" + timing.pass + "_min_ms"] = number(timing.minMs());
         row["time_" + timing.pass + "_max_ms"] = number(timing.maxMs());
     }
-    const uint64_t evaluations = run.lightEvaluations(), oracle = run.oracleLightEvaluations();
-    row["light_evaluations"] = evaluations;
-    row["oracle_evaluations"] = oracle;
-    row["culling_efficiency"] = evaluations > 0 ? double(oracle) / double(evaluations) : 1.0;
-    // Through statsJson, the one place that knows how the layout reports its size.
-    const nlohmann::json stats = statsJson(run);
-    row["bytes_per_pixel"] =
-        stats.contains("bytes_per_pixel") ? Json(stats["bytes_per_pixel"]) : Json(nullptr);
-    if (run.error) {
-        row["rmse"] = number(run.error->rmse);
-        row["relative_rmse"] = number(run.error->relativeRmse);
-        row["psnr"] = number(run.error->psnr); // +inf (identical images) -> null
-        row["max_abs"] = number(run.error->maxAbs);
-        row["relative_mean"] = number(run.error->relativeMean);
-        row["p99_abs"] = number(run.error->p99Abs);
-    }
+    row[metric::kLightEvaluations] = metrics.lightEvaluations;
+    row[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
+    row[metric::kCullingEfficiency] = metrics.cullingEfficiency;
+    row[metric::kBytesPerPixel] = metrics.bytesPerPixel;
+    for (const NamedFigure& figure : metrics.errorFigures())
+        row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
 }
 
 void writeReferenceExr(const fs::path& path, const std::string& key,
@@ -315,9 +293,9 @@ private:
                 job.compareReference ? &reference(job) : nullptr;
             RenderOptions options = job.options;
             options.compareReference = job.compareReference;
-            const RenderRun run = runRender(options, {}, referenceImage);
+            const RenderRun run = runRender(planRender(options), {}, referenceImage);
             writeRenderOutputs(run, dir, 0);
-            addMetrics(row, run);
+            addMetrics(row, run.metrics);
         } catch (const std::exception& e) {
             error = e.what();
             if (error.empty())
@@ -375,11 +353,9 @@ int runSweepCommand(const SweepOptions& options) {
         }
         return 0;
     } catch (const SweepError& e) {
-        std::cerr << "testbed: error: " << e.what() << "\n";
-        return 2;
+        return reportError(e, 2);
     } catch (const std::exception& e) {
-        std::cerr << "testbed: error: " << e.what() << "\n";
-        return 1;
+        return reportError(e);
     }
 }
 
@@ -391,8 +367,7 @@ int runMergeCommand(const std::vector<fs::path>& inputs, const fs::path& out) {
                   << "\n";
         return 0;
     } catch (const std::exception& e) {
-        std::cerr << "testbed: error: " << e.what() << "\n";
-        return 1;
+        return reportError(e);
     }
 }
 

@@ -3,9 +3,9 @@
 //   - reference: one double-precision reference per (scene, scene options, lights, seed, size),
 //     kept in memory while adjacent jobs need it and cached as DIR/references/<key>.exr (float
 //     R,G,B, bit-exact) so that a rerun or another shard writing to DIR reads it back;
-//   - the job: experiments::runRender with its warmup and repetitions and the reference, then
-//     writeRenderOutputs into DIR/jobs/<job_id>/ and, LAST and atomically, the done.json marker
-//     holding its results row;
+//   - the job: planRender then runRender (as `testbed render` does) with its warmup, repetitions
+//     and the reference, then writeRenderOutputs into DIR/jobs/<job_id>/ and, LAST and
+//     atomically, the done.json marker holding its results row (the run's RunMetrics);
 //   - the table: DIR/results.json and DIR/results.csv rebuilt (atomically) from the markers of
 //     every job of the sweep found in DIR, after each job and at the end.
 // A job whose marker says "ok" is finished and skipped by a rerun; a failed job (any exception)

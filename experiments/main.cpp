@@ -13,13 +13,14 @@
 
 #include <CLI/CLI.hpp>
 
-#include "experiments/DepthStudy.h"
+#include "experiments/CommandErrors.h"
 #include "experiments/DiffCommand.h"
-#include "experiments/NormalStudy.h"
 #include "experiments/RenderCommand.h"
 #include "experiments/ReportCommand.h"
 #include "experiments/SweepFile.h"
 #include "experiments/SweepRunner.h"
+#include "experiments/studies/DepthStudy.h"
+#include "experiments/studies/NormalStudy.h"
 #include "gbuffer/NormalCodec.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
@@ -134,7 +135,7 @@ int main(int argc, char** argv) {
     depth->add_option("--plots-script", depthOptions.plotsScript,
                       "matplotlib script (default: experiments/plots/depth.py of the source tree)");
     depth->add_option("--python", depthOptions.python,
-                      "Python with matplotlib (default: python3, else /usr/bin/python3)");
+                      "Python with matplotlib (default: /usr/bin/python3, else python3 on PATH)");
     experiments::NormalStudyOptions normalsOptions;
     std::uint64_t normalsDirections = experiments::kNormalStudyDirections;
     std::string normalsModels = experiments::kNormalStudyModelsDir;
@@ -171,7 +172,7 @@ int main(int argc, char** argv) {
         "--plots-script", normalsOptions.plotsScript,
         "matplotlib script (default: experiments/plots/normals.py of the source tree)");
     normals->add_option("--python", normalsOptions.python,
-                        "Python with matplotlib (default: python3, else /usr/bin/python3)");
+                        "Python with matplotlib (default: /usr/bin/python3, else python3 on PATH)");
     experiments::SweepOptions sweepOptions;
     std::string shardText = "1/1";
     int sweepThreads = -1;
@@ -200,10 +201,8 @@ int main(int argc, char** argv) {
     if (render->parsed()) {
         for (const std::string& text : sceneOptionTexts) {
             const size_t equals = text.find('=');
-            if (equals == std::string::npos || equals == 0) {
-                std::cerr << "testbed: error: --scene-option '" << text << "' is not key=value\n";
-                return 1;
-            }
+            if (equals == std::string::npos || equals == 0)
+                return experiments::reportError("--scene-option '" + text + "' is not key=value");
             renderOptions.render.sceneOptions[text.substr(0, equals)] = text.substr(equals + 1);
         }
         return experiments::runRenderCommand(renderOptions);
@@ -221,8 +220,7 @@ int main(int argc, char** argv) {
             std::tie(sweepOptions.shardIndex, sweepOptions.shardCount) =
                 experiments::parseShard(shardText);
         } catch (const std::exception& e) {
-            std::cerr << "testbed: error: " << e.what() << "\n";
-            return 2;
+            return experiments::reportError(e, 2);
         }
         if (sweepThreads >= 0)
             sweepOptions.threads = sweepThreads;

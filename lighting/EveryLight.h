@@ -15,6 +15,7 @@
 #include "gbuffer/Surface.h"
 #include "lighting/Brdf.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -47,7 +48,7 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
             result.lightsOracle[pixel] = contributing;
         }
     });
-    result.timingsMs.emplace_back("shading", millisecondsSince(start));
+    result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
 }
 
 } // namespace lighting

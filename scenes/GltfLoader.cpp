@@ -5,13 +5,14 @@
 // What is read: the node hierarchy of the default scene (else scene 0, else every root node)
 // with matrix or TRS transforms; every TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive
 // becomes one Mesh (one per primitive, stored once however many nodes use it, one Instance per
-// node that uses it); POSITION, NORMAL, TANGENT, TEXCOORD_0 and indices; the first perspective
-// camera met in the walk; KHR_lights_punctual lights; pbrMetallicRoughness materials mapped onto
-// Blinn-Phong (see materialFor).
+// node that uses it); POSITION, NORMAL, TANGENT, TEXCOORD_0, TEXCOORD_1 (when a material's
+// texture reads it) and indices; the first perspective camera met in the walk;
+// KHR_lights_punctual lights; metallic-roughness materials (see materialFor) with every texture's
+// texCoord and KHR_texture_transform, and KHR_materials_emissive_strength. Tangents absent from a
+// primitive whose material has a normal texture are generated (Tangents.h).
 // What is not: animations, skins and morph targets (the bind pose is drawn), sparse accessors
-// (an error), texture coordinate sets other than 0, samplers (Texture always wraps), and the
-// metallic-roughness, occlusion and emissive textures, for which Material has no slot (their
-// factors apply). Points and lines are skipped with a warning.
+// (an error), texture coordinate sets past 1 (the texture is dropped with a warning), samplers
+// (Texture always wraps). Points and lines are skipped with a warning.
 //
 // Conventions: glTF's own, which are Scene's (right-handed, metres, +Y up, cameras look down
 // -Z, counter-clockwise front faces); matrices are column-major like glm.
@@ -41,6 +42,8 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <tiny_gltf.h>
 
+#include "scenes/Tangents.h"
+
 namespace scenes {
 
 namespace {
@@ -56,12 +59,9 @@ constexpr int kMaxNodeDepth = 1024;
 // glTF's infinite far plane (zfar absent) becomes at least this multiple of znear: depth is
 // stored with finite precision downstream, and 1e4 keeps a 24-bit standard-Z buffer usable.
 constexpr float kInfiniteFarOverNear = 1e4f;
-// Blinn-Phong exponent limits: 1 is the broadest lobe that is still a lobe; beyond 2048 the
-// highlight is narrower than a texel of any texture we load.
-constexpr float kMinSpecularPower = 1.0f;
-constexpr float kMaxSpecularPower = 2048.0f;
-// roughness^4 below this is a perfect mirror for our purposes; it also avoids dividing by zero.
-constexpr float kMinRoughness4 = 1e-4f;
+// Extensions a file may require that the loader implements.
+const std::set<std::string> kImplementedExtensions = {
+    "KHR_lights_punctual", "KHR_texture_transform", "KHR_materials_emissive_strength"};
 // Markers in GltfConverter::mMeshOf for primitives not (yet) turned into a Mesh.
 constexpr int kNotConverted = -1;
 constexpr int kSkipped = -2;
@@ -271,6 +271,8 @@ private:
     Mesh convertPrimitive(int meshIndex, size_t primitiveIndex);
     uint32_t materialFor(int materialIndex);
     int textureFor(int textureIndex, bool srgb);
+    int textureFor(int textureIndex, int texCoord, const tinygltf::ExtensionMap& extensions,
+                   bool srgb, const std::string& where, TextureMapping& mapping);
 
     const tinygltf::Accessor& accessorAt(int accessorIndex, const std::string& what) const;
     AccessorData accessorData(const tinygltf::Accessor& accessor, const std::string& where) const;
@@ -334,7 +336,7 @@ Scene GltfConverter::convert() {
 // geometry that has no plain accessors), so it is an error.
 void GltfConverter::checkExtensions() const {
     for (const std::string& extension : mModel.extensionsRequired)
-        if (extension != "KHR_lights_punctual")
+        if (!kImplementedExtensions.count(extension))
             fail("requires the unsupported extension " + extension);
 }
 
@@ -625,6 +627,11 @@ Mesh GltfConverter::convertPrimitive(int meshIndex, size_t primitiveIndex) {
                   [&](int a, const std::string& w) { return readVectors<4>(a, w); });
     readAttribute(mesh.uvs, "TEXCOORD_0",
                   [&](int a, const std::string& w) { return readVectors<2>(a, w, true); });
+    mesh.material = materialFor(primitive.material);
+    const Material& material = mScene.materials[mesh.material];
+    if (material.usesSecondUvSet())
+        readAttribute(mesh.uvs1, "TEXCOORD_1",
+                      [&](int a, const std::string& w) { return readVectors<2>(a, w, true); });
 
     std::vector<uint32_t> vertices;
     if (primitive.indices >= 0) {
@@ -653,20 +660,30 @@ Mesh GltfConverter::convertPrimitive(int meshIndex, size_t primitiveIndex) {
             mesh.normals[v] = computed[v];
         }
     }
-    mesh.material = materialFor(primitive.material);
+    // Tangents matter only under a normal map; glTF wants them generated from the uvs the normal
+    // texture reads. Without those uvs there is no tangent frame to speak of.
+    const std::vector<glm::vec2>& normalUvs =
+        material.normalMapping.texCoord == 1 ? mesh.uvs1 : mesh.uvs;
+    if (mesh.tangents.empty() && material.normalTexture >= 0 && !normalUvs.empty())
+        mesh.tangents = generateTangents(mesh.positions, mesh.normals, normalUvs, mesh.indices);
     return mesh;
 }
 
-// glTF metallic-roughness onto Blinn-Phong: metals reflect their whole colour at normal
-// incidence and dielectrics about 4%, so ks = mix(0.04, 1, metallic) (a scalar approximation of
-// the coloured F0); the exponent matching a GGX lobe of the same roughness is 2 / roughness^4 - 2.
+// A glTF material: the metallic-roughness model with its factors, textures (each with its uv set
+// and KHR_texture_transform), alpha mode and KHR_materials_emissive_strength. The Blinn-Phong pair
+// is the approximation setBlinnPhongFromMetallicRoughness gives, for studies that force
+// Blinn-Phong.
 uint32_t GltfConverter::materialFor(int materialIndex) {
     if (materialIndex < 0) {
-        // A primitive without a material gets Material's defaults, a plain white dielectric,
-        // rather than glTF's default (fully metallic, fully rough) which Blinn-Phong draws badly.
+        // A primitive without a material gets a plain white dielectric (Material's defaults,
+        // roughness 0.5) rather than glTF's default (fully metallic, fully rough), which the
+        // Blinn-Phong approximation draws badly.
         if (mDefaultMaterial < 0) {
             mDefaultMaterial = int(mScene.materials.size());
-            mScene.materials.push_back(Material{.name = "default"});
+            Material material;
+            material.name = "default";
+            material.model = MaterialModel::MetallicRoughness;
+            mScene.materials.push_back(material);
         }
         return uint32_t(mDefaultMaterial);
     }
@@ -680,6 +697,7 @@ uint32_t GltfConverter::materialFor(int materialIndex) {
     const std::string where = "material " + std::to_string(materialIndex);
     Material material;
     material.name = source.name.empty() ? where : source.name;
+    material.model = MaterialModel::MetallicRoughness;
     if (pbr.baseColorFactor.size() != 4)
         fail(where + ": baseColorFactor needs 4 numbers");
     material.baseColorFactor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
@@ -690,17 +708,119 @@ uint32_t GltfConverter::materialFor(int materialIndex) {
         fail(where + ": roughnessFactor outside [0, 1]");
     material.metallic = float(pbr.metallicFactor);
     material.roughness = float(pbr.roughnessFactor);
-    material.specularIntensity = glm::mix(0.04f, 1.0f, material.metallic);
-    const float roughness2 = material.roughness * material.roughness;
-    const float roughness4 = std::max(roughness2 * roughness2, kMinRoughness4);
-    material.specularPower =
-        std::clamp(2.0f / roughness4 - 2.0f, kMinSpecularPower, kMaxSpecularPower);
-    material.baseColorTexture = textureFor(pbr.baseColorTexture.index, true);
-    material.normalTexture = textureFor(source.normalTexture.index, false);
+    setBlinnPhongFromMetallicRoughness(material);
+
+    // Colour textures are sRGB, data textures linear (glTF 2.0, "Materials").
+    material.baseColorTexture = textureFor(
+        pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions,
+        true, where + " baseColorTexture", material.baseColorMapping);
+    material.metallicRoughnessTexture =
+        textureFor(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                   pbr.metallicRoughnessTexture.extensions, false,
+                   where + " metallicRoughnessTexture", material.metallicRoughnessMapping);
+    material.normalTexture = textureFor(source.normalTexture.index, source.normalTexture.texCoord,
+                                        source.normalTexture.extensions, false,
+                                        where + " normalTexture", material.normalMapping);
+    material.occlusionTexture =
+        textureFor(source.occlusionTexture.index, source.occlusionTexture.texCoord,
+                   source.occlusionTexture.extensions, false, where + " occlusionTexture",
+                   material.occlusionMapping);
+    material.emissiveTexture =
+        textureFor(source.emissiveTexture.index, source.emissiveTexture.texCoord,
+                   source.emissiveTexture.extensions, true, where + " emissiveTexture",
+                   material.emissiveMapping);
+
+    if (!std::isfinite(source.normalTexture.scale))
+        fail(where + ": normalTexture.scale is not finite");
+    material.normalScale = float(source.normalTexture.scale);
+    if (!(source.occlusionTexture.strength >= 0.0 && source.occlusionTexture.strength <= 1.0))
+        fail(where + ": occlusionTexture.strength outside [0, 1]");
+    material.occlusionStrength = float(source.occlusionTexture.strength);
+    if (source.emissiveFactor.size() != 3)
+        fail(where + ": emissiveFactor needs 3 numbers");
+    for (double component : source.emissiveFactor)
+        if (!(component >= 0.0 && component <= 1.0))
+            fail(where + ": emissiveFactor outside [0, 1]");
+    material.emissiveFactor =
+        glm::vec3(source.emissiveFactor[0], source.emissiveFactor[1], source.emissiveFactor[2]);
+    const auto strength = source.extensions.find("KHR_materials_emissive_strength");
+    if (strength != source.extensions.end()) {
+        const tinygltf::Value& value = strength->second;
+        if (!value.IsObject())
+            fail(where + ": KHR_materials_emissive_strength is not an object");
+        if (value.Has("emissiveStrength")) {
+            const tinygltf::Value& number = value.Get("emissiveStrength");
+            if (!number.IsNumber() || !(number.GetNumberAsDouble() >= 0.0) ||
+                !std::isfinite(number.GetNumberAsDouble()))
+                fail(where + ": KHR_materials_emissive_strength.emissiveStrength must be a "
+                             "finite number >= 0");
+            material.emissiveStrength = float(number.GetNumberAsDouble());
+        }
+    }
+
+    if (source.alphaMode == "OPAQUE")
+        material.alphaMode = AlphaMode::Opaque;
+    else if (source.alphaMode == "MASK")
+        material.alphaMode = AlphaMode::Mask;
+    else if (source.alphaMode == "BLEND")
+        material.alphaMode = AlphaMode::Blend;
+    else
+        fail(where + ": alphaMode '" + source.alphaMode + "' (expected OPAQUE, MASK or BLEND)");
+    if (!(source.alphaCutoff >= 0.0) || !std::isfinite(source.alphaCutoff))
+        fail(where + ": alphaCutoff must be a finite number >= 0");
+    material.alphaCutoff = float(source.alphaCutoff);
+    material.doubleSided = source.doubleSided;
 
     mMaterialOf[size_t(materialIndex)] = int(mScene.materials.size());
     mScene.materials.push_back(material);
     return uint32_t(mMaterialOf[size_t(materialIndex)]);
+}
+
+// A texture slot of a material: the texture (see textureFor below) and its mapping, the texCoord
+// set and KHR_texture_transform (whose texCoord, when given, overrides the slot's). A texture
+// reading a uv set past TEXCOORD_1 is dropped with a warning: the factor alone applies.
+int GltfConverter::textureFor(int textureIndex, int texCoord,
+                              const tinygltf::ExtensionMap& extensions, bool srgb,
+                              const std::string& where, TextureMapping& mapping) {
+    if (textureIndex < 0)
+        return -1;
+    const auto transform = extensions.find("KHR_texture_transform");
+    if (transform != extensions.end()) {
+        const tinygltf::Value& value = transform->second;
+        if (!value.IsObject())
+            fail(where + ": KHR_texture_transform is not an object");
+        auto number = [&](const tinygltf::Value& v, const std::string& field) {
+            if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()))
+                fail(where + ": KHR_texture_transform." + field + " must be a finite number");
+            return float(v.GetNumberAsDouble());
+        };
+        auto pair = [&](const std::string& field, glm::vec2& into) {
+            if (!value.Has(field))
+                return;
+            const tinygltf::Value& array = value.Get(field);
+            if (!array.IsArray() || array.ArrayLen() != 2)
+                fail(where + ": KHR_texture_transform." + field + " needs 2 numbers");
+            into = glm::vec2(number(array.Get(0), field), number(array.Get(1), field));
+        };
+        pair("offset", mapping.offset);
+        pair("scale", mapping.scale);
+        if (value.Has("rotation"))
+            mapping.rotationRadians = number(value.Get("rotation"), "rotation");
+        if (value.Has("texCoord")) {
+            if (!value.Get("texCoord").IsInt())
+                fail(where + ": KHR_texture_transform.texCoord must be an integer");
+            texCoord = value.Get("texCoord").Get<int>();
+        }
+    }
+    if (texCoord < 0)
+        fail(where + ": texCoord " + std::to_string(texCoord) + " is negative");
+    if (texCoord > 1) {
+        warn(where + " reads TEXCOORD_" + std::to_string(texCoord) +
+             "; only TEXCOORD_0 and TEXCOORD_1 are kept, so the texture is not used");
+        return -1;
+    }
+    mapping.texCoord = texCoord;
+    return textureFor(textureIndex, srgb);
 }
 
 // Scene::textures index for a glTF texture, -1 (fall back to the factor) when its image could

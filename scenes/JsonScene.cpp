@@ -9,7 +9,8 @@
 // Objects contribute their geometry (meshes, materials, textures, instances) and their own
 // lights (a procedural object's ambient/sun options, a glTF file's KHR_lights_punctual), moved
 // by their transform; a procedural object's camera is used when the file sets none. A glTF file
-// placed several times is loaded once and instanced.
+// placed several times is loaded once and instanced. Material entries then change the objects'
+// materials by name (model, base colour, metallic/roughness or specular, emissive).
 // Thread safety: each call is independent.
 #include "scenes/SceneLoader.h"
 
@@ -83,10 +84,9 @@ Placeable addResources(Scene& scene, Scene&& part) {
     for (Texture& texture : part.textures)
         scene.textures.push_back(std::move(texture));
     for (Material& material : part.materials) {
-        if (material.baseColorTexture >= 0)
-            material.baseColorTexture += textureOffset;
-        if (material.normalTexture >= 0)
-            material.normalTexture += textureOffset;
+        for (int* texture : material.textureSlots())
+            if (*texture >= 0)
+                *texture += textureOffset;
         scene.materials.push_back(std::move(material));
     }
     Placeable placeable{uint32_t(scene.meshes.size()), std::move(part.instances),
@@ -145,6 +145,8 @@ private:
                    std::optional<Camera>& objectCamera);
     Camera camera(const Json& value, const std::string& field) const;
     Light light(const Json& value, const std::string& field) const;
+    void applyMaterial(const Json& value, const std::string& field, Scene& scene) const;
+    glm::vec4 colour(const Json& value, const std::string& field, bool alphaAllowed) const;
     void generateLights(const Json* generator, Scene& scene) const;
 
     fs::path mPath;
@@ -222,7 +224,7 @@ Scene JsonSceneReader::read() {
     } catch (const Json::parse_error& parseError) {
         fail("", std::string("invalid JSON: ") + parseError.what());
     }
-    expectKeys(root, "", {"name", "camera", "objects", "lights", "lightGenerator"});
+    expectKeys(root, "", {"name", "camera", "objects", "lights", "lightGenerator", "materials"});
 
     Scene scene;
     scene.name = member(root, "name") ? text(root["name"], "name") : mPath.stem().string();
@@ -235,6 +237,12 @@ Scene JsonSceneReader::read() {
     std::optional<Camera> objectCamera;
     for (size_t i = 0; i < objects->size(); ++i)
         addObject((*objects)[i], elementOf("objects", i), scene, objectCamera);
+    if (const Json* materials = member(root, "materials")) {
+        if (!materials->is_array())
+            fail("materials", "expected an array of material entries");
+        for (size_t i = 0; i < materials->size(); ++i)
+            applyMaterial((*materials)[i], elementOf("materials", i), scene);
+    }
 
     if (const Json* cameraValue = member(root, "camera"))
         scene.cameras.push_back(camera(*cameraValue, "camera"));
@@ -463,6 +471,120 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
         light.spotOuterCos = std::cos(glm::radians(outer));
     }
     return light;
+}
+
+// [r, g, b] or, with alphaAllowed, [r, g, b, a]: non-negative linear values (alpha at most 1).
+glm::vec4 JsonSceneReader::colour(const Json& value, const std::string& field,
+                                  bool alphaAllowed) const {
+    if (!value.is_array() || !(value.size() == 3 || (alphaAllowed && value.size() == 4)))
+        fail(field, alphaAllowed ? "expected an array of 3 or 4 numbers"
+                                 : "expected an array of 3 numbers");
+    glm::vec4 result(1.0f);
+    for (size_t c = 0; c < value.size(); ++c) {
+        result[int(c)] = number(value[c], field + "[" + std::to_string(c) + "]");
+        if (!(result[int(c)] >= 0.0f))
+            fail(field, "components must not be negative");
+    }
+    if (!(result.a <= 1.0f))
+        fail(field, "alpha must be in [0, 1]");
+    return result;
+}
+
+// One entry of "materials": every material of the scene named `name` ("*": every material)
+// takes the entry's values, in the order of the entries. Keys must suit the material's model
+// after the entry (its "model", else the model it had).
+void JsonSceneReader::applyMaterial(const Json& value, const std::string& field,
+                                    Scene& scene) const {
+    expectKeys(value, field,
+               {"name", "model", "baseColor", "metallic", "roughness", "specularIntensity",
+                "specularPower", "emissive", "emissiveStrength"});
+    const Json* nameValue = member(value, "name");
+    if (!nameValue)
+        fail(field, "missing key 'name' (a material name, or \"*\" for every material)");
+    const std::string name = text(*nameValue, fieldOf(field, "name"));
+    std::optional<MaterialModel> model;
+    if (const Json* modelValue = member(value, "model")) {
+        const std::string modelName = text(*modelValue, fieldOf(field, "model"));
+        for (MaterialModel candidate :
+             {MaterialModel::BlinnPhong, MaterialModel::MetallicRoughness})
+            if (modelName == materialModelName(candidate))
+                model = candidate;
+        if (!model)
+            fail(fieldOf(field, "model"), "unknown material model '" + modelName +
+                                              "' (valid: blinn-phong, metallic-roughness)");
+    }
+    auto unit = [&](const char* key) -> std::optional<float> {
+        const Json* v = member(value, key);
+        if (!v)
+            return std::nullopt;
+        const float result = number(*v, fieldOf(field, key));
+        if (!(result >= 0.0f && result <= 1.0f))
+            fail(fieldOf(field, key), "expected a number in [0, 1]");
+        return result;
+    };
+    auto nonNegative = [&](const char* key) -> std::optional<float> {
+        const Json* v = member(value, key);
+        if (!v)
+            return std::nullopt;
+        const float result = number(*v, fieldOf(field, key));
+        if (!(result >= 0.0f))
+            fail(fieldOf(field, key), "must not be negative");
+        return result;
+    };
+    const std::optional<float> metallic = unit("metallic"), roughness = unit("roughness");
+    const std::optional<float> specularIntensity = unit("specularIntensity");
+    std::optional<float> specularPower;
+    if (const Json* power = member(value, "specularPower"))
+        specularPower = positive(*power, fieldOf(field, "specularPower"));
+    const std::optional<float> emissiveStrength = nonNegative("emissiveStrength");
+    std::optional<glm::vec4> baseColor, emissive;
+    if (const Json* v = member(value, "baseColor"))
+        baseColor = colour(*v, fieldOf(field, "baseColor"), true);
+    if (const Json* v = member(value, "emissive"))
+        emissive = colour(*v, fieldOf(field, "emissive"), false);
+
+    size_t matched = 0;
+    for (Material& material : scene.materials) {
+        if (name != "*" && material.name != name)
+            continue;
+        ++matched;
+        material.model = model.value_or(material.model);
+        const bool metallicRoughness = material.model == MaterialModel::MetallicRoughness;
+        const char* wrongKey = metallicRoughness ? (specularIntensity ? "specularIntensity"
+                                                    : specularPower   ? "specularPower"
+                                                                      : nullptr)
+                                                 : (metallic    ? "metallic"
+                                                    : roughness ? "roughness"
+                                                                : nullptr);
+        if (wrongKey)
+            fail(fieldOf(field, wrongKey), std::string("does not apply to material '") +
+                                               material.name + "', whose model is " +
+                                               materialModelName(material.model));
+        if (baseColor)
+            material.baseColorFactor = *baseColor;
+        if (emissive)
+            material.emissiveFactor = glm::vec3(*emissive);
+        material.emissiveStrength = emissiveStrength.value_or(material.emissiveStrength);
+        if (metallic || roughness) {
+            material.metallic = metallic.value_or(material.metallic);
+            material.roughness = roughness.value_or(material.roughness);
+            // The Blinn-Phong pair stays the approximation of the new values (Material.h).
+            setBlinnPhongFromMetallicRoughness(material);
+        }
+        material.specularIntensity = specularIntensity.value_or(material.specularIntensity);
+        if (specularPower) {
+            material.specularPower = *specularPower;
+            material.roughness = roughnessForSpecularPower(*specularPower);
+        }
+    }
+    if (matched == 0) {
+        std::vector<std::string> names;
+        for (const Material& material : scene.materials)
+            if (std::find(names.begin(), names.end(), material.name) == names.end())
+                names.push_back(material.name);
+        fail(fieldOf(field, "name"),
+             "no material named '" + name + "' (the scene's: " + commaSeparated(names) + ")");
+    }
 }
 
 // Unset generator fields take defaultScatterFor(scene)'s values. The request's lightCount and

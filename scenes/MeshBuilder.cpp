@@ -103,9 +103,10 @@ void appendGrid(Mesh& mesh, int cellCountU, int cellCountV, Facing facing, NodeA
         for (int i = 0; i <= cellCountU; ++i) {
             const GridNode node = nodeAt(i, j);
             const glm::vec3 normal = side * node.normal;
-            // uv.y decreases along j, so the bitangent (towards increasing uv.y) is -alongJ.
+            // uv.y decreases along j, so the bitangent (towards decreasing uv.y, glTF's "up in
+            // the image") is alongJ.
             const float bitangentSign =
-                glm::dot(glm::cross(normal, node.tangent), -node.alongJ) >= 0.0f ? 1.0f : -1.0f;
+                glm::dot(glm::cross(normal, node.tangent), node.alongJ) >= 0.0f ? 1.0f : -1.0f;
             mesh.positions.push_back(node.position);
             mesh.normals.push_back(normal);
             mesh.tangents.push_back(glm::vec4(node.tangent, bitangentSign));

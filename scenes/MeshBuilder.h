@@ -7,8 +7,9 @@
 //   from the front, and the front is the side the normals point to: outward for closed shapes.
 // - Normals are unit length and analytic where the surface has a formula (sphere, cylinder,
 //   cloth), so they do not depend on the tessellation.
-// - Tangents: xyz is the unit direction of increasing uv.x; w = +-1 such that
-//   w * cross(normal, tangent.xyz) points towards increasing uv.y.
+// - Tangents (glTF's convention, as Mesh::tangents): xyz is the unit direction of increasing
+//   uv.x; w = +-1 such that w * cross(normal, tangent.xyz) points towards decreasing uv.y, i.e.
+//   up in the image, where a normal map's +Y (green) points.
 // - uvs: each tessellated patch (a quad, a box face, a cylinder's side) spans [0,1]^2, with
 //   uv.y = 0 at its top for upright faces (glTF: (0,0) is the image's top-left corner).
 // - Within one shape, vertices shared by two patches along an edge are computed from the same

@@ -93,8 +93,7 @@ uint32_t addMaterial(Scene& scene, const std::string& name, const glm::vec3& alb
     material.baseColorFactor = glm::vec4(albedo, 1.0f);
     material.specularIntensity = specularIntensity;
     material.specularPower = specularPower;
-    // The loader's mapping power = 2 / roughness^4 - 2, inverted, so the field stays truthful.
-    material.roughness = std::pow(2.0f / (specularPower + 2.0f), 0.25f);
+    material.roughness = roughnessForSpecularPower(specularPower);
     scene.materials.push_back(material);
     return uint32_t(scene.materials.size() - 1);
 }

@@ -44,6 +44,8 @@ void validate(const Scene& scene) {
                  std::to_string(mesh.positions.size()) + " positions");
         if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
             fail(where + ": uv count differs from position count");
+        if (!mesh.uvs1.empty() && mesh.uvs1.size() != mesh.positions.size())
+            fail(where + ": second uv set's count differs from position count");
         if (!mesh.tangents.empty() && mesh.tangents.size() != mesh.positions.size())
             fail(where + ": tangent count differs from position count");
         for (uint32_t index : mesh.indices)
@@ -60,9 +62,13 @@ void validate(const Scene& scene) {
             fail(where + ": material " + std::to_string(mesh.material) + " out of range");
     }
     for (const Material& material : scene.materials) {
-        for (int t : {material.baseColorTexture, material.normalTexture})
+        for (int t : material.textureIndices())
             if (t >= int(scene.textures.size()))
                 fail("material '" + material.name + "': texture index out of range");
+        for (const TextureMapping* mapping : material.textureMappings())
+            if (mapping->texCoord != 0 && mapping->texCoord != 1)
+                fail("material '" + material.name + "': texCoord " +
+                     std::to_string(mapping->texCoord) + " (only 0 and 1 are kept)");
     }
     for (const Instance& instance : scene.instances)
         if (instance.mesh >= scene.meshes.size())

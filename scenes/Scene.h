@@ -15,6 +15,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scenes/Material.h"
 #include "scenes/Texture.h"
 
 namespace scenes {
@@ -40,28 +41,19 @@ struct Aabb {
     glm::vec3 size() const { return max - min; }
 };
 
-// Lambert + Blinn-Phong parameters (the one BRDF of DESIGN.md). glTF metallic-roughness
-// materials are mapped onto it by the loader: specularPower = 2 / roughness^4 - 2.
-struct Material {
-    std::string name;
-    glm::vec4 baseColorFactor{1.0f}; // linear RGBA, multiplied with the texture
-    int baseColorTexture = -1;       // index into Scene::textures, -1 = none
-    float specularIntensity = 0.04f; // ks, unitless reflectance at normal incidence
-    float specularPower = 32.0f;     // Blinn-Phong exponent
-    float roughness = 0.5f;          // as given by glTF (informative; power is derived from it)
-    float metallic = 0.0f;
-    int normalTexture = -1; // tangent-space normal map, index into Scene::textures, -1 = none
-};
-
 // One triangle list with one material. Attributes are per vertex, in object space.
 struct Mesh {
     std::string name;
     std::vector<glm::vec3> positions;
-    std::vector<glm::vec3> normals;  // unit length, same count as positions
-    std::vector<glm::vec4> tangents; // xyz tangent, w = bitangent sign; empty when unknown
-    std::vector<glm::vec2> uvs;      // empty when the mesh has no texture coordinates
-    std::vector<uint32_t> indices;   // triangle list, 3 per triangle, counter-clockwise = front
-    uint32_t material = 0;           // index into Scene::materials
+    std::vector<glm::vec3> normals; // unit length, same count as positions
+    // xyz unit tangent (direction of increasing uv.x), w = +-1: the bitangent
+    // w * cross(normal, xyz) points up the image (decreasing uv.y), glTF's convention. From the
+    // file, or generated (Tangents.h) for glTF meshes with a normal texture; may be empty.
+    std::vector<glm::vec4> tangents;
+    std::vector<glm::vec2> uvs;    // TEXCOORD_0; empty when the mesh has no texture coordinates
+    std::vector<glm::vec2> uvs1;   // TEXCOORD_1; empty unless a material's texture reads it
+    std::vector<uint32_t> indices; // triangle list, 3 per triangle, counter-clockwise = front
+    uint32_t material = 0;         // index into Scene::materials
 
     size_t triangleCount() const { return indices.size() / 3; }
 };

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots of the depth/position study (`testbed depth`, experiments/DepthStudy.h), matplotlib.
+"""Plots of the depth/position study (`testbed depth`, experiments/studies/DepthStudy.h), matplotlib.
 
 Called by the C++ command, not by hand (but it can be):
 
@@ -12,22 +12,16 @@ and OUTDIR/depth_step_vs_distance.png (metres between neighbouring depth codes a
 panel per camera, one line per format x far plane, with d * 1e-3 as a guide). Samples lost to
 background (null errors / steps) are gaps in the lines. Each PNG is written to a temporary name
 in OUTDIR and renamed (os.replace), so an interrupted run leaves no partial file.
-Exit status 0 on success, 2 on bad arguments or input, 3 when matplotlib is missing.
+Exit status 0 on success, 2 on bad arguments or input, 3 when matplotlib is missing (plotfiles.py).
 """
 import json
 import math
 import os
 import sys
 
-try:
-    import matplotlib
+from plotfiles import pyplot, save_png
 
-    matplotlib.use("Agg")  # no display; must precede pyplot
-    import matplotlib.pyplot as plt
-except ImportError:
-    print("depth.py: matplotlib is not installed (Debian: apt-get install python3-matplotlib)",
-          file=sys.stderr)
-    sys.exit(3)
+plt = pyplot("depth.py")
 
 DPI = 100
 # Drawing order: f32 last, on top of unorm24, which it equals wherever NDC depth >= 1/2 (there the
@@ -68,15 +62,7 @@ def grid(count):
 
 
 def save(fig, path):
-    root, ext = os.path.splitext(path)
-    temp = f"{os.path.dirname(path)}/.{os.path.basename(root)}.tmp-{os.getpid()}{ext}"
-    try:
-        fig.savefig(temp, dpi=DPI)
-        os.replace(temp, path)
-    finally:
-        if os.path.exists(temp):
-            os.remove(temp)
-        plt.close(fig)
+    save_png(fig, path, dpi=DPI)
 
 
 def panels(cameras, title):
@@ -88,6 +74,17 @@ def panels(cameras, title):
     for extra in axes.flat[len(cameras):]:
         extra.set_visible(False)
     return fig, list(axes.flat)
+
+
+def style_panel(axis, near, far, y_label):
+    """Log-log axes of one camera's panel, against view depth."""
+    axis.set_xscale("log")
+    axis.set_yscale("log")
+    axis.set_title(f"near {near:g} m, far {far:g} m")
+    axis.set_xlabel("view depth d (m)")
+    axis.set_ylabel(y_label)
+    axis.grid(True, which="major", alpha=0.3)
+    axis.minorticks_off()  # hundreds of log-axis minor ticks cost most of the drawing time
 
 
 def plot_errors(data, out):
@@ -113,13 +110,7 @@ def plot_errors(data, out):
                 if lost:  # the surface reads as background there: drawn as error 1 (100%)
                     axis.plot(lost, [1.0] * len(lost), "x", color=COLOURS.get(fmt), markersize=5)
         axis.axhline(1e-3, color="grey", linewidth=0.8, linestyle=(0, (1, 3)))
-        axis.set_xscale("log")
-        axis.set_yscale("log")
-        axis.set_title(f"near {near:g} m, far {far:g} m")
-        axis.set_xlabel("view depth d (m)")
-        axis.set_ylabel("max relative error")
-        axis.grid(True, which="major", alpha=0.3)
-        axis.minorticks_off()  # hundreds of log-axis minor ticks cost most of the drawing time
+        style_panel(axis, near, far, "max relative error")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     fig.subplots_adjust(left=0.07, right=0.98, top=0.89, bottom=0.2, hspace=0.3, wspace=0.18)
@@ -146,13 +137,7 @@ def plot_steps(data, out):
         if distances:
             axis.plot(distances, [d * 1e-3 for d in distances], color="grey", linewidth=0.8,
                       linestyle=(0, (1, 3)))
-        axis.set_xscale("log")
-        axis.set_yscale("log")
-        axis.set_title(f"near {near:g} m, far {far:g} m")
-        axis.set_xlabel("view depth d (m)")
-        axis.set_ylabel("depth step (m)")
-        axis.grid(True, which="major", alpha=0.3)
-        axis.minorticks_off()  # hundreds of log-axis minor ticks cost most of the drawing time
+        style_panel(axis, near, far, "depth step (m)")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=5, fontsize=8, frameon=False)
     fig.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.13, hspace=0.3, wspace=0.18)

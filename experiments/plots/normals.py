@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots of the normal-encoding precision study (`testbed normals`, experiments/NormalStudy.h).
+"""Plots of the normal-encoding precision study (`testbed normals`, experiments/studies/NormalStudy.h).
 
 Called by the C++ command after it has written DIR/normals.json and the error grids
 DIR/maps/<codec>-<bits>.f32 (it can also be run by hand):
@@ -14,24 +14,18 @@ writes
                                colour scale), longitude = azimuth atan2(y, x), latitude = asin(z):
                                top row +Z (facing the camera), bottom row -Z
 Each PNG is written to a temporary name and renamed (os.replace): no partial files.
-Exit status 0 on success, 2 on bad arguments or input, 3 when matplotlib is missing.
+Exit status 0 on success, 2 on bad arguments or input, 3 when matplotlib is missing (plotfiles.py).
 """
 import argparse
 import json
 import os
 import sys
 
-try:
-    import matplotlib
+from plotfiles import pyplot, save_png
 
-    matplotlib.use("Agg")  # no display; must precede pyplot
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import LogNorm
-    import numpy as np
-except ImportError:
-    print("normals.py: matplotlib/numpy not installed (Debian: apt-get install python3-matplotlib)",
-          file=sys.stderr)
-    sys.exit(3)
+plt = pyplot("normals.py")
+from matplotlib.colors import LogNorm  # noqa: E402 (after the backend is chosen)
+import numpy as np  # noqa: E402 (Debian's python3-matplotlib depends on python3-numpy)
 
 DPI = 100
 # Floor of the log colour scale and of the error axis (degrees): float32's float rounding.
@@ -39,11 +33,7 @@ FLOOR_DEG = 1e-6
 
 
 def save(fig, path):
-    root, ext = os.path.splitext(path)
-    temp = f"{root}.tmp-{os.getpid()}{ext}"
-    fig.savefig(temp, dpi=DPI, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(temp, path)
+    save_png(fig, path, dpi=DPI, bbox_inches="tight")
 
 
 def error_vs_bits(study, out_dir):

@@ -19,7 +19,8 @@ Called by the C++ commands, not by hand (but it can be, for debugging):
 Only ok jobs are plotted; a metric that is null, missing, a string ("inf") or not finite
 (NaN/inf PSNR) is left out of the plot it would be in. Every file is written to a temporary name
 in the same folder and renamed (os.replace), so an interrupted run leaves no partial PNG.
-Exit status 0 on success, 2 on bad arguments or input (message on stderr).
+Exit status 0 on success, 2 on bad arguments or input (message on stderr), 3 when matplotlib is
+missing. PNGs are written through plotfiles.py (beside this script).
 """
 import argparse
 import json
@@ -28,10 +29,10 @@ import os
 import statistics
 import sys
 
-import matplotlib
+from plotfiles import pyplot, save_png
 
-matplotlib.use("Agg")  # no display; must precede pyplot
-import matplotlib.pyplot as plt  # noqa: E402
+plt = pyplot("report.py")
+import matplotlib  # noqa: E402 (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 TIME = "time_total_median_ms"
@@ -57,18 +58,6 @@ def text(value):
     return str(value)
 
 
-def atomic_savefig(fig, path):
-    directory, name = os.path.split(path)
-    temp = os.path.join(directory, ".%s.tmp-%d.png" % (os.path.splitext(name)[0], os.getpid()))
-    try:
-        fig.savefig(temp, format="png", dpi=DPI)
-        os.replace(temp, path)
-    finally:
-        plt.close(fig)
-        if os.path.exists(temp):
-            os.remove(temp)
-
-
 def atomic_write_text(path, content):
     directory, name = os.path.split(path)
     temp = os.path.join(directory, ".%s.tmp-%d" % (name, os.getpid()))
@@ -84,7 +73,7 @@ class Report:
         self.skipped = []
 
     def save(self, fig, name, title, caption):
-        atomic_savefig(fig, os.path.join(self.out, name + ".png"))
+        save_png(fig, os.path.join(self.out, name + ".png"), dpi=DPI)
         self.plots.append({"file": name + ".png", "title": title, "caption": caption})
 
     def skip(self, title, reason):
@@ -283,7 +272,7 @@ def plot_diff(args):
     bar = fig.colorbar(shown, ax=ax, fraction=0.046, pad=0.02)
     bar.set_label("absolute difference (linear radiance)", fontsize=8)
     fig.tight_layout()
-    atomic_savefig(fig, args.out)
+    save_png(fig, args.out, dpi=DPI)
 
 
 def main():

@@ -28,6 +28,7 @@
 #include "lighting/LightListShading.h"
 #include "lighting/culling/ClusterGrid.h"
 #include "lighting/stages/Stages.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -77,7 +78,7 @@ public:
                 mGrid->build(mOptions, gb.view(), nearDepth, farDepth);
             ClusterGrid& grid = *mGrid;
             grid.assign(boundingSpheresView(*inputs.lights));
-            result.timingsMs.emplace_back("assign", millisecondsSince(assignStart));
+            result.timingsMs.emplace_back(pass::kAssign, millisecondsSince(assignStart));
             pairs = std::to_string(grid.pairCount());
 
             const auto shadingStart = std::chrono::steady_clock::now();
@@ -99,10 +100,10 @@ public:
                                        result);
                 }
             });
-            result.timingsMs.emplace_back("shading", millisecondsSince(shadingStart));
+            result.timingsMs.emplace_back(pass::kShading, millisecondsSince(shadingStart));
         } else {
-            result.timingsMs.emplace_back("assign", millisecondsSince(assignStart));
-            result.timingsMs.emplace_back("shading", 0.0);
+            result.timingsMs.emplace_back(pass::kAssign, millisecondsSince(assignStart));
+            result.timingsMs.emplace_back(pass::kShading, 0.0);
         }
 
         std::string grid = std::to_string(mOptions.tilesX);

@@ -28,6 +28,7 @@
 #include "lighting/LightBounds.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/stages/VolumeStageOptions.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -67,7 +68,7 @@ public:
                           [&](uint32_t light, int x, int y, size_t pixel) {
                               addLight(x, y, pixel, lights[light]);
                           });
-        result.timingsMs.emplace_back("shading", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
 
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
     }

@@ -24,6 +24,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardGeometry.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -41,15 +42,15 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
-        result.timingsMs.emplace_back("transform", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         mForward.drawDepthPrepass();
-        result.timingsMs.emplace_back("prepass", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         buildIlluminationSets(*inputs.lights);
-        result.timingsMs.emplace_back("cull", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
@@ -97,7 +98,7 @@ public:
             mForward.draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
                           addLight);
         }
-        result.timingsMs.emplace_back("shading", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
     }
 
 private:

@@ -23,6 +23,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardGeometry.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -43,17 +44,17 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
-        result.timingsMs.emplace_back("transform", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         buildObjectLightLists(*inputs.lights);
-        result.timingsMs.emplace_back("cull", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
 
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
         if (mPrepass) {
             start = std::chrono::steady_clock::now();
             mForward.drawDepthPrepass();
-            result.timingsMs.emplace_back("prepass", millisecondsSince(start));
+            result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
         } else {
             mForward.clearDepth();
         }
@@ -82,7 +83,7 @@ public:
         // closer test is shaded); with one, the redraw that passes each visible fragment once.
         mForward.draw(visibility.triangles(),
                       mPrepass ? visibility.redrawState() : visibility.drawState(), shadeFragment);
-        result.timingsMs.emplace_back("shading", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
     }
 
 private:

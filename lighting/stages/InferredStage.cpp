@@ -71,6 +71,7 @@
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -264,9 +265,9 @@ public:
             fallbacks += f;
         for (uint32_t f : rowIdFallbacks)
             idFallbacks += f;
-        result.timingsMs.emplace_back("cull", cullMs);
-        result.timingsMs.emplace_back("lighting", lightingMs);
-        result.timingsMs.emplace_back("material", materialMs);
+        result.timingsMs.emplace_back(pass::kCull, cullMs);
+        result.timingsMs.emplace_back(pass::kLighting, lightingMs);
+        result.timingsMs.emplace_back(pass::kMaterial, materialMs);
         result.parameters["scale"] = std::to_string(scale);
         result.parameters["depth"] = std::to_string(mOptions.depthThreshold);
         result.parameters["normal"] = std::to_string(mOptions.normalThreshold);

@@ -32,6 +32,7 @@
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/culling/TileFrusta.h"
 #include "lighting/stages/VolumeStageOptions.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -75,7 +76,7 @@ public:
         };
         cull.volumes.draw(cull.spheres, cull.drawn,
                           [&](uint32_t light, int, int, size_t pixel) { append(pixel, light); });
-        result.timingsMs.emplace_back("index", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kIndex, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         const bool anyOverflow =
@@ -104,7 +105,7 @@ public:
             }
             overflowPerRow[size_t(y)] = overflowed;
         });
-        result.timingsMs.emplace_back("shading", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
 
         uint64_t overflowPixels = 0;
         for (uint32_t n : overflowPerRow)

@@ -46,6 +46,7 @@
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -122,9 +123,9 @@ public:
         uint64_t pairs = 0;
         for (const auto& list : tileLights)
             pairs += list.size();
-        result.timingsMs.emplace_back("cull", cullMs);
-        result.timingsMs.emplace_back("lighting", lightingMs);
-        result.timingsMs.emplace_back("material", materialMs);
+        result.timingsMs.emplace_back(pass::kCull, cullMs);
+        result.timingsMs.emplace_back(pass::kLighting, lightingMs);
+        result.timingsMs.emplace_back(pass::kMaterial, materialMs);
         result.parameters["spec"] = mChroma ? "chroma" : "grey";
         result.parameters["tile"] = std::to_string(mTileSizePixels);
         result.parameters["tile_light_pairs"] = std::to_string(pairs);

@@ -40,6 +40,7 @@
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -66,16 +67,16 @@ public:
 
         auto start = std::chrono::steady_clock::now();
         mForward.prepare(inputs);
-        result.timingsMs.emplace_back("transform", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         mForward.drawDepthPrepass();
-        result.timingsMs.emplace_back("prepass", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         const TileGrid grid = TileGrid::make(width, view.height, mOptions.tileSizePixels);
         const size_t lightsAfterVfc = buildTileLightLists(view, grid, *inputs.lights);
-        result.timingsMs.emplace_back("cull", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
@@ -90,7 +91,7 @@ public:
                                size_t(fragment.y) * width + fragment.x, lights, list, result);
         };
         mForward.draw(visibility.triangles(), visibility.redrawState(), shadeFragment);
-        result.timingsMs.emplace_back("shading", millisecondsSince(start));
+        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
 
         uint64_t pairs = 0;
         for (const std::vector<uint32_t>& list : mTileLights)

@@ -33,6 +33,7 @@
 
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
+#include "lighting/PassNames.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
@@ -103,8 +104,8 @@ public:
             pairs += tileLights[tile].size();
             backfaceRejected += tileBackfaceRejected[tile];
         }
-        result.timingsMs.emplace_back("cull", cullMs);
-        result.timingsMs.emplace_back("shading", shadeMs);
+        result.timingsMs.emplace_back(pass::kCull, cullMs);
+        result.timingsMs.emplace_back(pass::kShading, shadeMs);
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";

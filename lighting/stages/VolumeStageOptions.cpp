@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "lighting/stages/Stages.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -28,7 +29,7 @@ VolumeCull cullLightVolumes(const gbuffer::GBuffer& gb, const LightList& lights,
                     LightVolumeRasterizer(gb, options.shape, options.stencil, options.spotProxy),
                     {}};
     cull.drawn = cull.volumes.lightsToDraw(cull.spheres, options.frustumCull);
-    result.timingsMs.emplace_back("cull", millisecondsSince(start));
+    result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
     return cull;
 }
 

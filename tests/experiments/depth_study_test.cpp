@@ -1,5 +1,5 @@
-// The depth/position study (experiments/DepthStudy.h): `testbed depth --quick` writes every row
-// to depth.csv and depth.json, its data shows reversed float depth beating standard float depth
+// The depth/position study (experiments/studies/DepthStudy.h): `testbed depth --quick` writes every
+// row to depth.csv and depth.json, its data shows reversed float depth beating standard float depth
 // near the far plane, the plots exist (skipped only when no python3 with matplotlib is found), and
 // the study does not depend on the thread count. Outputs go to
 // <build>/test-output/experiments/<suite>.<test>/ and are left there for inspection.
@@ -18,8 +18,9 @@
 #include <tbb/task_arena.h>
 
 #include "TestFolders.h"
-#include "experiments/DepthStudy.h"
 #include "experiments/PlotScript.h"
+#include "experiments/studies/DepthStudy.h"
+#include "experiments/studies/DepthStudyOutputs.h"
 
 namespace experiments {
 namespace {

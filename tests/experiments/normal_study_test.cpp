@@ -1,5 +1,5 @@
-// `testbed normals` (experiments/NormalStudy.h) driven in-process with --quick: the outputs hold
-// one row per codec x bits x dataset, the figures do not depend on the thread count, the hard
+// `testbed normals` (experiments/studies/NormalStudy.h) driven in-process with --quick: the outputs
+// hold one row per codec x bits x dataset, the figures do not depend on the thread count, the hard
 // cases give no NaN/Inf and stay within each codec's derived bound where it applies, and the
 // Monte Carlo negative-z fractions agree with their closed forms.
 //
@@ -17,8 +17,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/NormalStudy.h"
 #include "experiments/PlotScript.h"
+#include "experiments/studies/NormalStudy.h"
 #include "gbuffer/NormalCodec.h"
 
 namespace {

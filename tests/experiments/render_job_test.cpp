@@ -15,6 +15,7 @@
 namespace {
 
 using experiments::PassTiming;
+using experiments::planRender;
 using experiments::RenderOptions;
 using experiments::renderReference;
 using experiments::RenderRun;
@@ -54,9 +55,9 @@ bool sameDecodedGBuffer(const gbuffer::GBuffer& a, const gbuffer::GBuffer& b) {
 }
 
 TEST(RenderJob, BitwiseIdenticalForAnyThreadCount) {
-    const RenderRun one = runRender(smallAtrium(1));
+    const RenderRun one = runRender(planRender(smallAtrium(1)));
     for (int threads : {2, 7}) {
-        const RenderRun many = runRender(smallAtrium(threads));
+        const RenderRun many = runRender(planRender(smallAtrium(threads)));
         EXPECT_TRUE(bitwiseEqual(one.gbuffer().depth(), many.gbuffer().depth())) << threads;
         EXPECT_TRUE(sameDecodedGBuffer(one.gbuffer(), many.gbuffer())) << threads;
         for (int c = 0; c < 3; ++c)
@@ -71,10 +72,10 @@ TEST(RenderJob, BitwiseIdenticalForAnyThreadCount) {
 TEST(RenderJob, BruteMatchesReferenceOnAtrium) {
     RenderOptions options = smallAtrium(0);
     options.compareReference = true;
-    const RenderRun run = runRender(options);
-    ASSERT_TRUE(run.error.has_value());
-    EXPECT_LT(run.error->relativeRmse, 1e-4) << "rmse " << run.error->rmse;
-    EXPECT_GT(run.error->relativeRmse, 0.0) << "float and double should differ a little";
+    const RenderRun run = runRender(planRender(options));
+    ASSERT_TRUE(run.metrics.error.has_value());
+    EXPECT_LT(run.metrics.error->relativeRmse, 1e-4) << "rmse " << run.metrics.error->rmse;
+    EXPECT_GT(run.metrics.error->relativeRmse, 0.0) << "float and double should differ a little";
     // The scene is lit: not a black image compared with a black image.
     double sum = 0.0;
     for (float v : run.reference.radiance[1])
@@ -83,7 +84,7 @@ TEST(RenderJob, BruteMatchesReferenceOnAtrium) {
 }
 
 TEST(RenderJob, BruteEvaluatesEveryLightAndCountsTheOracle) {
-    const RenderRun run = runRender(smallAtrium(0));
+    const RenderRun run = runRender(planRender(smallAtrium(0)));
     const uint32_t lightCount = uint32_t(run.scene().lights.size());
     uint64_t covered = 0, oracle = 0;
     for (size_t pixel = 0; pixel < run.oracle.size(); ++pixel) {
@@ -112,7 +113,7 @@ TEST(RenderJob, CullingStaysConservativeOnLossyLayouts) {
             options.stage = stage;
             options.normals = normals;
             options.depth = depth;
-            const RenderRun run = runRender(options);
+            const RenderRun run = runRender(planRender(options));
             EXPECT_EQ(run.gbuffer().layout().normals.text(), normals);
             size_t dropped = 0;
             for (size_t pixel = 0; pixel < run.oracle.size(); ++pixel)
@@ -128,18 +129,18 @@ TEST(RenderJob, NormalEncodingsTradeBytesForError) {
         RenderOptions options = smallAtrium(0);
         options.compareReference = true;
         options.normals = normals;
-        return runRender(options);
+        return runRender(planRender(options));
     };
     const RenderRun spheremap = render("spheremap:16");
     const RenderRun octahedral = render("octahedral-precise:32");
     const RenderRun exact = render("float32:96");
-    ASSERT_TRUE(spheremap.error && octahedral.error && exact.error);
-    EXPECT_GT(spheremap.error->rmse, octahedral.error->rmse);
-    EXPECT_GT(octahedral.error->rmse, exact.error->rmse);
+    ASSERT_TRUE(spheremap.metrics.error && octahedral.metrics.error && exact.metrics.error);
+    EXPECT_GT(spheremap.metrics.error->rmse, octahedral.metrics.error->rmse);
+    EXPECT_GT(octahedral.metrics.error->rmse, exact.metrics.error->rmse);
     EXPECT_LT(spheremap.gbuffer().layout().bytesPerPixel(),
               exact.gbuffer().layout().bytesPerPixel());
-    EXPECT_GT(spheremap.error->p99Abs, 0.0);
-    EXPECT_LE(spheremap.error->p99Abs, spheremap.error->maxAbs);
+    EXPECT_GT(spheremap.metrics.error->p99Abs, 0.0);
+    EXPECT_LE(spheremap.metrics.error->p99Abs, spheremap.metrics.error->maxAbs);
 }
 
 TEST(RenderJob, RepetitionsRecordEveryPassAndAGivenReferenceIsReused) {
@@ -148,11 +149,11 @@ TEST(RenderJob, RepetitionsRecordEveryPassAndAGivenReferenceIsReused) {
     options.warmup = 1;
     options.repetitions = 3;
     const lighting::StageResult reference = renderReference(options);
-    const RenderRun run = runRender(options, {}, &reference);
-    ASSERT_TRUE(run.error.has_value());
+    const RenderRun run = runRender(planRender(options), {}, &reference);
+    ASSERT_TRUE(run.metrics.error.has_value());
     EXPECT_EQ(run.prepared->exact, nullptr) << "the given reference must not be rendered again";
     std::vector<std::string> passes;
-    for (const PassTiming& timing : run.passTimings) {
+    for (const PassTiming& timing : run.metrics.passes) {
         passes.push_back(timing.pass);
         EXPECT_EQ(timing.samplesMs.size(), 3u) << timing.pass;
         EXPECT_LE(timing.minMs(), timing.medianMs());
@@ -161,8 +162,8 @@ TEST(RenderJob, RepetitionsRecordEveryPassAndAGivenReferenceIsReused) {
     EXPECT_EQ(passes, (std::vector<std::string>{"gbuffer", "cull", "shading", "total"}));
     // The same reference rendered inside the job gives the same error.
     options.compareReference = true;
-    const RenderRun inside = runRender(options);
-    EXPECT_EQ(inside.error->rmse, run.error->rmse);
+    const RenderRun inside = runRender(planRender(options));
+    EXPECT_EQ(inside.metrics.error->rmse, run.metrics.error->rmse);
 }
 
 struct BadCase {

@@ -77,12 +77,25 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
         EXPECT_LE(job["time_total_min_ms"].get<double>(), job["time_total_max_ms"].get<double>());
         EXPECT_TRUE(job["rmse"].is_number()) << job.dump();
         EXPECT_TRUE(job["bytes_per_pixel"].is_number()) << job.dump();
-        EXPECT_GE(job["light_evaluations"].get<double>(), job["oracle_evaluations"].get<double>());
+        EXPECT_GE(job["light_evaluations"].get<double>(),
+                  job["oracle_light_evaluations"].get<double>());
         EXPECT_EQ(job["repetitions"], 2);
         const fs::path folder = dir / "out" / "jobs" / job["job_id"].get<std::string>();
         for (const char* name :
              {"render.exr", "preview.png", "heatmap.png", "stats.json", "done.json"})
             EXPECT_TRUE(fs::is_regular_file(folder / name)) << folder / name;
+        // One RunMetrics behind both files: the row's figures are the job's stats.json figures,
+        // by the same names.
+        std::ifstream statsFile(folder / "stats.json");
+        const Json stats = Json::parse(statsFile);
+        for (const char* figure : {"light_evaluations", "oracle_light_evaluations",
+                                   "culling_efficiency", "bytes_per_pixel"})
+            EXPECT_EQ(job[figure], stats[figure]) << figure;
+        for (const char* figure : {"rmse", "relative_rmse", "max_abs", "relative_mean", "p99_abs"})
+            EXPECT_EQ(job[figure], stats["error"][figure]) << figure;
+        for (const char* pass : {"gbuffer", "total"})
+            EXPECT_EQ(job[std::string("time_") + pass + "_median_ms"], stats["timings_ms"][pass])
+                << pass;
     }
     std::ifstream csv(dir / "out" / "results.csv");
     size_t lines = 0;
@@ -106,7 +119,7 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
     const Json redone = experiments::readResults(dir / "out")["jobs"][3];
     EXPECT_EQ(redone["job_id"], victim["job_id"]);
     for (const char* metric :
-         {"rmse", "max_abs", "p99_abs", "light_evaluations", "oracle_evaluations"})
+         {"rmse", "max_abs", "p99_abs", "light_evaluations", "oracle_light_evaluations"})
         EXPECT_EQ(redone[metric], victim[metric]) << metric;
 }
 

@@ -5,8 +5,8 @@
 //
 // Conventions: view depth d > 0 in metres; "float NDC" is the projection of the exact point
 // through the float matrix, z / w in double, rounded once to float (what the rasterizer stores,
-// see experiments/DepthStudy.h); relative errors are |p' - p| / d. kEps = 2^-24 is float's unit
-// roundoff (half an ulp at 1). Screen 1280x720, 60 degree vertical field of view throughout.
+// see experiments/studies/DepthStudy.h); relative errors are |p' - p| / d. kEps = 2^-24 is float's
+// unit roundoff (half an ulp at 1). Screen 1280x720, 60 degree vertical field of view throughout.
 #include <gtest/gtest.h>
 
 #include <algorithm>

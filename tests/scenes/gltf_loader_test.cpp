@@ -567,6 +567,157 @@ TEST(GltfLoader, UndecodableImageWarnsAndFallsBack) {
     EXPECT_EQ(scene.materials.at(0).baseColorTexture, -1);
 }
 
+// ---- metallic-roughness materials -----------------------------------------------------------
+
+// The triangle with normals, TEXCOORD_0 and TEXCOORD_1, and a material (given) over image 0, the
+// two-pixel BMP.
+GltfDocument materialDocument(const json& material) {
+    GltfDocument document;
+    const int positions = document.addVec3({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+    json& primitive = document.addPrimitive(positions, document.addIndices({0, 1, 2}), -1,
+                                            document.addVec3({{0, 0, 1}, {0, 0, 1}, {0, 0, 1}}));
+    const std::vector<glm::vec2> uv0 = {{0, 1}, {1, 1}, {0, 0}}, uv1 = {{0.5f, 0}, {1, 0}, {0, 1}};
+    primitive["attributes"]["TEXCOORD_0"] = document.addAccessor(uv0, kFloat, "VEC2", 3);
+    primitive["attributes"]["TEXCOORD_1"] = document.addAccessor(uv1, kFloat, "VEC2", 3);
+    primitive["material"] = 0;
+    (*document)["materials"] = {material};
+    (*document)["textures"] = {{{"source", 0}}};
+    (*document)["images"] = {{{"uri", "data:image/bmp;base64," + base64(twoPixelBmp())}}};
+    return document;
+}
+
+TEST(GltfLoader, MaterialReadsEveryTextureInItsColourSpaceWithItsFactors) {
+    const json material = {
+        {"pbrMetallicRoughness",
+         {{"baseColorTexture", {{"index", 0}}},
+          {"metallicRoughnessTexture", {{"index", 0}}},
+          {"metallicFactor", 0.25},
+          {"roughnessFactor", 0.75}}},
+        {"normalTexture", {{"index", 0}, {"scale", 0.5}}},
+        {"occlusionTexture", {{"index", 0}, {"strength", 0.25}}},
+        {"emissiveTexture", {{"index", 0}}},
+        {"emissiveFactor", {1.0, 0.5, 0.0}},
+        {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 3.0}}}}},
+        {"alphaMode", "MASK"},
+        {"alphaCutoff", 0.3},
+        {"doubleSided", true}};
+    const Scene scene = scenes::loadGltf(
+        writeFile(testDirectory() / "m.gltf", materialDocument(material).gltfText()));
+    EXPECT_TRUE(scene.warnings.empty());
+    const scenes::Material& m = scene.materials.at(0);
+    EXPECT_EQ(m.model, scenes::MaterialModel::MetallicRoughness);
+    EXPECT_EQ(m.metallic, 0.25f);
+    EXPECT_EQ(m.roughness, 0.75f);
+    EXPECT_EQ(m.normalScale, 0.5f);
+    EXPECT_EQ(m.occlusionStrength, 0.25f);
+    EXPECT_EQ(m.emissiveFactor, glm::vec3(1.0f, 0.5f, 0.0f));
+    EXPECT_EQ(m.emissiveStrength, 3.0f);
+    EXPECT_EQ(m.alphaMode, scenes::AlphaMode::Mask);
+    EXPECT_FLOAT_EQ(m.alphaCutoff, 0.3f);
+    EXPECT_TRUE(m.doubleSided);
+    // One image, two colour spaces: base colour and emissive are sRGB, the rest linear data.
+    ASSERT_EQ(scene.textures.size(), 2u);
+    for (int colour : {m.baseColorTexture, m.emissiveTexture})
+        EXPECT_TRUE(scene.textures.at(size_t(colour)).srgb);
+    for (int data : {m.metallicRoughnessTexture, m.normalTexture, m.occlusionTexture})
+        EXPECT_FALSE(scene.textures.at(size_t(data)).srgb);
+    EXPECT_EQ(m.baseColorTexture, m.emissiveTexture);
+    EXPECT_EQ(m.normalTexture, m.occlusionTexture);
+    // The red texel decodes to 1 either way; a mid-grey would not (sRGB 0.5 is linear 0.214).
+    EXPECT_FLOAT_EQ(scene.textures[size_t(m.baseColorTexture)].sample({0.25f, 0.5f}).r, 1.0f);
+    // No TEXCOORD_1 is read when no texture uses it; tangents are generated for the normal map.
+    const scenes::Mesh& mesh = scene.meshes.at(0);
+    EXPECT_TRUE(mesh.uvs1.empty());
+    ASSERT_EQ(mesh.tangents.size(), 3u);
+    for (const glm::vec4& t : mesh.tangents) // u along +X, v down: bitangent +Y, w = +1
+        EXPECT_EQ(t, glm::vec4(1, 0, 0, 1));
+}
+
+TEST(GltfLoader, TextureTransformAndSecondUvSet) {
+    const json transform = {{"offset", {0.0, 1.0}}, {"rotation", 1.5}, {"scale", {0.5, 2.0}}};
+    const json material = {
+        {"pbrMetallicRoughness",
+         {{"baseColorTexture",
+           {{"index", 0},
+            {"texCoord", 1},
+            {"extensions", {{"KHR_texture_transform", transform}}}}}}},
+        {"emissiveTexture",
+         {{"index", 0}, {"extensions", {{"KHR_texture_transform", {{"texCoord", 1}}}}}}}};
+    GltfDocument document = materialDocument(material);
+    (*document)["extensionsUsed"] = {"KHR_texture_transform"};
+    (*document)["extensionsRequired"] = {"KHR_texture_transform"};
+    const Scene scene =
+        scenes::loadGltf(writeFile(testDirectory() / "t.gltf", document.gltfText()));
+    const scenes::Material& m = scene.materials.at(0);
+    EXPECT_EQ(m.baseColorMapping.texCoord, 1);
+    EXPECT_EQ(m.baseColorMapping.offset, glm::vec2(0.0f, 1.0f));
+    EXPECT_EQ(m.baseColorMapping.rotationRadians, 1.5f);
+    EXPECT_EQ(m.baseColorMapping.scale, glm::vec2(0.5f, 2.0f));
+    EXPECT_EQ(m.emissiveMapping.texCoord, 1); // the extension's texCoord overrides the slot's
+    EXPECT_TRUE(m.emissiveMapping.isIdentity());
+    const scenes::Mesh& mesh = scene.meshes.at(0);
+    ASSERT_EQ(mesh.uvs1.size(), 3u);
+    EXPECT_EQ(mesh.uvs1[0], glm::vec2(0.5f, 0.0f));
+    EXPECT_TRUE(mesh.tangents.empty()); // no normal map
+}
+
+TEST(GltfLoader, TexCoordPastOneWarnsAndFallsBackToTheFactor) {
+    const json material = {
+        {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 2}}}}}};
+    const Scene scene = scenes::loadGltf(
+        writeFile(testDirectory() / "c.gltf", materialDocument(material).gltfText()));
+    ASSERT_EQ(scene.warnings.size(), 1u);
+    EXPECT_NE(scene.warnings[0].find("TEXCOORD_2"), std::string::npos) << scene.warnings[0];
+    EXPECT_EQ(scene.materials.at(0).baseColorTexture, -1);
+}
+
+TEST(GltfLoader, BadMaterialValuesAreErrors) {
+    const fs::path directory = testDirectory();
+    struct Bad {
+        json material;
+        std::string detail;
+    };
+    for (const Bad& bad :
+         {Bad{{{"alphaMode", "CUTOUT"}}, "alphaMode 'CUTOUT'"},
+          Bad{{{"alphaCutoff", -0.5}}, "alphaCutoff"},
+          Bad{{{"occlusionTexture", {{"index", 0}, {"strength", 2}}}}, "occlusionTexture.strength"},
+          Bad{{{"emissiveFactor", {2, 0, 0}}}, "emissiveFactor outside [0, 1]"},
+          Bad{{{"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", -1}}}}}},
+              "emissiveStrength"},
+          Bad{{{"emissiveTexture",
+                {{"index", 0},
+                 {"extensions", {{"KHR_texture_transform", {{"offset", {1, 2, 3}}}}}}}}},
+              "KHR_texture_transform.offset needs 2 numbers"}}) {
+        const fs::path file =
+            writeFile(directory / "bad.gltf", materialDocument(bad.material).gltfText());
+        expectGltfError(file, bad.detail);
+    }
+}
+
+TEST(GltfLoader, SharedModelsBringTheirMaterials) {
+    const Scene helmet = scenes::loadGltf(sharedModel("DamagedHelmet/DamagedHelmet.gltf"));
+    const scenes::Material& h = helmet.materials.at(0);
+    EXPECT_EQ(h.model, scenes::MaterialModel::MetallicRoughness);
+    for (int texture : h.textureIndices())
+        EXPECT_GE(texture, 0); // all five slots are filled
+    EXPECT_TRUE(helmet.textures.at(size_t(h.emissiveTexture)).srgb);
+    EXPECT_FALSE(helmet.textures.at(size_t(h.metallicRoughnessTexture)).srgb);
+    EXPECT_FALSE(helmet.textures.at(size_t(h.occlusionTexture)).srgb);
+    EXPECT_EQ(h.emissiveFactor, glm::vec3(1.0f));
+    // The helmet ships no tangents: they are generated for its normal map.
+    for (const scenes::Mesh& mesh : helmet.meshes)
+        EXPECT_EQ(mesh.tangents.size(), mesh.positions.size());
+
+    // BoomBox's occlusion-roughness-metallic image is missing: those slots fall back to the
+    // factors; its emissive and normal textures are there.
+    const Scene boomBox = scenes::loadGltf(sharedModel("BoomBox/BoomBox.gltf"));
+    const scenes::Material& b = boomBox.materials.at(0);
+    EXPECT_EQ(b.metallicRoughnessTexture, -1);
+    EXPECT_EQ(b.occlusionTexture, -1);
+    EXPECT_GE(b.emissiveTexture, 0);
+    EXPECT_GE(b.normalTexture, 0);
+}
+
 // ---- malformed files ------------------------------------------------------------------------
 
 // Writes `document` (after `breakIt`) as NAME.gltf and expects a SceneError mentioning `detail`.

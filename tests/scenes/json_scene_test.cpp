@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <stdexcept>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -338,6 +339,84 @@ TEST(JsonSceneErrors, BadValues) {
     json nearFar = spheresOnly();
     nearFar["camera"] = {{"position", {0, 0, 5}}, {"forward", {0, 0, -1}}, {"near", 2}, {"far", 1}};
     expectJsonError(nearFar, {"'far' must exceed 'near'"});
+}
+
+// ---- materials ------------------------------------------------------------------------------
+
+const scenes::Material& materialNamed(const Scene& scene, const std::string& name) {
+    for (const scenes::Material& material : scene.materials)
+        if (material.name == name)
+            return material;
+    throw std::runtime_error("no material " + name);
+}
+
+TEST(JsonScene, MaterialsDefaultToTheirSourcesModel) {
+    json document = spheresOnly();
+    document["objects"].push_back({{"gltf", kSuzanne.string()}});
+    const Scene scene = loadJson(document);
+    EXPECT_EQ(materialNamed(scene, "sphere-gold").model, scenes::MaterialModel::BlinnPhong);
+    EXPECT_EQ(materialNamed(scene, "Suzanne").model, scenes::MaterialModel::MetallicRoughness);
+}
+
+TEST(JsonScene, MaterialEntriesSetModelMetallicRoughnessAndEmissive) {
+    json document = spheresOnly();
+    document["materials"] = {
+        {{"name", "*"}, {"emissive", {0.5, 0.25, 0}}},
+        {{"name", "sphere-gold"},
+         {"model", "metallic-roughness"},
+         {"baseColor", {1.0, 0.8, 0.3}},
+         {"metallic", 1},
+         {"roughness", 0.5},
+         {"emissiveStrength", 4}},
+        {{"name", "sphere-chrome"}, {"specularPower", 30}, {"specularIntensity", 1}}};
+    const Scene reference = scenes::buildProceduralScene("spheres", {});
+    const Scene scene = loadJson(document);
+    for (const scenes::Material& material : scene.materials)
+        expectNear(material.emissiveFactor, {0.5f, 0.25f, 0.0f});
+    const scenes::Material& gold = materialNamed(scene, "sphere-gold");
+    EXPECT_EQ(gold.model, scenes::MaterialModel::MetallicRoughness);
+    EXPECT_EQ(gold.baseColorFactor, glm::vec4(1.0f, 0.8f, 0.3f, 1.0f));
+    EXPECT_EQ(gold.metallic, 1.0f);
+    EXPECT_EQ(gold.roughness, 0.5f);
+    EXPECT_EQ(gold.emissiveStrength, 4.0f);
+    // The Blinn-Phong approximation follows: ks = mix(0.04, 1, 1), power = 2 / 0.5^4 - 2.
+    EXPECT_FLOAT_EQ(gold.specularIntensity, 1.0f);
+    EXPECT_FLOAT_EQ(gold.specularPower, 30.0f);
+    const scenes::Material& chrome = materialNamed(scene, "sphere-chrome");
+    EXPECT_EQ(chrome.model, scenes::MaterialModel::BlinnPhong);
+    EXPECT_EQ(chrome.specularPower, 30.0f);
+    EXPECT_EQ(chrome.specularIntensity, 1.0f);
+    EXPECT_FLOAT_EQ(chrome.roughness, 0.5f); // (2 / 32)^(1/4)
+    // Untouched materials keep their values.
+    const scenes::Material& white = materialNamed(scene, "sphere-matte-white");
+    EXPECT_EQ(white.specularPower, materialNamed(reference, "sphere-matte-white").specularPower);
+    EXPECT_EQ(white.model, scenes::MaterialModel::BlinnPhong);
+}
+
+TEST(JsonSceneErrors, BadMaterialEntries) {
+    auto with = [](json entry) {
+        json document = spheresOnly();
+        document["materials"] = {entry};
+        return document;
+    };
+    expectJsonError(
+        with({{"name", "unobtainium"}}),
+        {"materials[0].name", "no material named 'unobtainium'", "sphere-gold", "sphere-chrome"});
+    expectJsonError(with({{"model", "phong"}, {"name", "sphere-gold"}}),
+                    {"materials[0].model", "'phong'", "metallic-roughness"});
+    expectJsonError(with({{"name", "sphere-gold"}, {"metallic", 0.5}}),
+                    {"materials[0].metallic", "'sphere-gold'", "blinn-phong"});
+    expectJsonError(
+        with({{"name", "sphere-gold"}, {"model", "metallic-roughness"}, {"specularPower", 8}}),
+        {"materials[0].specularPower", "metallic-roughness"});
+    expectJsonError(
+        with({{"name", "sphere-gold"}, {"model", "metallic-roughness"}, {"roughness", 2}}),
+        {"materials[0].roughness", "[0, 1]"});
+    expectJsonError(with({{"name", "sphere-gold"}, {"emissive", {1, -1, 0}}}),
+                    {"materials[0].emissive", "negative"});
+    expectJsonError(with({{"name", "sphere-gold"}, {"shininess", 3}}),
+                    {"materials[0]", "unknown key 'shininess'"});
+    expectJsonError(with({{"model", "blinn-phong"}}), {"materials[0]", "missing key 'name'"});
 }
 
 TEST(JsonSceneErrors, BadObjects) {

@@ -109,7 +109,8 @@ void expectWellFormed(const Mesh& mesh) {
             const glm::dvec3 tangent(glm::vec3(mesh.tangents[c]));
             const glm::dvec3 bitangent = double(mesh.tangents[c].w) * glm::cross(n, tangent);
             expectTrue(glm::dot(uDirection, tangent) > 0.0, where + ": tangent against uv.x");
-            expectTrue(glm::dot(vDirection, bitangent) > 0.0, where + ": bitangent against uv.y");
+            // glTF: the bitangent points up the image, towards decreasing uv.y.
+            expectTrue(glm::dot(vDirection, bitangent) < 0.0, where + ": bitangent along uv.y");
         }
     }
     EXPECT_EQ(failures, 0);

@@ -34,6 +34,10 @@
 // the commit, the machine's thread count and the study's time. Every file is written under a
 // temporary name and renamed.
 //
+// Pieces (experiments/studies/): DepthSampler.h (the sample model, steps 1-4), DepthStudy.cpp
+// (the statistics over the pixel grid and the per-series summary, the command),
+// DepthStudyOutputs.h (CSV through CsvTable, JSON, the printed table), StudyPlots.h (the plots).
+//
 // Thread safety: runDepthStudy runs the (format, camera) series in parallel (TBB), each writing
 // only its own rows, so the result is identical for any thread count. All functions share no
 // state.
@@ -47,10 +51,13 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
-#include "gbuffer/CameraView.h"
 #include "gbuffer/DepthFormat.h"
 
 namespace experiments {
+
+// The reconstruction methods the study compares, in row order.
+inline constexpr gbuffer::PositionMethod kDepthStudyMethods[] = {
+    gbuffer::PositionMethod::InverseProjection, gbuffer::PositionMethod::ViewRay};
 
 struct DepthStudyCamera {
     double nearMetres = 0.1;
@@ -116,49 +123,12 @@ struct DepthStudyResult {
     double studySeconds = 0.0;
 };
 
-// One camera and one format: the CameraView and DepthProjection the G-buffer would use, and the
-// sample model above. Cheap to copy; const methods are thread-safe.
-class DepthSampler {
-public:
-    DepthSampler(const DepthStudyOptions& options, DepthStudyCamera camera,
-                 gbuffer::DepthFormatSpec format);
-
-    const gbuffer::CameraView& view() const { return mView; }
-    const gbuffer::DepthProjection& projection() const { return mProjection; }
-    // Exact view-space point at view depth d on the ray through pixel (x, y)'s centre.
-    glm::dvec3 exactPointView(int x, int y, double viewDepthMetres) const;
-    // Step 2 of the model: float NDC depth of an exact view-space point.
-    float rasterDepthNdc(const glm::dvec3& pointView) const;
-    // Step 3: whether a float NDC depth is lost (clipped or equal to the clear value).
-    bool lost(float depthNdc) const;
-    // Steps 4: the position GBuffer reconstructs at pixel (x, y) from NDC depth `depthNdc`.
-    glm::vec3 reconstruct(gbuffer::PositionMethod method, int x, int y, float depthNdc) const;
-    double depthStepMetres(double viewDepthMetres) const;
-
-private:
-    double codeViewDepthExact(uint32_t code) const;
-    bool validCode(uint64_t code) const;
-
-    gbuffer::DepthFormatSpec mFormat;
-    gbuffer::CameraView mView;
-    gbuffer::DepthProjection mProjection;
-    glm::dmat4 mRasterClipFromView; // the float matrix, widened: what the rasterizer applies
-    double mViewXPerNdc = 1.0;      // exact: x_view = ndc.x * d * mViewXPerNdc
-    double mViewYPerNdc = 1.0;
-};
-
 // The distances the study measures: log-spaced from just inside near to just inside far.
 std::vector<double> depthStudyDistances(const DepthStudyOptions& options, DepthStudyCamera camera);
 
 // Runs the study. Throws std::invalid_argument for empty lists, counts < 2, sizes < 1, a field of
 // view outside (0, 180) degrees, or a camera without 0 < near < far.
 DepthStudyResult runDepthStudy(const DepthStudyOptions& options);
-
-std::string depthStudyCsv(const DepthStudyResult& result);
-std::string depthStepsCsv(const DepthStudyResult& result);
-nlohmann::json depthStudyJson(const DepthStudyResult& result);
-// The summary table printed by `testbed depth`.
-std::string depthSummaryTable(const DepthStudyResult& result);
 
 struct DepthCommandOptions {
     std::filesystem::path out = "depth";
@@ -168,8 +138,6 @@ struct DepthCommandOptions {
     // Empty = found by findPythonWithMatplotlib (experiments/PlotScript.h).
     std::string python;
 };
-
-std::filesystem::path defaultDepthPlotsScript();
 
 // Runs the study, writes the outputs, draws the plots, prints the summary and "outputs in DIR";
 // returns the exit code. Errors (unwritable folder, missing python3/matplotlib or script, failing

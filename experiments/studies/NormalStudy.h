@@ -23,6 +23,11 @@
 // (one thread, SoA arrays), labelled as such; the Google Benchmark figures are in
 // tests/bench/normal_codec_bench.cpp.
 // Memory: one dataset at a time, 32 bytes per sample (N = 10^7: ~320 MB).
+//
+// Pieces (experiments/studies/): NormalSampling.h (random streams and data sets),
+// HardNormalCases.cpp (the hard set), NormalStatistics.h (errors, occupancy, throughput, maps,
+// negative-z fractions), NormalStudyOutputs.h (CSV through CsvTable, JSON, the printed table),
+// StudyPlots.h (the matplotlib script); NormalStudy.cpp runs the steps in order.
 #pragma once
 
 #include <cstdint>
@@ -121,8 +126,8 @@ struct NormalStudyResult {
 };
 
 // Runs the study and writes DIR/normals.csv, DIR/normals.json and the error grids; then the
-// plots unless options.plots is false. Throws UsageError-like std::invalid_argument for bad
-// options (before any work) and std::runtime_error when a step fails (e.g. no python3 with
+// plots unless options.plots is false. Throws std::invalid_argument for bad options and a missing
+// plot script (before any work) and std::runtime_error when a step fails (e.g. no python3 with
 // matplotlib: the message says so; csv/json are written first). `progress` receives one line
 // per step.
 NormalStudyResult runNormalStudy(const NormalStudyOptions& options,

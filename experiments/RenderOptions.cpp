@@ -1,0 +1,152 @@
+#include "experiments/RenderOptions.h"
+
+#include <algorithm>
+#include <charconv>
+#include <filesystem>
+
+#include "lighting/StageRegistry.h"
+#include "scenes/ProceduralScenes.h"
+
+namespace experiments {
+
+namespace {
+
+std::string joined(const std::vector<std::string>& names) {
+    std::string text;
+    for (const std::string& name : names)
+        text += (text.empty() ? "" : ", ") + name;
+    return text;
+}
+
+template <typename Number> Number parseNumber(const std::string& key, const std::string& value) {
+    Number number{};
+    const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
+    if (error != std::errc() || end != value.data() + value.size())
+        throw UsageError("option '" + key + "': '" + value + "' is not a valid number");
+    return number;
+}
+
+void checkSizes(const RenderOptions& options) {
+    if (options.width <= 0 || options.height <= 0 || options.width > kMaxImageSide ||
+        options.height > kMaxImageSide ||
+        uint64_t(options.width) * uint64_t(options.height) > kMaxPixels)
+        throw UsageError("image size " + std::to_string(options.width) + "x" +
+                         std::to_string(options.height) + " refused: each side must be 1.." +
+                         std::to_string(kMaxImageSide) + " and at most " +
+                         std::to_string(kMaxPixels) + " pixels in all");
+    if (options.lights < 0 || options.lights > kMaxLights)
+        throw UsageError("--lights " + std::to_string(options.lights) + " refused: must be 0.." +
+                         std::to_string(kMaxLights));
+    if (options.threads < 0 || options.threads > kMaxThreads)
+        throw UsageError("--threads " + std::to_string(options.threads) +
+                         " refused: must be 0 (all) .. " + std::to_string(kMaxThreads));
+}
+
+void checkScene(const std::string& scene) {
+    if (scenes::isProceduralScene(scene))
+        return;
+    const std::filesystem::path path(scene);
+    const std::string extension = path.extension().string();
+    if (extension != ".gltf" && extension != ".glb" && extension != ".json")
+        throw UsageError("unknown scene '" + scene + "': not a built-in scene (" +
+                         joined(scenes::proceduralSceneNames()) + ") nor a .gltf/.glb/.json file");
+    if (!std::filesystem::is_regular_file(path))
+        throw UsageError("scene file '" + scene + "' not found");
+}
+
+void checkRepetitions(const RenderOptions& options) {
+    if (options.warmup < 0 || options.warmup > kMaxRepetitions || options.repetitions < 1 ||
+        options.repetitions > kMaxRepetitions)
+        throw UsageError("--warmup " + std::to_string(options.warmup) + " / --repetitions " +
+                         std::to_string(options.repetitions) + " refused: warmup 0.." +
+                         std::to_string(kMaxRepetitions) + ", repetitions 1.." +
+                         std::to_string(kMaxRepetitions));
+}
+
+// The G-buffer names of the options parsed (throws UsageError for bad encodings, formats or
+// presets).
+gbuffer::LayoutRequest layoutRequest(const RenderOptions& options) {
+    return usageErrorFrom([&] {
+        gbuffer::LayoutRequest request;
+        if (!options.layout.empty()) {
+            const std::vector<std::string> presets = gbuffer::layoutPresetNames();
+            if (std::find(presets.begin(), presets.end(), options.layout) == presets.end())
+                throw UsageError("unknown G-buffer layout '" + options.layout +
+                                 "'; valid: " + joined(presets));
+            request.preset = options.layout;
+        }
+        if (!options.normals.empty())
+            request.normals = gbuffer::NormalCodecSpec::parse(options.normals);
+        if (!options.depth.empty())
+            request.depth = gbuffer::DepthFormatSpec::parse(options.depth);
+        if (!options.position.empty())
+            request.position = gbuffer::parsePositionMethod(options.position);
+        if (!options.normalSpace.empty())
+            request.normalSpace = gbuffer::parseNormalSpace(options.normalSpace);
+        return request;
+    });
+}
+
+} // namespace
+
+CheckedOptions checkOptions(const RenderOptions& options) {
+    checkSizes(options);
+    CheckedOptions checked;
+    checked.stage = lighting::makeStage(options.stage); // throws StageError listing valid names
+    checkScene(options.scene);
+    checkRepetitions(options);
+    checked.layoutRequest = layoutRequest(options);
+    return checked;
+}
+
+void validate(const RenderOptions& options) {
+    checkOptions(options);
+}
+
+std::vector<std::string> renderOptionKeys() {
+    return {
+        "scene",   "stage",  "lights",  "seed",         "width", "height",   "resolution",
+        "threads", "layout", "normals", "normal-space", "depth", "position", "scene-option.<key>"};
+}
+
+void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
+    static const std::string kSceneOption = "scene-option.";
+    if (key == "scene")
+        options.scene = value;
+    else if (key == "stage")
+        options.stage = value;
+    else if (key == "lights")
+        options.lights = parseNumber<int>(key, value);
+    else if (key == "seed")
+        options.seed = parseNumber<uint64_t>(key, value);
+    else if (key == "width")
+        options.width = parseNumber<int>(key, value);
+    else if (key == "height")
+        options.height = parseNumber<int>(key, value);
+    else if (key == "threads")
+        options.threads = parseNumber<int>(key, value);
+    else if (key == "layout")
+        options.layout = value;
+    else if (key == "normals")
+        options.normals = value;
+    else if (key == "normal-space")
+        options.normalSpace = value;
+    else if (key == "depth")
+        options.depth = value;
+    else if (key == "position")
+        options.position = value;
+    else if (key == "resolution") {
+        const size_t x = value.find('x');
+        if (x == std::string::npos)
+            throw UsageError("option 'resolution': '" + value + "' is not WIDTHxHEIGHT");
+        options.width = parseNumber<int>(key, value.substr(0, x));
+        options.height = parseNumber<int>(key, value.substr(x + 1));
+    } else if (key.rfind(kSceneOption, 0) == 0 && key.size() > kSceneOption.size()) {
+        options.sceneOptions[key.substr(kSceneOption.size())] = value;
+    } else {
+        throw UsageError("unknown render option '" + key +
+                         "'; valid: " + joined(renderOptionKeys()));
+    }
+}
+
+} // namespace experiments

@@ -1,0 +1,91 @@
+// RenderOptions: every option of one render (the CLI's `testbed render` and every job of a
+// sweep), their defaults in one place, setting them from text by name, and their validation.
+// Validation is cheap (it loads no scene and allocates no image) and names the first bad option;
+// planRender (RenderPlan.h) validates once and keeps what validation built on the way.
+//
+// Errors: UsageError, one clear message naming the option and what was expected. A bad G-buffer
+// name reported by the gbuffer library as std::invalid_argument becomes a UsageError through
+// usageErrorFrom, the one place that conversion is written.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "gbuffer/LayoutDerivation.h"
+#include "lighting/ShadingStage.h"
+
+namespace experiments {
+
+// Every option of a render, with its default in one place (the CLI's --help shows these).
+struct RenderOptions {
+    std::string scene = "atrium";
+    std::map<std::string, std::string> sceneOptions; // --scene-option key=value
+    std::string stage = "brute";
+    int lights = 256;
+    uint64_t seed = 1;
+    int width = 1280;
+    int height = 720;
+    int threads = 0; // 0 = every hardware thread
+    bool compareReference = false;
+    // G-buffer: a preset name ("" = derived from the scene and the stage,
+    // gbuffer/LayoutDerivation.h), then overrides of its normal encoding ("NAME:BITS"), depth
+    // format and position method.
+    std::string layout;
+    std::string normals;
+    std::string depth;
+    std::string position;
+    std::string normalSpace; // "view" (default) or "world"
+    int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
+    int repetitions = 1; // timed runs; timings are reported as median, min and max over them
+};
+
+// Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
+// seed, width, height, resolution (WxH), threads, layout, normals, normal-space, depth, position,
+// and scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown
+// key throws UsageError naming it. The sweep runner goes through this, so every stage, encoding
+// or scene added later is reachable without touching the runner.
+void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
+// The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
+std::vector<std::string> renderOptionKeys();
+
+// Limits checked before any work or allocation (issue: 100000x100000 must be refused up front).
+inline constexpr int kMaxImageSide = 16384;
+inline constexpr uint64_t kMaxPixels = uint64_t(8192) * 8192;
+inline constexpr int kMaxLights = 1'000'000;
+inline constexpr int kMaxThreads = 1024;
+inline constexpr int kMaxRepetitions = 1000;
+
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// What validating the options builds on its way: the stage (made from its spec, options parsed)
+// and the G-buffer layout request (names parsed). planRender keeps them instead of building them
+// again.
+struct CheckedOptions {
+    std::unique_ptr<lighting::ShadingStage> stage;
+    gbuffer::LayoutRequest layoutRequest;
+};
+
+// Checks every option in a fixed order (size, lights, threads, stage, scene, repetitions, G-buffer
+// names) and throws UsageError (lighting::StageError for a bad stage spec, listing the valid
+// names) for the first bad one. Cheap: loads nothing.
+CheckedOptions checkOptions(const RenderOptions& options);
+// checkOptions for its verdict alone (the sweep checks every job this way before running any).
+void validate(const RenderOptions& options);
+
+// Runs `build`; a std::invalid_argument it throws (the gbuffer library's way of refusing a name
+// or a layout) becomes a UsageError with the same message.
+template <typename Build> auto usageErrorFrom(Build&& build) -> decltype(build()) {
+    try {
+        return build();
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+    }
+}
+
+} // namespace experiments

@@ -1,0 +1,37 @@
+#include "experiments/RenderPlan.h"
+
+#include <algorithm>
+#include <thread>
+
+#include "scenes/SceneLoader.h"
+
+namespace experiments {
+
+int effectiveThreads(int requested) {
+    return requested > 0 ? requested : std::max(1, int(std::thread::hardware_concurrency()));
+}
+
+scenes::Scene loadRequestedScene(const RenderOptions& options) {
+    scenes::SceneRequest request;
+    request.lightCount = options.lights;
+    request.seed = options.seed;
+    request.options = options.sceneOptions;
+    return scenes::loadScene(options.scene, request);
+}
+
+RenderPlan planRender(const RenderOptions& options) {
+    CheckedOptions checked = checkOptions(options);
+    RenderPlan plan;
+    plan.options = options;
+    plan.threads = effectiveThreads(options.threads);
+    plan.scene = loadRequestedScene(options);
+    plan.stage = std::move(checked.stage);
+    plan.requirements = plan.stage->requirements();
+    plan.layout = usageErrorFrom([&] {
+        return gbuffer::makeLayout(plan.scene, plan.requirements.channels, plan.stage->name(),
+                                   checked.layoutRequest);
+    });
+    return plan;
+}
+
+} // namespace experiments

@@ -1,0 +1,39 @@
+// RenderPlan: everything decided about a render before any heavy work. planRender validates the
+// options once (RenderOptions.h), loads the scene (its materials decide the derived layout), makes
+// the stage and derives the G-buffer layout; runRender (RenderJob.h) then rasterizes and shades
+// exactly that. `testbed render` (also for --explain-layout, which stops at the plan) and every
+// job of a sweep go through this pair, so the CLI and the sweep cannot plan a render differently.
+//
+// Cost: planning loads the scene (a glTF file with its textures) but rasterizes nothing and
+// allocates no image. Errors: UsageError for bad options and a layout lacking a channel the stage
+// reads, lighting::StageError for a bad stage spec, scenes::SceneError for a bad scene file.
+#pragma once
+
+#include <memory>
+
+#include "experiments/RenderOptions.h"
+#include "gbuffer/GBufferLayout.h"
+#include "lighting/ShadingStage.h"
+#include "scenes/Scene.h"
+
+namespace experiments {
+
+struct RenderPlan {
+    RenderOptions options; // validated
+    int threads = 0;       // effective: options.threads, or every hardware thread for 0
+    scenes::Scene scene;   // loaded with the requested lights, seed and scene options
+    std::unique_ptr<lighting::ShadingStage> stage;
+    lighting::StageRequirements requirements; // stage->requirements()
+    gbuffer::GBufferLayout layout;            // derived, or the requested preset with overrides
+};
+
+RenderPlan planRender(const RenderOptions& options);
+
+// The scene of the options (lights generated with the seed, scene options applied). Throws
+// scenes::SceneError for a bad file or option.
+scenes::Scene loadRequestedScene(const RenderOptions& options);
+
+// The worker threads of a thread option: itself, or every hardware thread for 0.
+int effectiveThreads(int requested);
+
+} // namespace experiments

@@ -1,0 +1,112 @@
+// RunMetrics: the figures of one render, computed once (at the end of runRender) and written by
+// both of its outputs: stats.json (RenderCommand.h statsJson) and a sweep's results row
+// (SweepRunner.cpp). The names below are the names in both files; a figure is renamed here or
+// nowhere.
+//
+// What is measured:
+//   passes        one PassTiming per pass in execution order: gbuffer, exact_surface (reference
+//                 stage only), the stage's own passes (lighting/PassNames.h), total (G-buffer plus
+//                 the stage's passes). Samples are the timed repetitions, after the warm-up runs.
+//   stage         the stage's own passes summed per repetition (total without the G-buffer pass):
+//                 what papers that exclude the G-buffer pass report (Örtegren's "Total").
+//   light evaluations   lights the stage evaluated, summed over pixels; the oracle's count is the
+//                 lights that contribute (DESIGN.md); culling efficiency = oracle / evaluated (1
+//                 when nothing was evaluated).
+//   bytes per pixel     the layout's bits as a GPU packs them, and what this run allocates.
+//   error         against the double-precision reference, when compared (compareImages).
+// Thread safety: values; compareImages runs ImageBufAlgo on the calling thread's pool.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "lighting/ShadingStage.h"
+
+namespace experiments {
+
+// Output names shared by stats.json and the sweep's result columns.
+namespace metric {
+inline constexpr const char* kLightEvaluations = "light_evaluations";
+inline constexpr const char* kOracleLightEvaluations = "oracle_light_evaluations";
+inline constexpr const char* kCullingEfficiency = "culling_efficiency";
+inline constexpr const char* kBytesPerPixel = "bytes_per_pixel";
+inline constexpr const char* kAllocatedBytesPerPixel = "allocated_bytes_per_pixel";
+inline constexpr const char* kRmse = "rmse";
+inline constexpr const char* kRelativeRmse = "relative_rmse";
+inline constexpr const char* kPsnr = "psnr";
+inline constexpr const char* kMaxAbs = "max_abs";
+inline constexpr const char* kRelativeMean = "relative_mean";
+inline constexpr const char* kP99Abs = "p99_abs";
+} // namespace metric
+
+// Passes the runner adds around the stage's (lighting/PassNames.h has the frame's passes).
+namespace pass {
+inline constexpr const char* kStage = "stage"; // the stage's own passes summed
+inline constexpr const char* kTotal = "total"; // G-buffer plus the stage's passes
+} // namespace pass
+
+// Over all pixels and the three colour channels.
+struct ErrorMetrics {
+    double rmse = 0.0;
+    double relativeRmse = 0.0; // rmse / rms of the reference
+    double maxAbs = 0.0;
+    double psnr = 0.0;         // dB, peak = the reference's maximum channel value
+    double relativeMean = 0.0; // mean |image - reference| / mean |reference|
+    double p99Abs = 0.0;       // 99th percentile of |image - reference|
+};
+
+ErrorMetrics compareImages(const lighting::StageResult& image,
+                           const lighting::StageResult& reference);
+
+// One pass's times over the timed repetitions.
+struct PassTiming {
+    std::string pass;
+    std::vector<double> samplesMs;
+    double medianMs() const;
+    double minMs() const;
+    double maxMs() const;
+};
+
+// A named figure of a run, in output order.
+struct NamedFigure {
+    const char* name;
+    double value;
+};
+
+struct RunMetrics {
+    std::vector<PassTiming> passes; // execution order, total last
+    PassTiming stage;               // pass::kStage; no samples when the stage reports no pass
+    double oracleMs = 0.0;          // measurement, not part of the stage
+    double referenceMs = 0.0;
+    uint64_t lightEvaluations = 0;
+    uint64_t oracleLightEvaluations = 0;
+    double cullingEfficiency = 1.0;
+    double bytesPerPixel = 0.0;
+    double allocatedBytesPerPixel = 0.0;
+    std::optional<ErrorMetrics> error;
+
+    // rmse, relative_rmse, psnr, max_abs, relative_mean, p99_abs (empty without a reference);
+    // psnr is +inf for identical images.
+    std::vector<NamedFigure> errorFigures() const;
+};
+
+// Adds one repetition's pass times (in the stage's order; a pass reported twice is summed) to
+// `passes`, keeping the passes' first-seen order.
+void addRepetition(std::vector<PassTiming>& passes,
+                   const std::vector<std::pair<std::string, double>>& repetition);
+
+// The metrics of a run from what it measured: the timed passes, the per-pixel counts of the
+// stage and the oracle, the layout's sizes, and the error when compared.
+RunMetrics measureRun(std::vector<PassTiming> passes, const std::vector<uint32_t>& evaluated,
+                      const std::vector<uint32_t>& oracle, double bytesPerPixel,
+                      double allocatedBytesPerPixel, std::optional<ErrorMetrics> error);
+
+// The sweep's metric column names that a RunMetrics fills, after the time columns, in table order:
+// light_evaluations, oracle_light_evaluations, culling_efficiency, bytes_per_pixel, then the
+// error figures.
+std::vector<std::string> runFigureColumns();
+
+} // namespace experiments

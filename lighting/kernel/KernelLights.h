@@ -1,0 +1,44 @@
+// KernelLights: a frame's view-space lights as the shading kernel reads them, built once per frame
+// from the float LightInView list (lighting/Brdf.h). Each light is one 64-byte record (one cache
+// line) whose fields the vector kernel broadcasts to every lane; the parts of the formula that
+// depend only on the light (range squared, spot cone width) are computed here once instead of
+// once per pixel, with the very same float operations evaluateLight performs, so the values are
+// bitwise the ones it would compute. The source list is kept for the scalar path, which calls
+// evaluateLight itself. Immutable after construction: safe to share between threads.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "lighting/Brdf.h"
+
+namespace lighting::kernel {
+
+// The light types as the kernel switches on them (values of scenes::LightType, stored as an int).
+struct alignas(64) KernelLight {
+    float positionView[3];
+    float rangeSquared; // rangeMetres * rangeMetres
+    float directionView[3];
+    float spotOuterCos;
+    float radiance[3];
+    float spotWidth; // spotInnerCos - spotOuterCos; the smoothstep is skipped when not > 0
+    uint32_t type;   // scenes::LightType
+    uint32_t padding[3];
+};
+static_assert(sizeof(KernelLight) == 64, "one light per cache line");
+
+class KernelLights {
+public:
+    KernelLights() = default;
+    explicit KernelLights(std::vector<LightInView<float>> lights);
+
+    size_t size() const { return mSource.size(); }
+    const KernelLight* records() const { return mRecords.data(); }
+    const std::vector<LightInView<float>>& source() const { return mSource; }
+
+private:
+    std::vector<LightInView<float>> mSource;
+    std::vector<KernelLight> mRecords; // alignas(64) element: the allocator aligns (C++17)
+};
+
+} // namespace lighting::kernel

@@ -1,0 +1,88 @@
+// shadePacketScalar: the kernel's scalar path and the vector path's oracle. Each lane calls
+// lighting/Brdf.h's evaluateLight<float> for each light, exactly as the per-pixel stages do today;
+// the packet-level early-out counters come from earlyExit, which repeats evaluateLight's three
+// rejection tests with the same float operations (so they take the same decisions), and apply the
+// vector path's rule: a light is skipped when every active lane rejects it.
+#include "lighting/kernel/LightKernel.h"
+
+#include <cmath>
+
+#include "lighting/Brdf.h"
+
+namespace lighting::kernel {
+
+namespace {
+
+enum class EarlyExit { None, Range, ConeOrFacing };
+
+// Where evaluateLight returns zero before shading, for this point and light.
+EarlyExit earlyExit(const gbuffer::Surface& s, const LightInView<float>& light) {
+    using scenes::LightType;
+    if (light.type == LightType::Ambient)
+        return EarlyExit::None;
+    glm::vec3 toLight;
+    if (light.type == LightType::Directional) {
+        toLight = -light.directionView;
+    } else {
+        const glm::vec3 offset = light.positionView - s.positionView;
+        const float distance2 = glm::dot(offset, offset);
+        if (!(distance2 < light.rangeMetres * light.rangeMetres))
+            return EarlyExit::Range;
+        toLight = distance2 > 0.0f ? offset / std::sqrt(distance2) : s.normalView;
+        if (light.type == LightType::Spot &&
+            !(-glm::dot(toLight, light.directionView) > light.spotOuterCos))
+            return EarlyExit::ConeOrFacing;
+    }
+    return glm::dot(s.normalView, toLight) > 0.0f ? EarlyExit::None : EarlyExit::ConeOrFacing;
+}
+
+} // namespace
+
+void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const KernelLights& lights,
+                       std::span<const uint32_t> lightIndices, PacketAccumulator& accumulator,
+                       bool countContributing) {
+    laneMask &= packet.laneMask;
+    if (laneMask == 0)
+        return;
+    gbuffer::Surface points[kPacketLanes];
+    glm::vec3 toViewer[kPacketLanes];
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        if (!(laneMask >> lane & 1u))
+            continue;
+        gbuffer::Surface& p = points[lane];
+        for (int c = 0; c < 3; ++c) {
+            p.positionView[c] = packet.positionView[c][lane];
+            p.normalView[c] = packet.normalView[c][lane];
+            p.albedo[c] = packet.albedo[c][lane];
+        }
+        p.specularIntensity = packet.specularIntensity[lane];
+        p.specularPower = packet.specularPower[lane];
+        toViewer[lane] = glm::normalize(-p.positionView);
+        accumulator.lightsEvaluated[lane] += uint32_t(lightIndices.size());
+    }
+    const std::vector<LightInView<float>>& source = lights.source();
+    for (uint32_t index : lightIndices) {
+        const LightInView<float>& light = source[index];
+        bool anyShaded = false, anyPastRange = false;
+        for (int lane = 0; lane < kPacketLanes; ++lane) {
+            if (!(laneMask >> lane & 1u))
+                continue;
+            const EarlyExit exit = earlyExit(points[lane], light);
+            anyShaded |= exit == EarlyExit::None;
+            anyPastRange |= exit != EarlyExit::Range;
+            const glm::vec3 radiance = evaluateLight(points[lane], toViewer[lane], light);
+            for (int c = 0; c < 3; ++c)
+                accumulator.radiance[c][lane] += radiance[c];
+            if (countContributing)
+                accumulator.lightsContributing[lane] += contributes(radiance) ? 1u : 0u;
+        }
+        if (anyShaded)
+            ++accumulator.lightsShaded;
+        else if (anyPastRange)
+            ++accumulator.lightsSkippedAtConeOrFacing;
+        else
+            ++accumulator.lightsSkippedAtRange;
+    }
+}
+
+} // namespace lighting::kernel

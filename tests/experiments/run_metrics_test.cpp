@@ -1,0 +1,96 @@
+// The render plan and the metrics record: planRender decides the layout the run uses and refuses
+// bad input before any rendering; measureRun derives the stage's time, the light counts and the
+// culling efficiency from what a run measured; the table columns are RunMetrics' names.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "experiments/RenderJob.h"
+#include "experiments/ResultsTable.h"
+#include "experiments/RunMetrics.h"
+#include "lighting/StageRegistry.h"
+
+namespace {
+
+using experiments::PassTiming;
+using experiments::RenderOptions;
+using experiments::RunMetrics;
+
+RenderOptions tinySpheres() {
+    RenderOptions options;
+    options.scene = "spheres";
+    options.stage = "tiled";
+    options.lights = 8;
+    options.width = 96;
+    options.height = 54;
+    options.threads = 2;
+    return options;
+}
+
+TEST(RenderPlan, DecidesTheLayoutAndStageTheRunUses) {
+    RenderOptions options = tinySpheres();
+    options.normals = "octahedral:16";
+    options.depth = "unorm24";
+    experiments::RenderPlan plan = experiments::planRender(options);
+    EXPECT_EQ(plan.stage->name(), "tiled");
+    EXPECT_EQ(plan.threads, 2);
+    const std::string normals = plan.layout.normals.text();
+    const double bytes = plan.layout.bytesPerPixel();
+    EXPECT_EQ(normals, "octahedral:16");
+    const experiments::RenderRun run = experiments::runRender(std::move(plan));
+    EXPECT_EQ(run.gbuffer().layout().normals.text(), normals);
+    EXPECT_EQ(run.gbuffer().layout().depth.text(), "unorm24");
+    EXPECT_EQ(run.metrics.bytesPerPixel, bytes);
+}
+
+TEST(RenderPlan, RefusesBadInputBeforeRendering) {
+    RenderOptions options = tinySpheres();
+    options.layout = "no-such-preset";
+    EXPECT_THROW(experiments::planRender(options), experiments::UsageError);
+    options = tinySpheres();
+    options.normals = "octahedral:7";
+    EXPECT_THROW(experiments::planRender(options), experiments::UsageError);
+    options = tinySpheres();
+    options.stage = "tiled:tile=0";
+    EXPECT_THROW(experiments::planRender(options), lighting::StageError);
+    options = tinySpheres();
+    options.width = 0;
+    EXPECT_THROW(experiments::planRender(options), experiments::UsageError);
+}
+
+TEST(RunMetrics, StageTimeExcludesTheRunnersPassesAndEfficiencyIsOracleOverEvaluated) {
+    std::vector<PassTiming> passes;
+    experiments::addRepetition(
+        passes,
+        {{"gbuffer", 10.0}, {"cull", 1.0}, {"shading", 2.0}, {"shading", 0.5}, {"total", 13.5}});
+    experiments::addRepetition(
+        passes, {{"gbuffer", 12.0}, {"cull", 3.0}, {"shading", 4.0}, {"total", 19.0}});
+    ASSERT_EQ(passes.size(), 4u);
+    EXPECT_EQ(passes[2].pass, "shading");
+    EXPECT_EQ(passes[2].samplesMs, (std::vector<double>{2.5, 4.0})); // reported twice: summed
+    const RunMetrics metrics =
+        experiments::measureRun(passes, {3, 0, 5}, {1, 0, 3}, 7.0, 8.0, std::nullopt);
+    EXPECT_EQ(metrics.stage.pass, "stage");
+    EXPECT_EQ(metrics.stage.samplesMs, (std::vector<double>{3.5, 7.0}));
+    EXPECT_EQ(metrics.stage.medianMs(), 5.25);
+    EXPECT_EQ(metrics.lightEvaluations, 8u);
+    EXPECT_EQ(metrics.oracleLightEvaluations, 4u);
+    EXPECT_EQ(metrics.cullingEfficiency, 0.5);
+    EXPECT_EQ(metrics.bytesPerPixel, 7.0);
+    EXPECT_EQ(metrics.allocatedBytesPerPixel, 8.0);
+    EXPECT_TRUE(metrics.errorFigures().empty());
+    // Nothing evaluated: nothing wasted.
+    EXPECT_EQ(experiments::measureRun({}, {0}, {0}, 0, 0, std::nullopt).cullingEfficiency, 1.0);
+}
+
+TEST(RunMetrics, TheTableColumnsAreTheRecordsFigures) {
+    const std::vector<std::string> columns = experiments::metricColumns({});
+    const std::vector<std::string> figures = experiments::runFigureColumns();
+    EXPECT_EQ(columns, figures);
+    EXPECT_EQ(figures, (std::vector<std::string>{"light_evaluations", "oracle_light_evaluations",
+                                                 "culling_efficiency", "bytes_per_pixel", "rmse",
+                                                 "relative_rmse", "psnr", "max_abs",
+                                                 "relative_mean", "p99_abs"}));
+}
+
+} // namespace

@@ -1,0 +1,164 @@
+// Inputs for the kernel tests: random packets and lights (seeded, so every run sees the same
+// cases), the double-precision reference of one lane, and ULP distances. View space as everywhere
+// (camera at the origin looking down -Z).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "lighting/Brdf.h"
+#include "lighting/kernel/KernelIsa.h"
+#include "lighting/kernel/KernelLights.h"
+#include "lighting/kernel/ShadingPacket.h"
+
+namespace kerneltest {
+
+using lighting::LightInView;
+using lighting::kernel::kPacketLanes;
+using lighting::kernel::ShadingPacket;
+using scenes::LightType;
+
+struct Surface {
+    glm::vec3 position{0.0f, 0.0f, -5.0f};
+    glm::vec3 normal{0.0f, 0.0f, 1.0f};
+    glm::vec3 albedo{0.5f};
+    float specularIntensity = 0.2f;
+    float specularPower = 16.0f;
+};
+
+inline gbuffer::Surface pointOf(const Surface& s) {
+    return {s.position, s.normal, s.albedo, s.specularIntensity, s.specularPower};
+}
+
+inline void setLane(ShadingPacket& packet, int lane, const Surface& s) {
+    packet.setLane(lane, s.position, s.normal, s.albedo, s.specularIntensity, s.specularPower);
+}
+
+// A packet whose inactive lanes hold NaN, so a kernel that lets them leak is caught.
+inline ShadingPacket poisonedPacket() {
+    ShadingPacket packet;
+    packet.clear();
+    const float nan = std::nanf("");
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        for (int c = 0; c < 3; ++c) {
+            packet.positionView[c][lane] = nan;
+            packet.normalView[c][lane] = nan;
+            packet.albedo[c][lane] = nan;
+        }
+        packet.specularIntensity[lane] = nan;
+        packet.specularPower[lane] = nan;
+    }
+    return packet;
+}
+
+class RandomScene {
+public:
+    explicit RandomScene(uint32_t seed) : mRandom(seed) {}
+
+    float uniform(float lo, float hi) {
+        return std::uniform_real_distribution<float>(lo, hi)(mRandom);
+    }
+    bool chance(float p) { return uniform(0.0f, 1.0f) < p; }
+
+    glm::vec3 unitVector() {
+        for (;;) {
+            const glm::vec3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+            const float length2 = glm::dot(v, v);
+            if (length2 > 1e-4f && length2 <= 1.0f)
+                return v / std::sqrt(length2);
+        }
+    }
+
+    // A surface point in front of the camera, mostly facing it, with a material of the range
+    // the scenes use (specular powers 1..8192, sometimes 0).
+    Surface surface() {
+        Surface s;
+        s.position = {uniform(-6, 6), uniform(-4, 4), uniform(-25, -0.5f)};
+        s.normal = unitVector();
+        if (glm::dot(s.normal, -s.position) < 0.0f && chance(0.8f))
+            s.normal = -s.normal;
+        s.albedo = {uniform(0.01f, 1), uniform(0.01f, 1), uniform(0.01f, 1)};
+        s.specularIntensity = chance(0.1f) ? 0.0f : uniform(0, 1);
+        s.specularPower = chance(0.05f) ? 0.0f : std::exp2(uniform(0, 13));
+        return s;
+    }
+
+    // A light near `target`: mostly points, some spots (some with a zero-width cone edge),
+    // a few directional and ambient lights.
+    LightInView<float> lightNear(const glm::vec3& target) {
+        LightInView<float> light;
+        light.radiance = {uniform(0, 3), uniform(0, 3), uniform(0, 3)};
+        const float kind = uniform(0, 1);
+        if (kind < 0.02f) {
+            light.type = LightType::Ambient;
+            light.radiance *= 0.05f;
+            return light;
+        }
+        if (kind < 0.07f) {
+            light.type = LightType::Directional;
+            light.directionView = unitVector();
+            return light;
+        }
+        light.type = kind < 0.25f ? LightType::Spot : LightType::Point;
+        light.positionView = target + unitVector() * uniform(0, 6);
+        light.rangeMetres = uniform(0.5f, 8);
+        if (light.type == LightType::Spot) {
+            light.directionView = glm::normalize(target - light.positionView + unitVector());
+            light.spotOuterCos = uniform(0.3f, 0.95f);
+            light.spotInnerCos = chance(0.2f)
+                                     ? light.spotOuterCos
+                                     : std::min(1.0f, light.spotOuterCos + uniform(0, 0.1f));
+        }
+        return light;
+    }
+
+    std::mt19937& engine() { return mRandom; }
+
+private:
+    std::mt19937 mRandom;
+};
+
+// The double-precision sum of `lights[indices]` at a lane's surface, from the same float inputs.
+inline glm::dvec3 referenceSum(const Surface& s, const std::vector<LightInView<float>>& lights,
+                               const std::vector<uint32_t>& indices) {
+    gbuffer::BasicSurface<double> p{glm::dvec3(s.position), glm::dvec3(s.normal), glm::dvec3(s.albedo),
+                           double(s.specularIntensity), double(s.specularPower)};
+    const glm::dvec3 toViewer = glm::normalize(-p.positionView);
+    glm::dvec3 sum(0.0);
+    for (uint32_t index : indices) {
+        const LightInView<float>& l = lights[index];
+        LightInView<double> light{l.type,
+                                  glm::dvec3(l.positionView),
+                                  glm::dvec3(l.directionView),
+                                  glm::dvec3(l.radiance),
+                                  double(l.rangeMetres),
+                                  double(l.spotInnerCos),
+                                  double(l.spotOuterCos)};
+        sum += lighting::evaluateLight(p, toViewer, light);
+    }
+    return sum;
+}
+
+// Distance in units in the last place between two finite floats of the same sign (or zeros).
+inline int64_t ulpDistance(float a, float b) {
+    int32_t ia, ib;
+    std::memcpy(&ia, &a, 4);
+    std::memcpy(&ib, &b, 4);
+    // Map to a monotonic integer line (negative floats reversed).
+    const int64_t la = ia < 0 ? int64_t(INT32_MIN) - ia : ia;
+    const int64_t lb = ib < 0 ? int64_t(INT32_MIN) - ib : ib;
+    return la > lb ? la - lb : lb - la;
+}
+
+inline std::vector<lighting::kernel::KernelIsa> vectorIsas() {
+    std::vector<lighting::kernel::KernelIsa> isas;
+    for (const auto& isa : lighting::kernel::KernelIsa::available())
+        if (!isa.isScalar())
+            isas.push_back(isa);
+    return isas;
+}
+
+} // namespace kerneltest
