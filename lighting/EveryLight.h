@@ -14,8 +14,8 @@
 
 #include "gbuffer/Surface.h"
 #include "lighting/Brdf.h"
-#include "lighting/ShadingStage.h"
 #include "lighting/PassNames.h"
+#include "lighting/ShadingStage.h"
 
 namespace lighting {
 

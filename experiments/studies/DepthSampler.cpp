@@ -33,7 +33,7 @@ DepthSampler::DepthSampler(const DepthStudyOptions& options, DepthStudyCamera ca
     c.nearMetres = float(camera.nearMetres);
     c.farMetres = float(camera.farMetres);
     mView = gbuffer::CameraView::fromCamera(c, options.width, options.height, format.convention(),
-                                           format.infiniteFar);
+                                            format.infiniteFar);
     mProjection = gbuffer::DepthProjection::of(mView);
     mRasterClipFromView = glm::dmat4(mView.clipFromView);
     // glm::perspective: [1][1] = 1 / tan(fovY / 2), [0][0] = [1][1] / aspect, from the same

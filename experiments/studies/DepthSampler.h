@@ -9,8 +9,8 @@
 #include <glm/glm.hpp>
 
 #include "experiments/studies/DepthStudy.h"
-#include "gbuffer/DepthFormat.h"
 #include "gbuffer/CameraView.h"
+#include "gbuffer/DepthFormat.h"
 
 namespace experiments {
 

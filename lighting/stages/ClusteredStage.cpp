@@ -26,9 +26,9 @@
 
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
+#include "lighting/PassNames.h"
 #include "lighting/culling/ClusterGrid.h"
 #include "lighting/stages/Stages.h"
-#include "lighting/PassNames.h"
 
 namespace lighting {
 

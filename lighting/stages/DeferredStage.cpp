@@ -26,9 +26,9 @@
 #include <chrono>
 
 #include "lighting/LightBounds.h"
+#include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/stages/VolumeStageOptions.h"
-#include "lighting/PassNames.h"
 
 namespace lighting {
 

@@ -70,8 +70,8 @@
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
-#include "lighting/culling/TileFrusta.h"
 #include "lighting/PassNames.h"
+#include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
 

@@ -29,10 +29,10 @@
 
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
+#include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/culling/TileFrusta.h"
 #include "lighting/stages/VolumeStageOptions.h"
-#include "lighting/PassNames.h"
 
 namespace lighting {
 

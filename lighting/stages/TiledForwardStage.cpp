@@ -39,8 +39,8 @@
 #include "lighting/ForwardGeometry.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
-#include "lighting/culling/TileFrusta.h"
 #include "lighting/PassNames.h"
+#include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
 

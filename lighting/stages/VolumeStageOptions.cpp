@@ -2,8 +2,8 @@
 
 #include <chrono>
 
-#include "lighting/stages/Stages.h"
 #include "lighting/PassNames.h"
+#include "lighting/stages/Stages.h"
 
 namespace lighting {
 

@@ -124,8 +124,9 @@ private:
 // The double-precision sum of `lights[indices]` at a lane's surface, from the same float inputs.
 inline glm::dvec3 referenceSum(const Surface& s, const std::vector<LightInView<float>>& lights,
                                const std::vector<uint32_t>& indices) {
-    gbuffer::BasicSurface<double> p{glm::dvec3(s.position), glm::dvec3(s.normal), glm::dvec3(s.albedo),
-                           double(s.specularIntensity), double(s.specularPower)};
+    gbuffer::BasicSurface<double> p{glm::dvec3(s.position), glm::dvec3(s.normal),
+                                    glm::dvec3(s.albedo), double(s.specularIntensity),
+                                    double(s.specularPower)};
     const glm::dvec3 toViewer = glm::normalize(-p.positionView);
     glm::dvec3 sum(0.0);
     for (uint32_t index : indices) {
