@@ -17,6 +17,7 @@
 
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/ShadingStage.h"
+#include "scenes/Limits.h"
 
 namespace experiments {
 
@@ -52,10 +53,11 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();
 
-// Limits checked before any work or allocation (issue: 100000x100000 must be refused up front).
-inline constexpr int kMaxImageSide = 16384;
-inline constexpr uint64_t kMaxPixels = uint64_t(8192) * 8192;
-inline constexpr int kMaxLights = 1'000'000;
+// Limits checked before any work or allocation (issue: 100000x100000 must be refused up front);
+// the memory-sizing ones are defined, with their reasons, in scenes/Limits.h.
+inline constexpr int kMaxImageSide = scenes::limits::kMaxImageSide;
+inline constexpr uint64_t kMaxPixels = scenes::limits::kMaxPixels;
+inline constexpr int kMaxLights = scenes::limits::kMaxLights;
 inline constexpr int kMaxThreads = 1024;
 inline constexpr int kMaxRepetitions = 1000;
 

@@ -21,6 +21,9 @@
 
 #include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
+#include "experiments/ImageOutput.h"
+#include "scenes/Limits.h"
+#include "scenes/NestingDepth.h"
 
 namespace experiments {
 
@@ -35,12 +38,20 @@ constexpr const char* kJobImages[] = {"preview", "heatmap", "error"};
 constexpr const char* kCaptionColumns[] = {"scene",  "stage",  "lights",  "width",
                                            "height", "layout", "normals", "depth"};
 
+// Results are ours but may have been edited: the nesting is bounded before parsing, as for every
+// JSON input (scenes/Limits.h), since the report copies values recursively.
 json readJsonFile(const fs::path& path) {
     std::ifstream file(path, std::ios::binary);
     if (!file)
         throw std::runtime_error("cannot read " + path.string() + ": " + std::strerror(errno));
+    const std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+    scenes::NestingViolation violation;
+    if (scenes::jsonNestsDeeperThan(text, scenes::limits::kMaxNestingDepth, &violation))
+        throw std::runtime_error("cannot parse " + path.string() + ": line " +
+                                 std::to_string(violation.line) + " nests deeper than " +
+                                 std::to_string(scenes::limits::kMaxNestingDepth) + " levels");
     try {
-        return json::parse(file);
+        return json::parse(text);
     } catch (const json::exception& e) {
         throw std::runtime_error("cannot parse " + path.string() + ": " + e.what());
     }
@@ -142,11 +153,7 @@ bool makeThumbnail(const fs::path& source, const fs::path& thumbnail, int width)
     if (!OIIO::ImageBufAlgo::resize(small, image))
         throw std::runtime_error("cannot make a thumbnail of " + source.string() + ": " +
                                  small.geterror());
-    writeFileAtomically(thumbnail, [&](const fs::path& tempPath) {
-        if (!small.write(tempPath.string(), OIIO::TypeDesc::UINT8, "png"))
-            throw std::runtime_error("cannot write " + thumbnail.string() + ": " +
-                                     small.geterror());
-    });
+    writeImageAtomically(thumbnail, small, OIIO::TypeDesc::UINT8, "png");
     return true;
 }
 

@@ -12,6 +12,8 @@
 #include "experiments/RunMetrics.h"
 #include "experiments/SweepFile.h"
 #include "lighting/PassNames.h"
+#include "scenes/Limits.h"
+#include "scenes/NestingDepth.h"
 
 namespace experiments {
 
@@ -51,6 +53,17 @@ std::string readText(const fs::path& path) {
     std::stringstream text;
     text << in.rdbuf();
     return text.str();
+}
+
+// Results and markers are ours but may have been edited: nesting past scenes::limits is refused
+// before parsing (values are copied recursively afterwards).
+Json parseBounded(const std::string& text, const fs::path& path) {
+    scenes::NestingViolation violation;
+    if (scenes::jsonNestsDeeperThan(text, scenes::limits::kMaxNestingDepth, &violation))
+        throw SweepError(path.string() + ":" + std::to_string(violation.line) +
+                         ": nests deeper than " + std::to_string(scenes::limits::kMaxNestingDepth) +
+                         " levels");
+    return Json::parse(text);
 }
 
 // Hard link when the file system allows it (no copy of EXRs), else a copy.
@@ -147,7 +160,7 @@ Json readResults(const fs::path& dir) {
                          " a sweep output folder?)");
     Json results;
     try {
-        results = Json::parse(readText(file));
+        results = parseBounded(readText(file), file);
     } catch (const nlohmann::json::parse_error& e) {
         throw SweepError(file.string() + ": not valid JSON: " + e.what());
     }
@@ -185,7 +198,7 @@ size_t mergeSweepOutputs(const std::vector<fs::path>& inputs, const fs::path& ou
             // The marker's row, not the table's (which is padded with the table's columns).
             Json marker;
             try {
-                marker = Json::parse(readText(folder / kDoneMarker));
+                marker = parseBounded(readText(folder / kDoneMarker), folder / kDoneMarker);
             } catch (const nlohmann::json::parse_error& e) {
                 throw SweepError("merge: " + (folder / kDoneMarker).string() + ": " + e.what());
             }

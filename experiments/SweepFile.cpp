@@ -11,6 +11,9 @@
 
 #include <toml++/toml.h>
 
+#include "scenes/Limits.h"
+#include "scenes/NestingDepth.h"
+
 namespace experiments {
 
 namespace {
@@ -379,15 +382,31 @@ SweepSpec parseSweep(const Json& object, const std::string& origin) {
 
 SweepSpec readSweepFile(const std::filesystem::path& file) {
     const std::string origin = file.string();
+    std::error_code error;
+    const uintmax_t size = std::filesystem::file_size(file, error);
+    if (!error && size > scenes::limits::kMaxFileBytes)
+        throw SweepError(origin + ": " + std::to_string(size) + " bytes, more than the limit of " +
+                         std::to_string(scenes::limits::kMaxFileBytes));
     std::ifstream in(file, std::ios::binary);
     if (!in)
         throw SweepError(origin + ": cannot open the sweep file");
     std::stringstream text;
     text << in.rdbuf();
+    return readSweepText(text.str(), origin, file.extension() == ".toml");
+}
+
+SweepSpec readSweepText(const std::string& text, const std::string& origin, bool isToml) {
+    // Both parsers' results are copied and converted recursively (and toml++ builds and destroys
+    // dotted-key tables recursively), so the nesting is bounded before either parser runs.
+    scenes::NestingViolation violation;
+    if (isToml ? scenes::tomlNestsDeeperThan(text, scenes::limits::kMaxNestingDepth, &violation)
+               : scenes::jsonNestsDeeperThan(text, scenes::limits::kMaxNestingDepth, &violation))
+        throw SweepError(origin + ":" + std::to_string(violation.line) + ": nests deeper than " +
+                         std::to_string(scenes::limits::kMaxNestingDepth) + " levels");
     Json object;
-    if (file.extension() == ".toml") {
+    if (isToml) {
         try {
-            const toml::table table = toml::parse(text.str(), origin);
+            const toml::table table = toml::parse(text, origin);
             object = tomlToJson(table);
         } catch (const toml::parse_error& e) {
             const auto& begin = e.source().begin;
@@ -397,7 +416,7 @@ SweepSpec readSweepFile(const std::filesystem::path& file) {
         }
     } else {
         try {
-            object = Json::parse(text.str());
+            object = Json::parse(text);
         } catch (const nlohmann::json::parse_error& e) {
             throw SweepError(origin + ": JSON syntax error: " + e.what());
         }
@@ -496,14 +515,17 @@ SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads) {
     }
     const std::vector<std::vector<SweepSetting>> cases =
         effective.cases.empty() ? std::vector<std::vector<SweepSetting>>{{}} : effective.cases;
-    size_t combinations = 1;
+    // Counted in double: twenty axes of 10 values would overflow any integer product.
+    double combinations = 1.0;
     for (const auto& [key, values] : effective.axes)
-        combinations *= values.size();
-    const size_t total = cases.size() * combinations;
-    constexpr size_t kMaxJobs = 1'000'000; // a typo'd axis must not allocate forever
-    if (total > kMaxJobs)
+        combinations *= double(values.size());
+    const double jobCount = double(cases.size()) * combinations;
+    if (jobCount > double(scenes::limits::kMaxSweepJobs))
         fail(spec.origin,
-             std::to_string(total) + " jobs refused (at most " + std::to_string(kMaxJobs) + ")");
+             (jobCount < 1e18 ? std::to_string(uint64_t(jobCount)) : "more than 10^18") +
+                 " jobs refused (at most " + std::to_string(scenes::limits::kMaxSweepJobs) + ")");
+    const size_t total = size_t(jobCount);
+    // A typo'd axis must not allocate forever: the total is known before any job is made.
     const size_t digits = std::max<size_t>(4, std::to_string(total ? total - 1 : 0).size());
 
     SweepExpansion expansion;

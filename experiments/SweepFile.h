@@ -65,7 +65,11 @@ struct SweepSpec {
 
 // Reads FILE (.toml as TOML, anything else as JSON) and checks its structure. Throws SweepError
 // naming the file (and line for syntax errors, key for unknown or mistyped keys).
+// Files over scenes::limits::kMaxFileBytes or nested deeper than kMaxNestingDepth are refused
+// before parsing.
 SweepSpec readSweepFile(const std::filesystem::path& file);
+// The same from the file's text (isToml: TOML, else JSON); origin names it in messages.
+SweepSpec readSweepText(const std::string& text, const std::string& origin, bool isToml);
 // The same from an already parsed object; origin names it in messages.
 SweepSpec parseSweep(const nlohmann::ordered_json& object, const std::string& origin);
 

@@ -21,17 +21,24 @@
 // this file checks all of it before reading, so a malformed file gives one SceneError naming the
 // file, never a crash or a hang. An image that cannot be read is not an error: it gives one
 // warning naming it (Scene::warnings and stderr) and materials fall back to their factors.
+// Limits (scenes/Limits.h) are checked before the memory they bound is allocated: the JSON's
+// nesting before tinygltf parses it (tinygltf converts JSON recursively), every file's size
+// before it is read (external buffers and images must be regular files), an image's declared
+// size before it is decoded, and the vertices and drawn triangles every primitive would add
+// before any is converted.
 // Thread safety: each call owns its tinygltf instance; calls may run concurrently.
 #include "scenes/SceneLoader.h"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -40,8 +47,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <stb/stb_image.h>
 #include <tiny_gltf.h>
 
+#include "scenes/Limits.h"
+#include "scenes/NestingDepth.h"
 #include "scenes/Tangents.h"
 
 namespace scenes {
@@ -97,9 +107,9 @@ std::vector<unsigned char> readFile(const fs::path& path) {
     const uintmax_t size = fs::file_size(path, error);
     if (error)
         fail(path, "cannot read the size: " + error.message());
-    // tinygltf takes the size as unsigned int.
-    if (size > std::numeric_limits<unsigned int>::max())
-        fail(path, "larger than 4 GiB");
+    if (size > limits::kMaxFileBytes)
+        fail(path, "the file has " + str(size) + " bytes, more than the limit of " +
+                       str(limits::kMaxFileBytes));
     std::vector<unsigned char> bytes(size);
     std::ifstream in(path, std::ios::binary);
     if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
@@ -140,34 +150,100 @@ void checkGlbLayout(const fs::path& path, const std::vector<unsigned char>& byte
         fail(path, "the GLB BIN chunk runs past the end of the file");
 }
 
+// What the image callbacks learn while tinygltf reads a file: why an image was not decoded (by
+// image index), and the decoded texture memory granted so far (limits::kMaxTextureBytes).
+struct ImageBudget {
+    std::map<int, std::string> problems;
+    uint64_t decodedBytes = 0;
+};
+
+// Reads an encoded image's header (stb_image, the decoder tinygltf uses) and grants its decoded
+// size from the budget. Returns why it must not be decoded, or "" when it may be.
+std::string admitImage(const unsigned char* bytes, int size, ImageBudget& budget) {
+    int width = 0, height = 0, components = 0;
+    if (size <= 0 || !stbi_info_from_memory(bytes, size, &width, &height, &components))
+        return "could not be decoded";
+    const uint64_t pixels = uint64_t(width) * uint64_t(height);
+    if (width > limits::kMaxTextureSide || height > limits::kMaxTextureSide ||
+        pixels > limits::kMaxTexturePixels)
+        return "is " + std::to_string(width) + "x" + std::to_string(height) +
+               ", over the texture limit (sides up to " + std::to_string(limits::kMaxTextureSide) +
+               ", " + std::to_string(limits::kMaxTexturePixels) + " pixels)";
+    const uint64_t rgba8Bytes = 4 * pixels;
+    if (budget.decodedBytes + rgba8Bytes > limits::kMaxTextureBytes)
+        return "would take the scene's decoded textures past " +
+               std::to_string(limits::kMaxTextureBytes) + " bytes";
+    budget.decodedBytes += rgba8Bytes;
+    return "";
+}
+
 // tinygltf calls this for every image it could read from a file or data URI. Decoding failures
 // are recorded instead of failing the whole load: an undecodable texture is only a warning.
 bool decodeImage(tinygltf::Image* image, int imageIndex, std::string*, std::string*, int width,
-                 int height, const unsigned char* bytes, int size, void* undecodable) {
+                 int height, const unsigned char* bytes, int size, void* budgetPointer) {
     // Images stored in bufferViews reach here before anything checked that the bufferView lies
     // inside its buffer; GltfConverter::readImages decodes them once it has.
     if (image->bufferView >= 0)
         return true;
+    ImageBudget& budget = *static_cast<ImageBudget*>(budgetPointer);
+    std::string problem = admitImage(bytes, size, budget);
     std::string error;
-    if (!tinygltf::LoadImageData(image, imageIndex, &error, nullptr, width, height, bytes, size,
-                                 nullptr))
-        static_cast<std::set<int>*>(undecodable)->insert(imageIndex);
+    if (problem.empty() && !tinygltf::LoadImageData(image, imageIndex, &error, nullptr, width,
+                                                    height, bytes, size, nullptr))
+        problem = "could not be decoded";
+    if (!problem.empty())
+        budget.problems[imageIndex] = problem;
     return true;
 }
 
 // tinygltf looks for external files beside the model and then in the working directory; the
 // latter would silently pick up an unrelated file of the same name, so it is refused. Paths
-// searched in the working directory are the ones tinygltf builds as "./" + uri.
+// searched in the working directory are the ones tinygltf builds as "./" + uri. Only regular
+// files exist for us: tinygltf's own test (fopen) accepts a folder, whose size then reads as
+// 2^63 - 1 bytes.
 bool fileExistsBesideModel(const std::string& path, void*) {
-    return path.rfind("./", 0) != 0 && tinygltf::FileExists(path, nullptr);
+    std::error_code error;
+    return path.rfind("./", 0) != 0 && fs::is_regular_file(path, error);
 }
 
-tinygltf::Model parseModel(const fs::path& path, std::set<int>& undecodableImages) {
+// tinygltf's ReadWholeFile, with the size checked against limits::kMaxFileBytes before the
+// buffer is allocated.
+bool readWholeFileWithinLimit(std::vector<unsigned char>* out, std::string* error,
+                              const std::string& path, void*) {
+    std::error_code code;
+    const uintmax_t size = fs::is_regular_file(path, code) ? fs::file_size(path, code) : 0;
+    if (code || !fs::is_regular_file(path, code)) {
+        *error += "'" + path + "' is not a readable regular file\n";
+        return false;
+    }
+    if (size > limits::kMaxFileBytes) {
+        *error += "'" + path + "' has " + str(size) + " bytes, more than the limit of " +
+                  str(limits::kMaxFileBytes) + "\n";
+        return false;
+    }
+    out->resize(size);
+    std::ifstream in(path, std::ios::binary);
+    if (!in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size))) {
+        *error += "'" + path + "' cannot be read\n";
+        return false;
+    }
+    return true;
+}
+
+// The nesting bound (limits::kMaxNestingDepth) on the JSON text tinygltf is about to parse.
+void checkJsonNesting(const fs::path& path, std::string_view json) {
+    NestingViolation violation;
+    if (jsonNestsDeeperThan(json, limits::kMaxNestingDepth, &violation))
+        fail(path, "JSON nests deeper than " + std::to_string(limits::kMaxNestingDepth) +
+                       " levels (line " + str(violation.line) + ")");
+}
+
+tinygltf::Model parseModel(const fs::path& path, ImageBudget& imageBudget) {
     std::vector<unsigned char> bytes = readFile(path);
     tinygltf::TinyGLTF parser;
-    parser.SetImageLoader(decodeImage, &undecodableImages);
-    parser.SetFsCallbacks({fileExistsBesideModel, tinygltf::ExpandFilePath, tinygltf::ReadWholeFile,
-                           tinygltf::WriteWholeFile, nullptr});
+    parser.SetImageLoader(decodeImage, &imageBudget);
+    parser.SetFsCallbacks({fileExistsBesideModel, tinygltf::ExpandFilePath,
+                           readWholeFileWithinLimit, tinygltf::WriteWholeFile, nullptr});
     // tinygltf wants an absolute base directory; its warnings are all about images, which
     // GltfConverter::readImages reports in its own words, so they are not kept.
     const std::string baseDir = fs::absolute(path).parent_path().string();
@@ -176,11 +252,17 @@ tinygltf::Model parseModel(const fs::path& path, std::set<int>& undecodableImage
     bool loaded;
     if (isGlb(bytes)) {
         checkGlbLayout(path, bytes);
+        uint32_t jsonBytes;
+        std::memcpy(&jsonBytes, bytes.data() + 12, 4);
+        checkJsonNesting(
+            path, std::string_view(reinterpret_cast<const char*>(bytes.data()) + 20, jsonBytes));
         loaded = parser.LoadBinaryFromMemory(&model, &error, &ignoredWarnings, bytes.data(),
                                              unsigned(bytes.size()), baseDir);
     } else {
         if (path.extension() == ".glb")
             fail(path, "not a GLB file (it does not start with 'glTF')");
+        checkJsonNesting(
+            path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
         loaded = parser.LoadASCIIFromString(&model, &error, &ignoredWarnings,
                                             reinterpret_cast<const char*>(bytes.data()),
                                             unsigned(bytes.size()), baseDir);
@@ -247,9 +329,8 @@ struct AccessorData {
 
 class GltfConverter {
 public:
-    GltfConverter(fs::path path, tinygltf::Model model, std::set<int> undecodableImages)
-        : mPath(std::move(path)), mModel(std::move(model)),
-          mUndecodableImages(std::move(undecodableImages)) {}
+    GltfConverter(fs::path path, tinygltf::Model model, ImageBudget imageBudget)
+        : mPath(std::move(path)), mModel(std::move(model)), mImageBudget(std::move(imageBudget)) {}
 
     Scene convert();
 
@@ -258,6 +339,7 @@ private:
     void warn(const std::string& what);
 
     void checkExtensions() const;
+    void checkSizes() const;
     void readImages();
     std::vector<int> parentOfEachNode() const;
     std::vector<int> rootNodes(const std::vector<int>& parentOf) const;
@@ -284,7 +366,7 @@ private:
 
     fs::path mPath;
     tinygltf::Model mModel;
-    std::set<int> mUndecodableImages;
+    ImageBudget mImageBudget; // images not decoded (and why), decoded bytes granted
     Scene mScene;
     std::set<std::string> mWarned;
     std::vector<bool> mOnPath;             // per node: on the path from the root being walked
@@ -307,6 +389,7 @@ void GltfConverter::warn(const std::string& what) {
 Scene GltfConverter::convert() {
     mScene.name = mPath.stem().string();
     checkExtensions();
+    checkSizes();
     readImages();
     mOnPath.assign(mModel.nodes.size(), false);
     mMeshOf.resize(mModel.meshes.size());
@@ -340,6 +423,57 @@ void GltfConverter::checkExtensions() const {
             fail("requires the unsupported extension " + extension);
 }
 
+// The vertices the converted primitives will store and the triangles their instances will draw,
+// from the accessors' declared counts, before any accessor is read (limits::kMaxVertices,
+// kMaxTriangles): primitives may share one large accessor, so a small file can ask for far more
+// than its buffers hold. A mesh counts once per node that uses it, reachable from the scene or
+// not, which can only over-estimate. Sums are in double: the counts are the file's and may be
+// absurd.
+void GltfConverter::checkSizes() const {
+    std::vector<double> uses(mModel.meshes.size(), 0.0);
+    for (const tinygltf::Node& node : mModel.nodes)
+        if (node.mesh >= 0 && size_t(node.mesh) < uses.size())
+            uses[size_t(node.mesh)] += 1.0;
+    auto countOf = [&](int accessor) {
+        return accessor >= 0 && size_t(accessor) < mModel.accessors.size()
+                   ? double(mModel.accessors[size_t(accessor)].count)
+                   : 0.0;
+    };
+    double vertices = 0.0, triangles = 0.0;
+    for (size_t m = 0; m < mModel.meshes.size(); ++m) {
+        if (uses[m] == 0.0)
+            continue;
+        for (const tinygltf::Primitive& primitive : mModel.meshes[m].primitives) {
+            const int mode = primitive.mode;
+            if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+                mode != TINYGLTF_MODE_TRIANGLE_FAN)
+                continue;
+            const auto position = primitive.attributes.find("POSITION");
+            const double vertexCount =
+                position == primitive.attributes.end() ? 0.0 : countOf(position->second);
+            const double indexCount =
+                primitive.indices >= 0 ? countOf(primitive.indices) : vertexCount;
+            vertices += vertexCount;
+            triangles +=
+                uses[m] * (mode == TINYGLTF_MODE_TRIANGLES ? std::floor(indexCount / 3.0)
+                                                           : std::max(indexCount - 2.0, 0.0));
+        }
+    }
+    auto gib = [](double bytes) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.1f", bytes / double(uint64_t(1) << 30));
+        return std::string(text);
+    };
+    if (vertices > double(limits::kMaxVertices))
+        fail("the meshes would store " + std::to_string(uint64_t(std::min(vertices, 1e19))) +
+             " vertices (about " + gib(vertices * double(limits::kBytesPerVertex)) +
+             " GiB), over the limit of " + str(limits::kMaxVertices));
+    if (triangles > double(limits::kMaxTriangles))
+        fail("the instances would draw " + std::to_string(uint64_t(std::min(triangles, 1e19))) +
+             " triangles (about " + gib(triangles * double(limits::kBytesPerDrawnTriangle)) +
+             " GiB per frame), over the limit of " + str(limits::kMaxTriangles));
+}
+
 // Images tinygltf could not read (missing file, undecodable data) get one warning each, whether
 // or not a material slot we map uses them: the user should know the file is incomplete.
 void GltfConverter::readImages() {
@@ -359,17 +493,21 @@ void GltfConverter::readImages() {
                 view.byteLength > size_t(std::numeric_limits<int>::max()))
                 fail(name + ": bufferView " + std::to_string(image.bufferView) +
                      " runs past the end of its buffer");
+            const unsigned char* bytes = data.data() + view.byteOffset;
+            problem = admitImage(bytes, int(view.byteLength), mImageBudget);
             std::string error;
-            if (view.byteLength == 0 || !tinygltf::LoadImageData(&image, int(i), &error, nullptr, 0,
-                                                                 0, data.data() + view.byteOffset,
-                                                                 int(view.byteLength), nullptr))
+            if (problem.empty() && !tinygltf::LoadImageData(&image, int(i), &error, nullptr, 0, 0,
+                                                            bytes, int(view.byteLength), nullptr))
                 problem = "could not be decoded";
-        } else if (mUndecodableImages.count(int(i))) {
-            problem = "could not be decoded";
+        } else if (const auto found = mImageBudget.problems.find(int(i));
+                   found != mImageBudget.problems.end()) {
+            problem = found->second;
         } else if (image.image.empty()) {
             std::error_code error;
-            problem = fs::exists(mPath.parent_path() / image.uri, error) ? "could not be read"
-                                                                         : "file not found";
+            const fs::path file = mPath.parent_path() / image.uri;
+            problem = fs::is_regular_file(file, error) ? "could not be read"
+                      : fs::exists(file, error)        ? "is not a regular file"
+                                                       : "file not found";
         }
         const bool layoutKnown = image.width > 0 && image.height > 0 && image.component >= 1 &&
                                  image.component <= 4 && (image.bits == 8 || image.bits == 16);
@@ -540,7 +678,14 @@ void GltfConverter::addCamera() {
 // unbounded in glTF, but ours need finite support, so it reaches just past the farthest corner
 // of the model's bounds (the windowed falloff makes it slightly dimmer there than glTF's).
 // Intensities are taken as they are (candela or lux in glTF, unitless here).
+// What KHR_lights_punctual allows is checked here, with one error each: intensity and colour
+// finite and non-negative, range positive and finite when given (tinygltf reads an absent range
+// as 0, so 0 cannot be told from absent and means "no range"), and spot cones with
+// 0 <= innerConeAngle < outerConeAngle <= pi/2 (radians), as the extension's specification says.
 void GltfConverter::addLights() {
+    if (mPlacedLights.size() > size_t(limits::kMaxLights))
+        fail(str(mPlacedLights.size()) + " placed lights, over the limit of " +
+             std::to_string(limits::kMaxLights));
     const Aabb bounds = mScene.boundsWorld();
     for (const auto& [lightIndex, worldFromLight] : mPlacedLights) {
         if (lightIndex < 0 || size_t(lightIndex) >= mModel.lights.size())
@@ -556,10 +701,23 @@ void GltfConverter::addLights() {
             light.type = LightType::Directional;
         else
             fail(where + ": unknown type '" + source.type + "'");
+        auto finiteNonNegative = [](double x) { return std::isfinite(x) && x >= 0.0; };
         if (!source.color.empty()) {
-            if (source.color.size() != 3)
-                fail(where + ": color needs 3 numbers");
+            if (source.color.size() != 3 ||
+                !std::all_of(source.color.begin(), source.color.end(), finiteNonNegative))
+                fail(where + ": color needs 3 finite numbers >= 0");
             light.color = glm::vec3(source.color[0], source.color[1], source.color[2]);
+        }
+        if (!finiteNonNegative(source.intensity))
+            fail(where + ": intensity must be a finite number >= 0");
+        if (!finiteNonNegative(source.range))
+            fail(where + ": range must be a finite number > 0 (or absent)");
+        if (light.type == LightType::Spot) {
+            const double inner = source.spot.innerConeAngle, outer = source.spot.outerConeAngle;
+            if (!(inner >= 0.0 && inner < outer && outer <= 0.5 * std::numbers::pi))
+                fail(where + ": spot cone angles must satisfy 0 <= innerConeAngle < " +
+                     "outerConeAngle <= pi/2 (radians), got " + std::to_string(inner) + " and " +
+                     std::to_string(outer));
         }
         light.intensity = float(source.intensity);
         light.positionWorld = glm::vec3(worldFromLight[3]);
@@ -1001,9 +1159,9 @@ std::vector<uint32_t> GltfConverter::readIndices(int accessorIndex, const std::s
 
 Scene loadGltf(const fs::path& path) {
     try {
-        std::set<int> undecodableImages;
-        tinygltf::Model model = parseModel(path, undecodableImages);
-        return GltfConverter(path, std::move(model), std::move(undecodableImages)).convert();
+        ImageBudget imageBudget;
+        tinygltf::Model model = parseModel(path, imageBudget);
+        return GltfConverter(path, std::move(model), std::move(imageBudget)).convert();
     } catch (const SceneError&) {
         throw;
     } catch (const std::exception& error) {

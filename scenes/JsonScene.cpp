@@ -26,6 +26,8 @@
 #include <nlohmann/json.hpp>
 
 #include "scenes/LightGenerator.h"
+#include "scenes/Limits.h"
+#include "scenes/NestingDepth.h"
 #include "scenes/ProceduralScenes.h"
 
 namespace scenes {
@@ -74,6 +76,8 @@ struct Placeable {
     uint32_t meshOffset = 0;
     std::vector<Instance> instances;
     std::vector<Light> lights;
+    // Triangles one placement draws, an instance counting at least 1 (limits::kMaxTriangles).
+    uint64_t drawnTriangles = 0;
 };
 
 // Moves `part`'s textures, materials, meshes and warnings into `scene`, rebasing their indices;
@@ -91,6 +95,9 @@ Placeable addResources(Scene& scene, Scene&& part) {
     }
     Placeable placeable{uint32_t(scene.meshes.size()), std::move(part.instances),
                         std::move(part.lights)};
+    for (const Instance& instance : placeable.instances)
+        placeable.drawnTriangles +=
+            std::max<uint64_t>(1, part.meshes.at(instance.mesh).triangleCount());
     for (Mesh& mesh : part.meshes) {
         mesh.material += materialOffset;
         scene.meshes.push_back(std::move(mesh));
@@ -148,13 +155,32 @@ private:
     void applyMaterial(const Json& value, const std::string& field, Scene& scene) const;
     glm::vec4 colour(const Json& value, const std::string& field, bool alphaAllowed) const;
     void generateLights(const Json* generator, Scene& scene) const;
+    void placeWithinLimits(Scene& scene, const Placeable& object, const glm::mat4& worldFromObject,
+                           const std::string& field);
 
     fs::path mPath;
     const SceneRequest& mRequest;
     // glTF files already in the scene, by canonical path: placing one again adds only instances
     // and lights, so a model placed many times is loaded, and its textures stored, once.
     std::map<fs::path, Placeable> mModels;
+    // Triangles the placements so far draw (each instance at least 1): a model placed many
+    // times multiplies its instances, so the limit is checked before each placement is copied.
+    uint64_t mDrawnTriangles = 0;
 };
+
+void JsonSceneReader::placeWithinLimits(Scene& scene, const Placeable& object,
+                                        const glm::mat4& worldFromObject,
+                                        const std::string& field) {
+    if (mDrawnTriangles + object.drawnTriangles > limits::kMaxTriangles)
+        fail(field, "the objects placed so far and this one draw " +
+                        std::to_string(mDrawnTriangles + object.drawnTriangles) +
+                        " triangles, over the limit of " + std::to_string(limits::kMaxTriangles));
+    if (scene.lights.size() + object.lights.size() > size_t(limits::kMaxLights))
+        fail(field, "the objects placed so far and this one bring more than " +
+                        std::to_string(limits::kMaxLights) + " lights");
+    mDrawnTriangles += object.drawnTriangles;
+    place(scene, object, worldFromObject);
+}
 
 void JsonSceneReader::fail(const std::string& field, const std::string& what) const {
     throw SceneError(mPath.string() + ": " + (field.empty() ? "" : field + ": ") + what);
@@ -215,12 +241,25 @@ Scene JsonSceneReader::read() {
     std::error_code error;
     if (!fs::exists(mPath, error))
         fail("", "file not found");
-    std::ifstream in(mPath);
-    if (!in)
-        fail("", "cannot be opened");
+    const uintmax_t size = fs::file_size(mPath, error);
+    if (error || !fs::is_regular_file(mPath, error))
+        fail("", "not a readable regular file");
+    if (size > limits::kMaxFileBytes)
+        fail("", std::to_string(size) + " bytes, more than the limit of " +
+                     std::to_string(limits::kMaxFileBytes));
+    std::ifstream in(mPath, std::ios::binary);
+    std::string bytes(size, '\0');
+    if (!in || !in.read(bytes.data(), std::streamsize(size)))
+        fail("", "cannot be read");
+    // nlohmann::json parses and destroys iteratively, but the bound keeps every reader of the
+    // document (and of the glTF files it names) within one documented limit.
+    NestingViolation violation;
+    if (jsonNestsDeeperThan(bytes, limits::kMaxNestingDepth, &violation))
+        fail("", "JSON nests deeper than " + std::to_string(limits::kMaxNestingDepth) +
+                     " levels (line " + std::to_string(violation.line) + ")");
     Json root;
     try {
-        root = Json::parse(in);
+        root = Json::parse(bytes);
     } catch (const Json::parse_error& parseError) {
         fail("", std::string("invalid JSON: ") + parseError.what());
     }
@@ -337,7 +376,7 @@ void JsonSceneReader::addObject(const Json& value, const std::string& field, Sce
             }
             model = mModels.emplace(key, addResources(scene, std::move(part))).first;
         }
-        place(scene, model->second, worldFromObject);
+        placeWithinLimits(scene, model->second, worldFromObject, field);
     } else {
         const std::string name = text(*procedural, fieldOf(field, "procedural"));
         if (!isProceduralScene(name))
@@ -369,7 +408,7 @@ void JsonSceneReader::addObject(const Json& value, const std::string& field, Sce
         }
         if (!objectCamera && !part.cameras.empty())
             objectCamera = movedCamera(part.cameras.front(), worldFromObject);
-        place(scene, addResources(scene, std::move(part)), worldFromObject);
+        placeWithinLimits(scene, addResources(scene, std::move(part)), worldFromObject, field);
     }
 }
 
@@ -603,9 +642,12 @@ void JsonSceneReader::generateLights(const Json* generator, Scene& scene) const 
         const Json* countValue = member(*generator, "count");
         if (!countValue)
             fail(field, "missing key 'count'");
-        if (!countValue->is_number_integer() || countValue->get<int64_t>() < 0 ||
-            countValue->get<int64_t>() > std::numeric_limits<int>::max())
+        if (!countValue->is_number_integer() || countValue->get<int64_t>() < 0)
             fail(fieldOf(field, "count"), "expected a non-negative integer");
+        if (countValue->get<int64_t>() > limits::kMaxLights)
+            fail(fieldOf(field, "count"), std::to_string(countValue->get<int64_t>()) +
+                                              " lights, over the limit of " +
+                                              std::to_string(limits::kMaxLights));
         count = int(countValue->get<int64_t>());
         if (const Json* seedValue = member(*generator, "seed")) {
             if (!seedValue->is_number_unsigned())
@@ -635,6 +677,11 @@ void JsonSceneReader::generateLights(const Json* generator, Scene& scene) const 
         count = mRequest.lightCount;
         seed = mRequest.seed;
     }
+    // Explicit and object lights count against the same limit as generated ones.
+    if (uint64_t(count) + scene.lights.size() > uint64_t(limits::kMaxLights))
+        fail(field, std::to_string(count) + " generated lights and " +
+                        std::to_string(scene.lights.size()) + " others are over the limit of " +
+                        std::to_string(limits::kMaxLights));
     // Defaults only when lights are generated: defaultScatterFor() refuses degenerate bounds.
     if (count == 0)
         return;

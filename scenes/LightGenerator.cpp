@@ -10,6 +10,8 @@
 #include <cmath>
 #include <string>
 
+#include "scenes/Limits.h"
+
 namespace scenes {
 
 namespace {
@@ -57,6 +59,10 @@ void scatterPointLights(Scene& scene, const PointLightScatter& scatter, int coun
     };
     if (count < 0)
         fail("light count must be >= 0, got " + std::to_string(count));
+    if (uint64_t(count) + scene.lights.size() > uint64_t(limits::kMaxLights))
+        fail(std::to_string(count) + " lights and the scene's " +
+             std::to_string(scene.lights.size()) + " are over the limit of " +
+             std::to_string(limits::kMaxLights));
     if (scatter.region.empty())
         fail("the region is empty");
     if (!(scatter.minRangeMetres >= 0.0f) || !(scatter.maxRangeMetres >= scatter.minRangeMetres))

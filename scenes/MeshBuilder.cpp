@@ -14,15 +14,17 @@
 #include <utility>
 #include <vector>
 
+#include "scenes/Limits.h"
+
 namespace scenes {
 
 namespace {
 
 // uint32 indices would allow 4G vertices, but memory runs out long before (a vertex costs 48
-// bytes): a typo in a scene file must give an error, not an out-of-memory kill. 2^26 vertices
-// (3.2 GB) per mesh is far above any built-in mesh (the largest, atrium's walls at detail=16,
-// has 375k).
-constexpr size_t kMaxVertexCount = size_t(1) << 26;
+// bytes): a typo in a scene file must give an error, not an out-of-memory kill. The cap is the
+// scene-wide limits::kMaxVertices, far above any built-in mesh (the largest, atrium's walls at
+// detail=16, has 375k).
+constexpr size_t kMaxVertexCount = size_t(limits::kMaxVertices);
 
 struct GridNode {
     glm::vec3 position;

@@ -56,8 +56,9 @@ std::string describe(const std::vector<OptionSpec>& specs) {
 std::map<std::string, int> readOptions(const std::string& sceneName, const SceneRequest& request,
                                        const std::vector<OptionSpec>& specs) {
     for (const auto& [key, value] : request.options) {
-        const bool known = std::any_of(specs.begin(), specs.end(),
-                                       [&](const OptionSpec& spec) { return spec.key == key; });
+        const bool known =
+            std::any_of(specs.begin(), specs.end(),
+                        [&name = key](const OptionSpec& spec) { return spec.key == name; });
         if (!known)
             throw SceneError(sceneName + ": unknown option '" + key +
                              "'; valid options: " + describe(specs));
