@@ -19,6 +19,7 @@
 #include "experiments/ImageOutput.h"
 #include "experiments/ReportCommand.h"
 #include "experiments/RunMetrics.h"
+#include "scenes/Limits.h"
 
 namespace experiments {
 
@@ -29,8 +30,30 @@ namespace {
 
 constexpr const char* kBeauty[3] = {"R", "G", "B"};
 
+// The header is read first, so a file that declares an absurd size is refused before its pixels
+// are allocated (scenes/Limits.h: the render limits, and limits::kMaxImageChannels).
 OIIO::ImageBuf readImage(const fs::path& path) {
     OIIO::ImageBuf image(path.string());
+    if (!image.init_spec(path.string(), 0, 0))
+        throw std::runtime_error("cannot read " + path.string() + ": " + image.geterror());
+    const OIIO::ImageSpec& header = image.spec();
+    if (header.width <= 0 || header.height <= 0 || header.depth != 1 ||
+        header.width > scenes::limits::kMaxImageSide ||
+        header.height > scenes::limits::kMaxImageSide ||
+        uint64_t(header.width) * uint64_t(header.height) > scenes::limits::kMaxPixels ||
+        header.nchannels <= 0 || header.nchannels > scenes::limits::kMaxImageChannels ||
+        uint64_t(header.width) * uint64_t(header.height) * uint64_t(header.nchannels) >
+            scenes::limits::kMaxImageValues ||
+        header.deep)
+        throw std::runtime_error(
+            "cannot read " + path.string() + ": " + std::to_string(header.width) + "x" +
+            std::to_string(header.height) + "x" + std::to_string(header.depth) + " pixels of " +
+            std::to_string(header.nchannels) + (header.deep ? " deep" : "") +
+            " channels is outside the limits (sides 1.." +
+            std::to_string(scenes::limits::kMaxImageSide) + ", " +
+            std::to_string(scenes::limits::kMaxPixels) + " pixels, 1.." +
+            std::to_string(scenes::limits::kMaxImageChannels) + " flat channels, " +
+            std::to_string(scenes::limits::kMaxImageValues) + " values)");
     if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
         throw std::runtime_error("cannot read " + path.string() + ": " + image.geterror());
     return image;
@@ -90,7 +113,8 @@ void writeDiffPlot(const DiffCommandOptions& options, const ImageDiff& diff, con
     const fs::path script = requirePlotScript(options.plotsScript, "report.py");
     const std::string python = requirePythonWithMatplotlib(options.python);
     // The plot script reads raw float32; the temporary file is removed whatever happens.
-    const fs::path raw = options.out / (".absdiff.tmp-" + std::to_string(getpid()) + ".f32");
+    // Named as AtomicFile names temporaries, so that a killed run's leftover is cleaned.
+    const fs::path raw = temporaryPathFor(options.out / "absdiff.f32");
     struct RemoveOnExit {
         fs::path path;
         ~RemoveOnExit() {
@@ -102,6 +126,7 @@ void writeDiffPlot(const DiffCommandOptions& options, const ImageDiff& diff, con
         std::ofstream file(raw, std::ios::binary);
         file.write(reinterpret_cast<const char*>(diff.maxAbsDifference.data()),
                    std::streamsize(diff.maxAbsDifference.size() * sizeof(float)));
+        file.close(); // flushes: a full disk may only show here
         if (!file)
             throw std::runtime_error("cannot write " + raw.string());
     }

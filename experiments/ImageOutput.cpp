@@ -10,12 +10,16 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <set>
 #include <stdexcept>
 #include <string_view>
+#include <system_error>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -57,15 +61,88 @@ void checkPointer(const fs::path& path, const void* data, std::string_view what)
                                     " is null");
 }
 
-// Writes an in-memory image through AtomicFile with the format named explicitly, so the result
-// does not depend on the final name's extension.
-void writeImageBuf(const fs::path& path, const OIIO::ImageBuf& image, OIIO::TypeDesc fileType,
-                   const char* formatName) {
+// A file output for OpenImageIO that remembers the first failed write: OpenImageIO's own file
+// output ignores short writes, so a full disk left truncated (or empty) files that were then
+// renamed to their final names. Writes are buffered by stdio, so finish() flushes before it
+// judges.
+class CheckedFileOutput final : public OIIO::Filesystem::IOFile {
+public:
+    explicit CheckedFileOutput(const fs::path& path)
+        : IOFile(path.string(), IOProxy::Write), mOpened(handle() != nullptr),
+          mError(mOpened ? 0 : errno) {}
+
+    size_t write(const void* data, size_t size) override {
+        return checked(IOFile::write(data, size), size);
+    }
+    size_t pwrite(const void* data, size_t size, int64_t offset) override {
+        return checked(IOFile::pwrite(data, size, offset), size);
+    }
+    // OpenImageIO may close the proxy itself (ImageOutput::close); the buffered bytes are
+    // flushed and judged here, before IOFile closes without looking.
+    void close() override {
+        if (handle() && mError == 0 && std::fflush(handle()) != 0)
+            mError = errno;
+        if (handle() && mError == 0 && std::ferror(handle()))
+            mError = EIO;
+        IOFile::close();
+    }
+
+    // Closes if still open; throws std::runtime_error naming finalPath when the file could not
+    // be created or any byte could not be written.
+    void finish(const fs::path& finalPath) {
+        close();
+        if (!mOpened || mError != 0)
+            throw std::runtime_error(
+                "cannot write " + finalPath.string() + ": " +
+                std::error_code(mError ? mError : EIO, std::generic_category()).message());
+    }
+
+private:
+    size_t checked(size_t written, size_t size) {
+        if (written != size && mError == 0)
+            mError = errno != 0 ? errno : EIO;
+        return written;
+    }
+
+    bool mOpened;
+    int mError;
+};
+
+// Creates the named format's ImageOutput writing through file; throws naming path.
+std::unique_ptr<OIIO::ImageOutput> checkedImageOutput(const fs::path& path, const char* formatName,
+                                                      CheckedFileOutput& file) {
+    std::unique_ptr<OIIO::ImageOutput> output = OIIO::ImageOutput::create(formatName);
+    if (!output)
+        throw std::runtime_error("cannot write " + path.string() + ": " + OIIO::geterror());
+    if (!output->supports("ioproxy") || !output->set_ioproxy(&file))
+        throw std::runtime_error("cannot write " + path.string() + ": OpenImageIO's " + formatName +
+                                 " writer takes no I/O proxy");
+    return output;
+}
+
+} // namespace
+
+void writeImageAtomically(const fs::path& path, const OIIO::ImageBuf& image,
+                          OIIO::TypeDesc fileType, const char* formatName) {
     writeFileAtomically(path, [&](const fs::path& tempPath) {
-        if (!image.write(tempPath.string(), fileType, formatName))
-            throw std::runtime_error("cannot write " + path.string() + ": " + image.geterror());
+        auto fail = [&](const std::string& reason) {
+            return std::runtime_error("cannot write " + path.string() + ": " + reason);
+        };
+        CheckedFileOutput file(tempPath);
+        std::unique_ptr<OIIO::ImageOutput> output = checkedImageOutput(path, formatName, file);
+        OIIO::ImageSpec spec = image.spec();
+        spec.set_format(fileType);
+        if (!output->open(tempPath.string(), spec))
+            throw fail(output->geterror());
+        if (!image.write(output.get()))
+            throw fail(image.geterror());
+        if (!output->close())
+            throw fail(output->geterror());
+        file.finish(path);
     });
 }
+
+namespace {
 
 Rgb turbo(float t) {
     // Coefficients of 1, x, x^2, ..., x^5 per channel.
@@ -237,9 +314,8 @@ void writeMultiLayerExr(const fs::path& path, int width, int height,
         auto fail = [&](const std::string& reason) {
             return std::runtime_error("cannot write " + path.string() + ": " + reason);
         };
-        std::unique_ptr<OIIO::ImageOutput> output = OIIO::ImageOutput::create("openexr");
-        if (!output)
-            throw fail(OIIO::geterror());
+        CheckedFileOutput file(tempPath);
+        std::unique_ptr<OIIO::ImageOutput> output = checkedImageOutput(path, "openexr", file);
         if (!output->open(tempPath.string(), spec))
             throw fail(output->geterror());
         std::vector<float> chunk(size_t(width) * kExrRowsPerChunk * channelCount);
@@ -257,6 +333,7 @@ void writeMultiLayerExr(const fs::path& path, int width, int height,
         }
         if (!output->close())
             throw fail(output->geterror());
+        file.finish(path);
     });
 }
 
@@ -278,7 +355,7 @@ void writePreviewPng(const fs::path& path, int width, int height, const float* r
         pixels[3 * i + 1] = toneMapToSrgb(g[i] * exposure);
         pixels[3 * i + 2] = toneMapToSrgb(b[i] * exposure);
     }
-    writeImageBuf(path, image, OIIO::TypeDesc::UINT8, "png");
+    writeImageAtomically(path, image, OIIO::TypeDesc::UINT8, "png");
 }
 
 void writeHeatmapPng(const fs::path& path, int width, int height, const uint32_t* counts,
@@ -300,7 +377,7 @@ void writeHeatmapPng(const fs::path& path, int width, int height, const uint32_t
             std::copy(colour.begin(), colour.end(), &pixels[(size_t(y) * canvasWidth + x) * 3]);
         }
     drawHeatmapLegend(path, canvas, height, scaleMax);
-    writeImageBuf(path, canvas, OIIO::TypeDesc::UINT8, "png");
+    writeImageAtomically(path, canvas, OIIO::TypeDesc::UINT8, "png");
 }
 
 uint32_t heatmapAutoScale(const uint32_t* counts, size_t n) {

@@ -23,7 +23,17 @@
 #include <utility>
 #include <vector>
 
+#include <OpenImageIO/imagebuf.h>
+
 namespace experiments {
+
+// Writes an in-memory image in the named OpenImageIO format ("png", "openexr"), pixels converted
+// to fileType, through writeFileAtomically. Every byte goes through a file proxy that checks the
+// write and the final flush (OpenImageIO's own file output ignores short writes), so a full disk
+// throws std::runtime_error naming path and leaves no file under that name. Every image file
+// the testbed writes goes through this or writeMultiLayerExr.
+void writeImageAtomically(const std::filesystem::path& path, const OIIO::ImageBuf& image,
+                          OIIO::TypeDesc fileType, const char* formatName);
 
 // One float plane of a multi-layer EXR. data is borrowed: it must hold width * height values and
 // stay alive during the write call.

@@ -29,7 +29,7 @@ import os
 import statistics
 import sys
 
-from plotfiles import pyplot, save_png
+from plotfiles import pyplot, save_png, write_text
 
 plt = pyplot("report.py")
 import matplotlib  # noqa: E402 (after the backend is chosen)
@@ -56,14 +56,6 @@ def text(value):
     if isinstance(value, float) and value.is_integer():
         return str(int(value))
     return str(value)
-
-
-def atomic_write_text(path, content):
-    directory, name = os.path.split(path)
-    temp = os.path.join(directory, ".%s.tmp-%d" % (name, os.getpid()))
-    with open(temp, "w", encoding="utf-8") as f:
-        f.write(content)
-    os.replace(temp, path)
 
 
 class Report:
@@ -253,7 +245,7 @@ def plot_results(args):
                      x_of=pixels)
     for i, table in enumerate(published):
         published_ratios(report, table, i)
-    atomic_write_text(os.path.join(args.out, "plots.json"), report.manifest())
+    write_text(os.path.join(args.out, "plots.json"), report.manifest())
 
 
 def plot_diff(args):

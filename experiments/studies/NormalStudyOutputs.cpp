@@ -217,6 +217,7 @@ void writeFloats(const std::filesystem::path& path, const std::vector<float>& va
         std::ofstream file(temp, std::ios::binary);
         file.write(reinterpret_cast<const char*>(values.data()),
                    static_cast<std::streamsize>(values.size() * sizeof(float)));
+        file.close(); // flushes: a full disk may only show here
         if (!file)
             throw std::runtime_error("cannot write " + temp.string());
     });
