@@ -8,7 +8,10 @@
 //   normals normal-encoding precision study -> normals.csv, normals.json, plots
 //   depth   depth-format / position-reconstruction study -> depth.csv, depth.json, plots
 // Every option's default is stated by --help; unknown options are errors.
+#include <charconv>
+#include <cstdint>
 #include <iostream>
+#include <limits>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -27,6 +30,19 @@
 
 namespace {
 
+// CLI11 converts an unsigned option with strtoull's rules, under which "-1" is 2^64 - 1, so a
+// seed is checked as text first: decimal digits only, at most 2^64 - 1.
+std::string checkSeed(std::string& text) {
+    uint64_t value = 0;
+    const char* end = text.data() + text.size();
+    const auto [stop, error] = std::from_chars(text.data(), end, value);
+    if (text.empty() || error != std::errc() || stop != end)
+        return "seed '" + text + "' is not an integer in 0.." +
+               std::to_string(std::numeric_limits<uint64_t>::max());
+    return "";
+}
+const CLI::Validator kSeedValidator(checkSeed, "UINT64");
+
 void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& options,
                       std::vector<std::string>& sceneOptionTexts) {
     experiments::RenderOptions& r = options.render;
@@ -39,7 +55,9 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
     render.add_option("--stage", r.stage, "shading stage, NAME or NAME:key=value,...")
         ->capture_default_str();
     render.add_option("--lights", r.lights, "generated point lights")->capture_default_str();
-    render.add_option("--seed", r.seed, "seed of the light generator")->capture_default_str();
+    render.add_option("--seed", r.seed, "seed of the light generator")
+        ->check(kSeedValidator)
+        ->capture_default_str();
     render.add_option("--width", r.width, "image width in pixels")->capture_default_str();
     render.add_option("--height", r.height, "image height in pixels")->capture_default_str();
     render.add_option("--threads", r.threads, "worker threads, 0 = all hardware threads")
@@ -148,6 +166,7 @@ int main(int argc, char** argv) {
                      "uniform sphere directions (--quick: 100000)")
         ->capture_default_str();
     normals->add_option("--seed", normalsOptions.seed, "seed of every random set")
+        ->check(kSeedValidator)
         ->capture_default_str();
     normals
         ->add_option("--scene", normalsOptions.scenes, "built-in scene or scene file (repeatable)")
