@@ -225,9 +225,10 @@ size_t mergeSweepOutputs(const std::vector<fs::path>& inputs, const fs::path& ou
                     continue;
                 linkOrCopy(entry.path(), target / name);
             }
+            // An explicit capture: clang 14 (sanitizer builds) cannot capture a structured binding.
+            const fs::path marker = source.folder / kDoneMarker;
             writeFileAtomically(target / kDoneMarker, [&](const fs::path& temporary) {
-                fs::copy_file(source.folder / kDoneMarker, temporary,
-                              fs::copy_options::overwrite_existing);
+                fs::copy_file(marker, temporary, fs::copy_options::overwrite_existing);
             });
         }
         rows.push_back(source.row);
