@@ -161,7 +161,7 @@ Json readResults(const fs::path& dir) {
     Json results;
     try {
         results = parseBounded(readText(file), file);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {
         throw SweepError(file.string() + ": not valid JSON: " + e.what());
     }
     for (const char* key : {"sweep", "sweep_file", "quick", "columns", "axis_columns", "jobs"})
@@ -199,7 +199,7 @@ size_t mergeSweepOutputs(const std::vector<fs::path>& inputs, const fs::path& ou
             Json marker;
             try {
                 marker = parseBounded(readText(folder / kDoneMarker), folder / kDoneMarker);
-            } catch (const nlohmann::json::parse_error& e) {
+            } catch (const nlohmann::json::exception& e) {
                 throw SweepError("merge: " + (folder / kDoneMarker).string() + ": " + e.what());
             }
             if (!marker.contains("row") || marker["row"].value("job_id", "") != id)

@@ -417,7 +417,8 @@ SweepSpec readSweepText(const std::string& text, const std::string& origin, bool
     } else {
         try {
             object = Json::parse(text);
-        } catch (const nlohmann::json::parse_error& e) {
+        } catch (const nlohmann::json::exception& e) {
+            // parse_error, or out_of_range for a number such as 1e999 (found by sweep_fuzzer)
             throw SweepError(origin + ": JSON syntax error: " + e.what());
         }
     }

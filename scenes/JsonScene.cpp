@@ -260,7 +260,7 @@ Scene JsonSceneReader::read() {
     Json root;
     try {
         root = Json::parse(bytes);
-    } catch (const Json::parse_error& parseError) {
+    } catch (const Json::exception& parseError) { // parse_error, or out_of_range for 1e999
         fail("", std::string("invalid JSON: ") + parseError.what());
     }
     expectKeys(root, "", {"name", "camera", "objects", "lights", "lightGenerator", "materials"});

@@ -179,6 +179,19 @@ TEST(InputLimits, DeeplyNestedJsonSceneIsRefused) {
     }
 }
 
+TEST(InputLimits, JsonSceneNumberPastDoubleIsAnError) {
+    // nlohmann reports it as out_of_range, not parse_error (sweep_fuzzer found it in sweeps).
+    const fs::path directory = testDirectory();
+    const fs::path path = writeFile(directory / "overflow.json", "{\"objects\": [1e999]}");
+    try {
+        scenes::loadScene(path.string(), {});
+        FAIL() << "no error";
+    } catch (const SceneError& error) {
+        EXPECT_NE(std::string(error.what()).find("overflow.json: invalid JSON"), std::string::npos)
+            << error.what();
+    }
+}
+
 TEST(InputLimits, BufferUriNamingAFolderIsAnError) {
     const fs::path directory = testDirectory();
     json document = triangleDocument(directory);
