@@ -110,10 +110,7 @@ void writeErrorPng(const std::filesystem::path& path, int w, int h,
                                             : (std::isfinite(v) ? 0.0f : 1.0f);
     largest.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values.data());
     const OIIO::ImageBuf coloured = OIIO::ImageBufAlgo::color_map(largest, 0, "turbo");
-    writeFileAtomically(path, [&](const std::filesystem::path& temp) {
-        if (!coloured.write(temp.string(), OIIO::TypeDesc::UINT8))
-            throw std::runtime_error("cannot write " + path.string() + ": " + coloured.geterror());
-    });
+    writeImageAtomically(path, coloured, OIIO::TypeDesc::UINT8, "png");
 }
 
 // What `testbed render` prints when done: the run, its pass medians, the error, the files.
