@@ -362,6 +362,18 @@ SweepSpec parseSweep(const Json& object, const std::string& origin) {
             fail(origin, "'reference' must be true or false");
         spec.reference = object["reference"].get<bool>();
     }
+    // Without settings the sweep would be one default render, which a typo'd or truncated file
+    // must not silently become (`testbed render` is the way to make a default render).
+    if (spec.fixed.empty() && spec.axes.empty() && spec.cases.empty())
+        fail(origin, "the sweep sets nothing to run: it needs 'fixed' settings, 'axes' or "
+                     "'cases' (e.g. \"axes\": {\"stage\": [\"brute\", \"tiled\"]}), and has " +
+                         (object.empty() ? std::string("no keys")
+                                         : "only " + joined([&] {
+                                               std::vector<std::string> keys;
+                                               for (const auto& [key, value] : object.items())
+                                                   keys.push_back("'" + key + "'");
+                                               return keys;
+                                           }())));
     checkDisjoint(spec, "");
     std::set<std::string> keys = settingKeys(spec);
     if (object.contains("quick")) {

@@ -141,6 +141,20 @@ TEST(SweepFile, QuickBlockOverrides) {
     EXPECT_NE(message.find("quick"), std::string::npos) << message;
 }
 
+// A file with only a name (a truncated or typo'd file) once ran one default render silently.
+TEST(SweepFile, SweepThatSetsNothingIsRefused) {
+    std::string message = errorOf(
+        [&] { experiments::parseSweep(Json::parse(R"({"name": "empty"})"), "empty.json"); });
+    EXPECT_NE(message.find("empty.json: the sweep sets nothing to run"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("only 'name'"), std::string::npos) << message;
+    message = errorOf([&] { experiments::parseSweep(Json::object(), "bare.json"); });
+    EXPECT_NE(message.find("has no keys"), std::string::npos) << message;
+    // One setting is enough.
+    EXPECT_NO_THROW(experiments::expandSweep(
+        experiments::parseSweep(Json::parse(R"({"fixed": {"scene": "wall"}})"), "one.json")));
+}
+
 TEST(SweepFile, RejectsUnknownKeysNamingFileAndKey) {
     Json file = baseSweep();
     file["axis"] = Json::object(); // typo of "axes"
