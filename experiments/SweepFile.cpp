@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
 #include <toml++/toml.h>
 
@@ -526,95 +527,183 @@ SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads) {
         std::erase_if(effective.fixed, [](const SweepSetting& s) { return s.key == "threads"; });
         effective.fixed.push_back({"threads", *threads});
     }
-    const std::vector<std::vector<SweepSetting>> cases =
+    SweepExpansion expansion;
+    expansion.mFixed = effective.fixed;
+    expansion.mCases =
         effective.cases.empty() ? std::vector<std::vector<SweepSetting>>{{}} : effective.cases;
-    // Counted in double: twenty axes of 10 values would overflow any integer product.
+    expansion.mAxes = effective.axes;
+    expansion.mWarmup = effective.warmup;
+    expansion.mRepetitions = effective.repetitions;
+    expansion.mReference = effective.reference;
+    // Counted in double: twenty axes of 10 values would overflow any integer product. The total
+    // is known before any job is made, so a typo'd axis is refused without allocating.
     double combinations = 1.0;
     for (const auto& [key, values] : effective.axes)
         combinations *= double(values.size());
-    const double jobCount = double(cases.size()) * combinations;
+    const double jobCount = double(expansion.mCases.size()) * combinations;
     if (jobCount > double(scenes::limits::kMaxSweepJobs))
         fail(spec.origin,
              (jobCount < 1e18 ? std::to_string(uint64_t(jobCount)) : "more than 10^18") +
                  " jobs refused (at most " + std::to_string(scenes::limits::kMaxSweepJobs) + ")");
+    static_assert(scenes::limits::kMaxSweepJobs <= UINT32_MAX, "run order entries are 32-bit");
+    expansion.mCombinations = size_t(combinations);
     const size_t total = size_t(jobCount);
-    // A typo'd axis must not allocate forever: the total is known before any job is made.
-    const size_t digits = std::max<size_t>(4, std::to_string(total ? total - 1 : 0).size());
+    expansion.mJobCount = total;
+    expansion.mIdDigits = std::max<size_t>(4, std::to_string(total ? total - 1 : 0).size());
 
-    SweepExpansion expansion;
+    // Each job is made once, validated and reduced to its reference group; groups are numbered in
+    // order of first appearance, through a hash of the reference key (a collision of two keys in
+    // 64 bits would only merge two groups' run order, never change a result).
     std::vector<std::string> errors;
-    std::vector<SweepJob> jobs;
-    jobs.reserve(total);
-    for (size_t c = 0; c < cases.size(); ++c)
-        for (size_t combo = 0; combo < combinations; ++combo) {
-            SweepJob job;
-            job.ordinal = jobs.size();
-            job.settings = effective.fixed;
-            job.settings.insert(job.settings.end(), cases[c].begin(), cases[c].end());
-            // Mixed radix, last axis fastest.
-            size_t rest = combo;
-            std::vector<SweepSetting> axisSettings(effective.axes.size());
-            for (size_t a = effective.axes.size(); a-- > 0;) {
-                const auto& [key, values] = effective.axes[a];
-                axisSettings[a] = {key, values[rest % values.size()]};
-                rest /= values.size();
+    size_t invalid = 0;
+    std::vector<uint32_t> groupOf(total);
+    std::unordered_map<uint64_t, uint32_t> groupOfKey;
+    for (size_t ordinal = 0; ordinal < total; ++ordinal) {
+        try {
+            const SweepJob job = expansion.jobAtOrdinal(ordinal);
+            validate(job.options);
+            groupOf[ordinal] =
+                groupOfKey.emplace(fnv1a(job.referenceKey), uint32_t(groupOfKey.size()))
+                    .first->second;
+        } catch (const std::exception& e) {
+            if (++invalid <= kMaxListedInvalidJobs) {
+                const std::vector<SweepSetting> settings = expansion.settingsOf(ordinal);
+                errors.push_back("job " + expansion.idOf(ordinal, settings) + " (" +
+                                 describeSettings(settings) + "): " + e.what());
             }
-            job.settings.insert(job.settings.end(), axisSettings.begin(), axisSettings.end());
-            job.options.warmup = effective.warmup;
-            job.options.repetitions = effective.repetitions;
-            job.compareReference = effective.reference;
-            std::vector<std::string> canonical;
-            for (const SweepSetting& s : job.settings)
-                canonical.push_back(s.key + "=" + settingText(s.value, s.key));
-            canonical.push_back("warmup=" + std::to_string(effective.warmup));
-            canonical.push_back("repetitions=" + std::to_string(effective.repetitions));
-            canonical.push_back(std::string("reference=") + (effective.reference ? "1" : "0"));
-            std::sort(canonical.begin(), canonical.end());
-            std::string text;
-            for (const std::string& line : canonical)
-                text += line + "\n";
-            std::string ordinal = std::to_string(job.ordinal);
-            ordinal.insert(0, digits - ordinal.size(), '0');
-            job.id = ordinal + "-" + hex8(fnv1a(text));
-            try {
-                for (const SweepSetting& s : job.settings)
-                    applySetting(job.options, s);
-                validate(job.options);
-                job.referenceKey = referenceKeyOf(job.options);
-            } catch (const std::exception& e) {
-                errors.push_back("job " + job.id + " (" + describeSettings(job.settings) +
-                                 "): " + e.what());
-            }
-            jobs.push_back(std::move(job));
         }
-    if (!errors.empty()) {
-        std::string message = spec.origin + ": " + std::to_string(errors.size()) + " of " +
-                              std::to_string(total) + " jobs are invalid:";
+    }
+    if (invalid > 0) {
+        std::string message =
+            spec.origin + ": " + std::to_string(invalid) + " of " + std::to_string(total) +
+            " jobs are invalid" +
+            (invalid > errors.size() ? " (the first " + std::to_string(errors.size()) + " listed)"
+                                     : "") +
+            ":";
         for (const std::string& error : errors)
             message += "\n  " + error;
         throw SweepError(message);
     }
-    // Run order: grouped by reference key, groups in order of first appearance, stable inside.
-    std::map<std::string, size_t> firstSeen;
-    for (const SweepJob& job : jobs)
-        firstSeen.emplace(job.referenceKey, firstSeen.size());
-    std::stable_sort(jobs.begin(), jobs.end(), [&](const SweepJob& a, const SweepJob& b) {
-        return firstSeen.at(a.referenceKey) < firstSeen.at(b.referenceKey);
-    });
+    // Run order: a counting sort of the ordinals by group (stable: ordinal order inside).
+    std::vector<size_t> groupStart(groupOfKey.size() + 1, 0);
+    for (uint32_t group : groupOf)
+        ++groupStart[group + 1];
+    for (size_t g = 1; g < groupStart.size(); ++g)
+        groupStart[g] += groupStart[g - 1];
+    expansion.mOrdinalAt.resize(total);
+    for (size_t ordinal = 0; ordinal < total; ++ordinal)
+        expansion.mOrdinalAt[groupStart[groupOf[ordinal]]++] = uint32_t(ordinal);
+
     std::vector<std::string> keys;
-    for (const SweepSetting& s : jobs.empty() ? std::vector<SweepSetting>{} : jobs.front().settings)
+    for (const SweepSetting& s : total ? expansion.settingsOf(0) : std::vector<SweepSetting>{})
         keys.push_back(s.key);
-    expansion.axisColumns = axisColumns(keys);
-    expansion.jobs = std::move(jobs);
+    expansion.mAxisColumns = axisColumns(keys);
     return expansion;
 }
 
-std::vector<SweepJob> shardJobs(const std::vector<SweepJob>& jobs, int index, int count) {
+std::vector<SweepSetting> SweepExpansion::settingsOf(size_t ordinal) const {
+    const size_t caseIndex = ordinal / mCombinations;
+    std::vector<SweepSetting> settings = mFixed;
+    settings.insert(settings.end(), mCases[caseIndex].begin(), mCases[caseIndex].end());
+    // Mixed radix, last axis fastest.
+    size_t rest = ordinal % mCombinations;
+    std::vector<SweepSetting> axisSettings(mAxes.size());
+    for (size_t a = mAxes.size(); a-- > 0;) {
+        const auto& [key, values] = mAxes[a];
+        axisSettings[a] = {key, values[rest % values.size()]};
+        rest /= values.size();
+    }
+    settings.insert(settings.end(), axisSettings.begin(), axisSettings.end());
+    return settings;
+}
+
+std::string SweepExpansion::idOf(size_t ordinal, const std::vector<SweepSetting>& settings) const {
+    std::vector<std::string> canonical;
+    for (const SweepSetting& s : settings)
+        canonical.push_back(s.key + "=" + settingText(s.value, s.key));
+    canonical.push_back("warmup=" + std::to_string(mWarmup));
+    canonical.push_back("repetitions=" + std::to_string(mRepetitions));
+    canonical.push_back(std::string("reference=") + (mReference ? "1" : "0"));
+    std::sort(canonical.begin(), canonical.end());
+    std::string text;
+    for (const std::string& line : canonical)
+        text += line + "\n";
+    std::string number = std::to_string(ordinal);
+    number.insert(0, mIdDigits - std::min(mIdDigits, number.size()), '0');
+    return number + "-" + hex8(fnv1a(text));
+}
+
+std::string SweepExpansion::jobId(size_t ordinal) const {
+    return idOf(ordinal, settingsOf(ordinal));
+}
+
+SweepJob SweepExpansion::jobAtOrdinal(size_t ordinal) const {
+    if (ordinal >= size())
+        throw std::out_of_range("sweep job ordinal " + std::to_string(ordinal) + " of " +
+                                std::to_string(size()));
+    SweepJob job;
+    job.ordinal = ordinal;
+    job.settings = settingsOf(ordinal);
+    job.id = idOf(ordinal, job.settings);
+    job.options.warmup = mWarmup;
+    job.options.repetitions = mRepetitions;
+    job.compareReference = mReference;
+    for (const SweepSetting& s : job.settings)
+        applySetting(job.options, s);
+    job.referenceKey = referenceKeyOf(job.options);
+    return job;
+}
+
+Json sweepJobJson(const SweepJob& job) {
+    Json settings = Json::array();
+    for (const SweepSetting& s : job.settings)
+        settings.push_back(Json{{"key", s.key}, {"value", s.value}});
+    return Json{{"ordinal", job.ordinal},
+                {"id", job.id},
+                {"settings", settings},
+                {"warmup", job.options.warmup},
+                {"repetitions", job.options.repetitions},
+                {"reference", job.compareReference}};
+}
+
+SweepJob sweepJobFromJson(const Json& json) {
+    SweepJob job;
+    try {
+        job.ordinal = json.at("ordinal").get<size_t>();
+        job.id = json.at("id").get<std::string>();
+        job.options.warmup = json.at("warmup").get<int>();
+        job.options.repetitions = json.at("repetitions").get<int>();
+        job.compareReference = json.at("reference").get<bool>();
+        for (const Json& setting : json.at("settings"))
+            job.settings.push_back({setting.at("key").get<std::string>(), setting.at("value")});
+        for (const SweepSetting& s : job.settings)
+            applySetting(job.options, s);
+    } catch (const nlohmann::json::exception& e) {
+        throw SweepError(std::string("malformed sweep job: ") + e.what());
+    } catch (const UsageError& e) {
+        throw SweepError(std::string("sweep job: ") + e.what());
+    }
+    job.referenceKey = referenceKeyOf(job.options);
+    return job;
+}
+
+std::vector<SweepJob> SweepExpansion::jobs() const {
+    std::vector<SweepJob> all;
+    all.reserve(size());
+    for (size_t position = 0; position < size(); ++position)
+        all.push_back(job(position));
+    return all;
+}
+
+std::pair<size_t, size_t> shardRange(size_t jobCount, int index, int count) {
     if (count < 1 || index < 1 || index > count)
         throw SweepError("shard " + std::to_string(index) + "/" + std::to_string(count) +
                          " refused: need 1 <= I <= N");
-    const size_t n = jobs.size(), first = n * size_t(index - 1) / size_t(count),
-                 last = n * size_t(index) / size_t(count);
+    return {jobCount * size_t(index - 1) / size_t(count), jobCount * size_t(index) / size_t(count)};
+}
+
+std::vector<SweepJob> shardJobs(const std::vector<SweepJob>& jobs, int index, int count) {
+    const auto [first, last] = shardRange(jobs.size(), index, count);
     return std::vector<SweepJob>(jobs.begin() + ptrdiff_t(first), jobs.begin() + ptrdiff_t(last));
 }
 

@@ -18,15 +18,18 @@
 // zero-padded ordinal and a hash of every setting that makes it ("0007-1a2b3c4d"), identical in
 // every shard and every rerun of the same file, and different when a setting changes. Jobs are
 // then run grouped by reference key (scene, scene options, lights, seed, size), so that one
-// reference image serves a run of adjacent jobs.
+// reference image serves a run of adjacent jobs. Jobs are made on demand (SweepExpansion), so
+// memory does not grow with the job count beyond 4 bytes a job.
 //
-// Errors: SweepError with a message naming the file and the key; expandSweep reports every
-// invalid job at once instead of stopping at the first.
+// Errors: SweepError with a message naming the file and the key; expandSweep reports the invalid
+// jobs together (the first kMaxListedInvalidJobs of them, and how many there are) instead of
+// stopping at the first.
 //
 // Thread safety: pure functions over values; no shared state.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -43,6 +46,10 @@ namespace experiments {
 struct SweepError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
+
+// Invalid jobs listed by expandSweep's error (the rest are counted): a typo in an axis of 10^6
+// jobs must not make a message of 10^6 lines.
+inline constexpr size_t kMaxListedInvalidJobs = 20;
 
 // One key = value of a sweep; value is a JSON string or number, as written in the file.
 struct SweepSetting {
@@ -88,16 +95,64 @@ struct SweepJob {
     std::string referenceKey; // filesystem-safe, e.g. "wall-1280x720-1500l-s1-9f3a0c11"
 };
 
-struct SweepExpansion {
-    std::vector<SweepJob> jobs;           // in run order: grouped by referenceKey
-    std::vector<std::string> axisColumns; // result columns of the settings, see axisColumns()
+// The jobs of a sweep, made on demand: the expansion keeps the sweep's settings and one 4-byte
+// run-order entry per job (4 MB at limits::kMaxSweepJobs), never the jobs themselves, so a sweep
+// of 10^6 jobs starts in tens of megabytes (a vector of job records took 2.7 GB before its first
+// job). Making a job costs O(settings).
+//
+// Run order: jobs grouped by reference key, groups in order of first appearance in the full
+// expansion, ordinal order inside a group; so one reference image serves a run of adjacent jobs,
+// and a shard (a contiguous block of the run order) shares references as far as possible.
+class SweepExpansion {
+public:
+    // Every job of the full expansion, in run order.
+    size_t size() const { return mJobCount; }
+    // The job at a position of the run order (0 <= position < size()).
+    SweepJob job(size_t position) const { return jobAtOrdinal(ordinalAt(position)); }
+    // The ordinal of the job at a position of the run order.
+    size_t ordinalAt(size_t position) const { return mOrdinalAt.at(position); }
+    // The job with this ordinal (0 <= ordinal < size()).
+    SweepJob jobAtOrdinal(size_t ordinal) const;
+    // The id of the job with this ordinal, without the rest of the job (cheaper).
+    std::string jobId(size_t ordinal) const;
+    // Result columns of the settings (axisColumns below).
+    const std::vector<std::string>& axisColumns() const { return mAxisColumns; }
+    // Every job, in run order: O(jobs) memory, for tests and small sweeps; the runner never
+    // holds them all.
+    std::vector<SweepJob> jobs() const;
+
+private:
+    friend SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads);
+    std::vector<SweepSetting> settingsOf(size_t ordinal) const;
+    std::string idOf(size_t ordinal, const std::vector<SweepSetting>& settings) const;
+
+    std::vector<SweepSetting> mFixed;
+    std::vector<std::vector<SweepSetting>> mCases; // at least one (empty) case
+    std::vector<std::pair<std::string, std::vector<nlohmann::ordered_json>>> mAxes;
+    size_t mJobCount = 0;
+    size_t mCombinations = 1; // product of the axes' sizes
+    size_t mIdDigits = 4;     // zero padding of the ordinal in ids
+    int mWarmup = 0;
+    int mRepetitions = 1;
+    bool mReference = true;
+    std::vector<std::string> mAxisColumns;
+    std::vector<uint32_t> mOrdinalAt; // run position -> ordinal
 };
 
-// Expands the spec (after applyQuick when wanted) into jobs and validates every one of them
-// (setRenderOption, then experiments::validate). `threads`, when set, is a fixed setting added
-// by the command line (an error if the file makes threads an axis or case key). Throws
-// SweepError listing every invalid job (id, settings, reason) when any is invalid.
+// Expands the spec (after applyQuick when wanted) and validates every job (setRenderOption, then
+// experiments::validate), making each job once and keeping none. `threads`, when set, is a fixed
+// setting added by the command line (an error if the file makes threads an axis or case key).
+// Throws SweepError when the sweep has more than limits::kMaxSweepJobs jobs (before making any)
+// or when any job is invalid (listing the first ones: id, settings, reason, and how many there
+// are).
 SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads = std::nullopt);
+
+// A job as JSON and back, for handing a job to a child process (JobProcess.h):
+// {"ordinal", "id", "settings": [{"key", "value"}...], "warmup", "repetitions", "reference"}.
+// sweepJobFromJson makes the options and the reference key again from the settings, as the
+// expansion does; it throws SweepError for a malformed object or an invalid setting.
+nlohmann::ordered_json sweepJobJson(const SweepJob& job);
+SweepJob sweepJobFromJson(const nlohmann::ordered_json& json);
 
 // The result columns for settings: every key the sweep sets, in the canonical order scene,
 // stage, lights, seed, resolution, width, height, threads, layout, normals, normal-space, depth,
@@ -110,9 +165,12 @@ std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys
 // repetitions / warmup.
 nlohmann::ordered_json axisValue(const SweepJob& job, const std::string& column);
 
-// The jobs of shard `index` (1-based) of `count`: a contiguous block of the run order, so a
-// reference is shared by the jobs of one shard as far as possible; blocks differ in size by at
-// most one job. Throws SweepError when not 1 <= index <= count.
+// The run positions [first, last) of shard `index` (1-based) of `count` among `jobCount` jobs: a
+// contiguous block of the run order, so a reference is shared by the jobs of one shard as far as
+// possible; blocks differ in size by at most one job. Throws SweepError when not
+// 1 <= index <= count.
+std::pair<size_t, size_t> shardRange(size_t jobCount, int index, int count);
+// The jobs of a shard of a job list (shardRange of its size).
 std::vector<SweepJob> shardJobs(const std::vector<SweepJob>& jobs, int index, int count);
 
 // Parses "I/N" (both positive, I <= N). Throws SweepError otherwise.

@@ -9,16 +9,12 @@
 #include <map>
 #include <sstream>
 
-#include <OpenImageIO/imagebuf.h>
-
 #include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
-#include "experiments/ImageOutput.h"
-#include "experiments/RenderCommand.h"
-#include "experiments/RenderJob.h"
+#include "experiments/JobProcess.h"
 #include "experiments/ResultsTable.h"
-#include "experiments/RunMetrics.h"
 #include "experiments/SweepFile.h"
+#include "experiments/SweepJobRun.h"
 
 namespace experiments {
 
@@ -82,10 +78,6 @@ std::optional<Json> markerRow(const fs::path& marker) {
     return std::nullopt;
 }
 
-Json number(double value) {
-    return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
-
 // The row's axis values and status; metrics are added by the caller.
 Json baseRow(const SweepJob& job, const std::vector<std::string>& axisColumns) {
     Json row = Json::object();
@@ -97,125 +89,77 @@ Json baseRow(const SweepJob& job, const std::vector<std::string>& axisColumns) {
     return row;
 }
 
-// The run's metrics as result columns: time_<pass>_{median,min,max}_ms for every pass and the
-// stage's sum, then RunMetrics' figures (runFigureColumns() order); non-finite values are null.
-void addMetrics(Json& row, const RunMetrics& metrics) {
-    std::vector<PassTiming> passes = metrics.passes;
-    if (!metrics.stage.samplesMs.empty())
-        passes.push_back(metrics.stage);
-    for (const PassTiming& timing : passes) {
-        row["time_" + timing.pass + "_median_ms"] = number(timing.medianMs());
-        row["time_" + timing.pass + "_min_ms"] = number(timing.minMs());
-        row["time_" + timing.pass + "_max_ms"] = number(timing.maxMs());
-    }
-    row[metric::kLightEvaluations] = metrics.lightEvaluations;
-    row[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
-    row[metric::kCullingEfficiency] = metrics.cullingEfficiency;
-    row[metric::kBytesPerPixel] = metrics.bytesPerPixel;
-    for (const NamedFigure& figure : metrics.errorFigures())
-        row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
-}
-
-void writeReferenceExr(const fs::path& path, const std::string& key,
-                       const lighting::StageResult& image) {
-    writeMultiLayerExr(path, image.width, image.height,
-                       {{"R", image.radiance[0].data()},
-                        {"G", image.radiance[1].data()},
-                        {"B", image.radiance[2].data()}},
-                       {{"testbed:reference_key", key},
-                        {"testbed:what", "double-precision reference, stored as float32"}});
-}
-
-// Reads a cached reference; nullopt when absent or not the expected image (then it is rendered).
-std::optional<lighting::StageResult> readReferenceExr(const fs::path& path, const std::string& key,
-                                                      int width, int height) {
-    if (!fs::is_regular_file(path))
+// The ordinal of a job folder's name "<ordinal>-<hash>", or nullopt for another name.
+std::optional<size_t> ordinalOfFolder(const std::string& name) {
+    const size_t dash = name.find('-');
+    if (dash == 0 || dash == std::string::npos || dash > 20)
         return std::nullopt;
-    OIIO::ImageBuf buffer(path.string());
-    if (!buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT))
-        return std::nullopt;
-    const OIIO::ImageSpec& spec = buffer.spec();
-    if (spec.width != width || spec.height != height ||
-        spec.get_string_attribute("testbed:reference_key") != key)
-        return std::nullopt;
-    lighting::StageResult image;
-    image.width = width;
-    image.height = height;
-    const size_t pixels = size_t(width) * size_t(height);
-    const char* names[3] = {"R", "G", "B"};
-    for (int c = 0; c < 3; ++c) {
-        const int channel = spec.channelindex(names[c]);
-        if (channel < 0)
+    size_t ordinal = 0;
+    for (size_t i = 0; i < dash; ++i) {
+        if (name[i] < '0' || name[i] > '9')
             return std::nullopt;
-        image.radiance[c].resize(pixels);
-        OIIO::ROI roi = buffer.roi();
-        roi.chbegin = channel;
-        roi.chend = channel + 1;
-        if (!buffer.get_pixels(roi, OIIO::TypeDesc::FLOAT, image.radiance[c].data()))
-            return std::nullopt;
+        ordinal = ordinal * 10 + size_t(name[i] - '0');
     }
-    return image;
+    return ordinal;
 }
 
 class Runner {
 public:
-    Runner(const SweepOptions& options, std::ostream& log) : mOptions(options), mLog(log) {}
+    Runner(const SweepOptions& options, std::ostream& log)
+        : mOptions(options), mLog(log), mReferences(options.out / "references") {}
 
     SweepSummary run() {
         SweepSpec spec = readSweepFile(mOptions.file);
         if (mOptions.quick)
             spec = applyQuick(spec);
         mSpec = spec;
-        const SweepExpansion expansion = expandSweep(spec, mOptions.threads);
-        mAllJobs = expansion.jobs;
-        mAxisColumns = expansion.axisColumns;
-        const std::vector<SweepJob> jobs =
-            shardJobs(mAllJobs, mOptions.shardIndex, mOptions.shardCount);
+        mExpansion = expandSweep(spec, mOptions.threads);
+        const auto [first, last] =
+            shardRange(mExpansion.size(), mOptions.shardIndex, mOptions.shardCount);
         ensureWritableDirectory(mOptions.out);
         fs::create_directories(mOptions.out / "jobs");
         fs::create_directories(mOptions.out / "references");
 
-        mSummary.jobsInSweep = mAllJobs.size();
-        mSummary.jobsInShard = jobs.size();
+        const size_t shardSize = last - first;
+        mSummary.jobsInSweep = mExpansion.size();
+        mSummary.jobsInShard = shardSize;
         const std::string name = spec.name.empty() ? mOptions.file.stem().string() : spec.name;
-        mLog << "sweep " << name << (mOptions.quick ? " (quick)" : "") << ": " << jobs.size()
+        mLog << "sweep " << name << (mOptions.quick ? " (quick)" : "") << ": " << shardSize
              << " jobs";
         if (mOptions.shardCount > 1)
             mLog << " (shard " << mOptions.shardIndex << "/" << mOptions.shardCount << " of "
-                 << mAllJobs.size() << ")";
-        mLog << ", output " << mOptions.out.string() << "\n";
+                 << mExpansion.size() << ")";
+        mLog << ", output " << mOptions.out.string()
+             << (mOptions.isolation == JobIsolation::InProcess ? ", jobs in this process" : "")
+             << "\n";
 
-        // Which jobs still need a reference: a reference is dropped after its last user.
-        std::map<std::string, size_t> remainingUsers;
-        std::vector<bool> finished(jobs.size());
+        std::vector<bool> finished(shardSize);
         size_t toRun = 0;
-        for (size_t i = 0; i < jobs.size(); ++i) {
-            finished[i] = markerStatus(jobDir(jobs[i]) / kDoneMarker) == "ok";
-            if (!finished[i]) {
-                ++toRun;
-                if (jobs[i].compareReference)
-                    ++remainingUsers[jobs[i].referenceKey];
-            }
+        for (size_t i = 0; i < shardSize; ++i) {
+            finished[i] = markerStatus(jobDir(mExpansion.jobId(mExpansion.ordinalAt(first + i))) /
+                                       kDoneMarker) == "ok";
+            toRun += finished[i] ? 0 : 1;
         }
 
         const auto start = Clock::now();
         double runSeconds = 0.0;
-        for (size_t i = 0; i < jobs.size(); ++i) {
-            const SweepJob& job = jobs[i];
+        for (size_t i = 0; i < shardSize; ++i) {
             const std::string position =
-                "[" + std::to_string(i + 1) + "/" + std::to_string(jobs.size()) + "]";
+                "[" + std::to_string(i + 1) + "/" + std::to_string(shardSize) + "]";
             if (finished[i]) {
                 ++mSummary.skipped;
-                mLog << position << " skipped " << job.id << " (finished before)\n";
+                mLog << position << " skipped " << mExpansion.jobId(mExpansion.ordinalAt(first + i))
+                     << " (finished before)\n";
                 continue;
             }
+            const SweepJob job = mExpansion.job(first + i);
             const size_t left = toRun - mSummary.ran;
             const std::string remaining =
                 mSummary.ran == 0
                     ? "?"
                     : formatDuration(runSeconds / double(mSummary.ran) * double(left));
             mLog << position << " running " << job.id << ": " << describeSettings(job.settings)
-                 << " | done " << (mSummary.ran + mSummary.skipped) << "/" << jobs.size()
+                 << " | done " << (mSummary.ran + mSummary.skipped) << "/" << shardSize
                  << ", skipped " << mSummary.skipped << ", failed " << mSummary.failed
                  << " | elapsed " << formatDuration(secondsSince(start)) << ", remaining ~"
                  << remaining << "\n";
@@ -227,18 +171,13 @@ public:
             ++mSummary.ran;
             if (!error.empty())
                 ++mSummary.failed;
-            if (job.compareReference && --remainingUsers[job.referenceKey] == 0 &&
-                mReferenceKey == job.referenceKey) {
-                mReference.reset(); // no later job of this shard needs it
-                mReferenceKey.clear();
-            }
             mLog << position << (error.empty() ? " ok " : " FAILED ") << job.id << " in "
                  << formatDuration(seconds) << (error.empty() ? "" : ": " + error) << "\n";
-            rebuildTable();
+            rebuildTable(false);
         }
-        rebuildTable();
+        rebuildTable(true);
         mLog << "sweep " << name << " finished in " << formatDuration(secondsSince(start)) << ": "
-             << jobs.size() << " jobs, " << mSummary.ran << " ran, " << mSummary.skipped
+             << shardSize << " jobs, " << mSummary.ran << " ran, " << mSummary.skipped
              << " skipped, " << mSummary.failed
              << " failed; references: " << mSummary.referencesRendered << " rendered, "
              << mSummary.referencesLoaded << " read from disk; table of " << mSummary.rowsInTable
@@ -248,54 +187,37 @@ public:
     }
 
 private:
-    fs::path jobDir(const SweepJob& job) const { return mOptions.out / "jobs" / job.id; }
+    fs::path jobDir(const std::string& id) const { return mOptions.out / "jobs" / id; }
 
-    // The reference of the job's key: memory, then DIR/references, then rendered (and cached).
-    const lighting::StageResult& reference(const SweepJob& job) {
-        if (mReferenceKey == job.referenceKey && mReference)
-            return *mReference;
-        if (const auto failed = mReferenceErrors.find(job.referenceKey);
-            failed != mReferenceErrors.end())
-            throw std::runtime_error(failed->second);
-        mReference.reset();
-        mReferenceKey = job.referenceKey;
-        const fs::path path = mOptions.out / "references" / (job.referenceKey + ".exr");
-        if (auto loaded =
-                readReferenceExr(path, job.referenceKey, job.options.width, job.options.height)) {
-            mReference = std::move(*loaded);
-            ++mSummary.referencesLoaded;
-            return *mReference;
+    void onReference(ReferenceStore::Event event, const std::string& key) {
+        if (event == ReferenceStore::Event::Rendering) {
+            mLog << "  rendering reference " << key << "\n";
+            mLog.flush();
         }
-        mLog << "  rendering reference " << job.referenceKey << "\n";
-        mLog.flush();
-        try {
-            mReference = renderReference(job.options);
-        } catch (const std::exception& e) {
-            const std::string message =
-                std::string("reference ") + job.referenceKey + ": " + e.what();
-            mReferenceErrors[job.referenceKey] = message; // the key's other jobs fail at once
-            throw std::runtime_error(message);
-        }
-        ++mSummary.referencesRendered;
-        writeReferenceExr(path, job.referenceKey, *mReference);
-        return *mReference;
+        mSummary.referencesRendered += event == ReferenceStore::Event::Rendered ? 1 : 0;
+        mSummary.referencesLoaded += event == ReferenceStore::Event::Loaded ? 1 : 0;
     }
 
-    // Runs one job and writes its folder; returns "" or the error text.
+    // Runs one job (in a child process unless options.isolation is InProcess) and writes its
+    // marker; returns "" or the error text.
     std::string runJob(const SweepJob& job) {
-        const fs::path dir = jobDir(job);
-        Json row = baseRow(job, mAxisColumns);
+        const fs::path dir = jobDir(job.id);
+        Json row = baseRow(job, mExpansion.axisColumns());
         std::string error;
         try {
             fs::create_directories(dir);
             fs::remove(dir / kDoneMarker); // a failed job's old marker: the job is rerun now
-            const lighting::StageResult* referenceImage =
-                job.compareReference ? &reference(job) : nullptr;
-            RenderOptions options = job.options;
-            options.compareReference = job.compareReference;
-            const RenderRun run = runRender(planRender(options), {}, referenceImage);
-            writeRenderOutputs(run, dir, 0);
-            addMetrics(row, run.metrics);
+            Json metrics;
+            if (mOptions.isolation == JobIsolation::InProcess) {
+                metrics = runSweepJob(job, dir, mReferences,
+                                      [&](ReferenceStore::Event event, const std::string& key) {
+                                          onReference(event, key);
+                                      });
+            } else {
+                metrics = runIsolated(job);
+            }
+            for (const auto& [column, value] : metrics.items())
+                row[column] = value;
         } catch (const std::exception& e) {
             error = e.what();
             if (error.empty())
@@ -314,26 +236,69 @@ private:
         return error;
     }
 
-    // results.* from the markers of every job of the sweep present in DIR (any shard's).
-    void rebuildTable() {
+    // The job in a child process: its metrics, or throws its error (a crash included).
+    Json runIsolated(const SweepJob& job) {
+        if (job.compareReference) {
+            // A reference that failed (or crashed its process) fails its key's other jobs at
+            // once, as in-process; a reference not yet cached is announced like in-process.
+            if (const auto failed = mReferenceErrors.find(job.referenceKey);
+                failed != mReferenceErrors.end())
+                throw std::runtime_error(failed->second);
+            if (!fs::exists(mReferences.cachePath(job.referenceKey)))
+                onReference(ReferenceStore::Event::Rendering, job.referenceKey);
+        }
+        const JobProcessOutcome outcome = runJobProcess(
+            job, mOptions.out,
+            mOptions.isolation == JobIsolation::Fork ? JobStart::Fork : JobStart::Spawn,
+            mOptions.jobExecutable);
+        if (outcome.referenceRendered)
+            onReference(ReferenceStore::Event::Rendered, job.referenceKey);
+        if (outcome.referenceLoaded)
+            onReference(ReferenceStore::Event::Loaded, job.referenceKey);
+        if (!outcome.ok) {
+            if (outcome.referenceFailed)
+                mReferenceErrors[job.referenceKey] = outcome.error;
+            throw std::runtime_error(outcome.error);
+        }
+        return outcome.metrics;
+    }
+
+    // results.* from the markers of every job of this sweep in DIR (any shard's): the job folders
+    // present are listed and each is checked against the expansion (ordinal and id), so the cost
+    // grows with the jobs run, not the jobs of the sweep. After a job the table is rebuilt only
+    // when at least ten times the last rebuild's duration has passed since it, so that rebuilding
+    // takes at most ~10% of a sweep's time however many jobs it has; `force` rebuilds now.
+    void rebuildTable(bool force) {
+        if (!force && mLastRebuild && secondsSince(*mLastRebuild) < 10.0 * mLastRebuildSeconds)
+            return;
+        const auto start = Clock::now();
         std::vector<Json> rows;
-        for (const SweepJob& job : mAllJobs)
-            if (auto row = markerRow(jobDir(job) / kDoneMarker))
+        std::error_code error;
+        for (fs::directory_iterator it(mOptions.out / "jobs", error), end; !error && it != end;
+             it.increment(error)) {
+            const std::string name = it->path().filename().string();
+            const std::optional<size_t> ordinal = ordinalOfFolder(name);
+            if (!ordinal || *ordinal >= mExpansion.size() || mExpansion.jobId(*ordinal) != name)
+                continue; // not a job of this sweep (another file, --quick, or an edited sweep)
+            if (auto row = markerRow(it->path() / kDoneMarker))
                 rows.push_back(std::move(*row));
+        }
         mSummary.rowsInTable = rows.size();
         writeResults(mOptions.out, resultsJson(mSpec.source, mOptions.file.string(), mOptions.quick,
-                                               mAxisColumns, std::move(rows)));
+                                               mExpansion.axisColumns(), std::move(rows)));
+        mLastRebuild = Clock::now();
+        mLastRebuildSeconds = secondsSince(start);
     }
 
     const SweepOptions& mOptions;
     std::ostream& mLog;
     SweepSpec mSpec;
-    std::vector<SweepJob> mAllJobs;
-    std::vector<std::string> mAxisColumns;
+    SweepExpansion mExpansion;
     SweepSummary mSummary;
-    std::string mReferenceKey;
-    std::optional<lighting::StageResult> mReference;
-    std::map<std::string, std::string> mReferenceErrors;
+    ReferenceStore mReferences;
+    std::map<std::string, std::string> mReferenceErrors; // isolated jobs: key -> error
+    std::optional<Clock::time_point> mLastRebuild;
+    double mLastRebuildSeconds = 0.0;
 };
 
 } // namespace

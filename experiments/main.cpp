@@ -18,6 +18,7 @@
 
 #include "experiments/CommandErrors.h"
 #include "experiments/DiffCommand.h"
+#include "experiments/JobProcess.h"
 #include "experiments/RenderCommand.h"
 #include "experiments/ReportCommand.h"
 #include "experiments/SweepFile.h"
@@ -114,6 +115,9 @@ int listEverything() {
 } // namespace
 
 int main(int argc, char** argv) {
+    // Before anything of ours starts a thread: sweep jobs fork only while none has
+    // (experiments/JobProcess.h).
+    experiments::noteStartupThreads();
     CLI::App app{"testbed: CPU rasterizer research testbed for deferred shading"};
     app.require_subcommand(1);
     experiments::RenderCommandOptions renderOptions;
@@ -210,6 +214,14 @@ int main(int argc, char** argv) {
     sweep->add_option(
         "--threads", sweepThreads,
         "worker threads of every job, 0 = all hardware threads (default: the file's)");
+    // The child process of one sweep job (experiments/JobProcess.h): not for users, not in --help.
+    std::string sweepJobText;
+    long sweepJobParent = 0;
+    int sweepJobReportFd = -1;
+    CLI::App* sweepJob = app.add_subcommand("sweep-job", "")->group("");
+    sweepJob->add_option("--parent", sweepJobParent)->required();
+    sweepJob->add_option("--report-fd", sweepJobReportFd)->required();
+    sweepJob->add_option("job", sweepJobText)->required();
     std::vector<std::filesystem::path> mergeInputs;
     std::filesystem::path mergeOut;
     CLI::App* merge = app.add_subcommand("merge", "combine the output folders of a sweep's shards");
@@ -239,11 +251,18 @@ int main(int argc, char** argv) {
             std::tie(sweepOptions.shardIndex, sweepOptions.shardCount) =
                 experiments::parseShard(shardText);
         } catch (const std::exception& e) {
-            return experiments::reportError(e, 2);
+            return experiments::reportError(e);
         }
         if (sweepThreads >= 0)
             sweepOptions.threads = sweepThreads;
+        // Every job in a child process (experiments/JobProcess.h): forked, or this very binary
+        // (even if the file is rebuilt meanwhile).
+        sweepOptions.isolation = experiments::JobIsolation::Fork;
+        sweepOptions.jobExecutable = "/proc/self/exe";
         return experiments::runSweepCommand(sweepOptions);
+    }
+    if (sweepJob->parsed()) {
+        return experiments::runSweepJobCommand(sweepJobText, sweepJobParent, sweepJobReportFd);
     }
     if (merge->parsed())
         return experiments::runMergeCommand(mergeInputs, mergeOut);

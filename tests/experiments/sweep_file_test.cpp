@@ -47,11 +47,11 @@ std::string errorOf(const std::function<void()>& f) {
 TEST(SweepFile, ExpandsCasesTimesAxesWithStableIds) {
     const auto spec = experiments::parseSweep(baseSweep(), "unit.json");
     const auto expansion = experiments::expandSweep(spec);
-    ASSERT_EQ(expansion.jobs.size(), 2u * 3u * 2u);
+    ASSERT_EQ(expansion.jobs().size(), 2u * 3u * 2u);
     std::set<std::string> ids;
     std::set<size_t> ordinals;
     const std::regex idPattern("^[0-9]{4}-[0-9a-f]{8}$");
-    for (const SweepJob& job : expansion.jobs) {
+    for (const SweepJob& job : expansion.jobs()) {
         EXPECT_TRUE(std::regex_match(job.id, idPattern)) << job.id;
         EXPECT_EQ(job.id.substr(0, 4), std::string(4 - std::to_string(job.ordinal).size(), '0') +
                                            std::to_string(job.ordinal));
@@ -62,10 +62,10 @@ TEST(SweepFile, ExpandsCasesTimesAxesWithStableIds) {
         EXPECT_EQ(job.options.repetitions, 2);
         EXPECT_EQ(job.options.scene, "spheres");
     }
-    EXPECT_EQ(ids.size(), expansion.jobs.size());
-    EXPECT_EQ(*ordinals.rbegin(), expansion.jobs.size() - 1);
+    EXPECT_EQ(ids.size(), expansion.jobs().size());
+    EXPECT_EQ(*ordinals.rbegin(), expansion.jobs().size() - 1);
     // Ordinal order: cases outermost, then the axes in file order, last axis fastest.
-    std::vector<SweepJob> byOrdinal = expansion.jobs;
+    std::vector<SweepJob> byOrdinal = expansion.jobs();
     std::sort(byOrdinal.begin(), byOrdinal.end(),
               [](auto& a, auto& b) { return a.ordinal < b.ordinal; });
     EXPECT_EQ(byOrdinal[0].options.stage, "brute");
@@ -78,13 +78,13 @@ TEST(SweepFile, ExpandsCasesTimesAxesWithStableIds) {
     // The same file expands to the same ids; changing one setting changes only those jobs' ids.
     const auto again =
         experiments::expandSweep(experiments::parseSweep(baseSweep(), "other-name.json"));
-    for (size_t i = 0; i < again.jobs.size(); ++i)
-        EXPECT_EQ(again.jobs[i].id, expansion.jobs[i].id);
+    for (size_t i = 0; i < again.jobs().size(); ++i)
+        EXPECT_EQ(again.jobs()[i].id, expansion.jobs()[i].id);
     Json changed = baseSweep();
     changed["fixed"]["seed"] = 4;
     const auto moved = experiments::expandSweep(experiments::parseSweep(changed, "unit.json"));
-    for (size_t i = 0; i < moved.jobs.size(); ++i)
-        EXPECT_NE(moved.jobs[i].id, expansion.jobs[i].id);
+    for (size_t i = 0; i < moved.jobs().size(); ++i)
+        EXPECT_NE(moved.jobs()[i].id, expansion.jobs()[i].id);
 }
 
 TEST(SweepFile, JobsSharingAReferenceAreAdjacent) {
@@ -92,13 +92,13 @@ TEST(SweepFile, JobsSharingAReferenceAreAdjacent) {
         experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
     // Reference keys: (segments, lights) -> 4 groups of 3 stages each.
     std::vector<std::string> groups;
-    for (const SweepJob& job : expansion.jobs)
+    for (const SweepJob& job : expansion.jobs())
         if (groups.empty() || groups.back() != job.referenceKey)
             groups.push_back(job.referenceKey);
     EXPECT_EQ(groups.size(), 4u);
     EXPECT_EQ(std::set<std::string>(groups.begin(), groups.end()).size(), 4u)
         << "a key appears twice";
-    for (const SweepJob& job : expansion.jobs) {
+    for (const SweepJob& job : expansion.jobs()) {
         EXPECT_EQ(job.referenceKey.find('/'), std::string::npos);
         EXPECT_EQ(job.referenceKey.rfind("spheres-160x90-", 0), 0u) << job.referenceKey;
     }
@@ -111,8 +111,8 @@ TEST(SweepFile, AxisColumnsInCanonicalOrder) {
         "scene",       "stage", "lights", "seed",
         "resolution",  "width", "height", "scene-option.segments",
         "repetitions", "warmup"};
-    EXPECT_EQ(expansion.axisColumns, expected);
-    const SweepJob& job = expansion.jobs.front();
+    EXPECT_EQ(expansion.axisColumns(), expected);
+    const SweepJob job = expansion.job(0);
     EXPECT_EQ(experiments::axisValue(job, "width"), Json(160));
     EXPECT_EQ(experiments::axisValue(job, "resolution"), Json("160x90"));
     EXPECT_EQ(experiments::axisValue(job, "repetitions"), Json(2));
@@ -121,8 +121,8 @@ TEST(SweepFile, AxisColumnsInCanonicalOrder) {
 TEST(SweepFile, QuickBlockOverrides) {
     const auto quick = experiments::applyQuick(experiments::parseSweep(baseSweep(), "unit.json"));
     const auto expansion = experiments::expandSweep(quick);
-    ASSERT_EQ(expansion.jobs.size(), 2u * 1u * 2u);
-    for (const SweepJob& job : expansion.jobs) {
+    ASSERT_EQ(expansion.jobs().size(), 2u * 1u * 2u);
+    for (const SweepJob& job : expansion.jobs()) {
         EXPECT_EQ(job.options.width, 80);
         EXPECT_EQ(job.options.stage, "brute");
         EXPECT_EQ(job.options.repetitions, 1);
@@ -132,7 +132,7 @@ TEST(SweepFile, QuickBlockOverrides) {
     file["quick"] = Json::parse(R"({"fixed": {"lights": 2}})");
     const auto moved =
         experiments::expandSweep(experiments::applyQuick(experiments::parseSweep(file, "u.json")));
-    EXPECT_EQ(moved.jobs.size(), 2u * 3u);
+    EXPECT_EQ(moved.jobs().size(), 2u * 3u);
     Json noQuick = baseSweep();
     noQuick.erase("quick");
     const std::string message =
@@ -240,11 +240,11 @@ lights = [4, 8]
     std::ofstream(dir / "s.json") << baseSweep().dump();
     const auto fromToml = experiments::expandSweep(experiments::readSweepFile(dir / "s.toml"));
     const auto fromJson = experiments::expandSweep(experiments::readSweepFile(dir / "s.json"));
-    ASSERT_EQ(fromToml.jobs.size(), fromJson.jobs.size());
+    ASSERT_EQ(fromToml.jobs().size(), fromJson.jobs().size());
     std::set<std::string> tomlIds, jsonIds;
-    for (const SweepJob& job : fromToml.jobs)
+    for (const SweepJob& job : fromToml.jobs())
         tomlIds.insert(job.id);
-    for (const SweepJob& job : fromJson.jobs)
+    for (const SweepJob& job : fromJson.jobs())
         jsonIds.insert(job.id);
     EXPECT_EQ(tomlIds, jsonIds);
 
@@ -255,7 +255,7 @@ lights = [4, 8]
 
 TEST(SweepFile, ShardsPartitionTheJobs) {
     const auto jobs =
-        experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json")).jobs;
+        experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json")).jobs();
     for (int count : {1, 2, 5, 12, 13}) {
         std::multiset<std::string> seen;
         size_t smallest = jobs.size(), largest = 0;
@@ -289,8 +289,8 @@ TEST(SweepFile, ReproductionSweepsAreValid) {
         SCOPED_TRACE(entry.path().string());
         const auto spec = experiments::readSweepFile(entry.path());
         EXPECT_FALSE(spec.name.empty());
-        EXPECT_FALSE(experiments::expandSweep(spec).jobs.empty());
-        EXPECT_FALSE(experiments::expandSweep(experiments::applyQuick(spec)).jobs.empty());
+        EXPECT_FALSE(experiments::expandSweep(spec).jobs().empty());
+        EXPECT_FALSE(experiments::expandSweep(experiments::applyQuick(spec)).jobs().empty());
     }
     EXPECT_GE(files, 4u);
 }

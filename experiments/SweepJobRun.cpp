@@ -1,0 +1,137 @@
+#include "experiments/SweepJobRun.h"
+
+#include <cmath>
+
+#include <OpenImageIO/imagebuf.h>
+
+#include "experiments/ImageOutput.h"
+#include "experiments/RenderCommand.h"
+#include "experiments/RenderJob.h"
+
+namespace experiments {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+namespace {
+
+Json number(double value) {
+    return std::isfinite(value) ? Json(value) : Json(nullptr);
+}
+
+void writeReferenceExr(const fs::path& path, const std::string& key,
+                       const lighting::StageResult& image) {
+    writeMultiLayerExr(path, image.width, image.height,
+                       {{"R", image.radiance[0].data()},
+                        {"G", image.radiance[1].data()},
+                        {"B", image.radiance[2].data()}},
+                       {{"testbed:reference_key", key},
+                        {"testbed:what", "double-precision reference, stored as float32"}});
+}
+
+// Reads a cached reference; nullopt when absent or not the expected image (then it is rendered).
+std::optional<lighting::StageResult> readReferenceExr(const fs::path& path, const std::string& key,
+                                                      int width, int height) {
+    if (!fs::is_regular_file(path))
+        return std::nullopt;
+    OIIO::ImageBuf buffer(path.string());
+    if (!buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+        return std::nullopt;
+    const OIIO::ImageSpec& spec = buffer.spec();
+    if (spec.width != width || spec.height != height ||
+        spec.get_string_attribute("testbed:reference_key") != key)
+        return std::nullopt;
+    lighting::StageResult image;
+    image.width = width;
+    image.height = height;
+    const size_t pixels = size_t(width) * size_t(height);
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+        const int channel = spec.channelindex(names[c]);
+        if (channel < 0)
+            return std::nullopt;
+        image.radiance[c].resize(pixels);
+        OIIO::ROI roi = buffer.roi();
+        roi.chbegin = channel;
+        roi.chend = channel + 1;
+        if (!buffer.get_pixels(roi, OIIO::TypeDesc::FLOAT, image.radiance[c].data()))
+            return std::nullopt;
+    }
+    return image;
+}
+
+} // namespace
+
+fs::path ReferenceStore::cachePath(const std::string& key) const {
+    return mFolder / (key + ".exr");
+}
+
+void ReferenceStore::markFailed(const std::string& key, const std::string& message) {
+    mErrors[key] = message;
+    if (mKey == key) {
+        mImage.reset();
+        mKey.clear();
+    }
+}
+
+const lighting::StageResult& ReferenceStore::get(const SweepJob& job, const Listener& listener) {
+    const std::string& key = job.referenceKey;
+    if (mKey == key && mImage)
+        return *mImage;
+    if (const auto failed = mErrors.find(key); failed != mErrors.end())
+        throw std::runtime_error(failed->second);
+    mImage.reset();
+    mKey = key;
+    const fs::path path = cachePath(key);
+    if (auto loaded = readReferenceExr(path, key, job.options.width, job.options.height)) {
+        mImage = std::move(*loaded);
+        if (listener)
+            listener(Event::Loaded, key);
+        return *mImage;
+    }
+    if (listener)
+        listener(Event::Rendering, key);
+    try {
+        mImage = renderReference(job.options);
+    } catch (const std::exception& e) {
+        const std::string message = "reference " + key + ": " + e.what();
+        markFailed(key, message);
+        throw std::runtime_error(message);
+    }
+    writeReferenceExr(path, key, *mImage);
+    if (listener)
+        listener(Event::Rendered, key);
+    return *mImage;
+}
+
+Json metricColumnsOf(const RunMetrics& metrics) {
+    Json row = Json::object();
+    std::vector<PassTiming> passes = metrics.passes;
+    if (!metrics.stage.samplesMs.empty())
+        passes.push_back(metrics.stage);
+    for (const PassTiming& timing : passes) {
+        row["time_" + timing.pass + "_median_ms"] = number(timing.medianMs());
+        row["time_" + timing.pass + "_min_ms"] = number(timing.minMs());
+        row["time_" + timing.pass + "_max_ms"] = number(timing.maxMs());
+    }
+    row[metric::kLightEvaluations] = metrics.lightEvaluations;
+    row[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
+    row[metric::kCullingEfficiency] = metrics.cullingEfficiency;
+    row[metric::kBytesPerPixel] = metrics.bytesPerPixel;
+    for (const NamedFigure& figure : metrics.errorFigures())
+        row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
+    return row;
+}
+
+Json runSweepJob(const SweepJob& job, const fs::path& jobDir, ReferenceStore& references,
+                 const ReferenceStore::Listener& listener) {
+    const lighting::StageResult* referenceImage =
+        job.compareReference ? &references.get(job, listener) : nullptr;
+    RenderOptions options = job.options;
+    options.compareReference = job.compareReference;
+    const RenderRun run = runRender(planRender(options), {}, referenceImage);
+    writeRenderOutputs(run, jobDir, 0);
+    return metricColumnsOf(run.metrics);
+}
+
+} // namespace experiments

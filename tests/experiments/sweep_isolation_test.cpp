@@ -1,0 +1,271 @@
+// `testbed sweep` run as a child process, as a user runs it: a job whose process crashes or
+// aborts is recorded as failed with its signal and the sweep runs the rest (JobProcess.h); a
+// sweep at the job cap starts its first job in bounded memory, and one past the cap is refused
+// before any job is made.
+//
+// The crash is delivered from outside: the test stops a job's process (SIGSTOP, so that a job
+// that just finished cannot turn the signal into a no-op on a zombie), sends it SIGSEGV or
+// SIGABRT and resumes it; the process dies of the signal exactly as it would of its own fault.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+const fs::path kTestbed = fs::path(TESTBED_BINARY_DIR) / "bin" / "testbed";
+
+fs::path freshDir(const std::string& name) {
+    const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+// Starts testbed with args, stdout and stderr to `log`; returns the child's pid.
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) {
+            dup2(fd, STDOUT_FILENO);
+            dup2(fd, STDERR_FILENO);
+        }
+        std::vector<char*> argv = {const_cast<char*>(kTestbed.c_str())};
+        for (const std::string& arg : args)
+            argv.push_back(const_cast<char*>(arg.c_str()));
+        argv.push_back(nullptr);
+        execv(kTestbed.c_str(), argv.data());
+        _exit(127);
+    }
+    return pid;
+}
+
+// Waits for pid; its exit code, or -signal when a signal ended it.
+int waitExit(pid_t pid) {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+std::string readText(const fs::path& path) {
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+// The state letter of /proc/PID/stat (R, S, T, Z...) and the parent pid, or nullopt when gone.
+std::optional<std::pair<char, pid_t>> processState(pid_t pid) {
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string text;
+    if (!std::getline(stat, text))
+        return std::nullopt;
+    const size_t close = text.rfind(')'); // the command name may hold spaces and parentheses
+    if (close == std::string::npos)
+        return std::nullopt;
+    std::istringstream rest(text.substr(close + 1));
+    char state = 0;
+    long parent = 0;
+    rest >> state >> parent;
+    return std::make_pair(state, pid_t(parent));
+}
+
+// The child processes of parent (its job processes), found through /proc.
+std::vector<pid_t> childrenOf(pid_t parent) {
+    std::vector<pid_t> children;
+    for (const auto& entry : fs::directory_iterator("/proc")) {
+        const std::string name = entry.path().filename().string();
+        if (name.find_first_not_of("0123456789") != std::string::npos)
+            continue;
+        const pid_t pid = pid_t(std::stol(name));
+        if (const auto state = processState(pid); state && state->second == parent)
+            children.push_back(pid);
+    }
+    return children;
+}
+
+// Waits for a running job process of `sweep` other than those in `seen` and stops it (SIGSTOP);
+// returns its pid, or nullopt when none appeared within the time limit.
+std::optional<pid_t> stopNextJobProcess(pid_t sweep, std::set<pid_t>& seen) {
+    const auto deadline = Clock::now() + std::chrono::seconds(120);
+    while (Clock::now() < deadline) {
+        for (const pid_t child : childrenOf(sweep)) {
+            if (seen.count(child))
+                continue;
+            seen.insert(child);
+            kill(child, SIGSTOP);
+            // A job that ended before the stop is a zombie: a signal would do nothing, try the
+            // next one.
+            for (int tries = 0; tries < 1000; ++tries) {
+                const auto state = processState(child);
+                if (!state || state->first == 'Z' || state->first == 'X')
+                    break;
+                if (state->first == 'T' || state->first == 't')
+                    return child;
+                std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            }
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return std::nullopt;
+}
+
+// 8 jobs of a few tens of milliseconds each, without references (a crashed reference would
+// fail its key's other jobs too, which is not what this test is about).
+void writeSweep(const fs::path& file) {
+    std::ofstream(file) << R"({
+        "name": "isolation",
+        "fixed": {"scene": "atrium", "resolution": "240x136", "lights": 48},
+        "axes": {"seed": [1, 2], "stage": ["brute", "tiled", "deferred", "clustered"]},
+        "reference": false
+    })";
+}
+
+TEST(SweepIsolation, CrashedAndAbortedJobsFailAloneAndTheSweepGoesOn) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const fs::path dir = freshDir("sweep-isolation-crash");
+    writeSweep(dir / "sweep.json");
+    const fs::path out = dir / "out";
+    const pid_t sweep =
+        spawn({"sweep", (dir / "sweep.json").string(), "--out", out.string(), "--threads", "1"},
+              dir / "sweep.log");
+    ASSERT_GT(sweep, 0);
+
+    std::set<pid_t> seen;
+    for (const int signal : {SIGSEGV, SIGABRT}) {
+        const std::optional<pid_t> job = stopNextJobProcess(sweep, seen);
+        if (!job) {
+            kill(sweep, SIGKILL);
+            waitExit(sweep);
+            FAIL() << "no job process of the sweep appeared (jobs run in the sweep's process?); "
+                      "log:\n"
+                   << readText(dir / "sweep.log");
+        }
+        kill(*job, signal);
+        kill(*job, SIGCONT);
+    }
+    const int code = waitExit(sweep);
+    const std::string log = readText(dir / "sweep.log");
+    EXPECT_EQ(code, 1) << log; // some job failed; the sweep itself ended normally
+    EXPECT_NE(log.find("killed by signal 11 (SIGSEGV"), std::string::npos) << log;
+    EXPECT_NE(log.find("killed by signal 6 (SIGABRT"), std::string::npos) << log;
+    EXPECT_NE(log.find("8 jobs, 8 ran, 0 skipped, 2 failed"), std::string::npos) << log;
+
+    const Json results = Json::parse(readText(out / "results.json"));
+    ASSERT_EQ(results["jobs"].size(), 8u);
+    int failed = 0;
+    for (const Json& row : results["jobs"]) {
+        if (row["status"] == "ok")
+            continue;
+        ++failed;
+        EXPECT_NE(row["error"].get<std::string>().find("the job process crashed: killed by signal"),
+                  std::string::npos)
+            << row.dump();
+    }
+    EXPECT_EQ(failed, 2);
+
+    // A rerun retries the two crashed jobs and skips the rest.
+    const pid_t rerun =
+        spawn({"sweep", (dir / "sweep.json").string(), "--out", out.string(), "--threads", "1"},
+              dir / "rerun.log");
+    EXPECT_EQ(waitExit(rerun), 0) << readText(dir / "rerun.log");
+    EXPECT_NE(readText(dir / "rerun.log").find("8 jobs, 2 ran, 6 skipped, 0 failed"),
+              std::string::npos)
+        << readText(dir / "rerun.log");
+}
+
+// Peak resident memory of the children waited for so far, in MB.
+double peakChildMegabytes() {
+    rusage usage{};
+    getrusage(RUSAGE_CHILDREN, &usage);
+    return double(usage.ru_maxrss) / 1024.0;
+}
+
+TEST(SweepJobCap, SweepPastTheCapIsRefusedBeforeAnyJobIsMade) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const fs::path dir = freshDir("sweep-job-cap");
+    // 1001 x 1000 = 1 001 000 jobs, one past 10^6.
+    std::ofstream file(dir / "sweep.json");
+    file << R"({"name": "big", "fixed": {"scene": "wall", "resolution": "64x36"},)"
+         << R"("reference": false, "axes": {"seed": [)";
+    for (int i = 0; i < 1001; ++i)
+        file << (i ? "," : "") << i;
+    file << R"(], "lights": [)";
+    for (int i = 1; i <= 1000; ++i)
+        file << (i > 1 ? "," : "") << i;
+    file << "]}}";
+    file.close();
+    const pid_t sweep =
+        spawn({"sweep", (dir / "sweep.json").string(), "--out", (dir / "out").string()},
+              dir / "sweep.log");
+    EXPECT_EQ(waitExit(sweep), 2);
+    const std::string log = readText(dir / "sweep.log");
+    EXPECT_EQ(log.rfind("testbed: error: ", 0), 0u) << log;
+    EXPECT_NE(log.find("1001000 jobs refused (at most 1000000)"), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(dir / "out" / "jobs")) << "a refused sweep made its output folder";
+    // The refusal comes before the jobs are made: the process stays near the size of the
+    // binary's own libraries (~130 MB resident for `testbed list`), far from the 2.5 GB that a
+    // vector of 10^6 jobs took.
+    EXPECT_LT(peakChildMegabytes(), 400.0);
+}
+
+TEST(SweepJobCap, SweepAtTheCapStartsItsFirstJobInBoundedMemory) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const fs::path dir = freshDir("sweep-job-cap-start");
+    // 1000 x 1000 = 10^6 jobs, the cap: every job is made and validated once before the first
+    // runs, but none is kept (SweepExpansion).
+    std::ofstream file(dir / "sweep.json");
+    file << R"({"name": "at-cap", "fixed": {"scene": "wall", "resolution": "64x36"},)"
+         << R"("reference": false, "axes": {"seed": [)";
+    for (int i = 0; i < 1000; ++i)
+        file << (i ? "," : "") << i;
+    file << R"(], "lights": [)";
+    for (int i = 1; i <= 1000; ++i)
+        file << (i > 1 ? "," : "") << i;
+    file << "]}}";
+    file.close();
+    const pid_t sweep = spawn(
+        {"sweep", (dir / "sweep.json").string(), "--out", (dir / "out").string(), "--threads", "1"},
+        dir / "sweep.log");
+    const auto deadline = Clock::now() + std::chrono::seconds(300);
+    while (readText(dir / "sweep.log").find("running 000000-") == std::string::npos &&
+           Clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    // VmHWM: the sweep process's peak resident memory so far (its job processes are separate).
+    std::ifstream status("/proc/" + std::to_string(sweep) + "/status");
+    double peakMegabytes = -1.0;
+    for (std::string line; std::getline(status, line);)
+        if (line.rfind("VmHWM:", 0) == 0)
+            peakMegabytes = std::stod(line.substr(6)) / 1024.0;
+    kill(sweep, SIGKILL);
+    waitExit(sweep);
+    const std::string log = readText(dir / "sweep.log");
+    ASSERT_NE(log.find("running 000000-"), std::string::npos) << "no job started:\n" << log;
+    std::cout << "peak resident memory before the first job: " << peakMegabytes << " MB\n";
+    // 183 MB measured (most of it the libraries OpenImageIO pulls in); a vector of 10^6 job
+    // records reached 2.5 GB before the first job.
+    EXPECT_GT(peakMegabytes, 0.0);
+    EXPECT_LT(peakMegabytes, 600.0);
+}
+
+} // namespace
