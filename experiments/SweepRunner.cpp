@@ -15,6 +15,7 @@
 #include "experiments/ResultsTable.h"
 #include "experiments/SweepFile.h"
 #include "experiments/SweepJobRun.h"
+#include "experiments/SweepLock.h"
 
 namespace experiments {
 
@@ -117,6 +118,7 @@ public:
         const auto [first, last] =
             shardRange(mExpansion.size(), mOptions.shardIndex, mOptions.shardCount);
         ensureWritableDirectory(mOptions.out);
+        const SweepLock lock(mOptions.out, first, last, mOptions.waitForLock, mLog);
         fs::create_directories(mOptions.out / "jobs");
         fs::create_directories(mOptions.out / "references");
 

@@ -1,6 +1,6 @@
 // SweepRunner: `testbed sweep FILE --out DIR`: expands a sweep file (SweepFile.h, jobs made on
-// demand), validates every job before running any, then runs the jobs of this shard one after
-// the other:
+// demand), validates every job before running any, locks the shard's jobs in DIR against a second
+// sweep (SweepLock.h), then runs the jobs of this shard one after the other:
 //   - isolation: the CLI runs each job in a child process (JobProcess.h), so a job that crashes,
 //     aborts or is killed (SIGKILL by the out-of-memory killer) is recorded as failed with its
 //     signal and the sweep goes on; tests may run jobs in this process (JobIsolation::InProcess);
@@ -24,7 +24,7 @@
 //
 // Thread safety: one runSweep per process at a time. Several processes (shards) may share DIR
 // when their jobs are disjoint: each writes only its own jobs' folders, and references and tables
-// by rename.
+// by rename; a process whose jobs overlap a running one's is refused (or waits, with --wait).
 #pragma once
 
 #include <cstddef>
@@ -51,6 +51,7 @@ struct SweepOptions {
     // The testbed binary a Spawn child runs (`testbed sweep-job`); Fork uses it when this process
     // has several threads. The CLI passes "/proc/self/exe".
     std::filesystem::path jobExecutable;
+    bool waitForLock = false; // --wait: wait for a sweep running the same jobs into out
 };
 
 struct SweepSummary {
@@ -69,8 +70,8 @@ struct SweepSummary {
 SweepSummary runSweep(const SweepOptions& options, std::ostream& log);
 
 // The CLI: runs, prints errors as "testbed: error: ..." on stderr; exit code 0 when every job of
-// the shard is ok, 1 when a job failed or the sweep could not start (DIR unusable), 2 for an
-// invalid sweep.
+// the shard is ok, 1 when a job failed or the sweep could not start (DIR unusable, or in use by
+// another sweep: SweepBusyError), 2 for an invalid sweep.
 int runSweepCommand(const SweepOptions& options);
 
 // `testbed merge DIR... --out DIR` (ResultsTable.h mergeSweepOutputs); exit code 0 or 1.

@@ -214,6 +214,9 @@ int main(int argc, char** argv) {
     sweep->add_option(
         "--threads", sweepThreads,
         "worker threads of every job, 0 = all hardware threads (default: the file's)");
+    sweep->add_flag("--wait", sweepOptions.waitForLock,
+                    "when another sweep is running the same jobs into --out, wait for it to end "
+                    "(default: refuse, naming its process)");
     // The child process of one sweep job (experiments/JobProcess.h): not for users, not in --help.
     std::string sweepJobText;
     long sweepJobParent = 0;

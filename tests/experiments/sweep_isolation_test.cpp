@@ -1,7 +1,8 @@
 // `testbed sweep` run as a child process, as a user runs it: a job whose process crashes or
 // aborts is recorded as failed with its signal and the sweep runs the rest (JobProcess.h); a
-// sweep at the job cap starts its first job in bounded memory, and one past the cap is refused
-// before any job is made.
+// second sweep over the same jobs in the same --out is refused while the first holds the lock,
+// waits with --wait, and a disjoint shard runs beside it (SweepLock.h); a sweep at the job cap
+// starts its first job in bounded memory, and one past the cap is refused before any job is made.
 //
 // The crash is delivered from outside: the test stops a job's process (SIGSTOP, so that a job
 // that just finished cannot turn the signal into a no-op on a zombie), sends it SIGSEGV or
@@ -192,6 +193,60 @@ TEST(SweepIsolation, CrashedAndAbortedJobsFailAloneAndTheSweepGoesOn) {
     EXPECT_NE(readText(dir / "rerun.log").find("8 jobs, 2 ran, 6 skipped, 0 failed"),
               std::string::npos)
         << readText(dir / "rerun.log");
+}
+
+TEST(SweepLock, SecondSweepOnTheSameJobsIsRefusedOrWaits) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const fs::path dir = freshDir("sweep-lock");
+    writeSweep(dir / "sweep.json");
+    const std::string file = (dir / "sweep.json").string();
+    const std::string out = (dir / "out").string();
+
+    // The first sweep runs shard 1/2 and is held (stopped) in its first job: it holds its lock.
+    const pid_t first =
+        spawn({"sweep", file, "--out", out, "--threads", "1", "--shard", "1/2"}, dir / "first.log");
+    std::set<pid_t> seen;
+    const std::optional<pid_t> job = stopNextJobProcess(first, seen);
+    if (!job) {
+        kill(first, SIGKILL);
+        waitExit(first);
+        FAIL() << "the first sweep started no job; log:\n" << readText(dir / "first.log");
+    }
+    kill(first, SIGSTOP);
+
+    // The whole sweep overlaps shard 1/2: refused at once with one error line naming the holder.
+    const pid_t second = spawn({"sweep", file, "--out", out, "--threads", "1"}, dir / "second.log");
+    EXPECT_EQ(waitExit(second), 1);
+    const std::string refused = readText(dir / "second.log");
+    EXPECT_EQ(refused.rfind("testbed: error: ", 0), 0u) << refused;
+    EXPECT_EQ(std::count(refused.begin(), refused.end(), '\n'), 1) << refused;
+    EXPECT_NE(refused.find("is in use: process " + std::to_string(first)), std::string::npos)
+        << refused;
+    EXPECT_NE(refused.find("--wait"), std::string::npos) << refused;
+
+    // Shard 2/2 has none of shard 1/2's jobs: it runs beside it.
+    const pid_t disjoint = spawn({"sweep", file, "--out", out, "--threads", "1", "--shard", "2/2"},
+                                 dir / "disjoint.log");
+    EXPECT_EQ(waitExit(disjoint), 0) << readText(dir / "disjoint.log");
+
+    // With --wait, the whole sweep waits for the first one, then runs what is left.
+    const pid_t waiting =
+        spawn({"sweep", file, "--out", out, "--threads", "1", "--wait"}, dir / "waiting.log");
+    const auto deadline = Clock::now() + std::chrono::seconds(60);
+    while (readText(dir / "waiting.log").find("waiting until it ends") == std::string::npos &&
+           Clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_NE(readText(dir / "waiting.log").find("waiting until it ends (--wait)"),
+              std::string::npos)
+        << readText(dir / "waiting.log");
+    int status = 0;
+    EXPECT_EQ(waitpid(waiting, &status, WNOHANG), 0)
+        << "the waiting sweep ended while the lock was held";
+    kill(first, SIGKILL); // its stopped job process dies with it (PR_SET_PDEATHSIG)
+    waitExit(first);
+    EXPECT_EQ(waitExit(waiting), 0) << readText(dir / "waiting.log");
+    const std::string waited = readText(dir / "waiting.log");
+    EXPECT_NE(waited.find("8 jobs, 4 ran, 4 skipped, 0 failed"), std::string::npos) << waited;
 }
 
 // Peak resident memory of the children waited for so far, in MB.
