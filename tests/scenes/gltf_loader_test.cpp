@@ -223,8 +223,9 @@ class SharedModelTest : public ::testing::TestWithParam<SharedModel> {};
 TEST_P(SharedModelTest, LoadsWithStatedTriangleCountAndTextures) {
     const Scene scene = scenes::loadGltf(sharedModel(GetParam().path));
     EXPECT_EQ(scene.triangleCount(), GetParam().triangleCount);
-    ASSERT_EQ(scene.cameras.size(), 1u);
-    EXPECT_EQ(scene.cameras[0].name, "default"); // none of the models has a camera
+    // None of the models has a camera: the framing camera and three orbit views.
+    ASSERT_EQ(scene.cameras.size(), 4u);
+    EXPECT_EQ(scene.cameras[0].name, "default");
     ASSERT_EQ(scene.materials.size(), 1u);
     const scenes::Material& material = scene.materials[0];
     // Every model has a readable base colour texture; the helmet and the box have a normal map.
