@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +22,7 @@
 #include "experiments/ImageOutput.h"
 #include "lighting/PassNames.h"
 #include "scenes/Scene.h"
+#include "scenes/Viewpoints.h"
 
 namespace experiments {
 
@@ -258,6 +260,7 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["scene"] = run.scene().name;
     stats["scene_source"] = run.options.scene;
     stats["scene_options"] = run.options.sceneOptions;
+    stats["view"] = run.scene().cameras.front().name;
     stats["stage"] = run.options.stage;
     stats["stage_parameters"] = run.result.parameters;
     stats["width"] = run.options.width;
@@ -285,7 +288,65 @@ nlohmann::json statsJson(const RenderRun& run) {
     return stats;
 }
 
+namespace {
+
+// A view name as a folder name: letters, digits, '.', '-' and '_' are kept, anything else
+// (spaces, '/', ...) becomes '_'; a name that collides with an earlier one gets "-N".
+std::vector<std::string> viewFolderNames(const std::vector<std::string>& views) {
+    std::vector<std::string> folders;
+    for (const std::string& view : views) {
+        std::string folder;
+        for (char c : view)
+            folder +=
+                std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_'
+                    ? c
+                    : '_';
+        if (folder.empty() || folder == "." || folder == "..")
+            folder = "view";
+        const std::string base = folder;
+        for (int n = 2; std::find(folders.begin(), folders.end(), folder) != folders.end(); ++n)
+            folder = base + "-" + std::to_string(n);
+        folders.push_back(folder);
+    }
+    return folders;
+}
+
+// `render --view all`: one render per view of the scene into OUT/views/FOLDER/, each exactly
+// what `render --view NAME --out OUT/views/FOLDER` writes (its stats.json holds its figures), and
+// OUT/views.json listing the views and their folders in the scene's order.
+int renderEveryView(const RenderCommandOptions& options) {
+    RenderOptions sceneOnly = options.render;
+    sceneOnly.view.clear();
+    checkOptions(sceneOnly); // every input error before the scene is loaded
+    const std::vector<std::string> views = scenes::viewNames(loadRequestedScene(sceneOnly));
+    const std::vector<std::string> folders = viewFolderNames(views);
+    ensureWritableDirectory(options.out);
+    nlohmann::json index = nlohmann::json::array();
+    for (size_t i = 0; i < views.size(); ++i) {
+        RenderCommandOptions one = options;
+        one.render.view = views[i];
+        one.out = options.out / "views" / folders[i];
+        std::cout << "testbed: view " << (i + 1) << "/" << views.size() << " '" << views[i]
+                  << "'\n";
+        const int status = runRenderCommand(one);
+        if (status != 0)
+            return status;
+        index.push_back({{"view", views[i]}, {"folder", "views/" + folders[i]}});
+    }
+    writeTextAtomically(options.out / "views.json", index.dump(2) + "\n");
+    return 0;
+}
+
+} // namespace
+
 int runRenderCommand(const RenderCommandOptions& options) {
+    if (options.render.view == kEveryView && !options.explainLayout) {
+        try {
+            return renderEveryView(options);
+        } catch (const std::exception& e) {
+            return reportError(e);
+        }
+    }
     try {
         const bool terminal = isatty(STDERR_FILENO);
         const auto start = std::chrono::steady_clock::now();

@@ -104,9 +104,9 @@ void validate(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {
-        "scene",   "stage",  "lights",  "seed",         "width", "height",   "resolution",
-        "threads", "layout", "normals", "normal-space", "depth", "position", "scene-option.<key>"};
+    return {"scene",        "stage",      "lights",   "seed",   "width",
+            "height",       "resolution", "threads",  "layout", "normals",
+            "normal-space", "depth",      "position", "view",   "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -115,6 +115,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.scene = value;
     else if (key == "stage")
         options.stage = value;
+    else if (key == "view")
+        options.view = value;
     else if (key == "lights")
         options.lights = parseNumber<int>(key, value);
     else if (key == "seed")

@@ -25,6 +25,9 @@ namespace experiments {
 struct RenderOptions {
     std::string scene = "atrium";
     std::map<std::string, std::string> sceneOptions; // --scene-option key=value
+    // The scene's view (named camera, scenes/Viewpoints.h) to render: "" = its first view. "all"
+    // is resolved by `testbed render` and the sweep into one render per view before planning.
+    std::string view;
     std::string stage = "brute";
     int lights = 256;
     uint64_t seed = 1;
@@ -46,9 +49,9 @@ struct RenderOptions {
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
 // seed, width, height, resolution (WxH), threads, layout, normals, normal-space, depth, position,
-// and scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown
-// key throws UsageError naming it. The sweep runner goes through this, so every stage, encoding
-// or scene added later is reachable without touching the runner.
+// view, and scene-option.KEY. Values are checked later by validate(); a malformed number or an
+// unknown key throws UsageError naming it. The sweep runner goes through this, so every stage,
+// encoding or scene added later is reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();

@@ -4,6 +4,7 @@
 #include <thread>
 
 #include "scenes/SceneLoader.h"
+#include "scenes/Viewpoints.h"
 
 namespace experiments {
 
@@ -16,7 +17,10 @@ scenes::Scene loadRequestedScene(const RenderOptions& options) {
     request.lightCount = options.lights;
     request.seed = options.seed;
     request.options = options.sceneOptions;
-    return scenes::loadScene(options.scene, request);
+    scenes::Scene scene = scenes::loadScene(options.scene, request);
+    if (!options.view.empty())
+        scenes::selectView(scene, options.view);
+    return scene;
 }
 
 RenderPlan planRender(const RenderOptions& options) {

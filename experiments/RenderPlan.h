@@ -29,8 +29,8 @@ struct RenderPlan {
 
 RenderPlan planRender(const RenderOptions& options);
 
-// The scene of the options (lights generated with the seed, scene options applied). Throws
-// scenes::SceneError for a bad file or option.
+// The scene of the options (lights generated with the seed, scene options applied, the requested
+// view made cameras[0]). Throws scenes::SceneError for a bad file, option or view name.
 scenes::Scene loadRequestedScene(const RenderOptions& options);
 
 // The worker threads of a thread option: itself, or every hardware thread for 0.

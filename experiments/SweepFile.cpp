@@ -260,7 +260,13 @@ std::string referenceKeyOf(const RenderOptions& o) {
     canonical += "lights=" + std::to_string(o.lights) + "\nseed=" + std::to_string(o.seed) +
                  "\nwidth=" + std::to_string(o.width) + "\nheight=" + std::to_string(o.height) +
                  "\n";
-    const std::string stem = safeName(std::filesystem::path(o.scene).stem().string());
+    // The view changes the reference image; the default view ("") keeps the keys of sweeps
+    // written before views existed, so their reference folders stay valid.
+    std::string stem = safeName(std::filesystem::path(o.scene).stem().string());
+    if (!o.view.empty()) {
+        canonical += "view=" + o.view + "\n";
+        stem += "-" + safeName(o.view);
+    }
     return stem + "-" + std::to_string(o.width) + "x" + std::to_string(o.height) + "-" +
            std::to_string(o.lights) + "l-s" + std::to_string(o.seed) + "-" + hex8(fnv1a(canonical));
 }

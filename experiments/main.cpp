@@ -20,6 +20,7 @@
 #include "experiments/DiffCommand.h"
 #include "experiments/JobProcess.h"
 #include "experiments/RenderCommand.h"
+#include "experiments/RenderPlan.h"
 #include "experiments/ReportCommand.h"
 #include "experiments/SweepFile.h"
 #include "experiments/SweepRunner.h"
@@ -28,6 +29,7 @@
 #include "gbuffer/NormalCodec.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
+#include "scenes/Viewpoints.h"
 
 namespace {
 
@@ -55,6 +57,10 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->allow_extra_args(false);
     render.add_option("--stage", r.stage, "shading stage, NAME or NAME:key=value,...")
         ->capture_default_str();
+    render.add_option("--view", r.view,
+                      "the scene's named view (camera) to render, or `all` for one render per "
+                      "view in OUT/views/NAME/ (default: the scene's first view; `testbed list "
+                      "--views SCENE` lists them)");
     render.add_option("--lights", r.lights, "generated point lights")->capture_default_str();
     render.add_option("--seed", r.seed, "seed of the light generator")
         ->check(kSeedValidator)
@@ -92,6 +98,19 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
 }
 
+// `testbed list --views SCENE`: the scene's named views, the first being the default.
+int listViews(const std::string& scene) {
+    try {
+        experiments::RenderOptions options;
+        options.scene = scene;
+        for (const std::string& view : scenes::viewNames(experiments::loadRequestedScene(options)))
+            std::cout << view << "\n";
+        return 0;
+    } catch (const std::exception& e) {
+        return experiments::reportError(e);
+    }
+}
+
 int listEverything() {
     std::cout << "scenes (default " << scenes::kDefaultSceneName << "):\n";
     for (const std::string& name : scenes::proceduralSceneNames())
@@ -125,6 +144,8 @@ int main(int argc, char** argv) {
     CLI::App* render = app.add_subcommand("render", "render one scene with one shading stage");
     addRenderOptions(*render, renderOptions, sceneOptionTexts);
     CLI::App* list = app.add_subcommand("list", "list scenes and stages");
+    std::string listViewsScene;
+    list->add_option("--views", listViewsScene, "list the named views (cameras) of this scene");
     experiments::ReportCommandOptions reportOptions;
     CLI::App* report =
         app.add_subcommand("report", "write DIR/report.html for a sweep's results folder DIR");
@@ -242,7 +263,7 @@ int main(int argc, char** argv) {
         return experiments::runRenderCommand(renderOptions);
     }
     if (list->parsed())
-        return listEverything();
+        return listViewsScene.empty() ? listEverything() : listViews(listViewsScene);
     if (report->parsed())
         return experiments::runReportCommand(reportOptions);
     if (diff->parsed())

@@ -6,7 +6,7 @@
 // with matrix or TRS transforms; every TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive
 // becomes one Mesh (one per primitive, stored once however many nodes use it, one Instance per
 // node that uses it); POSITION, NORMAL, TANGENT, TEXCOORD_0, TEXCOORD_1 (when a material's
-// texture reads it) and indices; the first perspective camera met in the walk;
+// texture reads it) and indices; every perspective camera met in the walk (Viewpoints.h);
 // KHR_lights_punctual lights; metallic-roughness materials (see materialFor) with every texture's
 // texCoord and KHR_texture_transform, and KHR_materials_emissive_strength. Tangents absent from a
 // primitive whose material has a normal texture are generated (Tangents.h).
@@ -53,6 +53,7 @@
 #include "scenes/Limits.h"
 #include "scenes/NestingDepth.h"
 #include "scenes/Tangents.h"
+#include "scenes/Viewpoints.h"
 
 namespace scenes {
 
@@ -346,7 +347,7 @@ private:
     void visitNode(int nodeIndex, const glm::mat4& worldFromParent, int depth);
     glm::mat4 parentFromNode(int nodeIndex) const;
     void considerCamera(int cameraIndex, const glm::mat4& worldFromCamera);
-    void addCamera();
+    void addCamera(int cameraIndex, const glm::mat4& worldFromCamera);
     void addLights();
 
     int meshFor(int meshIndex, size_t primitiveIndex);
@@ -373,9 +374,9 @@ private:
     std::vector<std::vector<int>> mMeshOf; // [mesh][primitive] -> Scene::meshes index or marker
     std::vector<int> mMaterialOf;          // per glTF material -> Scene::materials, -1 = not yet
     int mDefaultMaterial = -1;             // Scene::materials index of the default, -1 = none
-    std::map<std::pair<int, bool>, int> mTextureOf; // (image, srgb) -> Scene::textures index
-    std::optional<std::pair<int, glm::mat4>> mPlacedCamera; // (camera, worldFromCamera)
-    std::vector<std::pair<int, glm::mat4>> mPlacedLights;   // (KHR light, worldFromLight)
+    std::map<std::pair<int, bool>, int> mTextureOf;        // (image, srgb) -> Scene::textures index
+    std::vector<std::pair<int, glm::mat4>> mPlacedCameras; // (camera, worldFromCamera), walk order
+    std::vector<std::pair<int, glm::mat4>> mPlacedLights;  // (KHR light, worldFromLight)
 };
 
 void GltfConverter::warn(const std::string& what) {
@@ -403,10 +404,17 @@ Scene GltfConverter::convert() {
         fail("the scene has no triangles to draw");
 
     addLights();
-    if (mPlacedCamera)
-        addCamera();
-    else
-        mScene.cameras.push_back(cameraFramingBounds(mScene.boundsWorld()));
+    for (const auto& [cameraIndex, worldFromCamera] : mPlacedCameras)
+        addCamera(cameraIndex, worldFromCamera);
+    if (mScene.cameras.empty()) {
+        // No camera of its own: the framing camera, then three orbit views of the same bounds
+        // (taken before any camera is added: Scene::boundsWorld includes camera positions).
+        const Aabb geometryBounds = mScene.boundsWorld();
+        mScene.cameras.push_back(cameraFramingBounds(geometryBounds));
+        for (const Camera& view : orbitViews(mScene.cameras.front(), geometryBounds))
+            mScene.cameras.push_back(view);
+    }
+    makeViewNamesUnique(mScene.cameras);
     try {
         validate(mScene);
     } catch (const SceneError& error) {
@@ -637,19 +645,19 @@ glm::mat4 GltfConverter::parentFromNode(int nodeIndex) const {
     return transform;
 }
 
-// The first perspective camera met in the walk is the one used. It is placed after the walk,
-// when the bounds that an infinite far plane must reach are known.
+// Every perspective camera met in the walk is kept, in walk order (the first is the default view);
+// a camera node instanced twice gives two views. They are placed after the walk, when the bounds
+// that an infinite far plane must reach are known.
 void GltfConverter::considerCamera(int cameraIndex, const glm::mat4& worldFromCamera) {
     const tinygltf::Camera& source = mModel.cameras[size_t(cameraIndex)];
     if (source.type != "perspective")
         warn("camera " + std::to_string(cameraIndex) + " is " + source.type +
              "; only perspective cameras are used");
-    else if (!mPlacedCamera)
-        mPlacedCamera.emplace(cameraIndex, worldFromCamera);
+    else
+        mPlacedCameras.emplace_back(cameraIndex, worldFromCamera);
 }
 
-void GltfConverter::addCamera() {
-    const auto& [cameraIndex, worldFromCamera] = *mPlacedCamera;
+void GltfConverter::addCamera(int cameraIndex, const glm::mat4& worldFromCamera) {
     const tinygltf::Camera& source = mModel.cameras[size_t(cameraIndex)];
     const tinygltf::PerspectiveCamera& lens = source.perspective;
     Camera camera;

@@ -29,6 +29,7 @@
 #include "scenes/Limits.h"
 #include "scenes/NestingDepth.h"
 #include "scenes/ProceduralScenes.h"
+#include "scenes/Viewpoints.h"
 
 namespace scenes {
 
@@ -37,6 +38,8 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
+// A camera path is expanded into one view per frame; 10^4 frames is minutes of animation.
+constexpr int64_t kMaxCameraPathFrames = 10000;
 // Camera defaults when the file leaves them out (documented in scenes/README.md).
 constexpr float kDefaultFovYDegrees = 60.0f;
 constexpr float kDefaultNearMetres = 0.1f;
@@ -151,6 +154,7 @@ private:
     void addObject(const Json& value, const std::string& field, Scene& scene,
                    std::optional<Camera>& objectCamera);
     Camera camera(const Json& value, const std::string& field) const;
+    void addViews(const Json& root, const std::optional<Camera>& objectCamera, Scene& scene) const;
     Light light(const Json& value, const std::string& field) const;
     void applyMaterial(const Json& value, const std::string& field, Scene& scene) const;
     glm::vec4 colour(const Json& value, const std::string& field, bool alphaAllowed) const;
@@ -263,7 +267,9 @@ Scene JsonSceneReader::read() {
     } catch (const Json::exception& parseError) { // parse_error, or out_of_range for 1e999
         fail("", std::string("invalid JSON: ") + parseError.what());
     }
-    expectKeys(root, "", {"name", "camera", "objects", "lights", "lightGenerator", "materials"});
+    expectKeys(root, "",
+               {"name", "camera", "cameras", "cameraPath", "objects", "lights", "lightGenerator",
+                "materials"});
 
     Scene scene;
     scene.name = member(root, "name") ? text(root["name"], "name") : mPath.stem().string();
@@ -283,12 +289,7 @@ Scene JsonSceneReader::read() {
             applyMaterial((*materials)[i], elementOf("materials", i), scene);
     }
 
-    if (const Json* cameraValue = member(root, "camera"))
-        scene.cameras.push_back(camera(*cameraValue, "camera"));
-    else if (objectCamera)
-        scene.cameras.push_back(*objectCamera);
-    else
-        scene.cameras.push_back(cameraFramingBounds(scene.boundsWorld()));
+    addViews(root, objectCamera, scene);
 
     if (const Json* lights = member(root, "lights")) {
         if (!lights->is_array())
@@ -413,7 +414,8 @@ void JsonSceneReader::addObject(const Json& value, const std::string& field, Sce
 }
 
 Camera JsonSceneReader::camera(const Json& value, const std::string& field) const {
-    expectKeys(value, field, {"position", "target", "forward", "up", "fovYDegrees", "near", "far"});
+    expectKeys(value, field,
+               {"name", "position", "target", "forward", "up", "fovYDegrees", "near", "far"});
     const Json* target = member(value, "target");
     const Json* forward = member(value, "forward");
     if (!member(value, "position"))
@@ -422,7 +424,7 @@ Camera JsonSceneReader::camera(const Json& value, const std::string& field) cons
         fail(field, "give exactly one of 'target' and 'forward'");
 
     Camera camera;
-    camera.name = "camera";
+    camera.name = member(value, "name") ? text(value["name"], fieldOf(field, "name")) : "camera";
     camera.positionWorld = vec3(value["position"], fieldOf(field, "position"));
     if (target) {
         const glm::vec3 toTarget = vec3(*target, fieldOf(field, "target")) - camera.positionWorld;
@@ -451,6 +453,51 @@ Camera JsonSceneReader::camera(const Json& value, const std::string& field) cons
     if (!(camera.farMetres > camera.nearMetres))
         fail(field, "'far' must exceed 'near'");
     return camera;
+}
+
+// The scene's views (Viewpoints.h), in this order: `camera`, then the `cameras` list; when neither
+// is given, the first procedural object's camera or else a camera framing the bounds; then the
+// frames of `cameraPath`. Names are made unique.
+void JsonSceneReader::addViews(const Json& root, const std::optional<Camera>& objectCamera,
+                               Scene& scene) const {
+    if (const Json* cameraValue = member(root, "camera"))
+        scene.cameras.push_back(camera(*cameraValue, "camera"));
+    if (const Json* cameras = member(root, "cameras")) {
+        if (!cameras->is_array() || cameras->empty())
+            fail("cameras", "expected a non-empty array of cameras");
+        for (size_t i = 0; i < cameras->size(); ++i) {
+            Camera view = camera((*cameras)[i], elementOf("cameras", i));
+            if (!member((*cameras)[i], "name"))
+                view.name = "camera " + std::to_string(i);
+            scene.cameras.push_back(view);
+        }
+    }
+    if (scene.cameras.empty())
+        scene.cameras.push_back(objectCamera ? *objectCamera
+                                             : cameraFramingBounds(scene.boundsWorld()));
+    if (const Json* path = member(root, "cameraPath")) {
+        expectKeys(*path, "cameraPath", {"name", "frames", "keys"});
+        const std::string name =
+            member(*path, "name") ? text((*path)["name"], "cameraPath.name") : "path";
+        const Json* frames = member(*path, "frames");
+        if (!frames || !frames->is_number_integer() || frames->get<int64_t>() < 2 ||
+            frames->get<int64_t>() > kMaxCameraPathFrames)
+            fail("cameraPath.frames",
+                 "expected an integer in [2, " + std::to_string(kMaxCameraPathFrames) + "]");
+        const Json* keys = member(*path, "keys");
+        if (!keys || !keys->is_array() || keys->size() < 2)
+            fail("cameraPath.keys", "expected an array of at least 2 cameras");
+        std::vector<Camera> keyCameras;
+        for (size_t i = 0; i < keys->size(); ++i)
+            keyCameras.push_back(camera((*keys)[i], elementOf("cameraPath.keys", i)));
+        try {
+            for (const Camera& view : cameraPath(name, keyCameras, int(frames->get<int64_t>())))
+                scene.cameras.push_back(view);
+        } catch (const SceneError& error) {
+            fail("cameraPath", error.what());
+        }
+    }
+    makeViewNamesUnique(scene.cameras);
 }
 
 Light JsonSceneReader::light(const Json& value, const std::string& field) const {

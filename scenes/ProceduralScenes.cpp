@@ -363,6 +363,15 @@ Scene buildAtrium(const SceneRequest& request) {
     scatter.maxIntensity = 1.5f;
     scatterPointLights(scene, scatter, request.lightCount, request.seed);
     addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
+    // More views (Viewpoints.h): back down the nave from the far end,
+    // from gallery height above the nave edge across to the far arcade, and from high above the
+    // near end looking down into the courtyard.
+    scene.cameras.push_back(makeCamera("far-end", {0.0f, 1.7f, -kAtriumHalfLength + 1.2f},
+                                       {0.0f, 5.0f, kAtriumHalfLength}, 45.0f));
+    scene.cameras.push_back(makeCamera("gallery", {3.0f, kGalleryFloorTop + 1.6f, 12.0f},
+                                       {-kAtriumHalfWidth, 2.0f, -8.0f}, 45.0f));
+    scene.cameras.push_back(makeCamera("overhead", {0.0f, kAtriumWallHeight - 1.0f, 16.0f},
+                                       {0.0f, 0.0f, -2.0f}, 50.0f));
     return scene;
 }
 
@@ -495,6 +504,14 @@ Scene buildWall(const SceneRequest& request) {
                     placeBehind);
 
     addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
+    // More views (Viewpoints.h), added after the lights (which are placed in wall-45's view):
+    // square-on, grazing along the face, and from behind (the side the "behind" lights are on).
+    scene.cameras.push_back(
+        makeCamera("wall-front", target + glm::vec3(0.0f, 0.0f, 9.0f), target, 100.0f));
+    scene.cameras.push_back(
+        makeCamera("wall-grazing", {-12.0f, 1.7f, 4.0f}, {6.0f, 2.5f, kWallFaceZ}, 100.0f));
+    scene.cameras.push_back(makeCamera("wall-behind", {away, 2.5f, -kWallHalfThickness - away},
+                                       {0.0f, 2.5f, -kWallHalfThickness}, 100.0f));
     return scene;
 }
 
@@ -556,6 +573,10 @@ Scene buildSpheres(const SceneRequest& request) {
     scatter.maxIntensity = 1.5f;
     scatterPointLights(scene, scatter, request.lightCount, request.seed);
     addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
+    // More views (Viewpoints.h): from above, low from the side (grazing the ground), from behind.
+    scene.cameras.push_back(makeCamera("above", {0.0f, 9.0f, 4.5f}, {0.0f, 0.5f, 0.0f}, 40.0f));
+    scene.cameras.push_back(makeCamera("low-side", {-8.5f, 0.6f, 1.5f}, {0.0f, 0.8f, 0.0f}, 40.0f));
+    scene.cameras.push_back(makeCamera("back", {1.5f, 2.2f, -8.5f}, {0.0f, 0.8f, 0.0f}, 40.0f));
     return scene;
 }
 

@@ -284,3 +284,69 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
 }
 
 } // namespace
+
+namespace {
+
+nlohmann::json readJson(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+}
+
+// `render --view all`: one render per view of the scene, each in its folder, the views listed in
+// views.json in the scene's order, and each stats.json naming its view; the default view's
+// render is bitwise the render without --view.
+TEST(RenderCommand, EveryViewRendersIntoItsOwnFolder) {
+    const std::filesystem::path out = std::filesystem::path(::testing::TempDir()) / "render_views";
+    std::filesystem::remove_all(out);
+    experiments::RenderCommandOptions options;
+    options.render = smallAtrium(2);
+    options.render.scene = "spheres";
+    options.render.width = 96;
+    options.render.height = 54;
+    options.render.view = experiments::kEveryView;
+    options.out = out;
+    testing::internal::CaptureStdout();
+    ASSERT_EQ(experiments::runRenderCommand(options), 0);
+    testing::internal::GetCapturedStdout();
+    const nlohmann::json views = readJson(out / "views.json");
+    ASSERT_EQ(views.size(), 4u);
+    EXPECT_EQ(views[0]["view"], "front");
+    for (const nlohmann::json& view : views) {
+        const std::filesystem::path folder = out / view["folder"].get<std::string>();
+        EXPECT_TRUE(std::filesystem::is_regular_file(folder / "render.exr")) << folder;
+        EXPECT_EQ(readJson(folder / "stats.json")["view"], view["view"]) << folder;
+    }
+
+    const RenderRun byDefault = [&] {
+        RenderOptions plain = options.render;
+        plain.view.clear();
+        return runRender(planRender(plain));
+    }();
+    const RenderRun front = [&] {
+        RenderOptions named = options.render;
+        named.view = "front";
+        return runRender(planRender(named));
+    }();
+    for (int c = 0; c < 3; ++c)
+        EXPECT_TRUE(bitwiseEqual(byDefault.result.radiance[c], front.result.radiance[c]));
+    const RenderRun above = [&] {
+        RenderOptions named = options.render;
+        named.view = "above";
+        return runRender(planRender(named));
+    }();
+    EXPECT_FALSE(bitwiseEqual(byDefault.result.radiance[0], above.result.radiance[0]));
+}
+
+TEST(RenderCommand, UnknownViewIsRefusedListingTheViews) {
+    experiments::RenderCommandOptions options;
+    options.render = smallAtrium(1);
+    options.render.view = "roof";
+    options.out = std::filesystem::path(::testing::TempDir()) / "render_bad_view";
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(experiments::runRenderCommand(options), 1);
+    const std::string message = testing::internal::GetCapturedStderr();
+    EXPECT_NE(message.find("no view 'roof'"), std::string::npos) << message;
+    EXPECT_NE(message.find("nave, far-end, gallery, overhead"), std::string::npos) << message;
+}
+
+} // namespace

@@ -104,6 +104,24 @@ TEST(SweepFile, JobsSharingAReferenceAreAdjacent) {
     }
 }
 
+// Each view has its own reference image; the default view keeps the key it had before views.
+TEST(SweepFile, EveryViewHasItsOwnReference) {
+    const auto plain = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
+    Json withViews = baseSweep();
+    withViews["axes"]["view"] = {"front", "above"};
+    const auto expansion =
+        experiments::expandSweep(experiments::parseSweep(withViews, "unit.json"));
+    std::set<std::string> keys;
+    for (const SweepJob& job : expansion.jobs) {
+        keys.insert(job.referenceKey);
+        EXPECT_NE(job.referenceKey.find("-" + job.options.view + "-"), std::string::npos)
+            << job.referenceKey;
+    }
+    EXPECT_EQ(keys.size(), 8u); // (segments, lights) x view
+    for (const SweepJob& job : plain.jobs)
+        EXPECT_EQ(job.referenceKey.find("front"), std::string::npos);
+}
+
 TEST(SweepFile, AxisColumnsInCanonicalOrder) {
     const auto expansion =
         experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));

@@ -223,8 +223,9 @@ class SharedModelTest : public ::testing::TestWithParam<SharedModel> {};
 TEST_P(SharedModelTest, LoadsWithStatedTriangleCountAndTextures) {
     const Scene scene = scenes::loadGltf(sharedModel(GetParam().path));
     EXPECT_EQ(scene.triangleCount(), GetParam().triangleCount);
-    ASSERT_EQ(scene.cameras.size(), 1u);
-    EXPECT_EQ(scene.cameras[0].name, "default"); // none of the models has a camera
+    // None of the models has a camera: the framing camera and three orbit views.
+    ASSERT_EQ(scene.cameras.size(), 4u);
+    EXPECT_EQ(scene.cameras[0].name, "default");
     ASSERT_EQ(scene.materials.size(), 1u);
     const scenes::Material& material = scene.materials[0];
     // Every model has a readable base colour texture; the helmet and the box have a normal map.
@@ -415,7 +416,7 @@ TEST(GltfLoader, ReadsByteIndicesNormalizedShortUvsAndGivenNormals) {
         expectNear(normal, {0, 0, 1});
 }
 
-TEST(GltfLoader, UsesFirstPerspectiveCameraWithItsNodeTransform) {
+TEST(GltfLoader, KeepsEveryPerspectiveCameraWithItsNodeTransform) {
     const fs::path directory = testDirectory();
     GltfDocument document = triangleDocument();
     // Turned 90 degrees about +Y, a camera looking down its -Z looks down world -X.
@@ -430,7 +431,11 @@ TEST(GltfLoader, UsesFirstPerspectiveCameraWithItsNodeTransform) {
     (*document)["nodes"].push_back({{"camera", 1}});
     (*document)["scenes"][0]["nodes"] = {0, 1, 2};
     const Scene scene = scenes::loadGltf(writeFile(directory / "cam.gltf", document.gltfText()));
-    ASSERT_EQ(scene.cameras.size(), 1u);
+    // Both cameras are views, in walk order: the first is the one rendered by default.
+    ASSERT_EQ(scene.cameras.size(), 2u);
+    EXPECT_EQ(scene.cameras[1].name, "camera 1"); // unnamed in the file
+    EXPECT_FLOAT_EQ(scene.cameras[1].verticalFovRadians, 0.5f);
+    EXPECT_FLOAT_EQ(scene.cameras[1].farMetres, 10.0f);
     const scenes::Camera& camera = scene.cameras[0];
     EXPECT_EQ(camera.name, "eye");
     expectNear(camera.positionWorld, {0, 1, 5});
@@ -441,8 +446,13 @@ TEST(GltfLoader, UsesFirstPerspectiveCameraWithItsNodeTransform) {
     EXPECT_FLOAT_EQ(camera.farMetres, 1e4f * 0.05f); // zfar absent: 1e4 znear covers the model
 }
 
-TEST(GltfLoader, DefaultCameraFramesTheModelFromOutside) {
+TEST(GltfLoader, WithoutCamerasTheDefaultViewAndThreeOrbitViewsFrameTheModel) {
     const Scene scene = scenes::loadGltf(sharedModel("Suzanne/Suzanne.gltf"));
+    ASSERT_EQ(scene.cameras.size(), 4u);
+    EXPECT_EQ(scene.cameras[0].name, "default");
+    EXPECT_EQ(scene.cameras[1].name, "left");
+    EXPECT_EQ(scene.cameras[2].name, "right");
+    EXPECT_EQ(scene.cameras[3].name, "above");
     const scenes::Camera& camera = scene.cameras.at(0);
     scenes::Aabb bounds;
     for (const scenes::Instance& instance : scene.instances)
@@ -453,6 +463,18 @@ TEST(GltfLoader, DefaultCameraFramesTheModelFromOutside) {
     expectNear(camera.forwardWorld, glm::normalize(toCentre));
     EXPECT_LT(camera.nearMetres, glm::length(toCentre) - 0.5f * glm::length(bounds.size()));
     EXPECT_GT(camera.farMetres, glm::length(toCentre) + 0.5f * glm::length(bounds.size()));
+    // The orbit views look at the centre the framing camera looks at (that of the geometry's
+    // bounds) from the same distance, with the same planes.
+    const glm::vec3 centre = bounds.centre();
+    const float distance = glm::length(centre - camera.positionWorld);
+    for (size_t i = 1; i < scene.cameras.size(); ++i) {
+        const scenes::Camera& orbit = scene.cameras[i];
+        const glm::vec3 orbitToCentre = centre - orbit.positionWorld;
+        EXPECT_NEAR(glm::length(orbitToCentre), distance, 1e-4f * distance);
+        expectNear(orbit.forwardWorld, glm::normalize(orbitToCentre), 1e-4f);
+        EXPECT_EQ(orbit.nearMetres, camera.nearMetres);
+        EXPECT_EQ(orbit.farMetres, camera.farMetres);
+    }
 }
 
 TEST(GltfLoader, PunctualLightIsPlacedByItsNode) {

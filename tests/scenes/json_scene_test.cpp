@@ -17,6 +17,7 @@
 #include "scenes/LightGenerator.h"
 #include "scenes/ProceduralScenes.h"
 #include "scenes/SceneLoader.h"
+#include "scenes/Viewpoints.h"
 
 namespace {
 
@@ -448,6 +449,47 @@ TEST(JsonSceneErrors, BadFiles) {
     scenes::SceneRequest request;
     request.options["segments"] = "8";
     expectJsonError(spheresOnly(), {"option 'segments'"}, request);
+}
+
+TEST(JsonScene, CamerasListAndCameraPathBecomeNamedViews) {
+    json document = spheresOnly();
+    document["cameras"] = {{{"name", "near"}, {"position", {0, 1, 4}}, {"target", {0, 0, 0}}},
+                           {{"position", {4, 1, 0}}, {"target", {0, 0, 0}}},
+                           {{"name", "near"}, {"position", {0, 5, 1}}, {"target", {0, 0, 0}}}};
+    document["cameraPath"] = {
+        {"name", "orbit"},
+        {"frames", 5},
+        {"keys",
+         {{{"position", {0, 1, 8}}, {"target", {0, 0, 0}}, {"fovYDegrees", 40}},
+          {{"position", {8, 1, 0}}, {"target", {0, 0, 0}}, {"fovYDegrees", 80}}}}};
+    const Scene scene = loadJson(document);
+    const std::vector<std::string> expected = {"near",    "camera 1", "near (2)", "orbit/0",
+                                               "orbit/1", "orbit/2",  "orbit/3",  "orbit/4"};
+    EXPECT_EQ(scenes::viewNames(scene), expected);
+    // The path starts and ends on its keys and interpolates in between.
+    expectNear(scene.cameras[3].positionWorld, {0, 1, 8});
+    expectNear(scene.cameras[7].positionWorld, {8, 1, 0});
+    expectNear(scene.cameras[5].positionWorld, {4, 1, 4});
+    EXPECT_NEAR(glm::degrees(scene.cameras[5].verticalFovRadians), 60.0f, 1e-4f);
+    EXPECT_NEAR(glm::length(scene.cameras[5].forwardWorld), 1.0f, 1e-6f);
+}
+
+TEST(JsonScene, BadCameraPathsAreRefusedNamingTheKey) {
+    json document = spheresOnly();
+    document["cameraPath"] = {{"frames", 1},
+                              {"keys",
+                               {{{"position", {0, 1, 8}}, {"target", {0, 0, 0}}},
+                                {{"position", {8, 1, 0}}, {"target", {0, 0, 0}}}}}};
+    expectJsonError(document, {"cameraPath.frames", "[2, 10000]"});
+    document["cameraPath"]["frames"] = 3;
+    document["cameraPath"]["keys"] = {{{"position", {0, 1, 8}}, {"target", {0, 0, 0}}}};
+    expectJsonError(document, {"cameraPath.keys", "at least 2"});
+    document["cameraPath"]["keys"] = {{{"position", {0, 0, 8}}, {"target", {0, 0, 0}}},
+                                      {{"position", {0, 0, -8}}, {"target", {0, 0, 0}}}};
+    expectJsonError(document, {"cameraPath", "opposite directions"});
+    document.erase("cameraPath");
+    document["cameras"] = json::array();
+    expectJsonError(document, {"cameras", "non-empty array"});
 }
 
 } // namespace
