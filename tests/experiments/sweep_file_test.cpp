@@ -112,13 +112,13 @@ TEST(SweepFile, EveryViewHasItsOwnReference) {
     const auto expansion =
         experiments::expandSweep(experiments::parseSweep(withViews, "unit.json"));
     std::set<std::string> keys;
-    for (const SweepJob& job : expansion.jobs) {
+    for (const SweepJob& job : expansion.jobs()) {
         keys.insert(job.referenceKey);
         EXPECT_NE(job.referenceKey.find("-" + job.options.view + "-"), std::string::npos)
             << job.referenceKey;
     }
     EXPECT_EQ(keys.size(), 8u); // (segments, lights) x view
-    for (const SweepJob& job : plain.jobs)
+    for (const SweepJob& job : plain.jobs())
         EXPECT_EQ(job.referenceKey.find("front"), std::string::npos);
 }
 
