@@ -130,6 +130,8 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     if (const std::optional<ErrorMetrics>& error = run.metrics.error)
         std::cout << "  error vs reference: rmse " << std::scientific << error->rmse << ", max_abs "
                   << error->maxAbs << ", relative rmse " << error->relativeRmse << "\n";
+    if (!run.metrics.lightCountsNote.empty())
+        std::cout << "  light counts: " << run.metrics.lightCountsNote << "\n";
     std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
     for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
         if (std::filesystem::exists(out / file))
@@ -146,10 +148,12 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
     const DecodedLayers layers = decodeLayers(gb);
     const std::vector<float> evaluated = toFloat(run.result.lightsEvaluated);
     const std::vector<float> oracle = toFloat(run.oracle);
-    // Evaluations that added nothing: the culling stage's waste at each pixel.
+    // Evaluations that added nothing: the culling stage's waste at each pixel it lit (a
+    // reduced-resolution stage lights only its samples: 0 at the pixels it filtered).
+    const std::vector<uint8_t>& lit = run.result.lightingSamples;
     std::vector<float> wasted(evaluated.size());
     for (size_t pixel = 0; pixel < wasted.size(); ++pixel)
-        wasted[pixel] = evaluated[pixel] - oracle[pixel];
+        wasted[pixel] = lit.empty() || lit[pixel] ? evaluated[pixel] - oracle[pixel] : 0.0f;
     const std::array<std::vector<float>, 3> error = errorPlanes(run);
     std::vector<ImagePlane> planes = {
         {"R", run.result.radiance[0].data()},   {"G", run.result.radiance[1].data()},
@@ -175,6 +179,9 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         {"testbed:stats", stats.dump()},
         {"testbed:Z", "view-space depth in metres decoded from the G-buffer, 0 = background"},
         {"testbed:error", "error.R,G,B = |R,G,B - reference| (double-precision reference)"},
+        {"testbed:lights.wasted",
+         "lights.evaluated - lights.oracle at the pixels the stage lit; 0 at pixels a "
+         "reduced-resolution stage only filtered"},
     };
     writeMultiLayerExr(dir / "render.exr", w, h, planes, metadata);
     writePreviewPng(dir / "preview.png", w, h, run.result.radiance[0].data(),
@@ -284,6 +291,9 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats[metric::kLightEvaluations] = metrics.lightEvaluations;
     stats[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
     stats[metric::kCullingEfficiency] = metrics.cullingEfficiency;
+    stats[metric::kCountedPixels] = metrics.countedPixels;
+    if (!metrics.lightCountsNote.empty())
+        stats["light_counts_note"] = metrics.lightCountsNote;
     stats["raster"] = rasterJson(run.prepared->rasterStats);
     if (metrics.error)
         stats["error"] = errorJson(metrics);

@@ -146,7 +146,8 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         }
         const gbuffer::GBufferLayout& layout = run.gbuffer().layout();
         run.metrics = measureRun(std::move(passes), run.result.lightsEvaluated, run.oracle,
-                                 layout.bytesPerPixel(), layout.allocatedBytesPerPixel(), error);
+                                 run.result.lightingSamples, layout.bytesPerPixel(),
+                                 layout.allocatedBytesPerPixel(), error);
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;
     });

@@ -122,6 +122,32 @@ TEST(RenderJob, CullingStaysConservativeOnLossyLayouts) {
         }
 }
 
+// Every stage's light counts are on the same footing: summed over the pixels the stage lit, so
+// that culling efficiency never exceeds 1 and no lit pixel wastes a negative number of lights.
+// inferred lights only its reduced-resolution samples (1 in scale^2 pixels): it says so.
+TEST(RenderJob, ReducedResolutionStagesCountTheSamePixelsAsTheOracle) {
+    for (const char* stage : {"inferred", "inferred:scale=4", "light-prepass", "tiled"}) {
+        RenderOptions options = smallAtrium(0);
+        options.stage = stage;
+        const RenderRun run = runRender(planRender(options));
+        const experiments::RunMetrics& m = run.metrics;
+        EXPECT_LE(m.cullingEfficiency, 1.0) << stage;
+        EXPECT_GE(m.lightEvaluations, m.oracleLightEvaluations) << stage;
+        const std::vector<uint8_t>& lit = run.result.lightingSamples;
+        size_t negative = 0;
+        for (size_t pixel = 0; pixel < run.oracle.size(); ++pixel)
+            if (lit.empty() || lit[pixel])
+                negative += run.result.lightsEvaluated[pixel] < run.oracle[pixel];
+        EXPECT_EQ(negative, 0u) << stage;
+        const bool reduced = std::string(stage).rfind("inferred", 0) == 0;
+        const int scale = std::string(stage) == "inferred:scale=4" ? 4 : 2;
+        EXPECT_EQ(m.countedPixels,
+                  reduced ? uint64_t((320 / scale) * (180 / scale)) : uint64_t(320 * 180))
+            << stage;
+        EXPECT_EQ(m.lightCountsNote.empty(), !reduced) << stage;
+    }
+}
+
 // Issue 4's acceptance check at test size: spheremap:16 costs more error than
 // octahedral-precise:32 and fewer bytes per pixel than float32.
 TEST(RenderJob, NormalEncodingsTradeBytesForError) {

@@ -89,7 +89,7 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
         std::ifstream statsFile(folder / "stats.json");
         const Json stats = Json::parse(statsFile);
         for (const char* figure : {"light_evaluations", "oracle_light_evaluations",
-                                   "culling_efficiency", "bytes_per_pixel"})
+                                   "culling_efficiency", "counted_pixels", "bytes_per_pixel"})
             EXPECT_EQ(job[figure], stats[figure]) << figure;
         for (const char* figure : {"rmse", "relative_rmse", "max_abs", "relative_mean", "p99_abs"})
             EXPECT_EQ(job[figure], stats["error"][figure]) << figure;
