@@ -95,27 +95,12 @@ std::array<std::vector<float>, 3> errorPlanes(const RenderRun& run) {
     return planes;
 }
 
-// False-colour PNG of the largest channel error per pixel, Turbo from 0 to the image's maximum
-// (ImageBufAlgo::color_map), for thumbnails; the exact values are the EXR's error layers.
-void writeErrorPng(const std::filesystem::path& path, int w, int h,
-                   const std::array<std::vector<float>, 3>& error) {
-    OIIO::ImageBuf largest(OIIO::ImageSpec(w, h, 1, OIIO::TypeDesc::FLOAT));
-    std::vector<float> values(size_t(w) * h);
-    float peak = 0.0f;
-    for (size_t i = 0; i < values.size(); ++i) {
+// The largest channel error per pixel (what error.png shows).
+std::vector<float> largestChannelError(const std::array<std::vector<float>, 3>& error) {
+    std::vector<float> values(error[0].size());
+    for (size_t i = 0; i < values.size(); ++i)
         values[i] = std::max({error[0][i], error[1][i], error[2][i]});
-        if (std::isfinite(values[i]))
-            peak = std::max(peak, values[i]);
-    }
-    for (float& v : values)
-        v = peak > 0.0f && std::isfinite(v) ? std::min(v / peak, 1.0f)
-                                            : (std::isfinite(v) ? 0.0f : 1.0f);
-    largest.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values.data());
-    const OIIO::ImageBuf coloured = OIIO::ImageBufAlgo::color_map(largest, 0, "turbo");
-    writeFileAtomically(path, [&](const std::filesystem::path& temp) {
-        if (!coloured.write(temp.string(), OIIO::TypeDesc::UINT8))
-            throw std::runtime_error("cannot write " + path.string() + ": " + coloured.geterror());
-    });
+    return values;
 }
 
 // What `testbed render` prints when done: the run, its pass medians, the error, the files.
@@ -140,8 +125,18 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
 
 } // namespace
 
+ScalarMapStyle errorMapStyle(const RenderOutputScales& scales) {
+    ScalarMapStyle style;
+    style.scale = scales.errorScale;
+    style.max = scales.errorMax;
+    style.colourMap = "turbo";
+    style.title = std::string("|render - reference|, largest of R,G,B (") +
+                  mapScaleName(scales.errorScale) + " scale)";
+    return style;
+}
+
 void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
-                        uint32_t heatmapMax) {
+                        const RenderOutputScales& scales) {
     const gbuffer::GBuffer& gb = run.gbuffer();
     const int w = gb.width(), h = gb.height();
     const nlohmann::json stats = statsJson(run);
@@ -186,9 +181,11 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
     writeMultiLayerExr(dir / "render.exr", w, h, planes, metadata);
     writePreviewPng(dir / "preview.png", w, h, run.result.radiance[0].data(),
                     run.result.radiance[1].data(), run.result.radiance[2].data());
-    writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(), heatmapMax);
+    writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(),
+                    scales.heatmapMax);
     if (run.metrics.error)
-        writeErrorPng(dir / "error.png", w, h, error);
+        writeScalarMapPng(dir / "error.png", w, h, largestChannelError(error).data(),
+                          errorMapStyle(scales));
     writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
 }
 
@@ -381,7 +378,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         ensureWritableDirectory(options.out); // before the G-buffer pass and the stage
         const RenderRun run = runRender(std::move(plan), progress);
         progress("writing outputs");
-        writeRenderOutputs(run, options.out, options.heatmapMax);
+        writeRenderOutputs(run, options.out, options.scales);
         printSummary(run, options.out);
         return 0;
     } catch (const std::exception& e) {

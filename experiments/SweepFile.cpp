@@ -18,8 +18,8 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 const std::vector<std::string> kTopLevelKeys = {
-    "name",   "description", "notes",     "fixed", "axes",     "cases",
-    "warmup", "repetitions", "reference", "quick", "published"};
+    "name",        "description", "notes", "fixed",     "axes",        "cases",     "warmup",
+    "repetitions", "reference",   "quick", "published", "heatmap-max", "error-max", "error-scale"};
 const std::vector<std::string> kQuickKeys = {"fixed",  "axes",        "cases",
                                              "warmup", "repetitions", "reference"};
 // Settings the runner applies itself (RenderOptions fields that setRenderOption may not know).
@@ -365,6 +365,30 @@ SweepSpec parseSweep(const Json& object, const std::string& origin) {
             fail(origin, "'reference' must be true or false");
         spec.reference = object["reference"].get<bool>();
     }
+    if (object.contains("heatmap-max")) {
+        const Json& value = object["heatmap-max"];
+        if (!value.is_number_integer() || value.get<int64_t>() < 0 ||
+            value.get<int64_t>() > int64_t(kMaxLights))
+            fail(origin, "'heatmap-max' must be a light count 0.." + std::to_string(kMaxLights) +
+                             " (0 = each image's maximum), got " + value.dump());
+        spec.heatmapMax = value.get<uint32_t>();
+    }
+    if (object.contains("error-max")) {
+        const Json& value = object["error-max"];
+        if (!value.is_number() || !(value.get<double>() >= 0.0) ||
+            !std::isfinite(value.get<double>()))
+            fail(origin,
+                 "'error-max' must be a number >= 0 (0 = each image's largest error), got " +
+                     value.dump());
+        spec.errorMax = value.get<double>();
+    }
+    if (object.contains("error-scale")) {
+        const Json& value = object["error-scale"];
+        if (!value.is_string() ||
+            (value.get<std::string>() != "linear" && value.get<std::string>() != "log"))
+            fail(origin, "'error-scale' must be \"linear\" or \"log\", got " + value.dump());
+        spec.errorScale = parseMapScale(value.get<std::string>());
+    }
     checkDisjoint(spec, "");
     std::set<std::string> keys = settingKeys(spec);
     if (object.contains("quick")) {
@@ -534,6 +558,9 @@ SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads) {
             job.options.warmup = effective.warmup;
             job.options.repetitions = effective.repetitions;
             job.compareReference = effective.reference;
+            job.heatmapMax = spec.heatmapMax;
+            job.errorScale = spec.errorScale;
+            job.errorMax = spec.errorMax;
             std::vector<std::string> canonical;
             for (const SweepSetting& s : job.settings)
                 canonical.push_back(s.key + "=" + settingText(s.value, s.key));

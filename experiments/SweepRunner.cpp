@@ -295,7 +295,7 @@ private:
             RenderOptions options = job.options;
             options.compareReference = job.compareReference;
             const RenderRun run = runRender(planRender(options), {}, referenceImage);
-            writeRenderOutputs(run, dir, 0);
+            writeRenderOutputs(run, dir, {job.heatmapMax, job.errorScale, float(job.errorMax)});
             addMetrics(row, run.metrics);
         } catch (const std::exception& e) {
             error = e.what();

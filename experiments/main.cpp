@@ -52,8 +52,22 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
     render.add_option("--out", options.out, "output folder")->capture_default_str();
     render
-        .add_option("--heatmap-max", options.heatmapMax,
+        .add_option("--heatmap-max", options.scales.heatmapMax,
                     "light count at the top of the heatmap scale, 0 = the image's maximum")
+        ->capture_default_str();
+    render
+        .add_option_function<std::string>(
+            "--error-scale",
+            [&options](const std::string& text) {
+                options.scales.errorScale = experiments::parseMapScale(text);
+            },
+            "scale of error.png: linear (0 to the maximum) or log (4 decades below the maximum, "
+            "so that one outlier does not darken the rest)")
+        ->check(CLI::IsMember({"linear", "log"}))
+        ->default_str("linear");
+    render
+        .add_option("--error-max", options.scales.errorMax,
+                    "error at the top of error.png's scale, 0 = the image's largest error")
         ->capture_default_str();
     render.add_flag("--compare-reference", r.compareReference,
                     "also render the double-precision reference and record the error");

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <regex>
 #include <set>
+#include <tuple>
 
 #include "experiments/SweepFile.h"
 
@@ -203,6 +204,37 @@ TEST(SweepFile, ReportsEveryInvalidJobBeforeRunning) {
         errorOf([&] { experiments::expandSweep(experiments::parseSweep(file, "bad.json")); });
     EXPECT_NE(unknown.find("no-such-option"), std::string::npos) << unknown;
     EXPECT_NE(unknown.find("12 of 12"), std::string::npos) << unknown;
+}
+
+// Display keys: one scale for every job's heatmap and error map; not part of the job ids.
+TEST(SweepFile, MapScalesApplyToEveryJobAndKeepTheIds) {
+    Json file = baseSweep();
+    const auto plain = experiments::expandSweep(experiments::parseSweep(file, "unit.json"));
+    file["heatmap-max"] = 64;
+    file["error-scale"] = "log";
+    file["error-max"] = 0.5;
+    const auto spec = experiments::parseSweep(file, "unit.json");
+    EXPECT_EQ(spec.heatmapMax, 64u);
+    EXPECT_EQ(spec.errorScale, experiments::MapScale::Log);
+    EXPECT_EQ(spec.errorMax, 0.5);
+    const auto scaled = experiments::expandSweep(spec);
+    ASSERT_EQ(scaled.jobs.size(), plain.jobs.size());
+    for (size_t i = 0; i < plain.jobs.size(); ++i) {
+        EXPECT_EQ(scaled.jobs[i].id, plain.jobs[i].id);
+        EXPECT_EQ(scaled.jobs[i].heatmapMax, 64u);
+        EXPECT_EQ(scaled.jobs[i].errorScale, experiments::MapScale::Log);
+        EXPECT_EQ(scaled.jobs[i].errorMax, 0.5);
+    }
+    for (const auto& [key, value, expected] :
+         {std::tuple<const char*, Json, const char*>{"heatmap-max", -1, "'heatmap-max' must be"},
+          {"heatmap-max", "64", "'heatmap-max' must be"},
+          {"error-scale", "logarithmic", "'error-scale' must be \"linear\" or \"log\""},
+          {"error-max", -0.5, "'error-max' must be a number >= 0"}}) {
+        Json bad = baseSweep();
+        bad[key] = value;
+        const std::string message = errorOf([&] { experiments::parseSweep(bad, "unit.json"); });
+        EXPECT_NE(message.find(expected), std::string::npos) << key << ": " << message;
+    }
 }
 
 TEST(SweepFile, ChecksPublishedTables) {
