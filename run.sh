@@ -2,7 +2,10 @@
 # One command for everything on a fresh Debian 12 machine (as root):
 #   ./run.sh main   install what is missing, build Release, render the default scene
 #   ./run.sh test   install what is missing, build Release, run the whole test suite (ctest)
-# Only missing Debian packages are installed; nothing is downloaded from anywhere else.
+# Only missing Debian packages are installed. The one download from elsewhere is NVIDIA's ꟻLIP
+# (the Python package flip-evaluator, from the Python package index) into the project-local
+# virtual environment .venv/; when the index cannot be reached, ꟻLIP is reported unavailable in
+# every output (experiments/FlipMetric.h) and nothing else changes.
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -16,6 +19,7 @@ packages=(
     fonts-dejavu-core
     libtomlplusplus-dev
     python3-matplotlib chromium
+    python3-venv python3-pip
 )
 missing=()
 for p in "${packages[@]}"; do
@@ -25,6 +29,16 @@ if ((${#missing[@]})); then
     echo "run.sh: installing ${missing[*]}" >&2
     apt-get update
     DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
+fi
+
+# ꟻLIP: a venv that sees Debian's numpy; a failed install (offline machine) is not an error.
+flip_version=1.6.0.1 # experiments/FlipMetric.h kFlipEvaluatorVersion
+if ! .venv/bin/python3 -c "import flip_evaluator" 2>/dev/null; then
+    python3 -m venv --system-site-packages .venv
+    .venv/bin/python3 -m pip install --quiet --timeout 20 --retries 1 \
+        "flip-evaluator==$flip_version" \
+        || echo "run.sh: cannot install flip-evaluator==$flip_version (no access to the Python" \
+                "package index?): FLIP will be reported unavailable" >&2
 fi
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release

@@ -112,13 +112,20 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     for (const PassTiming& timing : run.metrics.passes)
         std::cout << "  " << timing.pass << ": " << std::fixed << std::setprecision(2)
                   << timing.medianMs() << " ms\n";
-    if (const std::optional<ErrorMetrics>& error = run.metrics.error)
+    if (const std::optional<ErrorMetrics>& error = run.metrics.error) {
         std::cout << "  error vs reference: rmse " << std::scientific << error->rmse << ", max_abs "
                   << error->maxAbs << ", relative rmse " << error->relativeRmse << "\n";
+        if (error->flip)
+            std::cout << "  HDR-FLIP (flip-evaluator " << run.flipParameters.value("version", "?")
+                      << "): mean " << std::fixed << std::setprecision(4) << *error->flip << "\n";
+        else
+            std::cout << "  HDR-FLIP: unavailable: " << error->flipUnavailable << "\n";
+    }
     if (!run.metrics.lightCountsNote.empty())
         std::cout << "  light counts: " << run.metrics.lightCountsNote << "\n";
     std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
-    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
+    for (const char* file :
+         {"render.exr", "preview.png", "heatmap.png", "error.png", "flip.png", "stats.json"})
         if (std::filesystem::exists(out / file))
             std::cout << "  " << (out / file).string() << "\n";
 }
@@ -132,6 +139,14 @@ ScalarMapStyle errorMapStyle(const RenderOutputScales& scales) {
     style.colourMap = "turbo";
     style.title = std::string("|render - reference|, largest of R,G,B (") +
                   mapScaleName(scales.errorScale) + " scale)";
+    return style;
+}
+
+ScalarMapStyle flipMapStyle() {
+    ScalarMapStyle style;
+    style.max = 1.0f;
+    style.colourMap = "magma";
+    style.title = "HDR-FLIP error (flip-evaluator), 0..1";
     return style;
 }
 
@@ -166,6 +181,8 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         if (!error[size_t(c)].empty())
             planes.push_back({std::string("error.") + rgb[c], error[size_t(c)].data()});
     }
+    if (!run.flipMap.empty())
+        planes.push_back({"flip", run.flipMap.data()});
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"testbed:scene", run.options.scene},
         {"testbed:stage", run.options.stage},
@@ -174,6 +191,7 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         {"testbed:stats", stats.dump()},
         {"testbed:Z", "view-space depth in metres decoded from the G-buffer, 0 = background"},
         {"testbed:error", "error.R,G,B = |R,G,B - reference| (double-precision reference)"},
+        {"testbed:flip", "flip = HDR-FLIP per pixel against the reference, 0..1 (flip-evaluator)"},
         {"testbed:lights.wasted",
          "lights.evaluated - lights.oracle at the pixels the stage lit; 0 at pixels a "
          "reduced-resolution stage only filtered"},
@@ -186,6 +204,8 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
     if (run.metrics.error)
         writeScalarMapPng(dir / "error.png", w, h, largestChannelError(error).data(),
                           errorMapStyle(scales));
+    if (!run.flipMap.empty())
+        writeScalarMapPng(dir / "flip.png", w, h, run.flipMap.data(), flipMapStyle());
     writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
 }
 
@@ -237,16 +257,23 @@ void addTimings(nlohmann::json& stats, const RenderRun& run) {
                                  {"resolve", steps.resolveMs},
                                  {lighting::pass::kExactSurface, steps.exactMs}};
     stats["measurement_ms"] = {{"oracle", run.metrics.oracleMs},
-                               {"reference", run.metrics.referenceMs}};
+                               {"reference", run.metrics.referenceMs},
+                               {"flip", run.metrics.flipMs}};
 }
 
-// The error figures; psnr is +inf for identical images, written as "inf" (JSON has no infinity).
-nlohmann::json errorJson(const RunMetrics& metrics) {
+// The error figures; psnr is +inf for identical images, written as "inf" (JSON has no infinity);
+// flip is null when unavailable, with flip_unavailable saying why, else flip_parameters say what
+// flip-evaluator assumed.
+nlohmann::json errorJson(const RenderRun& run) {
+    const RunMetrics& metrics = run.metrics;
     nlohmann::json error = {{"reference", "reference"}};
     for (const NamedFigure& figure : metrics.errorFigures())
-        error[figure.name] = std::isinf(figure.value) && figure.value > 0
-                                 ? nlohmann::json("inf")
-                                 : nlohmann::json(figure.value);
+        error[figure.name] = std::isinf(figure.value) && figure.value > 0 ? nlohmann::json("inf")
+                             : std::isnan(figure.value)                   ? nlohmann::json()
+                                                        : nlohmann::json(figure.value);
+    error[metric::kFlipUnavailable] = metrics.error->flipUnavailable;
+    if (!run.flipParameters.is_null())
+        error["flip_parameters"] = run.flipParameters;
     return error;
 }
 
@@ -293,7 +320,7 @@ nlohmann::json statsJson(const RenderRun& run) {
         stats["light_counts_note"] = metrics.lightCountsNote;
     stats["raster"] = rasterJson(run.prepared->rasterStats);
     if (metrics.error)
-        stats["error"] = errorJson(metrics);
+        stats["error"] = errorJson(run);
     stats["warnings"] = run.scene().warnings;
     return stats;
 }

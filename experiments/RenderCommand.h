@@ -6,6 +6,7 @@
 //   heatmap.png  lights evaluated per pixel, false colour with a legend
 //   error.png    with a reference: the largest channel |render - reference| per pixel, false
 //                colour with a legend, linear or log scale (RenderOutputScales)
+//   flip.png     with a reference and flip-evaluator: the HDR-ꟻLIP map, magma from 0 to 1
 //   stats.json   configuration, machine, commit, timings, light counts, error metrics
 // The command plans the render (RenderPlan.h: options validated once, scene loaded, layout
 // derived), checks the output folder for writability, then runs the plan (RenderJob.h). Every
@@ -39,14 +40,16 @@ struct RenderCommandOptions {
 
 // The style of error.png for the scales (title, colour map, scale, maximum).
 ScalarMapStyle errorMapStyle(const RenderOutputScales& scales);
+// The style of flip.png: magma, linear from 0 to 1 (ꟻLIP's range), the same for every image.
+ScalarMapStyle flipMapStyle();
 
 // stats.json: the run's configuration, layout and machine, and its RunMetrics (RunMetrics.h
 // names the figures).
 nlohmann::json statsJson(const RenderRun& run);
 
-// Writes render.exr (with error.R,G,B when the run was compared with a reference), preview.png,
-// heatmap.png, error.png (with a reference) and stats.json into `dir` (which must exist), each
-// atomically.
+// Writes render.exr (with error.R,G,B when the run was compared with a reference, and flip when
+// ꟻLIP was computed), preview.png, heatmap.png, error.png and flip.png (with a reference) and
+// stats.json into `dir` (which must exist), each atomically.
 void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
                         const RenderOutputScales& scales = {});
 

@@ -4,6 +4,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "experiments/FlipMetric.h"
 #include "lighting/Oracle.h"
 #include "lighting/PassNames.h"
 #include "lighting/StageRegistry.h"
@@ -136,13 +137,21 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         countOracle(run);
         const double oracleMs = millisecondsSince(start);
         std::optional<ErrorMetrics> error;
-        double referenceMs = 0.0;
+        double referenceMs = 0.0, flipMs = 0.0;
         if (compare) {
             step("reference (double precision)");
             start = Clock::now();
             fillReference(run, plan.stage->name(), givenReference);
             referenceMs = millisecondsSince(start);
             error = compareImages(run.result, run.reference);
+            step("HDR-FLIP (flip-evaluator)");
+            start = Clock::now();
+            FlipResult flip = computeFlip(run.result, run.reference);
+            flipMs = millisecondsSince(start);
+            error->flip = flip.mean;
+            error->flipUnavailable = flip.unavailableReason;
+            run.flipMap = std::move(flip.errorMap);
+            run.flipParameters = std::move(flip.parameters);
         }
         const gbuffer::GBufferLayout& layout = run.gbuffer().layout();
         run.metrics = measureRun(std::move(passes), run.result.lightsEvaluated, run.oracle,
@@ -150,6 +159,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
                                  layout.allocatedBytesPerPixel(), error);
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;
+        run.metrics.flipMs = flipMs;
     });
     return run;
 }

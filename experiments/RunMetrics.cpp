@@ -128,7 +128,8 @@ std::vector<NamedFigure> RunMetrics::errorFigures() const {
             {metric::kPsnr, error->psnr},
             {metric::kMaxAbs, error->maxAbs},
             {metric::kRelativeMean, error->relativeMean},
-            {metric::kP99Abs, error->p99Abs}};
+            {metric::kP99Abs, error->p99Abs},
+            {metric::kFlip, error->flip ? *error->flip : std::numeric_limits<double>::quiet_NaN()}};
 }
 
 std::vector<std::string> runFigureColumns() {
@@ -139,6 +140,7 @@ std::vector<std::string> runFigureColumns() {
     withError.error = ErrorMetrics{};
     for (const NamedFigure& figure : withError.errorFigures())
         columns.push_back(figure.name);
+    columns.push_back(metric::kFlipUnavailable);
     return columns;
 }
 

@@ -16,7 +16,9 @@
 //                 (StageResult::lightingSamples); counted_pixels says how many, and
 //                 light_counts_note says why when that is not the whole image.
 //   bytes per pixel     the layout's bits as a GPU packs them, and what this run allocates.
-//   error         against the double-precision reference, when compared (compareImages).
+//   error         against the double-precision reference, when compared (compareImages), and
+//                 the mean HDR-ꟻLIP (FlipMetric.h), null with flip_unavailable saying why when
+//                 the package is missing.
 // Thread safety: values; compareImages runs ImageBufAlgo on the calling thread's pool.
 #pragma once
 
@@ -44,6 +46,8 @@ inline constexpr const char* kPsnr = "psnr";
 inline constexpr const char* kMaxAbs = "max_abs";
 inline constexpr const char* kRelativeMean = "relative_mean";
 inline constexpr const char* kP99Abs = "p99_abs";
+inline constexpr const char* kFlip = "flip";
+inline constexpr const char* kFlipUnavailable = "flip_unavailable";
 } // namespace metric
 
 // Passes the runner adds around the stage's (lighting/PassNames.h has the frame's passes).
@@ -57,9 +61,11 @@ struct ErrorMetrics {
     double rmse = 0.0;
     double relativeRmse = 0.0; // rmse / rms of the reference
     double maxAbs = 0.0;
-    double psnr = 0.0;         // dB, peak = the reference's maximum channel value
-    double relativeMean = 0.0; // mean |image - reference| / mean |reference|
-    double p99Abs = 0.0;       // 99th percentile of |image - reference|
+    double psnr = 0.0;           // dB, peak = the reference's maximum channel value
+    double relativeMean = 0.0;   // mean |image - reference| / mean |reference|
+    double p99Abs = 0.0;         // 99th percentile of |image - reference|
+    std::optional<double> flip;  // mean HDR-ꟻLIP (FlipMetric.h); nullopt when not computed
+    std::string flipUnavailable; // why flip is missing ("" when computed)
 };
 
 ErrorMetrics compareImages(const lighting::StageResult& image,
@@ -85,6 +91,7 @@ struct RunMetrics {
     PassTiming stage;               // pass::kStage; no samples when the stage reports no pass
     double oracleMs = 0.0;          // measurement, not part of the stage
     double referenceMs = 0.0;
+    double flipMs = 0.0;
     uint64_t lightEvaluations = 0;
     uint64_t oracleLightEvaluations = 0;
     double cullingEfficiency = 1.0;
@@ -94,8 +101,8 @@ struct RunMetrics {
     double allocatedBytesPerPixel = 0.0;
     std::optional<ErrorMetrics> error;
 
-    // rmse, relative_rmse, psnr, max_abs, relative_mean, p99_abs (empty without a reference);
-    // psnr is +inf for identical images.
+    // rmse, relative_rmse, psnr, max_abs, relative_mean, p99_abs, flip (empty without a
+    // reference); psnr is +inf for identical images, flip NaN when unavailable.
     std::vector<NamedFigure> errorFigures() const;
 };
 
@@ -114,7 +121,7 @@ RunMetrics measureRun(std::vector<PassTiming> passes, const std::vector<uint32_t
 
 // The sweep's metric column names that a RunMetrics fills, after the time columns, in table order:
 // light_evaluations, oracle_light_evaluations, culling_efficiency, counted_pixels,
-// bytes_per_pixel, then the error figures.
+// bytes_per_pixel, then the error figures and flip_unavailable (text).
 std::vector<std::string> runFigureColumns();
 
 } // namespace experiments

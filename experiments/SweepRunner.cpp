@@ -115,6 +115,8 @@ void addMetrics(Json& row, const RunMetrics& metrics) {
     row[metric::kBytesPerPixel] = metrics.bytesPerPixel;
     for (const NamedFigure& figure : metrics.errorFigures())
         row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
+    if (metrics.error)
+        row[metric::kFlipUnavailable] = metrics.error->flipUnavailable;
 }
 
 void writeReferenceExr(const fs::path& path, const std::string& key,

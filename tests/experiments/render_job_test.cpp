@@ -296,8 +296,16 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
         EXPECT_TRUE(stats.contains(key)) << key;
     for (const char* pass : {"gbuffer", "shading", "total"})
         EXPECT_TRUE(stats["timings_ms"].contains(pass)) << pass;
-    for (const char* metric : {"rmse", "max_abs", "psnr", "relative_mean", "p99_abs"})
+    for (const char* metric :
+         {"rmse", "max_abs", "psnr", "relative_mean", "p99_abs", "flip", "flip_unavailable"})
         EXPECT_TRUE(stats["error"].contains(metric)) << metric;
+    // ꟻLIP: a number with its map and parameters, or null with the reason.
+    if (stats["error"]["flip"].is_number()) {
+        EXPECT_TRUE(std::filesystem::is_regular_file(out / "flip.png"));
+        EXPECT_TRUE(stats["error"].contains("flip_parameters"));
+    } else {
+        EXPECT_FALSE(stats["error"]["flip_unavailable"].get<std::string>().empty());
+    }
     // The layout: every plane with name, format and bits, and the bytes per pixel they add up to.
     int bits = 0;
     for (const auto& plane : stats["layout"]["planes"]) {

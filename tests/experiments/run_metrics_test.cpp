@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "experiments/RenderJob.h"
 #include "experiments/ResultsTable.h"
@@ -98,14 +99,26 @@ TEST(RunMetrics, ReducedResolutionCountsOnlyTheLitPixels) {
         << metrics.lightCountsNote;
 }
 
+// ꟻLIP is a figure beside the others; unavailable, it is NaN (null in the outputs).
+TEST(RunMetrics, FlipIsAnErrorFigureAndNaNWhenUnavailable) {
+    RunMetrics metrics;
+    metrics.error = experiments::ErrorMetrics{};
+    metrics.error->flipUnavailable = "not installed";
+    const std::vector<experiments::NamedFigure> figures = metrics.errorFigures();
+    ASSERT_EQ(std::string(figures.back().name), "flip");
+    EXPECT_TRUE(std::isnan(figures.back().value));
+    metrics.error->flip = 0.25;
+    EXPECT_EQ(metrics.errorFigures().back().value, 0.25);
+}
+
 TEST(RunMetrics, TheTableColumnsAreTheRecordsFigures) {
     const std::vector<std::string> columns = experiments::metricColumns({});
     const std::vector<std::string> figures = experiments::runFigureColumns();
     EXPECT_EQ(columns, figures);
-    EXPECT_EQ(figures, (std::vector<std::string>{"light_evaluations", "oracle_light_evaluations",
-                                                 "culling_efficiency", "counted_pixels",
-                                                 "bytes_per_pixel", "rmse", "relative_rmse", "psnr",
-                                                 "max_abs", "relative_mean", "p99_abs"}));
+    EXPECT_EQ(figures, (std::vector<std::string>{
+                           "light_evaluations", "oracle_light_evaluations", "culling_efficiency",
+                           "counted_pixels", "bytes_per_pixel", "rmse", "relative_rmse", "psnr",
+                           "max_abs", "relative_mean", "p99_abs", "flip", "flip_unavailable"}));
 }
 
 } // namespace

@@ -91,8 +91,12 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
         for (const char* figure : {"light_evaluations", "oracle_light_evaluations",
                                    "culling_efficiency", "counted_pixels", "bytes_per_pixel"})
             EXPECT_EQ(job[figure], stats[figure]) << figure;
-        for (const char* figure : {"rmse", "relative_rmse", "max_abs", "relative_mean", "p99_abs"})
+        for (const char* figure : {"rmse", "relative_rmse", "max_abs", "relative_mean", "p99_abs",
+                                   "flip", "flip_unavailable"})
             EXPECT_EQ(job[figure], stats["error"][figure]) << figure;
+        // ꟻLIP is in every row: a number, or null with the reason it is unavailable.
+        EXPECT_TRUE(job["flip"].is_number() != !job["flip_unavailable"].get<std::string>().empty())
+            << job.dump();
         for (const char* pass : {"gbuffer", "total"})
             EXPECT_EQ(job[std::string("time_") + pass + "_median_ms"], stats["timings_ms"][pass])
                 << pass;
