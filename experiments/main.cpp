@@ -149,6 +149,20 @@ int main(int argc, char** argv) {
     report
         ->add_option("--thumbnail-width", reportOptions.thumbnailWidth, "thumbnail width in pixels")
         ->capture_default_str();
+    report
+        ->add_option("--error-metric", reportOptions.errorMetric,
+                     "y axis of the Pareto plots: relative_rmse, rmse, flip, psnr, max_abs, "
+                     "relative_mean or p99_abs")
+        ->capture_default_str();
+    report
+        ->add_option_function<std::string>(
+            "--error-scale",
+            [&reportOptions](const std::string& text) {
+                reportOptions.errorScale = experiments::parseMapScale(text);
+            },
+            "scale of the error maps: linear or log (default: the sweep file's error-scale, else "
+            "linear)")
+        ->check(CLI::IsMember({"linear", "log"}));
     experiments::DiffCommandOptions diffOptions;
     CLI::App* diff =
         app.add_subcommand("diff", "image-diff report of two EXRs (B is the reference)");
