@@ -81,15 +81,18 @@ void countOracle(RenderRun& run) {
 }
 
 // The reference image of the run: the given one, the stage's own image when the stage is the
-// reference, else rendered from the run's exact surface.
+// reference, else rendered from the run's exact surface, computed now (after the timed passes)
+// when the stage did not need it itself.
 void fillReference(RenderRun& run, const std::string& stageName,
                    const lighting::StageResult* givenReference) {
-    if (givenReference)
+    if (givenReference) {
         run.reference = *givenReference;
-    else if (stageName == kReferenceStage)
+    } else if (stageName == kReferenceStage) {
         run.reference = run.result;
-    else
+    } else {
+        run.prepared->addExactSurface();
         lighting::makeStage(kReferenceStage)->shade(run.prepared->inputs, run.reference);
+    }
 }
 
 } // namespace
@@ -125,9 +128,11 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
     tbb::task_arena arena(run.threads);
     arena.execute([&] {
         step("G-buffer pass");
-        const bool needExact = plan.requirements.exactSurface || (compare && !givenReference);
+        // The exact surface only when the stage reads it: the reference's (compare) is computed
+        // after the timed passes, so its work never inflates the stage's G-buffer time.
         run.prepared = std::make_unique<lighting::PreparedScene>(
-            std::move(plan.scene), options.width, options.height, needExact, plan.layout);
+            std::move(plan.scene), options.width, options.height, plan.requirements.exactSurface,
+            plan.layout);
         std::vector<PassTiming> passes =
             shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, step);
 

@@ -192,6 +192,28 @@ TEST(RenderJob, RepetitionsRecordEveryPassAndAGivenReferenceIsReused) {
     EXPECT_EQ(inside.metrics.error->rmse, run.metrics.error->rmse);
 }
 
+// Issue 16: the reference's exact surface used to be computed inside every timed G-buffer pass
+// (and inflated it) when only --compare-reference needed it. Counted, not timed: the stage's
+// passes compute no exact surface; the reference computes it once, afterwards, and is the same
+// image as a reference rendered on its own.
+TEST(RenderJob, TheReferenceWorkStaysOutOfTheTimedPasses) {
+    RenderOptions options = smallAtrium(0);
+    options.stage = "tiled";
+    options.warmup = 1;
+    options.repetitions = 3;
+    options.compareReference = true;
+    const RenderRun run = runRender(planRender(options));
+    EXPECT_EQ(run.prepared->exactSurfacePasses, 1) << "only the reference's, after the timing";
+    EXPECT_EQ(run.prepared->gbufferTimings.exactMs, 0.0) << "the last timed pass";
+    for (const PassTiming& timing : run.metrics.passes)
+        EXPECT_NE(timing.pass, "exact_surface");
+    EXPECT_TRUE(bitwiseEqual(run.reference.radiance[1], renderReference(options).radiance[1]));
+    // The reference stage reads the exact surface itself: computed in each of its 4 passes.
+    options.stage = "reference";
+    const RenderRun reference = runRender(planRender(options));
+    EXPECT_EQ(reference.prepared->exactSurfacePasses, 4);
+}
+
 struct BadCase {
     const char* name;
     RenderOptions options;
