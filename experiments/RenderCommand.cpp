@@ -103,15 +103,35 @@ std::vector<float> largestChannelError(const std::array<std::vector<float>, 3>& 
     return values;
 }
 
+// What the printed and recorded pass times are: a single timed run is one frame (a cold one
+// without warm-up: caches, page faults and the thread pool's start included), several are
+// summarised by their median and range.
+std::string timingFigure(const RenderOptions& options) {
+    const std::string warmup = options.warmup > 0
+                                   ? " after " + std::to_string(options.warmup) + " warm-up run" +
+                                         (options.warmup > 1 ? "s" : "")
+                                   : "";
+    if (options.repetitions <= 1)
+        return options.warmup > 0 ? "one frame" + warmup
+                                  : "cold frame (no warm-up, one repetition)";
+    return "median of " + std::to_string(options.repetitions) + " (min\u2013max)" + warmup;
+}
+
 // What `testbed render` prints when done: the run, its pass medians, the error, the files.
 void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     std::cout << "testbed: " << run.options.stage << " on " << run.scene().name << " ("
               << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
               << " lights) at " << run.options.width << "x" << run.options.height << ", "
               << run.threads << " threads\n";
-    for (const PassTiming& timing : run.metrics.passes)
+    const bool several = run.options.repetitions > 1;
+    std::cout << "  timings: " << timingFigure(run.options) << "\n";
+    for (const PassTiming& timing : run.metrics.passes) {
         std::cout << "  " << timing.pass << ": " << std::fixed << std::setprecision(2)
-                  << timing.medianMs() << " ms\n";
+                  << timing.medianMs() << " ms";
+        if (several)
+            std::cout << " (" << timing.minMs() << "\u2013" << timing.maxMs() << ")";
+        std::cout << "\n";
+    }
     if (const std::optional<ErrorMetrics>& error = run.metrics.error) {
         std::cout << "  error vs reference: rmse " << std::scientific << error->rmse << ", max_abs "
                   << error->maxAbs << ", relative rmse " << error->relativeRmse << "\n";
@@ -250,6 +270,7 @@ void addTimings(nlohmann::json& stats, const RenderRun& run) {
     stats["timings_ms"] = medians;
     stats["timings"] = {{"warmup", run.options.warmup},
                         {"repetitions", run.options.repetitions},
+                        {"figure", timingFigure(run.options)},
                         {"passes_ms", spread}};
     const gbuffer::GBufferPassTimings& steps = run.prepared->gbufferTimings;
     stats["gbuffer_steps_ms"] = {{"transform", steps.transformMs},

@@ -318,6 +318,8 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
         EXPECT_TRUE(stats.contains(key)) << key;
     for (const char* pass : {"gbuffer", "shading", "total"})
         EXPECT_TRUE(stats["timings_ms"].contains(pass)) << pass;
+    // One timed run without warm-up: the figures say they are a cold frame.
+    EXPECT_EQ(stats["timings"]["figure"], "cold frame (no warm-up, one repetition)");
     for (const char* metric :
          {"rmse", "max_abs", "psnr", "relative_mean", "p99_abs", "flip", "flip_unavailable"})
         EXPECT_TRUE(stats["error"].contains(metric)) << metric;
