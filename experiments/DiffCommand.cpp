@@ -16,7 +16,9 @@
 
 #include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
+#include "experiments/FlipMetric.h"
 #include "experiments/ImageOutput.h"
+#include "experiments/RenderCommand.h"
 #include "experiments/ReportCommand.h"
 #include "experiments/RunMetrics.h"
 #include "scenes/Limits.h"
@@ -167,14 +169,23 @@ std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
     html << "<h2>Metrics on the beauty R, G, B</h2>\n<table>\n"
          << "<tr><th>RMSE</th><th>relative RMSE</th><th>PSNR (dB)</th><th>max abs</th><th>mean "
             "abs</th>"
-            "<th>relative mean</th><th>99th percentile abs</th></tr>\n<tr><td>"
+            "<th>relative mean</th><th>99th percentile abs</th><th>ꟻLIP (HDR)</th></tr>\n"
+            "<tr><td>"
          << formatNumber(m.rmse) << "</td><td>" << formatNumber(m.relativeRmse) << "</td><td>"
          << formatNumber(m.psnr) << "</td><td>" << formatNumber(m.maxAbs) << "</td><td>"
          << formatNumber(m.meanAbs) << "</td><td>" << formatNumber(m.relativeMean) << "</td><td>"
-         << formatNumber(m.p99Abs) << "</td></tr>\n</table>\n"
+         << formatNumber(m.p99Abs) << "</td><td class=\"flip\">"
+         << (m.flip ? formatNumber(*m.flip) : std::string("&mdash;")) << "</td></tr>\n</table>\n"
          << "<p>relative RMSE = RMSE / RMS of B; relative mean = mean |A &minus; B| / |mean of B|; "
             "PSNR peak = "
             "the largest channel value of B.</p>\n";
+    if (m.flip)
+        html << "<p>ꟻLIP: mean HDR-ꟻLIP of A against B, by NVIDIA's flip-evaluator "
+             << htmlEscape(diff.flipParameters.value("version", "?")) << " ("
+             << htmlEscape(diff.flipParameters.dump()) << ").</p>\n";
+    else
+        html << "<p class=\"flip-unavailable\"><b>ꟻLIP unavailable:</b> "
+             << htmlEscape(m.flipUnavailable) << "</p>\n";
     html << "<h2>Images</h2>\n"
          << "<figure><a href=\"a.png\"><img class=\"preview\" src=\"a.png\" "
             "alt=\"A\"></a><figcaption>A (tone-mapped, exposure "
@@ -186,6 +197,10 @@ std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
             "alt=\"|A-B|\"></a>"
             "<figcaption>|A &minus; B|, maximum over R, G, B, linear radiance; the full-precision "
             "difference is in <a href=\"absdiff.exr\">absdiff.exr</a></figcaption></figure>\n";
+    if (!diff.flipMap.empty())
+        html << "<figure><a href=\"flip.png\"><img class=\"plot\" src=\"flip.png\" "
+                "alt=\"HDR-FLIP map\"></a><figcaption>HDR-ꟻLIP of A against B per pixel "
+                "(0 = no visible difference, 1 = the largest)</figcaption></figure>\n";
     html << "<h2>Per-channel statistics</h2>\n<p>Every channel present in both files; min, max and "
             "mean "
             "over finite values.</p>\n<table>\n<tr><th rowspan=\"2\">channel</th><th "
@@ -246,6 +261,11 @@ ImageDiff diffImageFiles(const fs::path& aPath, const fs::path& bPath) {
     lighting::StageResult resultA = beautyAsStageResult(rgbA), resultB = beautyAsStageResult(rgbB);
     DiffMetrics& m = diff.metrics;
     static_cast<ErrorMetrics&>(m) = compareImages(resultA, resultB);
+    FlipResult flip = computeFlip(resultA, resultB);
+    m.flip = flip.mean;
+    m.flipUnavailable = flip.unavailableReason;
+    diff.flipMap = std::move(flip.errorMap);
+    diff.flipParameters = std::move(flip.parameters);
     OIIO::ImageBuf absRgb;
     if (!OIIO::ImageBufAlgo::absdiff(absRgb, rgbA, rgbB))
         throw std::runtime_error("cannot compute |A - B|: " + absRgb.geterror());
@@ -331,7 +351,10 @@ json diffJson(const ImageDiff& diff, const fs::path& a, const fs::path& b) {
               {"max_abs", m.maxAbs},
               {"mean_abs", m.meanAbs},
               {"relative_mean", m.relativeMean},
-              {"p99_abs", m.p99Abs}}},
+              {"p99_abs", m.p99Abs},
+              {metric::kFlip, m.flip ? json(*m.flip) : json()},
+              {metric::kFlipUnavailable, m.flipUnavailable},
+              {"flip_parameters", diff.flipParameters}}},
             {"channels", channels},
             {"only_in_a", diff.onlyInA},
             {"only_in_b", diff.onlyInB}};
@@ -355,6 +378,11 @@ int runDiffCommand(const DiffCommandOptions& options) {
              {"B", diff.absDifference[2].data()}},
             {{"testbed:diff", "|A - B| of " + options.a.string() + " and " + options.b.string()}});
         writeDiffPlot(options, diff, options.out / "absdiff.png");
+        const fs::path flipPng = options.out / "flip.png";
+        if (!diff.flipMap.empty())
+            writeScalarMapPng(flipPng, w, h, diff.flipMap.data(), flipMapStyle());
+        else
+            fs::remove(flipPng); // an older diff's map must not pass for this one's
         writeTextAtomically(options.out / "diff.json",
                             diffJson(diff, options.a, options.b).dump(2) + "\n");
         writeTextAtomically(options.out / "index.html", diffPage(diff, options));
@@ -363,7 +391,8 @@ int runDiffCommand(const DiffCommandOptions& options) {
                   << " (" << w << "x" << h << "): rmse " << formatNumber(m.rmse) << ", psnr "
                   << formatNumber(m.psnr) << " dB, max_abs " << formatNumber(m.maxAbs)
                   << ", relative_mean " << formatNumber(m.relativeMean) << ", p99_abs "
-                  << formatNumber(m.p99Abs)
+                  << formatNumber(m.p99Abs) << ", HDR-FLIP "
+                  << (m.flip ? formatNumber(*m.flip) : "unavailable (" + m.flipUnavailable + ")")
                   << "\n  report: " << (options.out / "index.html").string() << "\n";
         return 0;
     } catch (const std::exception& e) {

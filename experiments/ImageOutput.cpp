@@ -13,6 +13,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <set>
 #include <stdexcept>
@@ -377,6 +378,164 @@ void writeHeatmapPng(const fs::path& path, int width, int height, const uint32_t
             std::copy(colour.begin(), colour.end(), &pixels[(size_t(y) * canvasWidth + x) * 3]);
         }
     drawHeatmapLegend(path, canvas, height, scaleMax);
+    writeImageAtomically(path, canvas, OIIO::TypeDesc::UINT8, "png");
+}
+
+MapScale parseMapScale(const std::string& text) {
+    if (text == "linear")
+        return MapScale::Linear;
+    if (text == "log")
+        return MapScale::Log;
+    throw std::invalid_argument("error scale '" + text + "': expected linear or log");
+}
+
+const char* mapScaleName(MapScale scale) {
+    return scale == MapScale::Log ? "log" : "linear";
+}
+
+std::pair<float, float> scalarMapRange(const float* values, size_t n, const ScalarMapStyle& style) {
+    float top = style.max;
+    if (!(top > 0.0f)) {
+        top = 0.0f;
+        for (size_t i = 0; i < n; ++i)
+            if (std::isfinite(values[i]))
+                top = std::max(top, values[i]);
+        top = std::max(top, std::numeric_limits<float>::min());
+    }
+    const float bottom =
+        style.scale == MapScale::Log ? float(double(top) / std::pow(10.0, style.logDecades)) : 0.0f;
+    return {bottom, top};
+}
+
+void writeScalarMapPng(const fs::path& path, int width, int height, const float* values,
+                       const ScalarMapStyle& style) {
+    checkImageSize(path, width, height);
+    checkPointer(path, values, "the value plane");
+    if (style.scale == MapScale::Log && !(style.logDecades > 0.0f && style.logDecades <= 30.0f))
+        throw std::invalid_argument("cannot write " + path.string() +
+                                    ": log scale needs 0 < decades <= 30");
+    if (!(style.max >= 0.0f) || !std::isfinite(style.max))
+        throw std::invalid_argument("cannot write " + path.string() +
+                                    ": the scale maximum must be finite and >= 0");
+    const size_t pixelCount = size_t(width) * height;
+    const auto [bottom, top] = scalarMapRange(values, pixelCount, style);
+    const double logBottom = std::log10(double(bottom)), logTop = std::log10(double(top));
+    // Position on the colour bar, 0..1, of a value inside (0, top].
+    auto position = [&](double v) -> float {
+        if (style.scale == MapScale::Linear)
+            return float(v / top);
+        return v <= bottom ? 0.0f : float((std::log10(v) - logBottom) / (logTop - logBottom));
+    };
+
+    const int canvasWidth = std::max(width, kScalarMapMinWidth);
+    const int canvasHeight = height + kScalarMapLegendHeight;
+    // One channel of bar positions for the data and the colour bar, coloured in one color_map
+    // call; the pixels that are not on the scale (zero, saturated, legend) are painted after.
+    constexpr float kZero = -1.0f, kSaturated = 2.0f, kBackground = -2.0f;
+    OIIO::ImageBuf positions(OIIO::ImageSpec(canvasWidth, canvasHeight, 1, OIIO::TypeDesc::FLOAT));
+    float* t = static_cast<float*>(positions.localpixels());
+    std::fill(t, t + size_t(canvasWidth) * canvasHeight, kBackground);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const float v = values[size_t(y) * width + x];
+            t[size_t(y) * canvasWidth + x] = !std::isfinite(v) || v > top ? kSaturated
+                                             : v <= 0.0f                  ? kZero
+                                                                          : position(v);
+        }
+
+    // Legend geometry: [margin][0 swatch][gap][ colour bar ][gap][>top swatch][margin], the
+    // title above, ticks and labels below.
+    constexpr int kMargin = 10, kTitleTop = 4, kBarTop = 24, kBarHeight = 14, kTickLength = 4;
+    constexpr int kLabelGap = 8, kSwatchHalfWidth = 7;
+    const int barY0 = height + kBarTop, barY1 = barY0 + kBarHeight;
+    const int labelTop = barY1 + kTickLength + 2;
+    // Powers of ten on a log scale as 1e-04; the maximum and linear ticks with 3 digits.
+    auto label = [&](double v) {
+        char text[32];
+        const bool powerOfTen = std::fabs(std::log10(v) - std::round(std::log10(v))) < 1e-9;
+        if (style.scale == MapScale::Log && powerOfTen)
+            std::snprintf(text, sizeof text, "%.0e", v);
+        else
+            std::snprintf(text, sizeof text, "%.3g", v);
+        return std::string(text);
+    };
+    const std::string topLabel = label(top), saturatedLabel = ">" + label(top);
+    const int saturatedLabelWidth = textWidth(path, saturatedLabel);
+    const int topLabelWidth = textWidth(path, topLabel);
+    const int zeroLabelWidth = textWidth(path, "0");
+    const int zeroCentre = kMargin + std::max(zeroLabelWidth, 2 * kSwatchHalfWidth) / 2;
+    const int saturatedCentre =
+        canvasWidth - kMargin - std::max(saturatedLabelWidth, 2 * kSwatchHalfWidth) / 2;
+    const int barX0 = zeroCentre + kSwatchHalfWidth + kLabelGap + topLabelWidth / 2;
+    const int barX1 = saturatedCentre - saturatedLabelWidth / 2 - kLabelGap - topLabelWidth / 2;
+    const int barWidth = std::max(1, barX1 - barX0);
+    for (int y = barY0; y < barY1; ++y) {
+        for (int x = barX0; x < barX1; ++x)
+            t[size_t(y) * canvasWidth + x] = (float(x - barX0) + 0.5f) / float(barWidth);
+        for (int x = zeroCentre - kSwatchHalfWidth; x < zeroCentre + kSwatchHalfWidth; ++x)
+            t[size_t(y) * canvasWidth + x] = kZero;
+        for (int x = saturatedCentre - kSwatchHalfWidth; x < saturatedCentre + kSwatchHalfWidth;
+             ++x)
+            t[size_t(y) * canvasWidth + x] = kSaturated;
+    }
+
+    OIIO::ImageBuf clamped(positions.spec());
+    float* c = static_cast<float*>(clamped.localpixels());
+    for (size_t i = 0; i < size_t(canvasWidth) * canvasHeight; ++i)
+        c[i] = std::clamp(t[i], 0.0f, 1.0f);
+    OIIO::ImageBuf canvas = OIIO::ImageBufAlgo::color_map(clamped, 0, style.colourMap);
+    if (canvas.has_error() || canvas.nchannels() != 3)
+        throw std::invalid_argument("cannot write " + path.string() + ": colour map '" +
+                                    style.colourMap + "' unknown to OpenImageIO (" +
+                                    canvas.geterror() + ")");
+    float* rgb = static_cast<float*>(canvas.localpixels());
+    for (size_t i = 0; i < size_t(canvasWidth) * canvasHeight; ++i) {
+        const Rgb* special = t[i] == kZero         ? &kCountZeroColour
+                             : t[i] == kSaturated  ? &kSaturatedColour
+                             : t[i] == kBackground ? &kLegendBackground
+                                                   : nullptr;
+        if (special)
+            std::copy(special->begin(), special->end(), &rgb[3 * i]);
+    }
+
+    drawLabel(path, canvas, zeroCentre, labelTop, "0");
+    drawLabel(path, canvas, saturatedCentre, labelTop, saturatedLabel);
+    if (!style.title.empty() &&
+        !OIIO::ImageBufAlgo::render_text(canvas, kMargin, height + kTitleTop, style.title,
+                                         kLegendFontSize, kLegendFontPath, kLegendTextColour,
+                                         OIIO::ImageBufAlgo::TextAlignX::Left,
+                                         OIIO::ImageBufAlgo::TextAlignY::Top))
+        throwFontError(path, canvas.geterror());
+    auto tickX = [&](double v) { return barX0 + int(std::lround(position(v) * barWidth)); };
+    auto drawTick = [&](double v) {
+        const int x = std::min(tickX(v), barX1 - 1);
+        fillRect(canvas, kLegendTextColour, x, x + 1, barY1, barY1 + kTickLength);
+        drawLabel(path, canvas, x, labelTop, label(v));
+    };
+    const int labelPitch = topLabelWidth + kLabelGap;
+    const int maxLabelCount = std::max(2, barWidth / labelPitch);
+    std::vector<double> ticks;
+    if (style.scale == MapScale::Linear) {
+        // The smallest of 1, 2, 5 x 10^k that keeps the labels apart.
+        const double minimumStep = double(top) / double(maxLabelCount - 1);
+        double step = std::pow(10.0, std::floor(std::log10(minimumStep)));
+        for (double mantissa : {1.0, 2.0, 5.0, 10.0})
+            if (mantissa * step >= minimumStep) {
+                step *= mantissa;
+                break;
+            }
+        for (double v = step; v < double(top); v += step) // 0 is the black swatch's label
+            ticks.push_back(v);
+    } else {
+        const int decades = int(std::ceil(logTop - logBottom));
+        const int every = std::max(1, int(std::ceil(double(decades) / double(maxLabelCount - 1))));
+        for (int k = int(std::ceil(logBottom)); k < int(std::floor(logTop)) + 1; k += every)
+            ticks.push_back(std::pow(10.0, k));
+    }
+    for (double v : ticks)
+        if (tickX(top) - tickX(v) >= labelPitch && tickX(v) - barX0 >= 0)
+            drawTick(v);
+    drawTick(top);
     writeImageAtomically(path, canvas, OIIO::TypeDesc::UINT8, "png");
 }
 

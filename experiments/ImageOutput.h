@@ -3,7 +3,9 @@
 //   - a multi-layer float32 OpenEXR with the beauty, G-buffer and light-count planes and the run's
 //     metadata in the header;
 //   - a tone-mapped 8-bit sRGB PNG preview of the beauty;
-//   - a false-colour PNG heatmap of per-pixel light counts with a legend strip below the data.
+//   - a false-colour PNG heatmap of per-pixel light counts with a legend strip below the data;
+//   - a false-colour PNG of per-pixel non-negative values (error maps), linear or log scale, with
+//     a legend strip below the data.
 //
 // Conventions: every plane is width * height values in row-major order, rows top to bottom (row 0
 // is the top of the image, as in OpenImageIO and EXR), no padding between rows. Colour planes are
@@ -83,5 +85,42 @@ void writeHeatmapPng(const std::filesystem::path& path, int width, int height,
 
 // The largest of the n counts, at least 1 (so an all-zero image still has a valid scale).
 uint32_t heatmapAutoScale(const uint32_t* counts, size_t n);
+
+// How a false-colour map of non-negative values (an error image) maps values to colours.
+enum class MapScale {
+    Linear, // 0 .. max
+    Log,    // max / 10^decades .. max, one colour step per equal ratio
+};
+// "linear" or "log"; throws std::invalid_argument naming the valid words otherwise.
+MapScale parseMapScale(const std::string& text);
+const char* mapScaleName(MapScale scale);
+
+struct ScalarMapStyle {
+    MapScale scale = MapScale::Linear;
+    float max = 0.0f;                // top of the scale; 0 = the image's largest finite value
+    float logDecades = 4.0f;         // log scale: the bottom of the scale is max / 10^logDecades
+    std::string colourMap = "turbo"; // an OpenImageIO color_map name ("turbo", "magma", ...)
+    std::string title;               // legend title, e.g. "|render - reference|, max of R,G,B"
+};
+
+// The range a style gives to the n values: {bottom, top}. top is style.max, or the largest
+// finite value (at least the smallest positive float, so an all-zero image has a valid scale);
+// bottom is 0 (linear) or top / 10^logDecades (log).
+std::pair<float, float> scalarMapRange(const float* values, size_t n, const ScalarMapStyle& style);
+
+inline constexpr int kScalarMapLegendHeight = 70; // pixels: title, colour bar, ticks, labels
+inline constexpr int kScalarMapMinWidth = 420;    // pixels: fits the title and ~8 labels
+
+// Writes a false-colour PNG of width x height non-negative values (e.g. the largest channel
+// error per pixel) with a legend strip of kScalarMapLegendHeight rows below the data, laid out
+// like the heatmap's: exactly 0 is black (the swatch "0" at the left of the bar), values in
+// (0, top] follow the colour map (linearly, or by log10 on a log scale, where values below the
+// bottom take the bar's first colour), values above top and non-finite values are white (the
+// swatch ">top"). The bar's ticks are round numbers (linear) or powers of ten (log). Use the
+// same explicit style.max for images that are to be compared side by side. Throws like
+// writeHeatmapPng (invalid argument, font missing, write failure), and std::invalid_argument
+// for an unknown colour map or a non-positive logDecades.
+void writeScalarMapPng(const std::filesystem::path& path, int width, int height,
+                       const float* values, const ScalarMapStyle& style);
 
 } // namespace experiments

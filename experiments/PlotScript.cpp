@@ -24,6 +24,10 @@ std::vector<std::string> pythonCandidates(const std::string& requested) {
 
 } // namespace
 
+std::filesystem::path sourceDirectory() {
+    return TESTBED_SOURCE_DIR;
+}
+
 std::filesystem::path plotScriptPath(const std::string& fileName) {
     return std::filesystem::path(TESTBED_SOURCE_DIR) / "experiments" / "plots" / fileName;
 }
@@ -37,7 +41,10 @@ std::filesystem::path requirePlotScript(const std::filesystem::path& requested,
     return script;
 }
 
-int runProcess(const std::vector<std::string>& argv, bool quiet) {
+namespace {
+
+// Runs argv with stdout and stderr sent to `output` when it is not null (a file path).
+int runChild(const std::vector<std::string>& argv, const char* output) {
     if (argv.empty())
         return 127;
     std::fflush(nullptr); // nothing buffered may be written twice by the child
@@ -45,11 +52,11 @@ int runProcess(const std::vector<std::string>& argv, bool quiet) {
     if (child < 0)
         return 127;
     if (child == 0) {
-        if (quiet) {
-            const int null = open("/dev/null", O_WRONLY);
-            if (null >= 0) {
-                dup2(null, STDOUT_FILENO);
-                dup2(null, STDERR_FILENO);
+        if (output) {
+            const int file = open(output, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+            if (file >= 0) {
+                dup2(file, STDOUT_FILENO);
+                dup2(file, STDERR_FILENO);
             }
         }
         std::vector<char*> args;
@@ -68,6 +75,16 @@ int runProcess(const std::vector<std::string>& argv, bool quiet) {
     if (WIFSIGNALED(status))
         return 128 + WTERMSIG(status);
     return 127;
+}
+
+} // namespace
+
+int runProcess(const std::vector<std::string>& argv, bool quiet) {
+    return runChild(argv, quiet ? "/dev/null" : nullptr);
+}
+
+int runProcessLogged(const std::vector<std::string>& argv, const std::filesystem::path& log) {
+    return runChild(argv, log.c_str());
 }
 
 std::string findPythonWithMatplotlib(const std::string& requested) {

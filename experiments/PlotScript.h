@@ -12,6 +12,8 @@
 
 namespace experiments {
 
+// The source tree this binary was built from (fixed at build time).
+std::filesystem::path sourceDirectory();
 // experiments/plots/<fileName> of the source tree this binary was built from.
 std::filesystem::path plotScriptPath(const std::string& fileName);
 // The script a command runs: `requested` (--plots-script) when not empty, else
@@ -24,6 +26,8 @@ std::filesystem::path requirePlotScript(const std::filesystem::path& requested,
 // when it cannot be started, 128 + signal when killed). Its stdout and stderr are this process'.
 // With quiet, both go to /dev/null.
 int runProcess(const std::vector<std::string>& argv, bool quiet = false);
+// The same with the child's stdout and stderr written to the file `log` (created or truncated).
+int runProcessLogged(const std::vector<std::string>& argv, const std::filesystem::path& log);
 
 // `requested` if it imports matplotlib (when given, nothing else is tried), else the first of
 // /usr/bin/python3 and python3 that does; "" when none does.

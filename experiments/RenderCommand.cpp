@@ -95,24 +95,26 @@ std::array<std::vector<float>, 3> errorPlanes(const RenderRun& run) {
     return planes;
 }
 
-// False-colour PNG of the largest channel error per pixel, Turbo from 0 to the image's maximum
-// (ImageBufAlgo::color_map), for thumbnails; the exact values are the EXR's error layers.
-void writeErrorPng(const std::filesystem::path& path, int w, int h,
-                   const std::array<std::vector<float>, 3>& error) {
-    OIIO::ImageBuf largest(OIIO::ImageSpec(w, h, 1, OIIO::TypeDesc::FLOAT));
-    std::vector<float> values(size_t(w) * h);
-    float peak = 0.0f;
-    for (size_t i = 0; i < values.size(); ++i) {
+// The largest channel error per pixel (what error.png shows).
+std::vector<float> largestChannelError(const std::array<std::vector<float>, 3>& error) {
+    std::vector<float> values(error[0].size());
+    for (size_t i = 0; i < values.size(); ++i)
         values[i] = std::max({error[0][i], error[1][i], error[2][i]});
-        if (std::isfinite(values[i]))
-            peak = std::max(peak, values[i]);
-    }
-    for (float& v : values)
-        v = peak > 0.0f && std::isfinite(v) ? std::min(v / peak, 1.0f)
-                                            : (std::isfinite(v) ? 0.0f : 1.0f);
-    largest.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values.data());
-    const OIIO::ImageBuf coloured = OIIO::ImageBufAlgo::color_map(largest, 0, "turbo");
-    writeImageAtomically(path, coloured, OIIO::TypeDesc::UINT8, "png");
+    return values;
+}
+
+// What the printed and recorded pass times are: a single timed run is one frame (a cold one
+// without warm-up: caches, page faults and the thread pool's start included), several are
+// summarised by their median and range.
+std::string timingFigure(const RenderOptions& options) {
+    const std::string warmup = options.warmup > 0
+                                   ? " after " + std::to_string(options.warmup) + " warm-up run" +
+                                         (options.warmup > 1 ? "s" : "")
+                                   : "";
+    if (options.repetitions <= 1)
+        return options.warmup > 0 ? "one frame" + warmup
+                                  : "cold frame (no warm-up, one repetition)";
+    return "median of " + std::to_string(options.repetitions) + " (min\u2013max)" + warmup;
 }
 
 // What `testbed render` prints when done: the run, its pass medians, the error, the files.
@@ -121,32 +123,67 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
               << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
               << " lights) at " << run.options.width << "x" << run.options.height << ", "
               << run.threads << " threads\n";
-    for (const PassTiming& timing : run.metrics.passes)
+    const bool several = run.options.repetitions > 1;
+    std::cout << "  timings: " << timingFigure(run.options) << "\n";
+    for (const PassTiming& timing : run.metrics.passes) {
         std::cout << "  " << timing.pass << ": " << std::fixed << std::setprecision(2)
-                  << timing.medianMs() << " ms\n";
-    if (const std::optional<ErrorMetrics>& error = run.metrics.error)
+                  << timing.medianMs() << " ms";
+        if (several)
+            std::cout << " (" << timing.minMs() << "\u2013" << timing.maxMs() << ")";
+        std::cout << "\n";
+    }
+    if (const std::optional<ErrorMetrics>& error = run.metrics.error) {
         std::cout << "  error vs reference: rmse " << std::scientific << error->rmse << ", max_abs "
                   << error->maxAbs << ", relative rmse " << error->relativeRmse << "\n";
+        if (error->flip)
+            std::cout << "  HDR-FLIP (flip-evaluator " << run.flipParameters.value("version", "?")
+                      << "): mean " << std::fixed << std::setprecision(4) << *error->flip << "\n";
+        else
+            std::cout << "  HDR-FLIP: unavailable: " << error->flipUnavailable << "\n";
+    }
+    if (!run.metrics.lightCountsNote.empty())
+        std::cout << "  light counts: " << run.metrics.lightCountsNote << "\n";
     std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
-    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "stats.json"})
+    for (const char* file :
+         {"render.exr", "preview.png", "heatmap.png", "error.png", "flip.png", "stats.json"})
         if (std::filesystem::exists(out / file))
             std::cout << "  " << (out / file).string() << "\n";
 }
 
 } // namespace
 
+ScalarMapStyle errorMapStyle(const RenderOutputScales& scales) {
+    ScalarMapStyle style;
+    style.scale = scales.errorScale;
+    style.max = scales.errorMax;
+    style.colourMap = "turbo";
+    style.title = std::string("|render - reference|, largest of R,G,B (") +
+                  mapScaleName(scales.errorScale) + " scale)";
+    return style;
+}
+
+ScalarMapStyle flipMapStyle() {
+    ScalarMapStyle style;
+    style.max = 1.0f;
+    style.colourMap = "magma";
+    style.title = "HDR-FLIP error (flip-evaluator), 0..1";
+    return style;
+}
+
 void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
-                        uint32_t heatmapMax) {
+                        const RenderOutputScales& scales) {
     const gbuffer::GBuffer& gb = run.gbuffer();
     const int w = gb.width(), h = gb.height();
     const nlohmann::json stats = statsJson(run);
     const DecodedLayers layers = decodeLayers(gb);
     const std::vector<float> evaluated = toFloat(run.result.lightsEvaluated);
     const std::vector<float> oracle = toFloat(run.oracle);
-    // Evaluations that added nothing: the culling stage's waste at each pixel.
+    // Evaluations that added nothing: the culling stage's waste at each pixel it lit (a
+    // reduced-resolution stage lights only its samples: 0 at the pixels it filtered).
+    const std::vector<uint8_t>& lit = run.result.lightingSamples;
     std::vector<float> wasted(evaluated.size());
     for (size_t pixel = 0; pixel < wasted.size(); ++pixel)
-        wasted[pixel] = evaluated[pixel] - oracle[pixel];
+        wasted[pixel] = lit.empty() || lit[pixel] ? evaluated[pixel] - oracle[pixel] : 0.0f;
     const std::array<std::vector<float>, 3> error = errorPlanes(run);
     std::vector<ImagePlane> planes = {
         {"R", run.result.radiance[0].data()},   {"G", run.result.radiance[1].data()},
@@ -164,6 +201,8 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         if (!error[size_t(c)].empty())
             planes.push_back({std::string("error.") + rgb[c], error[size_t(c)].data()});
     }
+    if (!run.flipMap.empty())
+        planes.push_back({"flip", run.flipMap.data()});
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"testbed:scene", run.options.scene},
         {"testbed:stage", run.options.stage},
@@ -172,13 +211,21 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         {"testbed:stats", stats.dump()},
         {"testbed:Z", "view-space depth in metres decoded from the G-buffer, 0 = background"},
         {"testbed:error", "error.R,G,B = |R,G,B - reference| (double-precision reference)"},
+        {"testbed:flip", "flip = HDR-FLIP per pixel against the reference, 0..1 (flip-evaluator)"},
+        {"testbed:lights.wasted",
+         "lights.evaluated - lights.oracle at the pixels the stage lit; 0 at pixels a "
+         "reduced-resolution stage only filtered"},
     };
     writeMultiLayerExr(dir / "render.exr", w, h, planes, metadata);
     writePreviewPng(dir / "preview.png", w, h, run.result.radiance[0].data(),
                     run.result.radiance[1].data(), run.result.radiance[2].data());
-    writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(), heatmapMax);
+    writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(),
+                    scales.heatmapMax);
     if (run.metrics.error)
-        writeErrorPng(dir / "error.png", w, h, error);
+        writeScalarMapPng(dir / "error.png", w, h, largestChannelError(error).data(),
+                          errorMapStyle(scales));
+    if (!run.flipMap.empty())
+        writeScalarMapPng(dir / "flip.png", w, h, run.flipMap.data(), flipMapStyle());
     writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
 }
 
@@ -223,6 +270,7 @@ void addTimings(nlohmann::json& stats, const RenderRun& run) {
     stats["timings_ms"] = medians;
     stats["timings"] = {{"warmup", run.options.warmup},
                         {"repetitions", run.options.repetitions},
+                        {"figure", timingFigure(run.options)},
                         {"passes_ms", spread}};
     const gbuffer::GBufferPassTimings& steps = run.prepared->gbufferTimings;
     stats["gbuffer_steps_ms"] = {{"transform", steps.transformMs},
@@ -230,16 +278,23 @@ void addTimings(nlohmann::json& stats, const RenderRun& run) {
                                  {"resolve", steps.resolveMs},
                                  {lighting::pass::kExactSurface, steps.exactMs}};
     stats["measurement_ms"] = {{"oracle", run.metrics.oracleMs},
-                               {"reference", run.metrics.referenceMs}};
+                               {"reference", run.metrics.referenceMs},
+                               {"flip", run.metrics.flipMs}};
 }
 
-// The error figures; psnr is +inf for identical images, written as "inf" (JSON has no infinity).
-nlohmann::json errorJson(const RunMetrics& metrics) {
+// The error figures; psnr is +inf for identical images, written as "inf" (JSON has no infinity);
+// flip is null when unavailable, with flip_unavailable saying why, else flip_parameters say what
+// flip-evaluator assumed.
+nlohmann::json errorJson(const RenderRun& run) {
+    const RunMetrics& metrics = run.metrics;
     nlohmann::json error = {{"reference", "reference"}};
     for (const NamedFigure& figure : metrics.errorFigures())
-        error[figure.name] = std::isinf(figure.value) && figure.value > 0
-                                 ? nlohmann::json("inf")
-                                 : nlohmann::json(figure.value);
+        error[figure.name] = std::isinf(figure.value) && figure.value > 0 ? nlohmann::json("inf")
+                             : std::isnan(figure.value)                   ? nlohmann::json()
+                                                        : nlohmann::json(figure.value);
+    error[metric::kFlipUnavailable] = metrics.error->flipUnavailable;
+    if (!run.flipParameters.is_null())
+        error["flip_parameters"] = run.flipParameters;
     return error;
 }
 
@@ -281,9 +336,12 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats[metric::kLightEvaluations] = metrics.lightEvaluations;
     stats[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
     stats[metric::kCullingEfficiency] = metrics.cullingEfficiency;
+    stats[metric::kCountedPixels] = metrics.countedPixels;
+    if (!metrics.lightCountsNote.empty())
+        stats["light_counts_note"] = metrics.lightCountsNote;
     stats["raster"] = rasterJson(run.prepared->rasterStats);
     if (metrics.error)
-        stats["error"] = errorJson(metrics);
+        stats["error"] = errorJson(run);
     stats["warnings"] = run.scene().warnings;
     return stats;
 }
@@ -368,7 +426,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         ensureWritableDirectory(options.out); // before the G-buffer pass and the stage
         const RenderRun run = runRender(std::move(plan), progress);
         progress("writing outputs");
-        writeRenderOutputs(run, options.out, options.heatmapMax);
+        writeRenderOutputs(run, options.out, options.scales);
         printSummary(run, options.out);
         return 0;
     } catch (const std::exception& e) {

@@ -4,6 +4,9 @@
 //                and timings in the header
 //   preview.png  tone-mapped beauty
 //   heatmap.png  lights evaluated per pixel, false colour with a legend
+//   error.png    with a reference: the largest channel |render - reference| per pixel, false
+//                colour with a legend, linear or log scale (RenderOutputScales)
+//   flip.png     with a reference and flip-evaluator: the HDR-ꟻLIP map, magma from 0 to 1
 //   stats.json   configuration, machine, commit, timings, light counts, error metrics
 // The command plans the render (RenderPlan.h: options validated once, scene loaded, layout
 // derived), checks the output folder for writability, then runs the plan (RenderJob.h). Every
@@ -15,26 +18,40 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/ImageOutput.h"
 #include "experiments/RenderJob.h"
 
 namespace experiments {
 
+// The scales of the false-colour PNGs. Give images that are compared side by side the same
+// explicit maxima (a sweep file's heatmap-max, error-max and error-scale do that for all its jobs).
+struct RenderOutputScales {
+    uint32_t heatmapMax = 0;                // 0 = the image's own maximum
+    MapScale errorScale = MapScale::Linear; // error.png: linear 0..max, or log (4 decades)
+    float errorMax = 0.0f;                  // 0 = the image's largest error
+};
+
 struct RenderCommandOptions {
     RenderOptions render;
     std::filesystem::path out = "out";
-    uint32_t heatmapMax = 0;    // 0 = the image's own maximum
+    RenderOutputScales scales;
     bool explainLayout = false; // print the derived layout and its reasons instead of rendering
 };
+
+// The style of error.png for the scales (title, colour map, scale, maximum).
+ScalarMapStyle errorMapStyle(const RenderOutputScales& scales);
+// The style of flip.png: magma, linear from 0 to 1 (ꟻLIP's range), the same for every image.
+ScalarMapStyle flipMapStyle();
 
 // stats.json: the run's configuration, layout and machine, and its RunMetrics (RunMetrics.h
 // names the figures).
 nlohmann::json statsJson(const RenderRun& run);
 
-// Writes render.exr (with error.R,G,B when the run was compared with a reference), preview.png,
-// heatmap.png, error.png (false colour |image - reference|, only with a reference) and stats.json
-// into `dir` (which must exist), each atomically. heatmapMax 0 = the image's own maximum.
+// Writes render.exr (with error.R,G,B when the run was compared with a reference, and flip when
+// ꟻLIP was computed), preview.png, heatmap.png, error.png and flip.png (with a reference) and
+// stats.json into `dir` (which must exist), each atomically.
 void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
-                        uint32_t heatmapMax);
+                        const RenderOutputScales& scales = {});
 
 // The --view value that renders every view of the scene (OUT/views/NAME/ and OUT/views.json).
 inline constexpr const char* kEveryView = "all";

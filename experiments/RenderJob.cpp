@@ -4,6 +4,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "experiments/FlipMetric.h"
 #include "lighting/Oracle.h"
 #include "lighting/PassNames.h"
 #include "lighting/StageRegistry.h"
@@ -80,15 +81,18 @@ void countOracle(RenderRun& run) {
 }
 
 // The reference image of the run: the given one, the stage's own image when the stage is the
-// reference, else rendered from the run's exact surface.
+// reference, else rendered from the run's exact surface, computed now (after the timed passes)
+// when the stage did not need it itself.
 void fillReference(RenderRun& run, const std::string& stageName,
                    const lighting::StageResult* givenReference) {
-    if (givenReference)
+    if (givenReference) {
         run.reference = *givenReference;
-    else if (stageName == kReferenceStage)
+    } else if (stageName == kReferenceStage) {
         run.reference = run.result;
-    else
+    } else {
+        run.prepared->addExactSurface();
         lighting::makeStage(kReferenceStage)->shade(run.prepared->inputs, run.reference);
+    }
 }
 
 } // namespace
@@ -124,9 +128,11 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
     tbb::task_arena arena(run.threads);
     arena.execute([&] {
         step("G-buffer pass");
-        const bool needExact = plan.requirements.exactSurface || (compare && !givenReference);
+        // The exact surface only when the stage reads it: the reference's (compare) is computed
+        // after the timed passes, so its work never inflates the stage's G-buffer time.
         run.prepared = std::make_unique<lighting::PreparedScene>(
-            std::move(plan.scene), options.width, options.height, needExact, plan.layout);
+            std::move(plan.scene), options.width, options.height, plan.requirements.exactSurface,
+            plan.layout);
         std::vector<PassTiming> passes =
             shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, step);
 
@@ -136,19 +142,29 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         countOracle(run);
         const double oracleMs = millisecondsSince(start);
         std::optional<ErrorMetrics> error;
-        double referenceMs = 0.0;
+        double referenceMs = 0.0, flipMs = 0.0;
         if (compare) {
             step("reference (double precision)");
             start = Clock::now();
             fillReference(run, plan.stage->name(), givenReference);
             referenceMs = millisecondsSince(start);
             error = compareImages(run.result, run.reference);
+            step("HDR-FLIP (flip-evaluator)");
+            start = Clock::now();
+            FlipResult flip = computeFlip(run.result, run.reference);
+            flipMs = millisecondsSince(start);
+            error->flip = flip.mean;
+            error->flipUnavailable = flip.unavailableReason;
+            run.flipMap = std::move(flip.errorMap);
+            run.flipParameters = std::move(flip.parameters);
         }
         const gbuffer::GBufferLayout& layout = run.gbuffer().layout();
         run.metrics = measureRun(std::move(passes), run.result.lightsEvaluated, run.oracle,
-                                 layout.bytesPerPixel(), layout.allocatedBytesPerPixel(), error);
+                                 run.result.lightingSamples, layout.bytesPerPixel(),
+                                 layout.allocatedBytesPerPixel(), error);
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;
+        run.metrics.flipMs = flipMs;
     });
     return run;
 }

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "experiments/RenderOptions.h"
 #include "experiments/RenderPlan.h"
 #include "experiments/RunMetrics.h"
@@ -27,17 +29,22 @@ struct RenderRun {
     std::vector<uint32_t> oracle;           // per pixel, from the stage or counted by brute force
     bool oracleFromLosslessGBuffer = false; // the layout lacked channels the oracle needs
     lighting::StageResult reference;        // filled when compared with the reference
+    // HDR-ꟻLIP against the reference (FlipMetric.h): the per-pixel map (empty when unavailable)
+    // and the package's parameters (null when unavailable); the mean is in metrics.error.
+    std::vector<float> flipMap;
+    nlohmann::json flipParameters;
     RunMetrics metrics;
 
     const scenes::Scene& scene() const { return prepared->scene; }
     const gbuffer::GBuffer& gbuffer() const { return *prepared->gbuffer; }
 };
 
-// Runs the plan under a tbb::task_arena of plan.threads. `progress`, when set, is told the name
-// of each step as it starts (for a terminal display). When `reference` is given it is the image
-// the error is measured against (compareReference is implied) and no reference is rendered: a
-// sweep renders it once per scene, lights and size. Throws UsageError when the given reference
-// has another size than the render.
+// Runs the plan under a tbb::task_arena of plan.threads. When compared with a reference, the
+// error figures include HDR-ꟻLIP (FlipMetric.h; unavailable without the package, saying why).
+// `progress`, when set, is told the name of each step as it starts (for a terminal display). When
+// `reference` is given it is the image the error is measured against (compareReference is implied)
+// and no reference is rendered: a sweep renders it once per scene, lights and size. Throws
+// UsageError when the given reference has another size than the render.
 RenderRun runRender(RenderPlan plan, const std::function<void(const std::string&)>& progress = {},
                     const lighting::StageResult* reference = nullptr);
 

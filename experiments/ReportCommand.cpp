@@ -7,7 +7,10 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -24,6 +27,8 @@
 #include "experiments/ImageOutput.h"
 #include "scenes/Limits.h"
 #include "scenes/NestingDepth.h"
+#include "experiments/RenderCommand.h"
+#include "experiments/RunMetrics.h"
 
 namespace experiments {
 
@@ -32,11 +37,21 @@ using nlohmann::json;
 
 namespace {
 
-// The job images the report shows as thumbnails, in column order.
-constexpr const char* kJobImages[] = {"preview", "heatmap", "error"};
-// Axis columns named in a thumbnail's caption, when the results have them.
-constexpr const char* kCaptionColumns[] = {"scene",  "stage",  "lights",  "width",
-                                           "height", "layout", "normals", "depth"};
+// The job images the report shows as thumbnails, in column order; all but the preview are
+// redrawn at their group's scale from render.exr when it is there.
+constexpr const char* kJobImages[] = {"preview", "heatmap", "error", "flip"};
+// Method columns: what a group compares (everything else makes the group).
+constexpr const char* kMethodColumns[] = {"stage",        "layout", "normals",
+                                          "normal-space", "depth",  "position"};
+// The columns of the results table a reader compares first, after the method columns; the rest
+// are behind the "all columns" toggle.
+constexpr const char* kMainMetricColumns[] = {"time_total_median_ms", "relative_rmse", "flip",
+                                              "culling_efficiency"};
+// Settings known to be axis columns, for results that do not list theirs.
+constexpr const char* kKnownAxisColumns[] = {
+    "scene",    "stage",   "lights", "seed",        "resolution",   "width",
+    "height",   "threads", "layout", "normals",     "normal-space", "depth",
+    "position", "view",    "views",  "repetitions", "warmup"};
 
 // Results are ours but may have been edited: the nesting is bounded before parsing, as for every
 // JSON input (scenes/Limits.h), since the report copies values recursively.
@@ -202,8 +217,29 @@ figcaption { font-size: 0.8em; max-width: 640px; }
 .thumbs img { display: block; }
 .missing { color: #999; font-style: italic; }
 #page-check { font-size: 0.7em; color: #888; }
+table.results.compact .extra { display: none; }
+section.group { border-left: 4px solid #9bd; padding-left: 0.8em; margin: 1.5em 0; }
+.flip-note, .counts-note { background: #fff4e0; border-left: 4px solid #e90; padding: 0.5em;
+  max-width: 60em; }
 </style>
+<script>
+function toggleColumns(button) {
+  var table = document.getElementById('results-table');
+  var compact = table.classList.toggle('compact');
+  button.textContent = compact ? 'Show all columns' : 'Show the main columns only';
+}
+</script>
 )";
+
+// ", median over different X, Y" when the matched jobs of a cell differ in some axis columns.
+std::string differNote(const json& cell) {
+    if (!cell.contains("differ_in") || cell["differ_in"].empty())
+        return "";
+    std::string columns;
+    for (const json& column : cell["differ_in"])
+        columns += (columns.empty() ? "" : ", ") + htmlEscape(column.get<std::string>());
+    return "<br><small>median over different " + columns + "</small>";
+}
 
 void appendPublishedSection(std::ostringstream& html, const json& table, int index) {
     html << "<h3 id=\"published-" << index << "\">" << htmlEscape(stringField(table, "title"))
@@ -216,7 +252,8 @@ void appendPublishedSection(std::ostringstream& html, const json& table, int ind
     const json& columns = table["columns"];
     html << "; ratios are value / value of column &ldquo;"
          << htmlEscape(columns[ratioTo.get<size_t>()].get<std::string>())
-         << "&rdquo; of the same row. Measured values are medians over the matching jobs.</p>\n";
+         << "&rdquo; of the same row. Measured values are medians over the matching ok jobs; "
+            "a cell whose jobs differ in a setting says which.</p>\n";
     html << "<div class=\"scroll\"><table class=\"published\">\n<tr><th class=\"text\" "
             "rowspan=\"2\">row</th>";
     for (const json& column : columns)
@@ -233,7 +270,7 @@ void appendPublishedSection(std::ostringstream& html, const json& table, int ind
                  << formatOptional(cell["measured"]) << "</td><td>"
                  << formatOptional(cell["published_ratio"], "&times;") << "</td><td>"
                  << formatOptional(cell["measured_ratio"], "&times;") << "</td><td>"
-                 << cell["matched_jobs"].get<int>() << "</td>";
+                 << cell["matched_jobs"].get<int>() << differNote(cell) << "</td>";
         html << "</tr>\n";
     }
     html << "</table></div>\n";
@@ -243,73 +280,260 @@ void appendPublishedSection(std::ostringstream& html, const json& table, int ind
              << "</p>\n";
 }
 
-void appendPlots(std::ostringstream& html, const json& manifest) {
+bool isMainColumn(const std::string& column, const std::vector<std::string>& varyingMethods,
+                  const std::string& errorMetric, bool anyFailed) {
+    if (column == "job_id" || column == "status" || column == "stage" || column == errorMetric ||
+        (column == "error" && anyFailed))
+        return true;
+    if (std::find(varyingMethods.begin(), varyingMethods.end(), column) != varyingMethods.end())
+        return true;
+    for (const char* main : kMainMetricColumns)
+        if (column == main)
+            return true;
+    return false;
+}
+
+// The plots of one group ("" = across groups) and kind filter, then the skipped ones.
+void appendPlots(std::ostringstream& html, const json& manifest, const std::string& group,
+                 const std::function<bool(const std::string&)>& kindWanted) {
     if (manifest.contains("plots"))
         for (const json& plot : manifest["plots"]) {
+            if (stringField(plot, "group") != group || !kindWanted(stringField(plot, "kind")))
+                continue;
             const std::string file = "report/" + plot["file"].get<std::string>();
-            html << "<figure><a href=\"" << urlPath(file) << "\"><img class=\"plot\" src=\""
-                 << urlPath(file) << "\" alt=\"" << htmlEscape(stringField(plot, "title"))
+            html << "<figure><a href=\"" << urlPath(file) << "\"><img class=\"plot\" data-kind=\""
+                 << htmlEscape(stringField(plot, "kind")) << "\" src=\"" << urlPath(file)
+                 << "\" alt=\"" << htmlEscape(stringField(plot, "title"))
                  << "\"></a><figcaption><b>" << htmlEscape(stringField(plot, "title")) << "</b> "
                  << htmlEscape(stringField(plot, "caption")) << "</figcaption></figure>\n";
         }
-    if (manifest.contains("skipped") && !manifest["skipped"].empty()) {
-        html << "<ul>\n";
-        for (const json& skipped : manifest["skipped"])
-            html << "<li class=\"note\">" << htmlEscape(stringField(skipped, "title"))
-                 << ": not enough data (" << htmlEscape(stringField(skipped, "reason"))
-                 << ")</li>\n";
-        html << "</ul>\n";
-    }
+    std::ostringstream skipped;
+    if (manifest.contains("skipped"))
+        for (const json& item : manifest["skipped"])
+            if (stringField(item, "group") == group && kindWanted(stringField(item, "kind")))
+                skipped << "<li class=\"note\" data-kind=\""
+                        << htmlEscape(stringField(item, "kind")) << "-skipped\">"
+                        << htmlEscape(stringField(item, "title")) << ": not enough data ("
+                        << htmlEscape(stringField(item, "reason")) << ")</li>\n";
+    if (!skipped.str().empty())
+        html << "<ul>\n" << skipped.str() << "</ul>\n";
 }
 
 void appendResultsTable(std::ostringstream& html, const json& jobs,
-                        const std::vector<std::string>& columns) {
-    html << "<div class=\"scroll\"><table class=\"results\">\n<tr>";
+                        const std::vector<std::string>& columns,
+                        const std::vector<std::string>& varyingMethods,
+                        const std::vector<JobGroup>& groups, const std::string& errorMetric) {
+    std::vector<std::string> groupOf(jobs.size());
+    for (const JobGroup& group : groups)
+        for (size_t job : group.jobs)
+            groupOf[job] = group.id;
+    const bool anyFailed =
+        std::any_of(jobs.begin(), jobs.end(), [](const json& j) { return !jobOk(j); });
+    // Main columns first (in table order, the group after the job id), then the others.
+    std::vector<std::string> ordered, extra;
     for (const std::string& column : columns)
-        html << "<th>" << htmlEscape(column) << "</th>";
+        (isMainColumn(column, varyingMethods, errorMetric, anyFailed) ? ordered : extra)
+            .push_back(column);
+    const size_t mainCount = ordered.size() + 1; // + group
+    ordered.insert(ordered.end(), extra.begin(), extra.end());
+    std::string mainNames = "group";
+    for (size_t i = 0; i + 1 < mainCount; ++i)
+        mainNames += " " + ordered[i];
+    html << "<p><button type=\"button\" id=\"toggle-columns\" onclick=\"toggleColumns(this)\">"
+            "Show all "
+         << columns.size() + 1 << " columns</button> The table shows the " << mainCount
+         << " columns a reader compares (method, time, error, ꟻLIP, culling efficiency); "
+            "the button shows the other "
+         << extra.size() << ".</p>\n";
+    html << "<div class=\"scroll\"><table class=\"results compact\" id=\"results-table\" "
+            "data-main-columns=\""
+         << htmlEscape(mainNames) << "\">\n<tr>";
+    auto cellClass = [&](size_t index) { return index < mainCount - 1 ? "" : " extra"; };
+    for (size_t i = 0; i < ordered.size(); ++i) {
+        html << "<th class=\"col" << cellClass(i) << "\" data-column=\"" << htmlEscape(ordered[i])
+             << "\">" << htmlEscape(ordered[i]) << "</th>";
+        if (ordered[i] == "job_id")
+            html << "<th class=\"col\" data-column=\"group\">group</th>";
+    }
     html << "</tr>\n";
-    for (const json& job : jobs) {
+    for (size_t j = 0; j < jobs.size(); ++j) {
+        const json& job = jobs[j];
         html << "<tr" << (jobOk(job) ? "" : " class=\"failed\"") << ">";
-        for (const std::string& column : columns) {
+        for (size_t i = 0; i < ordered.size(); ++i) {
+            const std::string& column = ordered[i];
             const auto it = job.find(column);
             const json value = it == job.end() ? json() : *it;
-            const char* cls = column == "error"   ? " class=\"error\""
-                              : value.is_string() ? " class=\"text\""
-                                                  : "";
-            html << "<td" << cls << ">"
+            const std::string cls = std::string(column == "error"   ? "error"
+                                                : value.is_string() ? "text"
+                                                                    : "") +
+                                    cellClass(i);
+            html << "<td" << (cls.empty() ? "" : " class=\"" + cls + "\"") << ">"
                  << (column == "error" && value.is_string() && value.get<std::string>().empty()
                          ? std::string()
                          : formatCell(value))
                  << "</td>";
+            if (column == "job_id")
+                html << "<td class=\"text\"><a href=\"#group-" << groupOf[j] << "\">" << groupOf[j]
+                     << "</a></td>";
         }
         html << "</tr>\n";
     }
     html << "</table></div>\n";
 }
 
-void appendThumbnails(std::ostringstream& html, const fs::path& dir, const json& jobs, int width) {
+// One job's maps as its group draws them: read from render.exr, or empty (then the job's own
+// PNGs are shown, at their own scale).
+struct JobMaps {
+    int width = 0, height = 0;
+    std::vector<uint32_t> evaluated;
+    std::vector<float> error; // largest channel |render - reference|; empty without a reference
+    std::vector<float> flip;  // empty without ꟻLIP
+};
+
+std::optional<JobMaps> readJobMaps(const fs::path& exr) {
+    std::error_code missing;
+    if (!fs::is_regular_file(exr, missing))
+        return std::nullopt;
+    OIIO::ImageBuf image(exr.string());
+    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+        return std::nullopt;
+    const OIIO::ImageSpec& spec = image.spec();
+    auto plane = [&](const char* name) -> std::vector<float> {
+        const int channel = spec.channelindex(name);
+        if (channel < 0)
+            return {};
+        std::vector<float> values(size_t(spec.width) * spec.height);
+        OIIO::ROI roi = image.roi();
+        roi.chbegin = channel;
+        roi.chend = channel + 1;
+        image.get_pixels(roi, OIIO::TypeDesc::FLOAT, values.data());
+        return values;
+    };
+    JobMaps maps;
+    maps.width = spec.width;
+    maps.height = spec.height;
+    const std::vector<float> evaluated = plane("lights.evaluated");
+    if (evaluated.empty())
+        return std::nullopt;
+    maps.evaluated.assign(evaluated.begin(), evaluated.end());
+    const std::vector<float> r = plane("error.R"), g = plane("error.G"), b = plane("error.B");
+    if (!r.empty() && !g.empty() && !b.empty()) {
+        maps.error.resize(r.size());
+        for (size_t i = 0; i < r.size(); ++i)
+            maps.error[i] = std::max({r[i], g[i], b[i]});
+    }
+    maps.flip = plane("flip");
+    return maps;
+}
+
+// The label of a job inside its group: its method columns that vary, stage first.
+std::string methodLabel(const json& job, const std::vector<std::string>& varyingMethods) {
+    std::string label = formatCell(job.value("stage", json()));
+    for (const std::string& column : varyingMethods)
+        if (column != "stage")
+            label += ", " + htmlEscape(column) + " " + formatCell(job.value(column, json()));
+    return label;
+}
+
+// The group's section: its plots, then every job's preview and maps at the group's one scale.
+void appendGroupSection(std::ostringstream& html, const fs::path& dir, const json& jobs,
+                        const JobGroup& group, const json& manifest,
+                        const std::vector<std::string>& varyingMethods,
+                        const RenderOutputScales& scales, int thumbnailWidth) {
+    size_t ok = 0;
+    for (size_t j : group.jobs)
+        ok += jobOk(jobs[j]);
+    html << "<section class=\"group\" id=\"group-" << group.id << "\" data-group=\"" << group.id
+         << "\" data-jobs=\"" << group.jobs.size() << "\" data-ok-jobs=\"" << ok
+         << "\">\n<h3>Group " << group.id << ": " << htmlEscape(group.label) << "</h3>\n<p>"
+         << group.jobs.size() << " jobs (" << ok << " ok) with the same";
+    std::string fixed;
+    for (const auto& [column, value] : group.fixed.items())
+        fixed += (fixed.empty() ? " " : ", ") + htmlEscape(column) + " " + formatCell(value);
+    html << (fixed.empty() ? " settings" : fixed) << ".</p>\n";
+    appendPlots(html, manifest, group.id, [](const std::string&) { return true; });
+
+    // Maps at the group's scale: read every job's EXR once, take the group's maxima (or the
+    // sweep's fixed ones), draw.
+    std::vector<std::optional<JobMaps>> maps(group.jobs.size());
+    uint32_t heatmapMax = scales.heatmapMax;
+    float errorMax = scales.errorMax;
+    bool computeHeat = heatmapMax == 0, computeError = !(errorMax > 0.0f);
+    uint32_t heatPeak = 1;
+    float errorPeak = 0.0f;
+    for (size_t k = 0; k < group.jobs.size(); ++k) {
+        const json& job = jobs[group.jobs[k]];
+        const std::string id = stringField(job, "job_id");
+        if (!jobOk(job) || id.empty())
+            continue;
+        maps[k] = readJobMaps(dir / "jobs" / id / "render.exr");
+        if (!maps[k])
+            continue;
+        heatPeak = std::max(heatPeak,
+                            heatmapAutoScale(maps[k]->evaluated.data(), maps[k]->evaluated.size()));
+        if (!maps[k]->error.empty())
+            errorPeak = std::max(
+                errorPeak, scalarMapRange(maps[k]->error.data(), maps[k]->error.size(), {}).second);
+    }
+    if (computeHeat)
+        heatmapMax = heatPeak;
+    if (computeError)
+        errorMax = errorPeak;
+    RenderOutputScales groupScales = scales;
+    groupScales.heatmapMax = heatmapMax;
+    groupScales.errorMax = errorMax;
+    const bool anyMaps =
+        std::any_of(maps.begin(), maps.end(), [](const auto& m) { return bool(m); });
+    html << "<p>Previews, lights evaluated per pixel, |render &minus; reference| and ꟻLIP";
+    if (anyMaps)
+        html << " at <b>one scale for the whole group</b>: heatmaps 0.." << heatmapMax
+             << " lights ("
+             << (computeHeat ? "the group's largest count" : "the sweep's heatmap-max")
+             << "), error maps " << mapScaleName(groupScales.errorScale) << " up to "
+             << displayNumber(errorMax, 3) << " ("
+             << (computeError ? "the group's largest error" : "the sweep's error-max")
+             << "), ꟻLIP 0..1";
+    else
+        html << " (each image at its own scale: the jobs have no render.exr to redraw them from)";
+    html << "; click for the full-size image.</p>\n";
     html << "<table class=\"thumbs\">\n<tr><th class=\"text\">job</th>";
     for (const char* image : kJobImages)
-        html << "<th class=\"text\">" << image << ".png</th>";
+        html << "<th class=\"text\">" << image << "</th>";
     html << "</tr>\n";
     fs::create_directories(dir / "report" / "thumbs");
-    for (const json& job : jobs) {
+    fs::create_directories(dir / "report" / "maps");
+    for (size_t k = 0; k < group.jobs.size(); ++k) {
+        const json& job = jobs[group.jobs[k]];
         const std::string id = stringField(job, "job_id");
         if (id.empty())
             continue;
         html << "<tr" << (jobOk(job) ? "" : " class=\"failed\"") << "><td><b>" << htmlEscape(id)
-             << "</b>";
-        for (const char* column : kCaptionColumns)
-            if (job.contains(column) && !job[column].is_null())
-                html << "<br>" << column << " " << formatCell(job[column]);
+             << "</b><br>" << methodLabel(job, varyingMethods);
         if (!jobOk(job))
             html << "<br><span class=\"error\">" << htmlEscape(stringField(job, "error"))
                  << "</span>";
         html << "</td>";
         for (const char* image : kJobImages) {
-            const std::string full = "jobs/" + id + "/" + image + ".png";
+            std::string full = "jobs/" + id + "/" + image + ".png";
+            if (maps[k] && std::string(image) != "preview") {
+                const JobMaps& m = *maps[k];
+                const std::string redrawn = "report/maps/" + id + "-" + image + ".png";
+                if (std::string(image) == "heatmap")
+                    writeHeatmapPng(dir / redrawn, m.width, m.height, m.evaluated.data(),
+                                    heatmapMax);
+                else if (std::string(image) == "error" && !m.error.empty())
+                    writeScalarMapPng(dir / redrawn, m.width, m.height, m.error.data(),
+                                      errorMapStyle(groupScales));
+                else if (std::string(image) == "flip" && !m.flip.empty())
+                    writeScalarMapPng(dir / redrawn, m.width, m.height, m.flip.data(),
+                                      flipMapStyle());
+                else
+                    full.clear();
+                if (!full.empty())
+                    full = redrawn;
+            }
             const std::string thumb = "report/thumbs/" + id + "-" + image + ".png";
-            if (makeThumbnail(dir / full, dir / thumb, width))
+            if (!full.empty() && makeThumbnail(dir / full, dir / thumb, thumbnailWidth))
                 html << "<td><a href=\"" << urlPath(full) << "\"><img src=\"" << urlPath(thumb)
                      << "\" alt=\"" << image << " of " << htmlEscape(id) << "\"></a></td>";
             else
@@ -317,7 +541,7 @@ void appendThumbnails(std::ostringstream& html, const fs::path& dir, const json&
         }
         html << "</tr>\n";
     }
-    html << "</table>\n";
+    html << "</table>\n</section>\n";
 }
 
 std::string shellQuote(const std::string& text) {
@@ -425,7 +649,95 @@ std::optional<double> median(std::vector<double> values) {
     return values.size() % 2 ? values[middle] : 0.5 * (values[middle - 1] + values[middle]);
 }
 
-json comparePublished(const json& published, const json& jobs) {
+std::vector<std::string> reportErrorMetrics() {
+    return {"relative_rmse", "rmse", "flip", "psnr", "max_abs", "relative_mean", "p99_abs"};
+}
+
+bool isMethodColumn(const std::string& column) {
+    for (const char* method : kMethodColumns)
+        if (column == method)
+            return true;
+    return false;
+}
+
+std::vector<std::string> axisColumnsOf(const json& results) {
+    std::vector<std::string> axes;
+    if (results.contains("axis_columns") && results["axis_columns"].is_array()) {
+        for (const json& column : results["axis_columns"])
+            if (column.is_string())
+                axes.push_back(column.get<std::string>());
+        return axes;
+    }
+    for (const std::string& column : resultColumns(results)) {
+        const bool known = std::any_of(std::begin(kKnownAxisColumns), std::end(kKnownAxisColumns),
+                                       [&](const char* name) { return column == name; }) ||
+                           column.rfind("scene-option.", 0) == 0;
+        if (known)
+            axes.push_back(column);
+    }
+    return axes;
+}
+
+std::vector<JobGroup> comparableGroups(const json& jobs, const std::vector<std::string>& axes) {
+    std::vector<std::string> grouping;
+    for (const std::string& column : axes)
+        if (!isMethodColumn(column) && column != "resolution")
+            grouping.push_back(column);
+    // Which grouping columns vary: those are named in every label, with the always-named ones.
+    std::vector<std::string> varying;
+    for (const std::string& column : grouping) {
+        std::set<std::string> values;
+        for (const json& job : jobs)
+            values.insert(normalisedSelectValue(job.value(column, json())));
+        if (values.size() > 1)
+            varying.push_back(column);
+    }
+    std::vector<JobGroup> groups;
+    std::map<std::string, size_t> byKey;
+    for (size_t j = 0; j < jobs.size(); ++j) {
+        const json& job = jobs[j];
+        std::string key;
+        for (const std::string& column : grouping)
+            key += column + "=" + normalisedSelectValue(job.value(column, json())) + "\n";
+        auto [it, inserted] = byKey.emplace(key, groups.size());
+        if (inserted) {
+            JobGroup group;
+            group.id = "g" + std::to_string(groups.size() + 1);
+            group.fixed = nlohmann::ordered_json::object();
+            std::string label;
+            auto add = [&](const std::string& part) {
+                label += (label.empty() ? "" : ", ") + part;
+            };
+            auto text = [&](const char* column) {
+                return normalisedSelectValue(job.value(column, json()));
+            };
+            for (const std::string& column : grouping) {
+                group.fixed[column] = job.value(column, json());
+                const bool named =
+                    std::find(varying.begin(), varying.end(), column) != varying.end();
+                if (job.value(column, json()).is_null())
+                    continue;
+                if (column == "scene")
+                    add(text("scene"));
+                else if (column == "lights")
+                    add(text("lights") + " lights");
+                else if (column == "width")
+                    add(text("width") + "x" + text("height"));
+                else if (column == "threads")
+                    add(text("threads") + " threads");
+                else if (named && column != "height")
+                    add(column + " " + normalisedSelectValue(job.value(column, json())));
+            }
+            group.label = label.empty() ? "all jobs" : label;
+            groups.push_back(std::move(group));
+        }
+        groups[it->second].jobs.push_back(j);
+    }
+    return groups;
+}
+
+json comparePublished(const json& published, const json& jobs,
+                      const std::vector<std::string>& axisColumns) {
     const std::string title = published.is_object() ? stringField(published, "title") : "";
     auto fail = [&](const std::string& what) -> std::runtime_error {
         return std::runtime_error("published entry '" + title + "': " + what);
@@ -474,6 +786,7 @@ json comparePublished(const json& published, const json& jobs) {
                        std::to_string(columns.size()) + ")");
         std::vector<std::optional<double>> publishedValues, measuredValues;
         std::vector<int> matchCounts;
+        std::vector<json> differIn;
         for (size_t c = 0; c < columns.size(); ++c) {
             if (!values[c].is_null() && !values[c].is_number())
                 throw fail(where + ".values[" + std::to_string(c) + "] must be a number or null");
@@ -481,6 +794,7 @@ json comparePublished(const json& published, const json& jobs) {
                                                           : std::optional(values[c].get<double>()));
             std::vector<double> measured;
             int matched = 0;
+            std::map<std::string, std::set<std::string>> values; // per axis column
             for (const json& job : jobs) {
                 if (!jobOk(job) || !jobMatchesSelect(job, row.value("select", json::object())) ||
                     !jobMatchesSelect(job, columns[c].value("select", json::object())))
@@ -488,9 +802,16 @@ json comparePublished(const json& published, const json& jobs) {
                 ++matched;
                 if (const auto value = jobMetric(job, metric))
                     measured.push_back(*value);
+                for (const std::string& column : axisColumns)
+                    values[column].insert(normalisedSelectValue(job.value(column, json())));
             }
             measuredValues.push_back(median(measured));
             matchCounts.push_back(matched);
+            json differ = json::array();
+            for (const std::string& column : axisColumns)
+                if (values[column].size() > 1)
+                    differ.push_back(column);
+            differIn.push_back(differ);
         }
         auto ratio = [&](const std::vector<std::optional<double>>& v, size_t c) -> json {
             if (!v[c] || !v[ratioTo] || *v[ratioTo] == 0.0)
@@ -504,7 +825,8 @@ json comparePublished(const json& published, const json& jobs) {
                              {"measured", toJson(measuredValues[c])},
                              {"published_ratio", ratio(publishedValues, c)},
                              {"measured_ratio", ratio(measuredValues, c)},
-                             {"matched_jobs", matchCounts[c]}});
+                             {"matched_jobs", matchCounts[c]},
+                             {"differ_in", differIn[c]}});
         table["rows"].push_back(
             {{"label", row.value("label", "row " + std::to_string(r))}, {"cells", cells}});
     }
@@ -528,6 +850,101 @@ fs::path defaultPlotsScript() {
     return plotScriptPath("report.py");
 }
 
+namespace {
+
+// The method columns whose values differ among the jobs (stage always when present).
+std::vector<std::string> varyingMethodColumns(const json& jobs,
+                                              const std::vector<std::string>& axes) {
+    std::vector<std::string> varying;
+    for (const std::string& column : axes) {
+        if (!isMethodColumn(column))
+            continue;
+        std::set<std::string> values;
+        for (const json& job : jobs)
+            values.insert(normalisedSelectValue(job.value(column, json())));
+        if (column == "stage" || values.size() > 1)
+            varying.push_back(column);
+    }
+    return varying;
+}
+
+// The scales of the report's maps: the sweep's heatmap-max, error-max, error-scale, with
+// --error-scale overriding the last.
+RenderOutputScales mapScales(const json& sweep, const ReportCommandOptions& options) {
+    RenderOutputScales scales;
+    if (sweep.is_object()) {
+        const json heat = sweep.value("heatmap-max", json(0));
+        if (heat.is_number_unsigned())
+            scales.heatmapMax = heat.get<uint32_t>();
+        const json errorMax = sweep.value("error-max", json(0.0));
+        if (errorMax.is_number() && errorMax.get<double>() > 0.0)
+            scales.errorMax = errorMax.get<float>();
+        const json errorScale = sweep.value("error-scale", json("linear"));
+        if (errorScale.is_string())
+            scales.errorScale =
+                usageErrorFrom([&] { return parseMapScale(errorScale.get<std::string>()); });
+    }
+    if (options.errorScale)
+        scales.errorScale = *options.errorScale;
+    return scales;
+}
+
+// A visible note when ꟻLIP is missing from some ok jobs: why (each distinct reason once).
+void appendFlipNote(std::ostringstream& html, const json& jobs,
+                    const std::vector<std::string>& columns) {
+    if (std::find(columns.begin(), columns.end(), metric::kFlip) == columns.end()) {
+        html << "<p class=\"flip-note\" id=\"flip-note\"><b>ꟻLIP not recorded:</b> these results "
+                "were made before the testbed measured ꟻLIP; rerun the sweep to get it.</p>\n";
+        return;
+    }
+    size_t ok = 0, missing = 0;
+    std::set<std::string> reasons;
+    for (const json& job : jobs) {
+        if (!jobOk(job))
+            continue;
+        ++ok;
+        if (!job.value(metric::kFlip, json()).is_number()) {
+            ++missing;
+            const std::string reason = stringField(job, metric::kFlipUnavailable);
+            reasons.insert(reason.empty() ? "the job was not compared with the reference" : reason);
+        }
+    }
+    if (missing == 0)
+        return;
+    html << "<p class=\"flip-note\" id=\"flip-note\"><b>ꟻLIP unavailable</b> for " << missing
+         << " of " << ok << " ok jobs (the flip column is empty there):";
+    for (const std::string& reason : reasons)
+        html << "<br>&bull; " << htmlEscape(reason);
+    html << "</p>\n";
+}
+
+// A note when some jobs counted lights over part of the image (reduced-resolution stages).
+void appendCountsNote(std::ostringstream& html, const json& jobs) {
+    std::set<std::string> stages;
+    for (const json& job : jobs) {
+        const json counted = job.value(metric::kCountedPixels, json());
+        const json width = job.value("width", json()), height = job.value("height", json());
+        if (counted.is_number() && width.is_number() && height.is_number() &&
+            counted.get<double>() < width.get<double>() * height.get<double>())
+            stages.insert(normalisedSelectValue(job.value("stage", json())));
+    }
+    if (stages.empty())
+        return;
+    std::string names;
+    for (const std::string& stage : stages)
+        names += (names.empty() ? "" : ", ") + stage;
+    html
+        << "<p class=\"counts-note\" id=\"counts-note\"><b>Light counts at reduced resolution:</b> "
+        << htmlEscape(names)
+        << " light only part of the pixels (their low-resolution samples) and filter the rest. "
+           "Their light_evaluations, oracle_light_evaluations and culling_efficiency are counted "
+           "over the pixels they light (counted_pixels), so the efficiency compares the same "
+           "samples; their evaluation totals are not comparable with full-resolution stages' "
+           "as a cost per image pixel.</p>\n";
+}
+
+} // namespace
+
 int runReportCommand(const ReportCommandOptions& options) {
     try {
         const fs::path& dir = options.dir;
@@ -537,10 +954,23 @@ int runReportCommand(const ReportCommandOptions& options) {
                                      ": expected an object with a \"jobs\" list");
         if (options.thumbnailWidth < 16 || options.thumbnailWidth > 4096)
             throw std::runtime_error("thumbnail width must be from 16 to 4096 pixels");
+        const std::vector<std::string> metrics = reportErrorMetrics();
+        if (std::find(metrics.begin(), metrics.end(), options.errorMetric) == metrics.end()) {
+            std::string valid;
+            for (const std::string& m : metrics)
+                valid += (valid.empty() ? "" : ", ") + m;
+            throw std::runtime_error("--error-metric '" + options.errorMetric +
+                                     "' is not an error column; valid: " + valid);
+        }
         const json& jobs = results["jobs"];
         const json sweep = results.value("sweep", json::object());
         const fs::path reportDir = dir / "report";
         ensureWritableDirectory(reportDir);
+        const std::vector<std::string> columns = resultColumns(results);
+        const std::vector<std::string> axes = axisColumnsOf(results);
+        const std::vector<JobGroup> groups = comparableGroups(jobs, axes);
+        const std::vector<std::string> varyingMethods = varyingMethodColumns(jobs, axes);
+        const RenderOutputScales scales = mapScales(sweep, options);
 
         json publishedTables = json::array();
         if (sweep.is_object() && sweep.contains("published")) {
@@ -548,22 +978,33 @@ int runReportCommand(const ReportCommandOptions& options) {
                 throw std::runtime_error((dir / "results.json").string() +
                                          ": sweep.published must be a list");
             for (const json& entry : sweep["published"])
-                publishedTables.push_back(comparePublished(entry, jobs));
+                publishedTables.push_back(comparePublished(entry, jobs, axes));
         }
         writeTextAtomically(reportDir / "published.json", publishedTables.dump(2) + "\n");
+        json groupsJson = {
+            {"method_columns", varyingMethods}, {"axis_columns", axes}, {"groups", json::array()}};
+        for (const JobGroup& group : groups) {
+            json ids = json::array();
+            for (size_t j : group.jobs)
+                ids.push_back(stringField(jobs[j], "job_id"));
+            groupsJson["groups"].push_back(
+                {{"id", group.id}, {"label", group.label}, {"fixed", group.fixed}, {"jobs", ids}});
+        }
+        writeTextAtomically(reportDir / "groups.json", groupsJson.dump(2) + "\n");
 
         const fs::path script = requirePlotScript(options.plotsScript, "report.py");
         const std::string python = requirePythonWithMatplotlib(options.python);
-        const int status = runProcess(
-            {python, script.string(), "results", "--results", (dir / "results.json").string(),
-             "--published", (reportDir / "published.json").string(), "--out", reportDir.string()});
+        const int status = runProcess({python, script.string(), "results", "--results",
+                                       (dir / "results.json").string(), "--published",
+                                       (reportDir / "published.json").string(), "--groups",
+                                       (reportDir / "groups.json").string(), "--error-metric",
+                                       options.errorMetric, "--out", reportDir.string()});
         if (status != 0)
             throw std::runtime_error("plot script failed (exit status " + std::to_string(status) +
                                      "): " + shellQuote(python) + " " +
                                      shellQuote(script.string()));
         const json manifest = readJsonFile(reportDir / "plots.json");
 
-        const std::vector<std::string> columns = resultColumns(results);
         const size_t failed = size_t(
             std::count_if(jobs.begin(), jobs.end(), [](const json& j) { return !jobOk(j); }));
         const std::string name = sweep.is_object() ? stringField(sweep, "name") : "";
@@ -581,32 +1022,46 @@ int runReportCommand(const ReportCommandOptions& options) {
         if (results.value("quick", false))
             html << " (quick size)";
         html << (sweepFile.empty() ? "" : ": ") << jobs.size() << " jobs, " << jobs.size() - failed
-             << " ok, " << failed << " failed.";
+             << " ok, " << failed << " failed, in " << groups.size() << " comparable group"
+             << (groups.size() == 1 ? "" : "s") << ".";
         const std::string description = sweep.is_object() ? stringField(sweep, "description") : "";
         if (!description.empty())
             html << " " << htmlEscape(description);
-        html << "</p>\n<p>Contents: ";
+        html << "</p>\n";
+        appendFlipNote(html, jobs, columns);
+        appendCountsNote(html, jobs);
+        html << "<p>Contents: ";
         if (!publishedTables.empty())
             html << "<a href=\"#published\">published vs measured</a> &middot; ";
-        html << "<a href=\"#plots\">plots</a> &middot; <a href=\"#results\">results table</a> "
-                "&middot; "
-                "<a href=\"#images\">images</a></p>\n";
+        html << "<a href=\"#groups\">comparable groups</a> &middot; <a href=\"#across\">across "
+                "groups</a> &middot; <a href=\"#results\">results table</a></p>\n";
         if (!publishedTables.empty()) {
             html << "<h2 id=\"published\">Published vs measured</h2>\n";
             for (size_t i = 0; i < publishedTables.size(); ++i)
                 appendPublishedSection(html, publishedTables[i], int(i));
+            appendPlots(html, manifest, "",
+                        [](const std::string& kind) { return kind == "published"; });
         }
-        html << "<h2 id=\"plots\">Plots</h2>\n";
-        appendPlots(html, manifest);
+        html << "<h2 id=\"groups\">Comparable groups</h2>\n<p>Jobs are compared only with jobs of "
+                "their group: the same value of every setting but the method ("
+             << "stage, layout, normals, normal-space, depth, position); jobs of different "
+                "scenes, light counts, sizes or thread counts are never pooled. Error axis: <code>"
+             << htmlEscape(options.errorMetric)
+             << "</code> against the double-precision reference (<code>testbed report "
+                "--error-metric</code> chooses another).</p>\n";
+        for (const JobGroup& group : groups)
+            appendGroupSection(html, dir, jobs, group, manifest, varyingMethods, scales,
+                               options.thumbnailWidth);
+        html << "<h2 id=\"across\">Across groups</h2>\n<p>One line per method; each plot holds "
+                "the jobs that share every other setting, and its caption says what varies with "
+                "the x axis.</p>\n";
+        appendPlots(html, manifest, "",
+                    [](const std::string& kind) { return kind != "published"; });
         html << "<h2 id=\"results\">Results (" << jobs.size() << " jobs)</h2>\n"
              << "<p>Times in ms (median, min, max over the repetitions); error against the "
-                "reference "
-                "render; &mdash; = not measured. Failed jobs in red with their error.</p>\n";
-        appendResultsTable(html, jobs, columns);
-        html << "<h2 id=\"images\">Images</h2>\n<p>Tone-mapped render, lights evaluated per pixel, "
-                "and "
-                "|render &minus; reference| per job; click for the full-size image.</p>\n";
-        appendThumbnails(html, dir, jobs, options.thumbnailWidth);
+                "reference render; &mdash; = not measured. Failed jobs in red with their "
+                "error.</p>\n";
+        appendResultsTable(html, jobs, columns, varyingMethods, groups, options.errorMetric);
         html << "<pre id=\"page-check\" data-status=\"pending\">PAGE-CHECK: "
                 "PENDING</pre>\n</body>\n</html>\n";
         writeTextAtomically(dir / "report.html", html.str());

@@ -2,28 +2,44 @@
 // DIR/jobs/<job_id>/, see experiments/sweeps and the sweep runner) into one HTML page,
 // DIR/report.html, with everything it shows under DIR/report/:
 //   report/published.json     the published-vs-measured tables (input of the plot script)
-//   report/plots.json         the plot script's manifest: plots drawn and plots skipped (why)
-//   report/*.png              matplotlib plots (experiments/plots/report.py): time against error
-//                             per stage and per encoding with the Pareto front, light evaluations,
-//                             culling efficiency and time against light count, published and
-//                             measured ratios
-//   report/thumbs/*.png       thumbnails of every job's preview.png, heatmap.png and error.png
+//   report/groups.json        the comparable groups (input of the plot script, see below)
+//   report/plots.json         the plot script's manifest: plots drawn and plots skipped (why),
+//                             each with its group ("" for plots across groups) and kind
+//   report/*.png              matplotlib plots (experiments/plots/report.py): per group, time
+//                             against error with the Pareto front and the timing spread as error
+//                             bars, bytes per pixel against error; across groups, light
+//                             evaluations, culling efficiency and time against light count and
+//                             time against resolution; published and measured ratios
+//   report/maps/*.png         every job's heatmap, error and ꟻLIP map redrawn at its group's one
+//                             scale (from render.exr), and report/thumbs/*.png thumbnails
 // The page references these (and the full-size job images) by relative paths, so DIR can be
-// moved or copied as a whole; it loads nothing from the network and carries one small inline
-// script that records image-load and script errors into the element #page-check (the headless
-// Chromium test reads it).
+// moved or copied as a whole; it loads nothing from the network and carries two small inline
+// scripts: one records image-load and script errors into #page-check (the headless Chromium test
+// reads it), one toggles the results table between the columns a reader compares and all.
+//
+// Comparable groups: jobs are compared (Pareto fronts, shared map scales) only with jobs of the
+// same group: the same value of every setting that is not a method column (method columns:
+// stage, layout, normals, normal-space, depth, position; everything else -- scene, scene
+// options, lights, seed, width, height, threads, repetitions, warmup, and any setting added
+// later -- makes the group). Jobs of different sizes are never pooled. Plots across groups (vs
+// light count, vs resolution) draw one line per method and one plot per remaining context, and
+// say which settings vary with the x axis; any median says over which jobs it is taken.
 //
 // Published figures: every entry of results.json's sweep.published becomes a table with, per
 // cell, the published value, the measured value, and both ratios to the baseline column
 // (ratio_to, default 0). A job matches a cell when, for every key of the row's and the column's
 // "select", the job's value equals the selected one compared as text after normalising numbers
 // (1500 == "1500" == 1500.0); only jobs with status "ok" count; several matches give the median
-// of the metric; a metric given as a list of columns is the sum of those columns per job (a job
-// missing any of them counts as missing).
+// of the metric, and the cell names the settings those jobs differ in; a metric given as a list
+// of columns is the sum of those columns per job (a job missing any of them counts as missing).
 //
-// Errors: a missing or malformed results.json, a missing python3 with matplotlib, or a failing
-// plot script give one line "testbed: error: ..." and exit code 1. Every file is written through
-// AtomicFile (the plot script writes to a temporary name and renames, too).
+// ꟻLIP: the results carry a flip column (FlipMetric.h); when it is null the page says why
+// (flip_unavailable) in a visible note, and plots of flip are skipped with that reason.
+//
+// Errors: a missing or malformed results.json, a missing python3 with matplotlib, a failing
+// plot script or an unknown --error-metric give one line "testbed: error: ..." and exit code 1.
+// Every file is written through AtomicFile (the plot script writes to a temporary name and
+// renames, too).
 //
 // Thread safety: the functions share no state.
 #pragma once
@@ -35,6 +51,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/ImageOutput.h"
 #include "experiments/PlotScript.h"
 
 namespace experiments {
@@ -45,7 +62,31 @@ struct ReportCommandOptions {
     std::string python;                // empty = the first of /usr/bin/python3, python3 that
                                        // imports matplotlib
     int thumbnailWidth = 192;          // pixels; thumbnails keep the image's aspect ratio
+    std::string errorMetric = "relative_rmse"; // the y axis of the Pareto plots (an error column)
+    std::optional<MapScale> errorScale;        // the error maps' scale; default: the sweep's
 };
+
+// The error columns --error-metric accepts; psnr is the one where higher is better.
+std::vector<std::string> reportErrorMetrics();
+
+// Settings that name a method (what a group compares); every other setting makes the group.
+bool isMethodColumn(const std::string& column);
+
+// The axis columns of a results object: its "axis_columns", else (older or hand-made results)
+// the columns that are neither metrics nor job_id/status/error.
+std::vector<std::string> axisColumnsOf(const nlohmann::json& results);
+
+struct JobGroup {
+    std::string id;               // "g1", "g2", ... in the order of the jobs' first appearance
+    std::string label;            // e.g. "atrium, 256 lights, 320x180, 2 threads"
+    nlohmann::ordered_json fixed; // {column: value} of every grouping column, in axis order
+    std::vector<size_t> jobs;     // indices into the jobs array, in order
+};
+
+// The comparable groups of jobs (every job, failed ones included): equal normalised values of
+// every axis column that is not a method column nor "resolution" (width and height carry it).
+std::vector<JobGroup> comparableGroups(const nlohmann::json& jobs,
+                                       const std::vector<std::string>& axisColumns);
 
 // The text a value is compared as when matching "select" entries: numbers (and strings that
 // parse completely as numbers) in their shortest round-trip form with integers printed without
@@ -67,11 +108,14 @@ std::optional<double> median(std::vector<double> values);
 //   { "title", "source", "metric" (as given), "metric_label", "finding", "ratio_to",
 //     "columns": [labels...],
 //     "rows": [ { "label", "cells": [ { "published", "measured", "published_ratio",
-//                                       "measured_ratio", "matched_jobs" } ] } ] }
+//                                       "measured_ratio", "matched_jobs", "differ_in" } ] } ] }
+// where differ_in lists the columns of `axisColumns` whose values differ among the matched jobs
+// (what the median is taken over; empty when they agree or only one matched).
 // with null for anything unknown (not published, no matching job, baseline missing or zero).
 // Throws std::runtime_error naming the entry and the field when the entry is malformed (no
 // columns, a row whose values do not have one entry per column, ratio_to out of range, ...).
-nlohmann::json comparePublished(const nlohmann::json& published, const nlohmann::json& jobs);
+nlohmann::json comparePublished(const nlohmann::json& published, const nlohmann::json& jobs,
+                                const std::vector<std::string>& axisColumns = {});
 
 // Writes DIR/report.html and DIR/report/; returns the exit code (0 on success). Prints the
 // path of the page on stdout; errors go to stderr as "testbed: error: ...".

@@ -26,10 +26,12 @@ OIIO::ImageBuf toImageBuf(const lighting::StageResult& image) {
     return buffer;
 }
 
-uint64_t sum(const std::vector<uint32_t>& counts) {
+// The sum of counts over the pixels marked in mask (every pixel when mask is empty).
+uint64_t sum(const std::vector<uint32_t>& counts, const std::vector<uint8_t>& mask) {
     uint64_t total = 0;
-    for (uint32_t count : counts)
-        total += count;
+    for (size_t i = 0; i < counts.size(); ++i)
+        if (mask.empty() || mask[i])
+            total += counts[i];
     return total;
 }
 
@@ -90,13 +92,24 @@ void addRepetition(std::vector<PassTiming>& passes,
 }
 
 RunMetrics measureRun(std::vector<PassTiming> passes, const std::vector<uint32_t>& evaluated,
-                      const std::vector<uint32_t>& oracle, double bytesPerPixel,
-                      double allocatedBytesPerPixel, std::optional<ErrorMetrics> error) {
+                      const std::vector<uint32_t>& oracle, const std::vector<uint8_t>& litPixels,
+                      double bytesPerPixel, double allocatedBytesPerPixel,
+                      std::optional<ErrorMetrics> error) {
     RunMetrics metrics;
     metrics.stage = stageTiming(passes);
     metrics.passes = std::move(passes);
-    metrics.lightEvaluations = sum(evaluated);
-    metrics.oracleLightEvaluations = sum(oracle);
+    metrics.lightEvaluations = sum(evaluated, litPixels);
+    metrics.oracleLightEvaluations = sum(oracle, litPixels);
+    metrics.countedPixels = litPixels.empty()
+                                ? uint64_t(evaluated.size())
+                                : uint64_t(std::count(litPixels.begin(), litPixels.end(), 1));
+    if (metrics.countedPixels < evaluated.size())
+        metrics.lightCountsNote =
+            "the stage lights " + std::to_string(metrics.countedPixels) + " of the " +
+            std::to_string(evaluated.size()) +
+            " pixels (its reduced-resolution samples) and filters the rest; light evaluations "
+            "and the oracle are both counted over those pixels, so culling efficiency compares "
+            "the same samples";
     metrics.cullingEfficiency =
         metrics.lightEvaluations > 0
             ? double(metrics.oracleLightEvaluations) / double(metrics.lightEvaluations)
@@ -115,16 +128,19 @@ std::vector<NamedFigure> RunMetrics::errorFigures() const {
             {metric::kPsnr, error->psnr},
             {metric::kMaxAbs, error->maxAbs},
             {metric::kRelativeMean, error->relativeMean},
-            {metric::kP99Abs, error->p99Abs}};
+            {metric::kP99Abs, error->p99Abs},
+            {metric::kFlip, error->flip ? *error->flip : std::numeric_limits<double>::quiet_NaN()}};
 }
 
 std::vector<std::string> runFigureColumns() {
     std::vector<std::string> columns = {metric::kLightEvaluations, metric::kOracleLightEvaluations,
-                                        metric::kCullingEfficiency, metric::kBytesPerPixel};
+                                        metric::kCullingEfficiency, metric::kCountedPixels,
+                                        metric::kBytesPerPixel};
     RunMetrics withError;
     withError.error = ErrorMetrics{};
     for (const NamedFigure& figure : withError.errorFigures())
         columns.push_back(figure.name);
+    columns.push_back(metric::kFlipUnavailable);
     return columns;
 }
 

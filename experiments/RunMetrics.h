@@ -11,9 +11,14 @@
 //                 what papers that exclude the G-buffer pass report (Örtegren's "Total").
 //   light evaluations   lights the stage evaluated, summed over pixels; the oracle's count is the
 //                 lights that contribute (DESIGN.md); culling efficiency = oracle / evaluated (1
-//                 when nothing was evaluated).
+//                 when nothing was evaluated). Both are summed over the same pixels: every pixel,
+//                 or for a stage that lights at reduced resolution (inferred) the pixels it lit
+//                 (StageResult::lightingSamples); counted_pixels says how many, and
+//                 light_counts_note says why when that is not the whole image.
 //   bytes per pixel     the layout's bits as a GPU packs them, and what this run allocates.
-//   error         against the double-precision reference, when compared (compareImages).
+//   error         against the double-precision reference, when compared (compareImages), and
+//                 the mean HDR-ꟻLIP (FlipMetric.h), null with flip_unavailable saying why when
+//                 the package is missing.
 // Thread safety: values; compareImages runs ImageBufAlgo on the calling thread's pool.
 #pragma once
 
@@ -32,6 +37,7 @@ namespace metric {
 inline constexpr const char* kLightEvaluations = "light_evaluations";
 inline constexpr const char* kOracleLightEvaluations = "oracle_light_evaluations";
 inline constexpr const char* kCullingEfficiency = "culling_efficiency";
+inline constexpr const char* kCountedPixels = "counted_pixels";
 inline constexpr const char* kBytesPerPixel = "bytes_per_pixel";
 inline constexpr const char* kAllocatedBytesPerPixel = "allocated_bytes_per_pixel";
 inline constexpr const char* kRmse = "rmse";
@@ -40,6 +46,8 @@ inline constexpr const char* kPsnr = "psnr";
 inline constexpr const char* kMaxAbs = "max_abs";
 inline constexpr const char* kRelativeMean = "relative_mean";
 inline constexpr const char* kP99Abs = "p99_abs";
+inline constexpr const char* kFlip = "flip";
+inline constexpr const char* kFlipUnavailable = "flip_unavailable";
 } // namespace metric
 
 // Passes the runner adds around the stage's (lighting/PassNames.h has the frame's passes).
@@ -53,9 +61,11 @@ struct ErrorMetrics {
     double rmse = 0.0;
     double relativeRmse = 0.0; // rmse / rms of the reference
     double maxAbs = 0.0;
-    double psnr = 0.0;         // dB, peak = the reference's maximum channel value
-    double relativeMean = 0.0; // mean |image - reference| / mean |reference|
-    double p99Abs = 0.0;       // 99th percentile of |image - reference|
+    double psnr = 0.0;           // dB, peak = the reference's maximum channel value
+    double relativeMean = 0.0;   // mean |image - reference| / mean |reference|
+    double p99Abs = 0.0;         // 99th percentile of |image - reference|
+    std::optional<double> flip;  // mean HDR-ꟻLIP (FlipMetric.h); nullopt when not computed
+    std::string flipUnavailable; // why flip is missing ("" when computed)
 };
 
 ErrorMetrics compareImages(const lighting::StageResult& image,
@@ -81,15 +91,18 @@ struct RunMetrics {
     PassTiming stage;               // pass::kStage; no samples when the stage reports no pass
     double oracleMs = 0.0;          // measurement, not part of the stage
     double referenceMs = 0.0;
+    double flipMs = 0.0;
     uint64_t lightEvaluations = 0;
     uint64_t oracleLightEvaluations = 0;
     double cullingEfficiency = 1.0;
+    uint64_t countedPixels = 0;  // pixels the two counts are summed over
+    std::string lightCountsNote; // why countedPixels is not the whole image ("" when it is)
     double bytesPerPixel = 0.0;
     double allocatedBytesPerPixel = 0.0;
     std::optional<ErrorMetrics> error;
 
-    // rmse, relative_rmse, psnr, max_abs, relative_mean, p99_abs (empty without a reference);
-    // psnr is +inf for identical images.
+    // rmse, relative_rmse, psnr, max_abs, relative_mean, p99_abs, flip (empty without a
+    // reference); psnr is +inf for identical images, flip NaN when unavailable.
     std::vector<NamedFigure> errorFigures() const;
 };
 
@@ -99,14 +112,16 @@ void addRepetition(std::vector<PassTiming>& passes,
                    const std::vector<std::pair<std::string, double>>& repetition);
 
 // The metrics of a run from what it measured: the timed passes, the per-pixel counts of the
-// stage and the oracle, the layout's sizes, and the error when compared.
+// stage and the oracle, the pixels the stage lit (StageResult::lightingSamples; empty = all), the
+// layout's sizes, and the error when compared.
 RunMetrics measureRun(std::vector<PassTiming> passes, const std::vector<uint32_t>& evaluated,
-                      const std::vector<uint32_t>& oracle, double bytesPerPixel,
-                      double allocatedBytesPerPixel, std::optional<ErrorMetrics> error);
+                      const std::vector<uint32_t>& oracle, const std::vector<uint8_t>& litPixels,
+                      double bytesPerPixel, double allocatedBytesPerPixel,
+                      std::optional<ErrorMetrics> error);
 
 // The sweep's metric column names that a RunMetrics fills, after the time columns, in table order:
-// light_evaluations, oracle_light_evaluations, culling_efficiency, bytes_per_pixel, then the
-// error figures.
+// light_evaluations, oracle_light_evaluations, culling_efficiency, counted_pixels,
+// bytes_per_pixel, then the error figures and flip_unavailable (text).
 std::vector<std::string> runFigureColumns();
 
 } // namespace experiments

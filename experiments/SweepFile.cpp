@@ -22,8 +22,8 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 const std::vector<std::string> kTopLevelKeys = {
-    "name",   "description", "notes",     "fixed", "axes",     "cases",
-    "warmup", "repetitions", "reference", "quick", "published"};
+    "name",        "description", "notes", "fixed",     "axes",        "cases",     "warmup",
+    "repetitions", "reference",   "quick", "published", "heatmap-max", "error-max", "error-scale"};
 const std::vector<std::string> kQuickKeys = {"fixed",  "axes",        "cases",
                                              "warmup", "repetitions", "reference"};
 // Settings the runner applies itself (RenderOptions fields that setRenderOption may not know).
@@ -381,6 +381,30 @@ SweepSpec parseSweep(const Json& object, const std::string& origin) {
                                                    keys.push_back("'" + key + "'");
                                                return keys;
                                            }())));
+    if (object.contains("heatmap-max")) {
+        const Json& value = object["heatmap-max"];
+        if (!value.is_number_integer() || value.get<int64_t>() < 0 ||
+            value.get<int64_t>() > int64_t(kMaxLights))
+            fail(origin, "'heatmap-max' must be a light count 0.." + std::to_string(kMaxLights) +
+                             " (0 = each image's maximum), got " + value.dump());
+        spec.heatmapMax = value.get<uint32_t>();
+    }
+    if (object.contains("error-max")) {
+        const Json& value = object["error-max"];
+        if (!value.is_number() || !(value.get<double>() >= 0.0) ||
+            !std::isfinite(value.get<double>()))
+            fail(origin,
+                 "'error-max' must be a number >= 0 (0 = each image's largest error), got " +
+                     value.dump());
+        spec.errorMax = value.get<double>();
+    }
+    if (object.contains("error-scale")) {
+        const Json& value = object["error-scale"];
+        if (!value.is_string() ||
+            (value.get<std::string>() != "linear" && value.get<std::string>() != "log"))
+            fail(origin, "'error-scale' must be \"linear\" or \"log\", got " + value.dump());
+        spec.errorScale = parseMapScale(value.get<std::string>());
+    }
     checkDisjoint(spec, "");
     std::set<std::string> keys = settingKeys(spec);
     if (object.contains("quick")) {
@@ -541,6 +565,9 @@ SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads) {
     expansion.mWarmup = effective.warmup;
     expansion.mRepetitions = effective.repetitions;
     expansion.mReference = effective.reference;
+    expansion.mHeatmapMax = spec.heatmapMax;
+    expansion.mErrorScale = spec.errorScale;
+    expansion.mErrorMax = spec.errorMax;
     // Counted in double: twenty axes of 10 values would overflow any integer product. The total
     // is known before any job is made, so a typo'd axis is refused without allocating.
     double combinations = 1.0;
@@ -654,6 +681,9 @@ SweepJob SweepExpansion::jobAtOrdinal(size_t ordinal) const {
     job.options.warmup = mWarmup;
     job.options.repetitions = mRepetitions;
     job.compareReference = mReference;
+    job.heatmapMax = mHeatmapMax;
+    job.errorScale = mErrorScale;
+    job.errorMax = mErrorMax;
     for (const SweepSetting& s : job.settings)
         applySetting(job.options, s);
     job.referenceKey = referenceKeyOf(job.options);
@@ -669,7 +699,10 @@ Json sweepJobJson(const SweepJob& job) {
                 {"settings", settings},
                 {"warmup", job.options.warmup},
                 {"repetitions", job.options.repetitions},
-                {"reference", job.compareReference}};
+                {"reference", job.compareReference},
+                {"heatmap_max", job.heatmapMax},
+                {"error_scale", mapScaleName(job.errorScale)},
+                {"error_max", job.errorMax}};
 }
 
 SweepJob sweepJobFromJson(const Json& json) {
@@ -680,6 +713,9 @@ SweepJob sweepJobFromJson(const Json& json) {
         job.options.warmup = json.at("warmup").get<int>();
         job.options.repetitions = json.at("repetitions").get<int>();
         job.compareReference = json.at("reference").get<bool>();
+        job.heatmapMax = json.at("heatmap_max").get<uint32_t>();
+        job.errorScale = parseMapScale(json.at("error_scale").get<std::string>());
+        job.errorMax = json.at("error_max").get<double>();
         for (const Json& setting : json.at("settings"))
             job.settings.push_back({setting.at("key").get<std::string>(), setting.at("value")});
         for (const SweepSetting& s : job.settings)
@@ -687,6 +723,8 @@ SweepJob sweepJobFromJson(const Json& json) {
     } catch (const nlohmann::json::exception& e) {
         throw SweepError(std::string("malformed sweep job: ") + e.what());
     } catch (const UsageError& e) {
+        throw SweepError(std::string("sweep job: ") + e.what());
+    } catch (const std::invalid_argument& e) { // parseMapScale
         throw SweepError(std::string("sweep job: ") + e.what());
     }
     job.referenceKey = referenceKeyOf(job.options);

@@ -8,6 +8,8 @@
 //   reference: true|false         measure the error against the reference image (default true)
 //   quick: {fixed, axes, cases, warmup, repetitions, reference}   overrides for `--quick`
 //   published: [...]              published figures of a reproduction (schema in the README)
+//   heatmap-max, error-scale, error-max   scales of every job's heatmap.png and error.png (and
+//                                 of the report's maps): display only, not part of a job's id
 // Keys are the names experiments::setRenderOption accepts (scene, stage, lights, seed, width,
 // height, resolution, threads, layout, normals, normal-space, depth, position, scene-option.KEY:
 // whatever renderOptionKeys() lists) plus warmup and repetitions. Values are strings or numbers
@@ -39,6 +41,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/ImageOutput.h"
 #include "experiments/RenderOptions.h"
 
 namespace experiments {
@@ -68,6 +71,11 @@ struct SweepSpec {
     int warmup = 0;
     int repetitions = 1;
     bool reference = true;
+    // Scales of the false-colour images of every job (RenderCommand.h RenderOutputScales): the
+    // same for all jobs, so that their images compare side by side. 0 = each image's own maximum.
+    uint32_t heatmapMax = 0;
+    MapScale errorScale = MapScale::Linear;
+    double errorMax = 0.0;
 };
 
 // Reads FILE (.toml as TOML, anything else as JSON) and checks its structure. Throws SweepError
@@ -93,6 +101,10 @@ struct SweepJob {
     RenderOptions options;              // settings applied through setRenderOption
     bool compareReference = true;
     std::string referenceKey; // filesystem-safe, e.g. "wall-1280x720-1500l-s1-9f3a0c11"
+    // The spec's map scales (SweepSpec), the same for every job: display only, not in the id.
+    uint32_t heatmapMax = 0;
+    MapScale errorScale = MapScale::Linear;
+    double errorMax = 0.0;
 };
 
 // The jobs of a sweep, made on demand: the expansion keeps the sweep's settings and one 4-byte
@@ -135,6 +147,9 @@ private:
     int mWarmup = 0;
     int mRepetitions = 1;
     bool mReference = true;
+    uint32_t mHeatmapMax = 0; // the spec's map scales, copied into every job
+    MapScale mErrorScale = MapScale::Linear;
+    double mErrorMax = 0.0;
     std::vector<std::string> mAxisColumns;
     std::vector<uint32_t> mOrdinalAt; // run position -> ordinal
 };

@@ -117,9 +117,12 @@ Json metricColumnsOf(const RunMetrics& metrics) {
     row[metric::kLightEvaluations] = metrics.lightEvaluations;
     row[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
     row[metric::kCullingEfficiency] = metrics.cullingEfficiency;
+    row[metric::kCountedPixels] = metrics.countedPixels;
     row[metric::kBytesPerPixel] = metrics.bytesPerPixel;
     for (const NamedFigure& figure : metrics.errorFigures())
         row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
+    if (metrics.error)
+        row[metric::kFlipUnavailable] = metrics.error->flipUnavailable;
     return row;
 }
 
@@ -130,7 +133,7 @@ Json runSweepJob(const SweepJob& job, const fs::path& jobDir, ReferenceStore& re
     RenderOptions options = job.options;
     options.compareReference = job.compareReference;
     const RenderRun run = runRender(planRender(options), {}, referenceImage);
-    writeRenderOutputs(run, jobDir, 0);
+    writeRenderOutputs(run, jobDir, {job.heatmapMax, job.errorScale, float(job.errorMax)});
     return metricColumnsOf(run.metrics);
 }
 

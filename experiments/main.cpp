@@ -71,8 +71,22 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
     render.add_option("--out", options.out, "output folder")->capture_default_str();
     render
-        .add_option("--heatmap-max", options.heatmapMax,
+        .add_option("--heatmap-max", options.scales.heatmapMax,
                     "light count at the top of the heatmap scale, 0 = the image's maximum")
+        ->capture_default_str();
+    render
+        .add_option_function<std::string>(
+            "--error-scale",
+            [&options](const std::string& text) {
+                options.scales.errorScale = experiments::parseMapScale(text);
+            },
+            "scale of error.png: linear (0 to the maximum) or log (4 decades below the maximum, "
+            "so that one outlier does not darken the rest)")
+        ->check(CLI::IsMember({"linear", "log"}))
+        ->default_str("linear");
+    render
+        .add_option("--error-max", options.scales.errorMax,
+                    "error at the top of error.png's scale, 0 = the image's largest error")
         ->capture_default_str();
     render.add_flag("--compare-reference", r.compareReference,
                     "also render the double-precision reference and record the error");
@@ -157,6 +171,20 @@ int main(int argc, char** argv) {
     report
         ->add_option("--thumbnail-width", reportOptions.thumbnailWidth, "thumbnail width in pixels")
         ->capture_default_str();
+    report
+        ->add_option("--error-metric", reportOptions.errorMetric,
+                     "y axis of the Pareto plots: relative_rmse, rmse, flip, psnr, max_abs, "
+                     "relative_mean or p99_abs")
+        ->capture_default_str();
+    report
+        ->add_option_function<std::string>(
+            "--error-scale",
+            [&reportOptions](const std::string& text) {
+                reportOptions.errorScale = experiments::parseMapScale(text);
+            },
+            "scale of the error maps: linear or log (default: the sweep file's error-scale, else "
+            "linear)")
+        ->check(CLI::IsMember({"linear", "log"}));
     experiments::DiffCommandOptions diffOptions;
     CLI::App* diff =
         app.add_subcommand("diff", "image-diff report of two EXRs (B is the reference)");

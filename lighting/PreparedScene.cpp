@@ -31,6 +31,16 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
 void PreparedScene::renderGBuffer() {
     gbufferTimings = mPass->render(*mRasterizer, *gbuffer, exact.get());
     rasterStats = mRasterizer->lastStats();
+    exactSurfacePasses += exact ? 1 : 0;
+}
+
+void PreparedScene::addExactSurface() {
+    if (exact)
+        return;
+    exact = std::make_unique<gbuffer::ExactSurface>();
+    mPass->render(*mRasterizer, *gbuffer, exact.get());
+    ++exactSurfacePasses;
+    inputs.exact = exact.get();
 }
 
 std::unique_ptr<gbuffer::GBuffer> PreparedScene::renderLosslessGBuffer() {

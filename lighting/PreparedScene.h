@@ -32,6 +32,7 @@ struct PreparedScene {
     StageInputs inputs;
     raster::RasterStats rasterStats;
     gbuffer::GBufferPassTimings gbufferTimings;
+    int exactSurfacePasses = 0; // G-buffer passes so far that also computed the exact surface
 
     // Renders `scene` from its first camera at width x height into `layout`; the view's depth
     // convention and far plane follow the layout's depth format.
@@ -44,6 +45,11 @@ struct PreparedScene {
     // Rasterizes the G-buffer (and the exact surface, if any) again: for timing repetitions.
     // The result is bitwise the same; gbufferTimings and rasterStats are replaced.
     void renderGBuffer();
+    // Computes the exact surface when the scene was prepared without it (one more G-buffer pass,
+    // writing the same G-buffer bitwise; gbufferTimings and rasterStats keep the last timed
+    // pass's values). The runner calls it after the timed repetitions, for the reference only,
+    // so that the reference's work never lands in the stage's timed G-buffer pass.
+    void addExactSurface();
     // A G-buffer of the same view in the lossless reference layout (float32 depth in the view's
     // convention): what forward stages shade, for measurements on frames whose layout lacks
     // channels. Costs one more G-buffer pass.

@@ -10,6 +10,7 @@ void StageResult::resize(int w, int h, bool withOracle) {
         plane.assign(n, 0.0f);
     lightsEvaluated.assign(n, 0);
     lightsOracle.assign(withOracle ? n : 0, 0);
+    lightingSamples.clear();
     timingsMs.clear();
     parameters.clear();
 }

@@ -40,6 +40,8 @@
 //   - lightsOracle: either left empty (resize(..., false): the runner counts the contributing
 //     lights itself, lighting/Oracle.h) or, when the stage evaluates every light anyway, the
 //     number of lights with non-zero radiance at every pixel.
+//   - lightingSamples: left empty, except by a stage that evaluates lights at some pixels only
+//     and fills the others from them (inferred): 1 at the pixels it lit, 0 elsewhere.
 //   - timingsMs: one entry per pass the stage runs, in execution order, with short lowercase
 //     names ("cull", "shading"...), measured with millisecondsSince; not the G-buffer pass (the
 //     runner adds "gbuffer" and "total").
@@ -100,11 +102,16 @@ struct StageResult {
     std::vector<uint32_t> lightsEvaluated; // per pixel: lights the stage evaluated
     std::vector<uint32_t> lightsOracle;    // per pixel: lights that contribute; empty when the
                                            // stage cannot know (the runner then computes it)
+    // Stages that light at reduced resolution (inferred): 1 at the full-res pixels whose lights
+    // the stage evaluated (its L-buffer samples), 0 at the pixels it only filtered; empty for
+    // every other stage (all pixels). The runner counts evaluated and oracle lights over these
+    // pixels only, so that culling efficiency compares the same samples.
+    std::vector<uint8_t> lightingSamples;
     std::vector<std::pair<std::string, double>> timingsMs; // per pass, in execution order
     std::map<std::string, std::string> parameters;         // the stage's effective options
 
     // Sizes every plane to w x h, zero-filled (lightsOracle empty unless withOracle), and clears
-    // timingsMs and parameters.
+    // lightingSamples, timingsMs and parameters.
     void resize(int w, int h, bool withOracle);
 };
 

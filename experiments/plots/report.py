@@ -3,14 +3,22 @@
 
 Called by the C++ commands, not by hand (but it can be, for debugging):
 
-  report.py results --results DIR/results.json --published DIR/report/published.json --out DIR/report
-      Plots of a sweep's results (see experiments/ReportCommand.h): time against error per stage
-      and per encoding with the Pareto front marked, error against bytes per G-buffer pixel,
-      light evaluations / culling efficiency / time against light count and time against pixel
-      count per stage, and published against measured ratios. Writes OUT/<name>.png and the
-      manifest OUT/plots.json: {"plots": [{"file", "title", "caption"}],
-      "skipped": [{"title", "reason"}]} -- a plot whose axes would hold fewer than two distinct
-      values is not drawn but listed under "skipped".
+  report.py results --results DIR/results.json --published DIR/report/published.json
+            --groups DIR/report/groups.json [--error-metric relative_rmse] --out DIR/report
+      Plots of a sweep's results (see experiments/ReportCommand.h). groups.json (written by the
+      report command) lists the comparable groups: jobs with the same value of every setting but
+      the method columns (stage, layout, normals, ...). Per group: time against the error metric
+      with the Pareto front and the repetitions' min-max time as error bars ("pareto"), and bytes
+      per G-buffer pixel against the error ("bytes") when the group's layouts differ in size.
+      Across groups: light evaluations, culling efficiency and time against the light count, and
+      time against the pixel count ("vs_lights", "vs_pixels"), one line per method and one plot per
+      context (the grouping settings other than the x axis's; a setting that changes together
+      with x, like a sweep case's lights and lights behind the wall, is named in the caption, not
+      split). Points are single jobs; a point that is a median says over which jobs. Published
+      against measured ratios ("published"). Writes OUT/<name>.png and the manifest
+      OUT/plots.json: {"plots": [{"file", "title", "caption", "group", "kind"}],
+      "skipped": [{"title", "reason", "group", "kind"}]} -- group is a group id or "" for plots
+      across groups; a plot without data to compare is listed under "skipped" with the reason.
 
   report.py diff --raw FILE --width W --height H --vmax V --out PNG [--title T]
       False-colour image of a per-pixel absolute difference (FILE: W*H little-endian float32,
@@ -36,7 +44,19 @@ import matplotlib  # noqa: E402 (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 TIME = "time_total_median_ms"
-ERROR = "rmse"
+TIME_MIN = "time_total_min_ms"
+TIME_MAX = "time_total_max_ms"
+# Error columns where a larger value is better (the Pareto front then keeps the largest).
+HIGHER_IS_BETTER = {"psnr"}
+ERROR_LABELS = {
+    "relative_rmse": "relative RMSE against the reference (RMSE / RMS of the reference)",
+    "rmse": "RMSE against the reference (linear radiance)",
+    "flip": "HDR-FLIP against the reference (mean, 0..1)",
+    "psnr": "PSNR against the reference (dB, higher is better)",
+    "max_abs": "largest absolute error against the reference",
+    "relative_mean": "mean absolute error / mean of the reference",
+    "p99_abs": "99th percentile of the absolute error",
+}
 DPI = 100
 # Colour-vision-friendly palette (Okabe & Ito 2008), then matplotlib's tab10 for more groups.
 PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442",
@@ -64,12 +84,13 @@ class Report:
         self.plots = []
         self.skipped = []
 
-    def save(self, fig, name, title, caption):
+    def save(self, fig, name, title, caption, group="", kind=""):
         save_png(fig, os.path.join(self.out, name + ".png"), dpi=DPI)
-        self.plots.append({"file": name + ".png", "title": title, "caption": caption})
+        self.plots.append({"file": name + ".png", "title": title, "caption": caption,
+                           "group": group, "kind": kind})
 
-    def skip(self, title, reason):
-        self.skipped.append({"title": title, "reason": reason})
+    def skip(self, title, reason, group="", kind=""):
+        self.skipped.append({"title": title, "reason": reason, "group": group, "kind": kind})
 
     def manifest(self):
         return json.dumps({"plots": self.plots, "skipped": self.skipped}, indent=2) + "\n"
@@ -90,90 +111,185 @@ def pareto_front(points):
     return front
 
 
-def series_key(job, columns, by, scenes_vary):
-    key = text(job.get(by))
-    if scenes_vary and by != "scene":
-        key += " @ " + text(job.get("scene"))
-    return key
-
-
 def colour_of(index):
     return PALETTE[index % len(PALETTE)]
 
 
-def scatter_with_front(report, jobs, by, name, x_column, x_label, title, caption_extra):
-    points = [(number(j.get(x_column)), number(j.get(ERROR)), text(j.get(by))) for j in jobs]
-    points = [p for p in points if p[0] is not None and p[1] is not None]
-    for axis, column in ((0, x_column), (1, ERROR)):
-        if len({p[axis] for p in points}) < 2:
-            report.skip(title, "fewer than two distinct values of %s among the jobs with %s and %s"
-                        % (column, x_column, ERROR))
-            return
-    groups = sorted({g for _, _, g in points})
+def method_label(job, method_columns):
+    """The job's method inside its group: the varying method columns, stage first."""
+    parts = [text(job.get("stage"))]
+    parts += ["%s %s" % (c, text(job.get(c))) for c in method_columns if c != "stage"]
+    return ", ".join(parts)
+
+
+def repetitions_note(jobs):
+    counts = sorted({int(number(j.get("repetitions"))) for j in jobs
+                     if number(j.get("repetitions")) is not None})
+    if not counts:
+        return "the repetitions' min-max total time"
+    return "min-max of the total time over %s repetition%s" % (
+        "/".join(str(c) for c in counts), "" if counts == [1] else "s")
+
+
+def pareto_plot(report, group, jobs, metric, method_columns, x_column=TIME, kind="pareto"):
+    """Time (or bytes) against the error metric inside one comparable group, with its front."""
+    gid, label = group["id"], group["label"]
+    what = "Time" if x_column == TIME else "Bytes per pixel"
+    title = "%s against %s, group %s: %s" % (what, metric, gid, label)
+    points = []
+    missing = []
+    for job in jobs:
+        x, y = number(job.get(x_column)), number(job.get(metric))
+        if x is None or y is None:
+            missing.append(job)
+            continue
+        low, high = number(job.get(TIME_MIN)), number(job.get(TIME_MAX))
+        points.append({"x": x, "y": y, "label": method_label(job, method_columns),
+                       "low": low if low is not None else x, "high": high if high is not None else x})
+    if len(points) < 2:
+        reasons = sorted({text(j.get("flip_unavailable")) for j in missing
+                          if metric == "flip" and j.get("flip_unavailable")})
+        report.skip(title, "%d job%s of the group with both %s and %s: nothing to compare%s" % (
+            len(points), "" if len(points) == 1 else "s", x_column, metric,
+            " (flip unavailable: %s)" % "; ".join(reasons) if reasons else ""), gid, kind)
+        return
+    sign = -1.0 if metric in HIGHER_IS_BETTER else 1.0
+    front = pareto_front([(p["x"], sign * p["y"]) for p in points])
+    front = [(x, sign * y) for x, y in front]
+    labels = []
+    for p in points:
+        if p["label"] not in labels:
+            labels.append(p["label"])
     fig, ax = plt.subplots(figsize=(7.2, 4.8))
-    for i, group in enumerate(groups):
-        xs = [x for x, _, g in points if g == group]
-        ys = [y for _, y, g in points if g == group]
-        ax.scatter(xs, ys, label=group, color=colour_of(i), marker=MARKERS[i % len(MARKERS)],
-                   s=36, alpha=0.85, zorder=3)
-    front = pareto_front([(x, y) for x, y, _ in points])
+    spread = False
+    for i, label_text in enumerate(labels):
+        mine = [p for p in points if p["label"] == label_text]
+        xs, ys = [p["x"] for p in mine], [p["y"] for p in mine]
+        if x_column == TIME:
+            lows = [max(0.0, p["x"] - p["low"]) for p in mine]
+            highs = [max(0.0, p["high"] - p["x"]) for p in mine]
+            spread = spread or any(v > 0 for v in lows + highs)
+            ax.errorbar(xs, ys, xerr=[lows, highs], fmt="none", ecolor=colour_of(i), elinewidth=1,
+                        capsize=3, alpha=0.8, zorder=2)
+        ax.scatter(xs, ys, label=label_text, color=colour_of(i), marker=MARKERS[i % len(MARKERS)],
+                   s=36, alpha=0.9, zorder=3)
     ax.step([x for x, _ in front], [y for _, y in front], where="post", color="0.3",
-            linestyle="--", linewidth=1, zorder=2, label="Pareto front")
+            linestyle="--", linewidth=1, zorder=1, label="Pareto front")
     ax.scatter([x for x, _ in front], [y for _, y in front], s=110, facecolors="none",
                edgecolors="0.1", linewidths=1.2, zorder=4)
-    if log_scale_fits([x for x, _, _ in points]):
+    if log_scale_fits([p["x"] for p in points]):
         ax.set_xscale("log")
-    if log_scale_fits([y for _, y, _ in points]):
+    if metric not in HIGHER_IS_BETTER and log_scale_fits([p["y"] for p in points]):
         ax.set_yscale("log")
-    ax.set_xlabel(x_label)
-    ax.set_ylabel("RMSE against the reference")
-    ax.set_title(title, fontsize=11)
+    ax.set_xlabel("total time, median over the repetitions (ms)" if x_column == TIME
+                  else "G-buffer bytes per pixel")
+    ax.set_ylabel(ERROR_LABELS.get(metric, metric), fontsize=8)
+    ax.set_title("Group %s: %s" % (gid, label), fontsize=10)
     ax.grid(True, alpha=0.3, which="both")
-    ax.legend(title=by, fontsize=7, title_fontsize=8, loc="best")
+    ax.legend(fontsize=6 if len(labels) > 8 else 7, ncol=2 if len(labels) > 12 else 1, loc="best")
     fig.tight_layout()
-    report.save(fig, name, title,
-                "One point per job (%d jobs); circled points are on the Pareto front (no job is "
-                "both faster and more accurate). %s" % (len(points), caption_extra))
+    if x_column == TIME:
+        bars = ("Horizontal bars: %s%s." % (repetitions_note(jobs), "" if spread else
+                " (no spread: one repetition, or equal times)"))
+    else:
+        bars = "The front: the most accurate layout for a memory budget."
+    caption = ("One point per job of this group (%d of its %d jobs have both figures; nothing is "
+               "averaged). Circled points are on the Pareto front: no other job of the group is "
+               "both %s and more accurate. %s" % (
+                   len(points), len(jobs), "faster" if x_column == TIME else "smaller", bars))
+    if missing:
+        caption += " Left out (no %s or %s): %s." % (x_column, metric, ", ".join(
+            text(j.get("job_id")) for j in missing))
+    report.save(fig, "%s_%s" % (kind, gid), title, caption, gid, kind)
 
 
-def against_axis(report, jobs, x_column, y_column, name, title, x_label, y_label, scenes_vary,
-                 x_of=None):
-    """Median of y_column per (stage, x) as one line per stage."""
-    x_of = x_of or (lambda j: number(j.get(x_column)))
-    series = {}
-    for job in jobs:
-        x, y = x_of(job), number(job.get(y_column))
-        if x is None or y is None:
-            continue
-        series.setdefault(series_key(job, None, "stage", scenes_vary), {}).setdefault(x, []).append(y)
-    xs_all = {x for s in series.values() for x in s}
-    if len(xs_all) < 2:
-        report.skip(title, "fewer than two distinct values of %s with %s measured" % (x_column, y_column))
+def context_plots(report, jobs, groups, x_of, x_columns, x_label, y_column, y_label, name, title,
+                  kind):
+    """y against x across groups: one plot per context (the grouping settings other than x's and
+    those that change with x), one line per method."""
+    grouping = [c for c in groups["axis_columns"] if c not in groups["method_columns"]
+                and c not in ("stage", "layout", "normals", "normal-space", "depth", "position",
+                              "resolution")]
+    others = [c for c in grouping if c not in x_columns]
+    measured = [j for j in jobs if x_of(j) is not None and number(j.get(y_column)) is not None]
+    if len({x_of(j) for j in measured}) < 2:
+        report.skip(title, "fewer than two distinct values of %s among the jobs with %s measured"
+                    % (" x ".join(x_columns), y_column), "", kind)
         return
-    fig, ax = plt.subplots(figsize=(7.2, 4.8))
-    for i, (label, values) in enumerate(sorted(series.items())):
-        xs = sorted(values)
-        ax.plot(xs, [statistics.median(values[x]) for x in xs], label=label, color=colour_of(i),
-                marker=MARKERS[i % len(MARKERS)], markersize=5)
-    if log_scale_fits(sorted(xs_all)):
-        ax.set_xscale("log")
-    ys = [statistics.median(v) for s in series.values() for v in s.values()]
-    if y_column != "culling_efficiency" and log_scale_fits(ys):
-        ax.set_yscale("log")
-    ax.set_xlabel(x_label)
-    ax.set_ylabel(y_label)
-    ax.set_title(title, fontsize=11)
-    ax.grid(True, alpha=0.3, which="both")
-    ax.legend(title="stage", fontsize=7, title_fontsize=8, loc="best")
-    fig.tight_layout()
-    report.save(fig, name, title, "Median over the jobs that share stage and %s." % x_column)
+    # Settings that change together with x (one value per x) are not a context of their own.
+    covarying = []
+    for column in others:
+        per_x = {}
+        for job in measured:
+            per_x.setdefault(x_of(job), set()).add(text(job.get(column)))
+        values = {text(j.get(column)) for j in measured}
+        if len(values) > 1 and all(len(v) == 1 for v in per_x.values()):
+            covarying.append(column)
+    context_columns = [c for c in others if c not in covarying]
+    contexts = {}
+    for job in measured:
+        key = tuple(text(job.get(c)) for c in context_columns)
+        contexts.setdefault(key, []).append(job)
+    varying_context = [c for i, c in enumerate(context_columns)
+                       if len({k[i] for k in contexts}) > 1]
+    for index, (key, members) in enumerate(sorted(contexts.items())):
+        context = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)
+                            if c in varying_context)
+        plot_title = title + (" (%s)" % context if context else "")
+        series = {}
+        for job in members:
+            series.setdefault(method_label(job, groups["method_columns"]), {}).setdefault(
+                x_of(job), []).append(job)
+        xs_all = {x for s in series.values() for x in s}
+        if len(xs_all) < 2:
+            report.skip(plot_title, "fewer than two distinct values of %s with %s measured" % (
+                " x ".join(x_columns), y_column), "", kind)
+            continue
+        fig, ax = plt.subplots(figsize=(7.2, 4.8))
+        aggregated = set()
+        for i, (label_text, values) in enumerate(sorted(series.items())):
+            xs = sorted(values)
+            ys = []
+            for x in xs:
+                group_jobs = values[x]
+                ys.append(statistics.median(number(j.get(y_column)) for j in group_jobs))
+                if len(group_jobs) > 1:
+                    aggregated.update(c for c in set(k for j in group_jobs for k in j)
+                                      if not c.startswith("time_") and c not in
+                                      ("job_id", "error", "status") and
+                                      len({text(j.get(c)) for j in group_jobs}) > 1
+                                      and c in groups["axis_columns"])
+            ax.plot(xs, ys, label=label_text, color=colour_of(i), marker=MARKERS[i % len(MARKERS)],
+                    markersize=5)
+        if log_scale_fits(sorted(xs_all)):
+            ax.set_xscale("log")
+        ys_all = [number(j.get(y_column)) for j in members]
+        if y_column != "culling_efficiency" and log_scale_fits(ys_all):
+            ax.set_yscale("log")
+        ax.set_xlabel(x_label)
+        ax.set_ylabel(y_label)
+        ax.set_title(plot_title, fontsize=10)
+        ax.grid(True, alpha=0.3, which="both")
+        ax.legend(title="method", fontsize=7, title_fontsize=8, loc="best")
+        fig.tight_layout()
+        fixed = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)) or "nothing else"
+        caption = "Fixed: %s. " % fixed
+        if covarying:
+            caption += "Changes with the x axis: %s. " % ", ".join(
+                "%s (%s)" % (c, ", ".join(sorted({text(j.get(c)) for j in members},
+                                                  key=lambda v: (len(v), v))))
+                for c in covarying)
+        caption += ("Each point is one job." if not aggregated else
+                    "Points with several jobs are their median; those jobs differ in: %s." %
+                    ", ".join(sorted(aggregated)))
+        report.save(fig, "%s_%d" % (name, index + 1), plot_title, caption, "", kind)
 
 
 def published_ratios(report, table, index):
     title = "Ratios to %s: %s" % (table["columns"][table["ratio_to"]], table["title"])
     rows, columns = table["rows"], table["columns"]
     if not rows or all(c["measured_ratio"] is None for r in rows for c in r["cells"]):
-        report.skip(title, "no measured ratio (no matching ok jobs)")
+        report.skip(title, "no measured ratio (no matching ok jobs)", "", "published")
         return
     fig, ax = plt.subplots(figsize=(min(9.0, max(6.0, 1.1 * len(rows) * len(columns))), 4.8))
     width = 0.8 / (2 * len(columns))
@@ -198,7 +314,8 @@ def published_ratios(report, table, index):
     ax.legend(fontsize=6, ncol=max(1, len(columns)), loc="best")
     fig.tight_layout()
     report.save(fig, "published_%d" % index, title,
-                "Light bars: published ratio; hatched bars: measured ratio (median of matching jobs).")
+                "Light bars: published ratio; hatched bars: measured ratio (median of matching "
+                "jobs; the table says which settings those jobs differ in).", "", "published")
 
 
 def plot_results(args):
@@ -208,41 +325,42 @@ def plot_results(args):
     if args.published:
         with open(args.published, encoding="utf-8") as f:
             published = json.load(f)
+    with open(args.groups, encoding="utf-8") as f:
+        groups = json.load(f)
+    metric = args.error_metric
     jobs = [j for j in results.get("jobs", []) if j.get("status") == "ok"]
-    columns = results.get("columns") or sorted({k for j in jobs for k in j})
+    by_id = {j.get("job_id"): j for j in jobs}
     report = Report(args.out)
     if not jobs:
         report.skip("All plots", "no job finished ok")
-    else:
-        scenes_vary = len({text(j.get("scene")) for j in jobs}) > 1
-        for by in ("stage", "normals", "layout", "depth", "position"):
-            if by not in columns:
-                continue
-            title = "Time against error, per %s" % by
-            if by != "stage" and len({text(j.get(by)) for j in jobs}) < 2:
-                report.skip(title, "only one value of %s" % by)
-                continue
-            scatter_with_front(report, jobs, by, "time_vs_error_by_%s" % by, TIME,
-                               "total time, median (ms)", title, "")
-        if "bytes_per_pixel" in columns:
-            by = "normals" if "normals" in columns else "stage"
-            scatter_with_front(report, jobs, by, "bytes_vs_error", "bytes_per_pixel",
-                               "G-buffer bytes per pixel", "Bytes per pixel against error, per %s" % by,
-                               "The front: the most accurate encoding for a memory budget.")
+    for group in groups["groups"]:
+        members = [by_id[i] for i in group["jobs"] if i in by_id]
+        if not members:
+            report.skip("Group %s: %s" % (group["id"], group["label"]), "no job finished ok",
+                        group["id"], "pareto")
+            continue
+        pareto_plot(report, group, members, metric, groups["method_columns"])
+        if len({number(j.get("bytes_per_pixel")) for j in members
+                if number(j.get("bytes_per_pixel")) is not None}) > 1:
+            pareto_plot(report, group, members, metric, groups["method_columns"],
+                        x_column="bytes_per_pixel", kind="bytes")
+    if jobs:
+        lights = lambda j: number(j.get("lights"))  # noqa: E731
         for column, label, name, title in (
-                ("light_evaluations", "light evaluations (total over the image)", "evaluations_vs_lights",
-                 "Light evaluations against light count"),
+                ("light_evaluations", "light evaluations (over the counted pixels)",
+                 "evaluations_vs_lights", "Light evaluations against light count"),
                 ("culling_efficiency", "culling efficiency (oracle / evaluated)", "culling_vs_lights",
                  "Culling efficiency against light count"),
                 (TIME, "total time, median (ms)", "time_vs_lights", "Time against light count")):
-            against_axis(report, jobs, "lights", column, name, title, "generated lights", label, scenes_vary)
+            context_plots(report, jobs, groups, lights, ["lights"], "generated lights", column,
+                          label, name, title, "vs_lights")
 
         def pixels(job):
             w, h = number(job.get("width")), number(job.get("height"))
             return w * h / 1e6 if w is not None and h is not None else None
-        against_axis(report, jobs, "width x height", TIME, "time_vs_pixels",
-                     "Time against resolution", "megapixels", "total time, median (ms)", scenes_vary,
-                     x_of=pixels)
+        context_plots(report, jobs, groups, pixels, ["width", "height", "resolution"], "megapixels",
+                      TIME, "total time, median (ms)", "time_vs_pixels", "Time against resolution",
+                      "vs_pixels")
     for i, table in enumerate(published):
         published_ratios(report, table, i)
     write_text(os.path.join(args.out, "plots.json"), report.manifest())
@@ -273,6 +391,8 @@ def main():
     results = commands.add_parser("results")
     results.add_argument("--results", required=True)
     results.add_argument("--published", default="")
+    results.add_argument("--groups", required=True)
+    results.add_argument("--error-metric", default="relative_rmse")
     results.add_argument("--out", required=True)
     diff = commands.add_parser("diff")
     diff.add_argument("--raw", required=True)

@@ -52,7 +52,9 @@
 // no power-only channel). Parameters record the options, the L-buffer size, dsf_fallbacks and
 // dsf_id_fallbacks.
 // lightsEvaluated: the tile list size at the full-res pixel each low-res sample reads, zero
-// elsewhere, so its sum is the number of light evaluations actually done.
+// elsewhere, so its sum is the number of light evaluations actually done. lightingSamples marks
+// those pixels, so that the oracle is counted over the same samples (culling efficiency at most 1,
+// no negative waste); the full-res oracle would count pixels this stage never lights itself.
 // Cost note (CPU): a contributing light costs two evaluateLight calls (diffuse, then specular
 // part) where `tiled` needs one; this keeps a single BRDF definition at the price of roughly
 // twice the per-light work in "lighting" (a GPU light buffer pays nothing comparable).
@@ -135,6 +137,12 @@ public:
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         auto sampleX = [&](int i) { return std::min(i * scale + scale / 2, width - 1); };
         auto sampleY = [&](int j) { return std::min(j * scale + scale / 2, height - 1); };
+        // The pixels whose lights this stage evaluates (before any timed pass): the runner counts
+        // evaluated and contributing lights there only (StageResult::lightingSamples).
+        result.lightingSamples.assign(size_t(width) * height, 0);
+        for (int j = 0; j < lowHeight; ++j)
+            for (int i = 0; i < lowWidth; ++i)
+                result.lightingSamples[size_t(sampleY(j)) * width + sampleX(i)] = 1;
 
         // Cull on the full-res grid with tiles of tile*scale pixels: full-res tile (tx, ty) holds
         // exactly the samples of low-res tile (tx, ty), since sample i lies in block i.

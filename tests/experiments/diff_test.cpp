@@ -141,6 +141,17 @@ TEST(DiffCommand, WritesPageJsonAndImages) {
     EXPECT_NEAR(result["metrics"]["p99_abs"].get<double>(), 0.125, 1e-12);
     EXPECT_EQ(result["channels"].size(), 5u);
     const std::string html = readText(options.out / "index.html");
+    // ꟻLIP beside the other metrics: its value and map, or a visible note saying why not.
+    ASSERT_TRUE(result["metrics"].contains("flip"));
+    if (result["metrics"]["flip"].is_number()) {
+        EXPECT_TRUE(fs::is_regular_file(options.out / "flip.png"));
+        EXPECT_NE(html.find("src=\"flip.png\""), std::string::npos);
+    } else {
+        const std::string reason = result["metrics"]["flip_unavailable"].get<std::string>();
+        EXPECT_FALSE(reason.empty());
+        EXPECT_NE(html.find("class=\"flip-unavailable\""), std::string::npos);
+        EXPECT_FALSE(fs::exists(options.out / "flip.png"));
+    }
     EXPECT_NE(html.find("src=\"absdiff.png\""), std::string::npos);
     EXPECT_NE(html.find("<td class=\"text\">Z</td>"), std::string::npos);
     EXPECT_EQ(html.find("http"), std::string::npos);

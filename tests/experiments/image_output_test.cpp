@@ -446,5 +446,81 @@ TEST(HeatmapPng, AllZeroImageAndHugeScaleStillWrite) {
     EXPECT_EQ(fileNamesIn(dir), (std::set<std::string>{"huge.png", "zeros.png"}));
 }
 
+// ---------------------------------------------------------------------------------------------
+// Scalar maps (error.png, flip.png)
+
+// A row of values 10^(-6 + 6 x / (w - 1)): six decades from 1e-6 to 1, then a zero row and a
+// row with an outlier above the scale.
+std::vector<float> decadeRamp(int width) {
+    std::vector<float> values(size_t(width) * 3);
+    for (int x = 0; x < width; ++x) {
+        values[size_t(x)] = float(std::pow(10.0, -6.0 + 6.0 * x / (width - 1)));
+        values[size_t(width + x)] = 0.0f;
+        values[size_t(2 * width + x)] = x == 0 ? 50.0f : 0.5f;
+    }
+    return values;
+}
+
+int brightness(const Rgb8& c) {
+    return int(c[0]) + int(c[1]) + int(c[2]);
+}
+
+TEST(ScalarMapPng, LinearScaleDarkensSmallValuesLogScaleSpreadsThem) {
+    const fs::path dir = freshTestFolder();
+    constexpr int kWidth = 200;
+    const std::vector<float> values = decadeRamp(kWidth);
+    ScalarMapStyle linear;
+    linear.max = 1.0f;
+    linear.title = "linear";
+    ScalarMapStyle log = linear;
+    log.scale = MapScale::Log;
+    log.logDecades = 6.0f;
+    log.title = "log";
+    writeScalarMapPng(dir / "linear.png", kWidth, 3, values.data(), linear);
+    writeScalarMapPng(dir / "log.png", kWidth, 3, values.data(), log);
+    const ReadImage a = readImage(dir / "linear.png", OIIO::TypeDesc::UINT8);
+    const ReadImage b = readImage(dir / "log.png", OIIO::TypeDesc::UINT8);
+    ASSERT_EQ(a.spec.width, kScalarMapMinWidth);
+    ASSERT_EQ(a.spec.height, 3 + kScalarMapLegendHeight);
+    // 1e-3 (half-way on the log scale) is about the colour map's bottom on the linear scale, and
+    // far from both ends on the log scale.
+    const int middle = kWidth / 2;
+    EXPECT_LE(std::abs(brightness(pixelAt(a, middle, 0)) - brightness(pixelAt(a, 1, 0))), 6) << dir;
+    EXPECT_GT(std::abs(brightness(pixelAt(b, middle, 0)) - brightness(pixelAt(b, 1, 0))), 60)
+        << dir;
+    EXPECT_NE(pixelAt(b, middle, 0), pixelAt(b, kWidth - 1, 0)) << dir;
+    // Exactly zero is black on both; above the maximum is white; the legend has labels.
+    for (const ReadImage* image : {&a, &b}) {
+        EXPECT_EQ(pixelAt(*image, 5, 1), (Rgb8{0, 0, 0})) << dir;
+        EXPECT_EQ(pixelAt(*image, 0, 2), (Rgb8{255, 255, 255})) << dir;
+        EXPECT_NE(pixelAt(*image, 1, 2), (Rgb8{255, 255, 255})) << dir;
+        EXPECT_TRUE(hasBrightPixels(*image, 3 + 40, 3 + kScalarMapLegendHeight)) << dir;
+    }
+    EXPECT_GT(brightness(pixelAt(b, middle, 0)), brightness(pixelAt(b, 1, 0)));
+}
+
+TEST(ScalarMapPng, AutoRangeAndBadArguments) {
+    const std::vector<float> values = {0.0f, 0.25f, std::numeric_limits<float>::infinity(), 2.0f};
+    ScalarMapStyle style;
+    EXPECT_EQ(scalarMapRange(values.data(), values.size(), style), std::make_pair(0.0f, 2.0f));
+    style.scale = MapScale::Log;
+    EXPECT_EQ(scalarMapRange(values.data(), values.size(), style).first, 2.0f / 10000.0f);
+    style.max = 8.0f;
+    EXPECT_EQ(scalarMapRange(values.data(), values.size(), style).second, 8.0f);
+    EXPECT_EQ(parseMapScale("log"), MapScale::Log);
+    EXPECT_EQ(parseMapScale("linear"), MapScale::Linear);
+    EXPECT_NE(thrownMessage<std::invalid_argument>([] {
+                  parseMapScale("logarithmic");
+              }).find("expected linear or log"),
+              std::string::npos);
+    const fs::path dir = freshTestFolder();
+    style.colourMap = "no-such-map";
+    EXPECT_NE(thrownMessage<std::invalid_argument>([&] {
+                  writeScalarMapPng(dir / "bad.png", 2, 2, values.data(), style);
+              }).find("no-such-map"),
+              std::string::npos);
+    EXPECT_TRUE(fileNamesIn(dir).empty());
+}
+
 } // namespace
 } // namespace experiments

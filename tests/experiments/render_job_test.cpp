@@ -122,6 +122,32 @@ TEST(RenderJob, CullingStaysConservativeOnLossyLayouts) {
         }
 }
 
+// Every stage's light counts are on the same footing: summed over the pixels the stage lit, so
+// that culling efficiency never exceeds 1 and no lit pixel wastes a negative number of lights.
+// inferred lights only its reduced-resolution samples (1 in scale^2 pixels): it says so.
+TEST(RenderJob, ReducedResolutionStagesCountTheSamePixelsAsTheOracle) {
+    for (const char* stage : {"inferred", "inferred:scale=4", "light-prepass", "tiled"}) {
+        RenderOptions options = smallAtrium(0);
+        options.stage = stage;
+        const RenderRun run = runRender(planRender(options));
+        const experiments::RunMetrics& m = run.metrics;
+        EXPECT_LE(m.cullingEfficiency, 1.0) << stage;
+        EXPECT_GE(m.lightEvaluations, m.oracleLightEvaluations) << stage;
+        const std::vector<uint8_t>& lit = run.result.lightingSamples;
+        size_t negative = 0;
+        for (size_t pixel = 0; pixel < run.oracle.size(); ++pixel)
+            if (lit.empty() || lit[pixel])
+                negative += run.result.lightsEvaluated[pixel] < run.oracle[pixel];
+        EXPECT_EQ(negative, 0u) << stage;
+        const bool reduced = std::string(stage).rfind("inferred", 0) == 0;
+        const int scale = std::string(stage) == "inferred:scale=4" ? 4 : 2;
+        EXPECT_EQ(m.countedPixels,
+                  reduced ? uint64_t((320 / scale) * (180 / scale)) : uint64_t(320 * 180))
+            << stage;
+        EXPECT_EQ(m.lightCountsNote.empty(), !reduced) << stage;
+    }
+}
+
 // Issue 4's acceptance check at test size: spheremap:16 costs more error than
 // octahedral-precise:32 and fewer bytes per pixel than float32.
 TEST(RenderJob, NormalEncodingsTradeBytesForError) {
@@ -164,6 +190,28 @@ TEST(RenderJob, RepetitionsRecordEveryPassAndAGivenReferenceIsReused) {
     options.compareReference = true;
     const RenderRun inside = runRender(planRender(options));
     EXPECT_EQ(inside.metrics.error->rmse, run.metrics.error->rmse);
+}
+
+// Issue 16: the reference's exact surface used to be computed inside every timed G-buffer pass
+// (and inflated it) when only --compare-reference needed it. Counted, not timed: the stage's
+// passes compute no exact surface; the reference computes it once, afterwards, and is the same
+// image as a reference rendered on its own.
+TEST(RenderJob, TheReferenceWorkStaysOutOfTheTimedPasses) {
+    RenderOptions options = smallAtrium(0);
+    options.stage = "tiled";
+    options.warmup = 1;
+    options.repetitions = 3;
+    options.compareReference = true;
+    const RenderRun run = runRender(planRender(options));
+    EXPECT_EQ(run.prepared->exactSurfacePasses, 1) << "only the reference's, after the timing";
+    EXPECT_EQ(run.prepared->gbufferTimings.exactMs, 0.0) << "the last timed pass";
+    for (const PassTiming& timing : run.metrics.passes)
+        EXPECT_NE(timing.pass, "exact_surface");
+    EXPECT_TRUE(bitwiseEqual(run.reference.radiance[1], renderReference(options).radiance[1]));
+    // The reference stage reads the exact surface itself: computed in each of its 4 passes.
+    options.stage = "reference";
+    const RenderRun reference = runRender(planRender(options));
+    EXPECT_EQ(reference.prepared->exactSurfacePasses, 4);
 }
 
 struct BadCase {
@@ -270,8 +318,18 @@ TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
         EXPECT_TRUE(stats.contains(key)) << key;
     for (const char* pass : {"gbuffer", "shading", "total"})
         EXPECT_TRUE(stats["timings_ms"].contains(pass)) << pass;
-    for (const char* metric : {"rmse", "max_abs", "psnr", "relative_mean", "p99_abs"})
+    // One timed run without warm-up: the figures say they are a cold frame.
+    EXPECT_EQ(stats["timings"]["figure"], "cold frame (no warm-up, one repetition)");
+    for (const char* metric :
+         {"rmse", "max_abs", "psnr", "relative_mean", "p99_abs", "flip", "flip_unavailable"})
         EXPECT_TRUE(stats["error"].contains(metric)) << metric;
+    // ꟻLIP: a number with its map and parameters, or null with the reason.
+    if (stats["error"]["flip"].is_number()) {
+        EXPECT_TRUE(std::filesystem::is_regular_file(out / "flip.png"));
+        EXPECT_TRUE(stats["error"].contains("flip_parameters"));
+    } else {
+        EXPECT_FALSE(stats["error"]["flip_unavailable"].get<std::string>().empty());
+    }
     // The layout: every plane with name, format and bits, and the bytes per pixel they add up to.
     int bits = 0;
     for (const auto& plane : stats["layout"]["planes"]) {

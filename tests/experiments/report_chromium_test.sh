@@ -4,8 +4,16 @@
 # tests/CMakeLists.txt; by hand:
 #   tests/experiments/report_chromium_test.sh build/bin/testbed /tmp/report-chromium-test
 #
-# Input: made here by `testbed sweep tests/experiments/fixtures/report-smoke.json` (six tiny jobs,
-# three stages x two light counts, with a published-figures entry), then `testbed report`.
+# Input: made here by `testbed sweep tests/experiments/fixtures/report-smoke.json` (eight tiny
+# jobs, four stages x two light counts, i.e. two comparable groups, with a published-figures
+# entry), then `testbed report`.
+#
+# What the loaded page must show (checked on the DOM Chromium dumps): one section per comparable
+# group (two) with exactly one Pareto plot each (img data-kind="pareto"), the shared-scale maps
+# of every job of the group, the results table with the flip (ꟻLIP) column among the main
+# columns and the others behind the toggle, and -- when ꟻLIP is unavailable on this machine (no
+# flip-evaluator) -- the visible note saying why; inferred's reduced-resolution light counts
+# are explained in a note.
 # Failed jobs, null metrics and single-valued axes are covered by tests/experiments/report_test.cpp.
 #
 # The page's inline script (experiments/ReportCommand.h, pageCheckScript) writes
@@ -70,11 +78,86 @@ if grep -E 'CONSOLE|Uncaught|Failed to load resource|ERR_FILE_NOT_FOUND' "$work/
     fail "the page logged errors (above; logs in $work)"
 fi
 
-"$python" - "$results" "$work/screenshot.png" <<'EOF'
+"$python" - "$results" "$work/screenshot.png" "$work/dom.html" <<'EOF'
 import json, os, sys
+from html.parser import HTMLParser
 import matplotlib.image as mpimg
 import numpy as np
-results, screenshot = sys.argv[1], sys.argv[2]
+results, screenshot, dom = sys.argv[1], sys.argv[2], sys.argv[3]
+
+class Page(HTMLParser):
+    """The loaded page's groups (with their Pareto plots and thumbnails), the results table's
+    header and the notes, as Chromium left them."""
+    def __init__(self):
+        super().__init__()
+        self.groups = []          # [{"id", "pareto", "images"}]
+        self.section_depth = 0
+        self.depth = 0
+        self.headers = []         # (data-column, class) of the results table
+        self.in_results = False
+        self.ids = set()
+        self.table_attrs = {}
+    VOID = {"img", "br", "meta", "input", "link", "hr", "wbr", "source", "area", "col"}
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag not in self.VOID:  # void elements have no end tag
+            self.depth += 1
+        if "id" in a:
+            self.ids.add(a["id"])
+        if tag == "section" and "group" in (a.get("class") or "").split():
+            self.groups.append({"id": a.get("data-group"), "pareto": 0, "images": 0})
+            self.section_depth = self.depth
+        if tag == "img" and self.section_depth:
+            self.groups[-1]["images"] += 1
+            if a.get("data-kind") == "pareto":
+                self.groups[-1]["pareto"] += 1
+        if tag == "table" and a.get("id") == "results-table":
+            self.in_results = True
+            self.table_attrs = a
+        if tag == "th" and self.in_results:
+            self.headers.append((a.get("data-column"), a.get("class") or ""))
+    def handle_endtag(self, tag):
+        if tag == "section" and self.section_depth == self.depth:
+            self.section_depth = 0
+        if tag == "table":
+            self.in_results = False
+        self.depth -= 1
+
+page = Page()
+page.feed(open(dom, encoding="utf-8").read())
+results_json = json.load(open(os.path.join(results, "results.json")))
+ok_jobs = [j for j in results_json["jobs"] if j["status"] == "ok"]
+problems = []
+print("  groups on the page: %s" % page.groups)
+if len(page.groups) != 2:
+    problems.append("expected 2 comparable groups (16 and 64 lights), found %d" % len(page.groups))
+for group in page.groups:
+    if group["pareto"] != 1:
+        problems.append("group %s has %d Pareto plots, expected exactly 1" % (group["id"], group["pareto"]))
+    if group["images"] < 1 + 4 * 3:  # the plot and preview, heatmap, error (+ flip) of 4 jobs
+        problems.append("group %s shows only %d images" % (group["id"], group["images"]))
+columns = dict(page.headers)
+if "flip" not in columns:
+    problems.append("the results table has no flip (FLIP) column: %s" % list(columns))
+elif "extra" in columns["flip"]:
+    problems.append("the flip column is hidden behind the toggle; it is a main column")
+main = (page.table_attrs.get("data-main-columns") or "").split()
+for wanted in ("stage", "time_total_median_ms", "relative_rmse", "flip", "culling_efficiency"):
+    if wanted not in main:
+        problems.append("%s is not among the main columns %s" % (wanted, main))
+if not any("extra" in cls for _, cls in page.headers):
+    problems.append("no column is behind the toggle")
+if "toggle-columns" not in page.ids:
+    problems.append("no toggle button")
+flip_missing = [j for j in ok_jobs if j.get("flip") is None]
+if flip_missing and "flip-note" not in page.ids:
+    problems.append("%d jobs lack FLIP but the page has no #flip-note" % len(flip_missing))
+if not flip_missing and "flip-note" in page.ids:
+    problems.append("every job has FLIP, yet the page says it is unavailable")
+print("  FLIP: %s" % ("unavailable on %d jobs: %s" % (len(flip_missing), flip_missing[0].get("flip_unavailable"))
+                      if flip_missing else "measured on every job"))
+if "counts-note" not in page.ids:
+    problems.append("inferred counts lights at reduced resolution but the page has no #counts-note")
 
 def distinct_colours(path):
     pixels = mpimg.imread(path)
@@ -85,7 +168,6 @@ def distinct_colours(path):
     return len(np.unique(rgb, axis=0)), 1.0 - background.mean()
 
 manifest = json.load(open(os.path.join(results, "report", "plots.json")))
-problems = []
 if len(manifest["plots"]) < 4:
     problems.append("only %d plots drawn: %s" % (len(manifest["plots"]), manifest))
 for plot in manifest["plots"]:

@@ -166,8 +166,12 @@ TEST(ReportPublished, MalformedEntriesAreRefusedByName) {
         std::string::npos);
 }
 
-// A results folder in the sweep runner's format: six ok jobs (two stages x three light counts)
-// with tiny images, one failed job without a folder; job 0005 lacks error.png.
+// A results folder in the sweep runner's format: six ok jobs (two stages x three light counts,
+// so three comparable groups of two) with tiny images, one failed job without a folder; job 0005
+// lacks error.png. Jobs 0000-0003 also have a render.exr whose lights.evaluated peak at
+// 8 * (ordinal + 1) and whose error peaks at 0.01 * (ordinal + 1), so that the report redraws
+// their maps at their group's scale; ꟻLIP is unavailable (null, with a reason) as on a machine
+// without flip-evaluator.
 fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
     const int w = 32, h = 18;
     std::vector<float> red(w * h), green(w * h), blue(w * h);
@@ -193,6 +197,22 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
             writeHeatmapPng(jobDir / "heatmap.png", w, h, counts.data(), 0);
             if (ordinal != 5)
                 writePreviewPng(jobDir / "error.png", w, h, blue.data(), red.data(), green.data());
+            if (ordinal < 4) {
+                std::vector<float> evaluated(w * h), error(w * h);
+                for (int i = 0; i < w * h; ++i) {
+                    evaluated[i] = float((i % 9) * (ordinal + 1));
+                    error[i] = 0.01f * float(ordinal + 1) * float(i % 5) / 4.0f;
+                }
+                writeMultiLayerExr(jobDir / "render.exr", w, h,
+                                   {{"R", red.data()},
+                                    {"G", green.data()},
+                                    {"B", blue.data()},
+                                    {"lights.evaluated", evaluated.data()},
+                                    {"error.R", error.data()},
+                                    {"error.G", error.data()},
+                                    {"error.B", error.data()}},
+                                   {});
+            }
             const bool brute = stage == "brute";
             const double time = (brute ? 2.0 : 0.5) * lights + ordinal;
             jobs.push_back({{"job_id", id},
@@ -203,15 +223,20 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
                             {"lights", lights},
                             {"width", w},
                             {"height", h},
+                            {"repetitions", 3},
                             {"time_total_median_ms", time},
-                            {"time_total_min_ms", time},
-                            {"time_total_max_ms", time},
+                            {"time_total_min_ms", time * 0.9},
+                            {"time_total_max_ms", time * 1.2},
                             {"light_evaluations", (brute ? 1.0 : 0.2) * lights * w * h},
                             {"culling_efficiency", brute ? 0.05 : 0.4 + 0.001 * lights},
+                            {"counted_pixels", w * h},
                             {"bytes_per_pixel", 16},
                             {"rmse", brute ? 1e-7 * (ordinal + 1) : 2e-6 * (ordinal + 1)},
+                            {"relative_rmse", brute ? 1e-6 * (ordinal + 1) : 2e-5 * (ordinal + 1)},
                             {"psnr", ordinal == 0 ? json("inf") : json(80.0 - ordinal)},
-                            {"max_abs", ordinal == 1 ? json() : json(1e-5)}});
+                            {"max_abs", ordinal == 1 ? json() : json(1e-5)},
+                            {"flip", nullptr},
+                            {"flip_unavailable", "flip-evaluator is not installed <here>"}});
             ++ordinal;
         }
     jobs.push_back({{"job_id", "9999-failed"},
@@ -222,15 +247,20 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
                     {"lights", 16},
                     {"width", w},
                     {"height", h},
+                    {"repetitions", 3},
                     {"time_total_median_ms", nullptr},
                     {"time_total_min_ms", nullptr},
                     {"time_total_max_ms", nullptr},
                     {"light_evaluations", nullptr},
                     {"culling_efficiency", nullptr},
+                    {"counted_pixels", nullptr},
                     {"bytes_per_pixel", nullptr},
                     {"rmse", nullptr},
+                    {"relative_rmse", nullptr},
                     {"psnr", nullptr},
-                    {"max_abs", nullptr}});
+                    {"max_abs", nullptr},
+                    {"flip", nullptr},
+                    {"flip_unavailable", nullptr}});
     const json columns = {"job_id",
                           "status",
                           "error",
@@ -239,15 +269,20 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
                           "lights",
                           "width",
                           "height",
+                          "repetitions",
                           "time_total_median_ms",
                           "time_total_min_ms",
                           "time_total_max_ms",
                           "light_evaluations",
                           "culling_efficiency",
+                          "counted_pixels",
                           "bytes_per_pixel",
                           "rmse",
+                          "relative_rmse",
                           "psnr",
-                          "max_abs"};
+                          "max_abs",
+                          "flip",
+                          "flip_unavailable"};
     const json published = json::array(
         {{{"title", "Thesis-like table"},
           {"source", "made up"},
@@ -299,7 +334,7 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
     EXPECT_NE(html.find("<tr class=\"failed\">"), std::string::npos);
     EXPECT_NE(html.find("stage &#39;nope&#39; &lt;unknown&gt;"), std::string::npos)
         << "error shown, escaped";
-    EXPECT_NE(html.find("<td class=\"text\">inf</td>"), std::string::npos)
+    EXPECT_NE(html.find("<td class=\"text extra\">inf</td>"), std::string::npos)
         << "psnr inf shown as text";
     EXPECT_NE(html.find("tiled wins &lt;by far&gt;"), std::string::npos);
     // Published table, row "Test 64": brute measured 129 (2*64 + ordinal 1), tiled 36 (0.5*64 +
@@ -322,14 +357,56 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
         EXPECT_NE(html.find("src=\"report/" + plot["file"].get<std::string>() + "\""),
                   std::string::npos);
     }
-    for (const char* expected : {"time_vs_error_by_stage.png", "evaluations_vs_lights.png",
-                                 "culling_vs_lights.png", "time_vs_lights.png", "published_0.png"})
+    // One Pareto plot per comparable group (the three light counts), nothing pooled across them.
+    for (const char* expected :
+         {"pareto_g1.png", "pareto_g2.png", "pareto_g3.png", "evaluations_vs_lights_1.png",
+          "culling_vs_lights_1.png", "time_vs_lights_1.png", "published_0.png"})
         EXPECT_EQ(files.count(expected), 1u) << expected << " in " << manifest.dump();
-    EXPECT_EQ(files.count("bytes_vs_error.png"), 0u) << "one bytes-per-pixel value: not drawn";
+    EXPECT_EQ(files.count("bytes_g1.png"), 0u) << "one bytes-per-pixel value: not drawn";
+    for (const json& plot : manifest["plots"]) {
+        if (plot["kind"] == "pareto") {
+            EXPECT_NE(plot["caption"].get<std::string>().find("min-max of the total time over 3 "
+                                                              "repetitions"),
+                      std::string::npos)
+                << plot.dump();
+        }
+    }
     EXPECT_NE(html.find("not enough data"), std::string::npos);
     EXPECT_TRUE(fs::exists(dir / "report" / "thumbs" / "0000-brute-preview.png"));
     EXPECT_TRUE(fs::exists(dir / "report" / "thumbs" / "0000-brute-heatmap.png"));
     EXPECT_FALSE(fs::exists(dir / "report" / "thumbs" / "0005-tiled-error.png"));
+
+    // Groups: one section each, with its Pareto plot inside.
+    const json groups = json::parse(readText(dir / "report" / "groups.json"));
+    ASSERT_EQ(groups["groups"].size(), 3u) << groups.dump();
+    EXPECT_EQ(groups["groups"][0]["label"], "atrium, 16 lights, 32x18");
+    EXPECT_EQ(groups["groups"][0]["jobs"],
+              json::array({"0000-brute", "0003-tiled", "9999-failed"}));
+    for (const char* id : {"g1", "g2", "g3"}) {
+        const size_t section = html.find(std::string("<section class=\"group\" id=\"group-") + id);
+        ASSERT_NE(section, std::string::npos) << id;
+        const size_t end = html.find("</section>", section);
+        const std::string body = html.substr(section, end - section);
+        EXPECT_NE(body.find(std::string("data-kind=\"pareto\" src=\"report/pareto_") + id),
+                  std::string::npos)
+            << id;
+    }
+    // Maps at the group's scale: g1 holds jobs 0000 (counts up to 8) and 0003 (up to 32), so both
+    // heatmaps are drawn 0..32; job 0005's group has no EXR for it, so its images keep their own.
+    EXPECT_TRUE(fs::exists(dir / "report" / "maps" / "0000-brute-heatmap.png"));
+    EXPECT_TRUE(fs::exists(dir / "report" / "maps" / "0003-tiled-error.png"));
+    EXPECT_NE(html.find("heatmaps 0..32 lights (the group's largest count)"), std::string::npos);
+    EXPECT_NE(html.find("error maps linear up to 0.04 (the group's largest error)"),
+              std::string::npos);
+    // The table: the compared columns first, the rest behind the toggle; ꟻLIP among the first,
+    // and a visible note saying why it is empty.
+    EXPECT_NE(html.find("id=\"toggle-columns\""), std::string::npos);
+    EXPECT_NE(html.find("<th class=\"col\" data-column=\"flip\">"), std::string::npos);
+    EXPECT_NE(html.find("<th class=\"col\" data-column=\"relative_rmse\">"), std::string::npos);
+    EXPECT_NE(html.find("<th class=\"col extra\" data-column=\"psnr\">"), std::string::npos);
+    EXPECT_NE(html.find("id=\"flip-note\""), std::string::npos);
+    EXPECT_NE(html.find("flip-evaluator is not installed &lt;here&gt;"), std::string::npos);
+    EXPECT_EQ(html.find("id=\"counts-note\""), std::string::npos) << "every job counts every pixel";
     const json published = json::parse(readText(dir / "report" / "published.json"));
     EXPECT_NEAR(published[0]["rows"][0]["cells"][1]["measured_ratio"].get<double>(), 36.0 / 129.0,
                 1e-12);
@@ -345,9 +422,79 @@ TEST(ReportCommand, SingleValuedAxesSayNotEnoughDataInsteadOfEmptyPlots) {
         << "one ok job, no brute baseline: nothing to plot: " << manifest.dump();
     EXPECT_GE(manifest["skipped"].size(), 4u);
     const std::string html = readText(dir / "report.html");
-    EXPECT_NE(html.find("Time against error, per stage: not enough data"), std::string::npos);
+    EXPECT_NE(html.find("Time against relative_rmse, group g1: atrium, 64 lights, 32x18: not "
+                        "enough data (1 job of the group"),
+              std::string::npos);
     EXPECT_NE(html.find("Culling efficiency against light count: not enough data"),
               std::string::npos);
+}
+
+TEST(ReportGroups, OnlyTheMethodColumnsVaryInsideAGroup) {
+    auto job = [](const char* stage, const char* normals, int lights, int width, int threads) {
+        return json{{"job_id", stage},    {"status", "ok"},     {"scene", "atrium"},
+                    {"stage", stage},     {"normals", normals}, {"lights", lights},
+                    {"width", width},     {"height", 90},       {"threads", threads},
+                    {"resolution", "any"}};
+    };
+    const json jobs = json::array({job("a", "oct:16", 64, 160, 1), job("b", "oct:24", 64, 160, 1),
+                                   job("c", "oct:16", 256, 160, 1), job("d", "oct:16", 64, 320, 1),
+                                   job("e", "oct:16", 64, 160, 2), job("f", "sph:16", 64, 160, 1)});
+    const std::vector<std::string> axes = {"scene", "stage",  "lights",  "resolution",
+                                           "width", "height", "threads", "normals"};
+    const std::vector<JobGroup> groups = comparableGroups(jobs, axes);
+    ASSERT_EQ(groups.size(), 4u);
+    EXPECT_EQ(groups[0].jobs, (std::vector<size_t>{0, 1, 5})) << "stage and normals are methods";
+    EXPECT_EQ(groups[0].label, "atrium, 64 lights, 160x90, 1 threads");
+    EXPECT_EQ(groups[1].jobs, (std::vector<size_t>{2}));
+    EXPECT_EQ(groups[2].jobs, (std::vector<size_t>{3})) << "another size is another group";
+    EXPECT_EQ(groups[3].jobs, (std::vector<size_t>{4})) << "other threads: another group";
+    EXPECT_FALSE(groups[0].fixed.contains("resolution"));
+    EXPECT_TRUE(isMethodColumn("normal-space"));
+    EXPECT_FALSE(isMethodColumn("lights"));
+}
+
+TEST(ReportPublished, AMedianSaysWhichSettingsItsJobsDifferIn) {
+    json a = okJob("0", "tiled", 64, 10.0), b = okJob("1", "tiled", 64, 20.0);
+    a["threads"] = 1;
+    b["threads"] = 2;
+    const json published = {
+        {"title", "T"},
+        {"metric", "time_total_median_ms"},
+        {"columns", {{{"label", "tiled"}, {"select", {{"stage", "tiled"}}}}}},
+        {"rows", {{{"label", "64"}, {"select", {{"lights", 64}}}, {"values", {1.0}}}}}};
+    const json table =
+        comparePublished(published, json::array({a, b}), {"stage", "lights", "threads"});
+    const json& cell = table["rows"][0]["cells"][0];
+    EXPECT_DOUBLE_EQ(cell["measured"].get<double>(), 15.0);
+    EXPECT_EQ(cell["differ_in"], json::array({"threads"}));
+}
+
+TEST(ReportCommand, TheErrorMetricIsTheUsersChoiceAndFlipSaysWhyItIsMissing) {
+    const fs::path dir = writeResultsFolder(freshTestFolder(), false);
+    ReportCommandOptions options;
+    options.dir = dir;
+    options.errorMetric = "flip";
+    ASSERT_EQ(runReportCommand(options), 0);
+    const json manifest = json::parse(readText(dir / "report" / "plots.json"));
+    size_t skippedPareto = 0;
+    for (const json& skipped : manifest["skipped"])
+        if (skipped["kind"] == "pareto") {
+            ++skippedPareto;
+            EXPECT_NE(skipped["reason"].get<std::string>().find(
+                          "flip unavailable: flip-evaluator is not installed <here>"),
+                      std::string::npos)
+                << skipped.dump();
+        }
+    EXPECT_EQ(skippedPareto, 3u);
+
+    options.errorMetric = "psnr";
+    ASSERT_EQ(runReportCommand(options), 0);
+    options.errorMetric = "speed";
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(runReportCommand(options), 1);
+    const std::string error = testing::internal::GetCapturedStderr();
+    EXPECT_NE(error.find("--error-metric 'speed' is not an error column"), std::string::npos)
+        << error;
 }
 
 TEST(ReportCommand, MissingResultsOrPythonIsOneClearError) {

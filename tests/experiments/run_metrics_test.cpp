@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "experiments/RenderJob.h"
 #include "experiments/ResultsTable.h"
@@ -69,28 +70,55 @@ TEST(RunMetrics, StageTimeExcludesTheRunnersPassesAndEfficiencyIsOracleOverEvalu
     EXPECT_EQ(passes[2].pass, "shading");
     EXPECT_EQ(passes[2].samplesMs, (std::vector<double>{2.5, 4.0})); // reported twice: summed
     const RunMetrics metrics =
-        experiments::measureRun(passes, {3, 0, 5}, {1, 0, 3}, 7.0, 8.0, std::nullopt);
+        experiments::measureRun(passes, {3, 0, 5}, {1, 0, 3}, {}, 7.0, 8.0, std::nullopt);
     EXPECT_EQ(metrics.stage.pass, "stage");
     EXPECT_EQ(metrics.stage.samplesMs, (std::vector<double>{3.5, 7.0}));
     EXPECT_EQ(metrics.stage.medianMs(), 5.25);
     EXPECT_EQ(metrics.lightEvaluations, 8u);
     EXPECT_EQ(metrics.oracleLightEvaluations, 4u);
     EXPECT_EQ(metrics.cullingEfficiency, 0.5);
+    EXPECT_EQ(metrics.countedPixels, 3u);
+    EXPECT_TRUE(metrics.lightCountsNote.empty());
     EXPECT_EQ(metrics.bytesPerPixel, 7.0);
     EXPECT_EQ(metrics.allocatedBytesPerPixel, 8.0);
     EXPECT_TRUE(metrics.errorFigures().empty());
     // Nothing evaluated: nothing wasted.
-    EXPECT_EQ(experiments::measureRun({}, {0}, {0}, 0, 0, std::nullopt).cullingEfficiency, 1.0);
+    EXPECT_EQ(experiments::measureRun({}, {0}, {0}, {}, 0, 0, std::nullopt).cullingEfficiency, 1.0);
+}
+
+// A reduced-resolution stage lights some pixels only: both counts are summed over those, so the
+// oracle at the pixels it only filtered does not make its efficiency exceed 1.
+TEST(RunMetrics, ReducedResolutionCountsOnlyTheLitPixels) {
+    const RunMetrics metrics =
+        experiments::measureRun({}, {4, 0, 0, 6}, {2, 5, 5, 3}, {1, 0, 0, 1}, 0, 0, std::nullopt);
+    EXPECT_EQ(metrics.lightEvaluations, 10u);
+    EXPECT_EQ(metrics.oracleLightEvaluations, 5u);
+    EXPECT_EQ(metrics.cullingEfficiency, 0.5);
+    EXPECT_EQ(metrics.countedPixels, 2u);
+    EXPECT_NE(metrics.lightCountsNote.find("2 of the 4 pixels"), std::string::npos)
+        << metrics.lightCountsNote;
+}
+
+// ꟻLIP is a figure beside the others; unavailable, it is NaN (null in the outputs).
+TEST(RunMetrics, FlipIsAnErrorFigureAndNaNWhenUnavailable) {
+    RunMetrics metrics;
+    metrics.error = experiments::ErrorMetrics{};
+    metrics.error->flipUnavailable = "not installed";
+    const std::vector<experiments::NamedFigure> figures = metrics.errorFigures();
+    ASSERT_EQ(std::string(figures.back().name), "flip");
+    EXPECT_TRUE(std::isnan(figures.back().value));
+    metrics.error->flip = 0.25;
+    EXPECT_EQ(metrics.errorFigures().back().value, 0.25);
 }
 
 TEST(RunMetrics, TheTableColumnsAreTheRecordsFigures) {
     const std::vector<std::string> columns = experiments::metricColumns({});
     const std::vector<std::string> figures = experiments::runFigureColumns();
     EXPECT_EQ(columns, figures);
-    EXPECT_EQ(figures, (std::vector<std::string>{"light_evaluations", "oracle_light_evaluations",
-                                                 "culling_efficiency", "bytes_per_pixel", "rmse",
-                                                 "relative_rmse", "psnr", "max_abs",
-                                                 "relative_mean", "p99_abs"}));
+    EXPECT_EQ(figures, (std::vector<std::string>{
+                           "light_evaluations", "oracle_light_evaluations", "culling_efficiency",
+                           "counted_pixels", "bytes_per_pixel", "rmse", "relative_rmse", "psnr",
+                           "max_abs", "relative_mean", "p99_abs", "flip", "flip_unavailable"}));
 }
 
 } // namespace

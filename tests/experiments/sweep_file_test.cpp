@@ -6,6 +6,7 @@
 #include <fstream>
 #include <regex>
 #include <set>
+#include <tuple>
 
 #include "experiments/SweepFile.h"
 
@@ -217,6 +218,44 @@ TEST(SweepFile, ReportsEveryInvalidJobBeforeRunning) {
         errorOf([&] { experiments::expandSweep(experiments::parseSweep(file, "bad.json")); });
     EXPECT_NE(unknown.find("no-such-option"), std::string::npos) << unknown;
     EXPECT_NE(unknown.find("12 of 12"), std::string::npos) << unknown;
+}
+
+// Display keys: one scale for every job's heatmap and error map; not part of the job ids.
+TEST(SweepFile, MapScalesApplyToEveryJobAndKeepTheIds) {
+    Json file = baseSweep();
+    const auto plain = experiments::expandSweep(experiments::parseSweep(file, "unit.json"));
+    file["heatmap-max"] = 64;
+    file["error-scale"] = "log";
+    file["error-max"] = 0.5;
+    const auto spec = experiments::parseSweep(file, "unit.json");
+    EXPECT_EQ(spec.heatmapMax, 64u);
+    EXPECT_EQ(spec.errorScale, experiments::MapScale::Log);
+    EXPECT_EQ(spec.errorMax, 0.5);
+    const std::vector<SweepJob> plainJobs = plain.jobs();
+    const std::vector<SweepJob> scaledJobs = experiments::expandSweep(spec).jobs();
+    ASSERT_EQ(scaledJobs.size(), plainJobs.size());
+    for (size_t i = 0; i < plainJobs.size(); ++i) {
+        EXPECT_EQ(scaledJobs[i].id, plainJobs[i].id);
+        EXPECT_EQ(scaledJobs[i].heatmapMax, 64u);
+        EXPECT_EQ(scaledJobs[i].errorScale, experiments::MapScale::Log);
+        EXPECT_EQ(scaledJobs[i].errorMax, 0.5);
+        // A job handed to its process as JSON keeps the scales.
+        const SweepJob again =
+            experiments::sweepJobFromJson(experiments::sweepJobJson(scaledJobs[i]));
+        EXPECT_EQ(again.heatmapMax, 64u);
+        EXPECT_EQ(again.errorScale, experiments::MapScale::Log);
+        EXPECT_EQ(again.errorMax, 0.5);
+    }
+    for (const auto& [key, value, expected] :
+         {std::tuple<const char*, Json, const char*>{"heatmap-max", -1, "'heatmap-max' must be"},
+          {"heatmap-max", "64", "'heatmap-max' must be"},
+          {"error-scale", "logarithmic", "'error-scale' must be \"linear\" or \"log\""},
+          {"error-max", -0.5, "'error-max' must be a number >= 0"}}) {
+        Json bad = baseSweep();
+        bad[key] = value;
+        const std::string message = errorOf([&] { experiments::parseSweep(bad, "unit.json"); });
+        EXPECT_NE(message.find(expected), std::string::npos) << key << ": " << message;
+    }
 }
 
 TEST(SweepFile, ChecksPublishedTables) {

@@ -89,10 +89,14 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
         std::ifstream statsFile(folder / "stats.json");
         const Json stats = Json::parse(statsFile);
         for (const char* figure : {"light_evaluations", "oracle_light_evaluations",
-                                   "culling_efficiency", "bytes_per_pixel"})
+                                   "culling_efficiency", "counted_pixels", "bytes_per_pixel"})
             EXPECT_EQ(job[figure], stats[figure]) << figure;
-        for (const char* figure : {"rmse", "relative_rmse", "max_abs", "relative_mean", "p99_abs"})
+        for (const char* figure : {"rmse", "relative_rmse", "max_abs", "relative_mean", "p99_abs",
+                                   "flip", "flip_unavailable"})
             EXPECT_EQ(job[figure], stats["error"][figure]) << figure;
+        // ꟻLIP is in every row: a number, or null with the reason it is unavailable.
+        EXPECT_TRUE(job["flip"].is_number() != !job["flip_unavailable"].get<std::string>().empty())
+            << job.dump();
         for (const char* pass : {"gbuffer", "total"})
             EXPECT_EQ(job[std::string("time_") + pass + "_median_ms"], stats["timings_ms"][pass])
                 << pass;
