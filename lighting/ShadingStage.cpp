@@ -12,6 +12,7 @@ void StageResult::resize(int w, int h, bool withOracle) {
     lightsOracle.assign(withOracle ? n : 0, 0);
     timingsMs.clear();
     parameters.clear();
+    lightTrace.assign(traceLights ? n : 0, {});
 }
 
 } // namespace lighting
