@@ -46,6 +46,7 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
             result.radiance[2][pixel] = float(sum.z);
             result.lightsEvaluated[pixel] = uint32_t(lights.size());
             result.lightsOracle[pixel] = contributing;
+            result.traceEveryLight(pixel, lights.size());
         }
     });
     result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));

@@ -26,6 +26,7 @@ inline void shadeWithLightList(const gbuffer::Surface& point, size_t pixel,
     result.radiance[1][pixel] = sum.y;
     result.radiance[2][pixel] = sum.z;
     result.lightsEvaluated[pixel] = uint32_t(lightIndices.size());
+    result.traceLightList(pixel, lightIndices);
 }
 
 // Shades pixel (x, y) of the G-buffer with `lightIndices`. Background pixels are left alone (zero

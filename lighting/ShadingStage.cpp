@@ -13,6 +13,7 @@ void StageResult::resize(int w, int h, bool withOracle) {
     lightingSamples.clear();
     timingsMs.clear();
     parameters.clear();
+    lightTrace.assign(traceLights ? n : 0, {});
 }
 
 } // namespace lighting

@@ -54,8 +54,10 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -110,9 +112,42 @@ struct StageResult {
     std::vector<std::pair<std::string, double>> timingsMs; // per pass, in execution order
     std::map<std::string, std::string> parameters;         // the stage's effective options
 
+    // Test hook, off by default: which lights were evaluated at each pixel, for the identity
+    // check of the tests (every contributing light is among them, not just as many). A caller
+    // sets traceLights before shade(); resize() then gives lightTrace one empty list per pixel
+    // and the shared loops fill it (shadeWithEveryLight, shadeWithLightList, and the light-volume
+    // and forward loops): the lights whose sum the pixel holds, in the order they were added (a
+    // forward stage's overdrawn fragments are replaced, as their radiance is). Approximate stages
+    // do not trace. Off, it costs one predictable branch per pixel list (per light and pixel in
+    // the additive loops) and no memory. Each pixel's list is written by the task that owns the
+    // pixel, like its radiance.
+    bool traceLights = false;
+    std::vector<std::vector<uint32_t>> lightTrace;
+
     // Sizes every plane to w x h, zero-filled (lightsOracle empty unless withOracle), and clears
-    // lightingSamples, timingsMs and parameters.
+    // lightingSamples, timingsMs and parameters; lightTrace gets w x h empty lists when
+    // traceLights, else none.
     void resize(int w, int h, bool withOracle);
+
+    bool tracing() const { return !lightTrace.empty(); }
+    // The pixel's lights are exactly `lightIndices` (a loop that overwrites the pixel).
+    void traceLightList(size_t pixel, std::span<const uint32_t> lightIndices) {
+        if (tracing())
+            lightTrace[pixel].assign(lightIndices.begin(), lightIndices.end());
+    }
+    // The pixel's lights are 0 .. lightCount - 1 (every light, in order).
+    void traceEveryLight(size_t pixel, size_t lightCount) {
+        if (tracing()) {
+            lightTrace[pixel].resize(lightCount);
+            for (size_t i = 0; i < lightCount; ++i)
+                lightTrace[pixel][i] = uint32_t(i);
+        }
+    }
+    // `light` was added to the pixel (a loop that accumulates light by light).
+    void traceAddedLight(size_t pixel, uint32_t light) {
+        if (tracing())
+            lightTrace[pixel].push_back(light);
+    }
 };
 
 // Milliseconds since `start` on the steady clock: how stages time their passes.

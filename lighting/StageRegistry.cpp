@@ -20,6 +20,11 @@ const std::vector<StageEntry>& registry() {
          makeReferenceStage},
         {{"brute", "every light at every pixel, float, from the G-buffer", StageKind::Exact},
          makeBruteStage},
+        {{"ideal",
+          "perfect culling, the ceiling of exact culling: each pixel shades exactly its "
+          "contributing lights (lists made outside the timer)",
+          StageKind::Exact},
+         makeIdealStage},
         {{"deferred",
           "traditional deferred: one light volume per light, shaded and added per fragment "
           "(volume=sphere|rect, spot=cone|sphere, stencil=0, vfc=1)",

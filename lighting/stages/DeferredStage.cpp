@@ -53,21 +53,21 @@ public:
                               result.radiance[2].data()};
         uint32_t* evaluated = result.lightsEvaluated.data();
         // Adds one light at one pixel; the pixel belongs to the calling task alone.
-        auto addLight = [&](int x, int y, size_t pixel, const LightInView<float>& light) {
+        auto addLight = [&](int x, int y, size_t pixel, uint32_t light) {
             gbuffer::Surface point;
             if (!gb.surfaceAt(x, y, point))
                 return;
             const glm::vec3 value =
-                evaluateLight(point, glm::normalize(-point.positionView), light);
+                evaluateLight(point, glm::normalize(-point.positionView), lights[light]);
             radiance[0][pixel] += value.x;
             radiance[1][pixel] += value.y;
             radiance[2][pixel] += value.z;
             ++evaluated[pixel];
+            result.traceAddedLight(pixel, light);
         };
-        cull.volumes.draw(cull.spheres, cull.drawn,
-                          [&](uint32_t light, int x, int y, size_t pixel) {
-                              addLight(x, y, pixel, lights[light]);
-                          });
+        cull.volumes.draw(
+            cull.spheres, cull.drawn,
+            [&](uint32_t light, int x, int y, size_t pixel) { addLight(x, y, pixel, light); });
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
 
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);

@@ -94,6 +94,7 @@ public:
                 result.radiance[1][pixel] += radiance.y;
                 result.radiance[2][pixel] += radiance.z;
                 ++result.lightsEvaluated[pixel];
+                result.traceAddedLight(pixel, l);
             };
             mForward.draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
                           addLight);

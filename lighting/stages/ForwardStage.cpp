@@ -78,6 +78,8 @@ public:
             result.radiance[1][pixel] = sum.y;
             result.radiance[2][pixel] = sum.z;
             result.lightsEvaluated[pixel] += mLightOffsets[object + 1] - mLightOffsets[object];
+            result.traceLightList(pixel, {mLightIndices.data() + mLightOffsets[object],
+                                          mLightIndices.data() + mLightOffsets[object + 1]});
         };
         // Without a pre-pass, the visibility draw's own state (every fragment that passes the
         // closer test is shaded); with one, the redraw that passes each visible fragment once.

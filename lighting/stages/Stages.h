@@ -33,5 +33,6 @@ std::unique_ptr<ShadingStage> makeForwardMultipassStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeLightPrepassStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeInferredStage(const StageSpec& spec);
 std::unique_ptr<ShadingStage> makeTiledForwardStage(const StageSpec& spec);
+std::unique_ptr<ShadingStage> makeIdealStage(const StageSpec& spec);
 
 } // namespace lighting

@@ -1,0 +1,46 @@
+// ContributingLights: per pixel of a G-buffer, the lights that contribute there, by brute force
+// over every light: the lights whose radiance at the pixel's decoded surface is non-zero
+// (Brdf.h contributes(), the definition the oracle counts with, lighting/Oracle.h), ascending.
+// It is what a perfect exact culling method would produce: the `ideal` stage shades these lists,
+// and the tests use them to check that every contributing light is among the lights a stage
+// evaluated at each pixel (not only that it evaluated as many).
+//
+// Storage: one CSR over the pixels (row-major, y from the top): offsets (pixel count + 1) and
+// light indices. Background pixels have empty lists.
+// Cost: every light at every covered pixel (as `brute`), plus 4 bytes per contributing pair.
+// Threads: rows in parallel, each pixel's list written by one task and concatenated in pixel
+// order, so the lists never depend on the thread count. build() is not reentrant; the const
+// queries are thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "gbuffer/GBuffer.h"
+#include "lighting/Brdf.h"
+
+namespace lighting {
+
+class ContributingLights {
+public:
+    // Lists the contributing lights of every pixel of `gb`; replaces the previous lists and
+    // reuses their storage. Throws std::length_error beyond 2^32 - 1 pairs.
+    void build(const gbuffer::GBuffer& gb, const std::vector<LightInView<float>>& lights);
+
+    int width() const { return mWidth; }
+    int height() const { return mHeight; }
+    std::span<const uint32_t> lightsOf(size_t pixel) const {
+        return {mIndices.data() + mOffsets[pixel], mIndices.data() + mOffsets[pixel + 1]};
+    }
+    size_t pairCount() const { return mIndices.size(); }
+
+private:
+    int mWidth = 0;
+    int mHeight = 0;
+    std::vector<uint32_t> mOffsets;
+    std::vector<uint32_t> mIndices;
+    std::vector<std::vector<uint32_t>> mRowLists; // scratch: one row's lists, concatenated
+};
+
+} // namespace lighting
