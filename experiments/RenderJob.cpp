@@ -127,6 +127,8 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         const bool needExact = plan.requirements.exactSurface || (compare && !givenReference);
         run.prepared = std::make_unique<lighting::PreparedScene>(
             std::move(plan.scene), options.width, options.height, needExact, plan.layout);
+        run.prepared->inputs.isa = plan.isa;
+        run.prepared->inputs.simtWarpLanes = options.simtWarp;
         std::vector<PassTiming> passes =
             shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, step);
 
@@ -147,6 +149,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         const gbuffer::GBufferLayout& layout = run.gbuffer().layout();
         run.metrics = measureRun(std::move(passes), run.result.lightsEvaluated, run.oracle,
                                  layout.bytesPerPixel(), layout.allocatedBytesPerPixel(), error);
+        run.metrics.setSimtModel(run.result.parameters);
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;
     });

@@ -107,6 +107,18 @@ RunMetrics measureRun(std::vector<PassTiming> passes, const std::vector<uint32_t
     return metrics;
 }
 
+void RunMetrics::setSimtModel(const std::map<std::string, std::string>& stageParameters) {
+    const auto slots = stageParameters.find(metric::kSimtLaneSlots);
+    if (slots == stageParameters.end()) {
+        simtLaneSlots.reset();
+        simtEfficiency.reset();
+        return;
+    }
+    simtLaneSlots = std::stoull(slots->second);
+    simtEfficiency =
+        *simtLaneSlots > 0 ? double(oracleLightEvaluations) / double(*simtLaneSlots) : 1.0;
+}
+
 std::vector<NamedFigure> RunMetrics::errorFigures() const {
     if (!error)
         return {};
@@ -119,8 +131,9 @@ std::vector<NamedFigure> RunMetrics::errorFigures() const {
 }
 
 std::vector<std::string> runFigureColumns() {
-    std::vector<std::string> columns = {metric::kLightEvaluations, metric::kOracleLightEvaluations,
-                                        metric::kCullingEfficiency, metric::kBytesPerPixel};
+    std::vector<std::string> columns = {metric::kLightEvaluations,  metric::kOracleLightEvaluations,
+                                        metric::kCullingEfficiency, metric::kSimtLaneSlots,
+                                        metric::kSimtEfficiency,    metric::kBytesPerPixel};
     RunMetrics withError;
     withError.error = ErrorMetrics{};
     for (const NamedFigure& figure : withError.errorFigures())

@@ -12,12 +12,18 @@
 //   light evaluations   lights the stage evaluated, summed over pixels; the oracle's count is the
 //                 lights that contribute (DESIGN.md); culling efficiency = oracle / evaluated (1
 //                 when nothing was evaluated).
+//   SIMT cost model     lane slots a SIMT GPU would spend on the stage's light evaluations (warps
+//                 of 32 or 64 lanes pay every lane for each light any lane evaluates; reported by
+//                 the stages on lighting/LightAccumulation.h as the parameter simt_lane_slots,
+//                 lighting/README.md); simt efficiency = oracle evaluations / lane slots. Both
+//                 null for stages without the model.
 //   bytes per pixel     the layout's bits as a GPU packs them, and what this run allocates.
 //   error         against the double-precision reference, when compared (compareImages).
 // Thread safety: values; compareImages runs ImageBufAlgo on the calling thread's pool.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -32,6 +38,8 @@ namespace metric {
 inline constexpr const char* kLightEvaluations = "light_evaluations";
 inline constexpr const char* kOracleLightEvaluations = "oracle_light_evaluations";
 inline constexpr const char* kCullingEfficiency = "culling_efficiency";
+inline constexpr const char* kSimtLaneSlots = "simt_lane_slots";
+inline constexpr const char* kSimtEfficiency = "simt_efficiency";
 inline constexpr const char* kBytesPerPixel = "bytes_per_pixel";
 inline constexpr const char* kAllocatedBytesPerPixel = "allocated_bytes_per_pixel";
 inline constexpr const char* kRmse = "rmse";
@@ -84,6 +92,11 @@ struct RunMetrics {
     uint64_t lightEvaluations = 0;
     uint64_t oracleLightEvaluations = 0;
     double cullingEfficiency = 1.0;
+    std::optional<uint64_t> simtLaneSlots; // absent: the stage does not run the SIMT model
+    std::optional<double> simtEfficiency;  // oracle / lane slots (1 when no slot was spent)
+
+    // Sets the SIMT figures from a stage's parameters (simt_lane_slots) and the oracle count.
+    void setSimtModel(const std::map<std::string, std::string>& stageParameters);
     double bytesPerPixel = 0.0;
     double allocatedBytesPerPixel = 0.0;
     std::optional<ErrorMetrics> error;
@@ -105,8 +118,8 @@ RunMetrics measureRun(std::vector<PassTiming> passes, const std::vector<uint32_t
                       double allocatedBytesPerPixel, std::optional<ErrorMetrics> error);
 
 // The sweep's metric column names that a RunMetrics fills, after the time columns, in table order:
-// light_evaluations, oracle_light_evaluations, culling_efficiency, bytes_per_pixel, then the
-// error figures.
+// light_evaluations, oracle_light_evaluations, culling_efficiency, simt_lane_slots,
+// simt_efficiency, bytes_per_pixel, then the error figures.
 std::vector<std::string> runFigureColumns();
 
 } // namespace experiments

@@ -111,6 +111,10 @@ void addMetrics(Json& row, const RunMetrics& metrics) {
     row[metric::kLightEvaluations] = metrics.lightEvaluations;
     row[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
     row[metric::kCullingEfficiency] = metrics.cullingEfficiency;
+    row[metric::kSimtLaneSlots] =
+        metrics.simtLaneSlots ? Json(*metrics.simtLaneSlots) : Json(nullptr);
+    row[metric::kSimtEfficiency] =
+        metrics.simtEfficiency ? number(*metrics.simtEfficiency) : Json(nullptr);
     row[metric::kBytesPerPixel] = metrics.bytesPerPixel;
     for (const NamedFigure& figure : metrics.errorFigures())
         row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
