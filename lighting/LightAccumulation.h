@@ -10,7 +10,8 @@
 // summed over its own list in list order, so an ascending list gives bitwise the image `brute`
 // gives with the same ISA whenever the culled lights contribute exactly zero.
 //
-// Two paths, chosen once per frame in choosePath (the one place that check lives):
+// Two paths, chosen once per frame by packetPathFits in LightAccumulation.cpp (the one place that
+// check lives):
 // - packets: the G-buffer layout is one PacketDecoder reads and every material of the scene uses
 //   the Blinn-Phong model; the kernel runs on the requested ISA (`scalar` = evaluateLight lane by
 //   lane, bitwise the former per-pixel loops; a vector target differs from it by a few ulps,

@@ -86,7 +86,6 @@ public:
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int width = gb.width(), height = gb.height();
         const size_t capacity = size_t(mMaxLights);
         result.resize(width, height, false);
