@@ -9,10 +9,10 @@
 //   quick: {fixed, axes, cases, warmup, repetitions, reference}   overrides for `--quick`
 //   published: [...]              published figures of a reproduction (schema in the README)
 // Keys are the names experiments::setRenderOption accepts (scene, stage, lights, seed, width,
-// height, resolution, threads, layout, normals, normal-space, depth, position, scene-option.KEY:
-// whatever renderOptionKeys() lists) plus warmup and repetitions. Values are strings or numbers
-// and reach setRenderOption as text, so this file knows no stage, encoding or scene: anything
-// registered later works unchanged.
+// height, resolution, threads, isa, simt-warp, layout, normals, normal-space, depth, position,
+// scene-option.KEY: whatever renderOptionKeys() lists) plus warmup and repetitions. Values are
+// strings or numbers and reach setRenderOption as text, so this file knows no stage, encoding or
+// scene: anything registered later works unchanged.
 //
 // Jobs: the full expansion (cases x axes) numbers jobs 0..n-1 in that order; a job's id is its
 // zero-padded ordinal and a hash of every setting that makes it ("0007-1a2b3c4d"), identical in
