@@ -321,6 +321,12 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["width"] = run.options.width;
     stats["height"] = run.options.height;
     stats["threads"] = run.threads;
+    // The kernel's instruction set as requested, and as dispatched: what the stage's shading
+    // loop ran (LightAccumulation.h), "scalar" for stages that do not use the kernel or frames
+    // it falls back to evaluateLight per pixel on.
+    stats["isa_requested"] = run.options.isa;
+    const auto dispatched = run.result.parameters.find("isa");
+    stats["isa"] = dispatched != run.result.parameters.end() ? dispatched->second : "scalar";
     stats["hardware_threads"] = std::thread::hardware_concurrency();
     stats["commit"] = kBuildCommit;
     stats["triangles"] = run.scene().triangleCount();
@@ -339,6 +345,10 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats[metric::kCountedPixels] = metrics.countedPixels;
     if (!metrics.lightCountsNote.empty())
         stats["light_counts_note"] = metrics.lightCountsNote;
+    stats[metric::kSimtLaneSlots] =
+        metrics.simtLaneSlots ? nlohmann::json(*metrics.simtLaneSlots) : nlohmann::json(nullptr);
+    stats[metric::kSimtEfficiency] =
+        metrics.simtEfficiency ? nlohmann::json(*metrics.simtEfficiency) : nlohmann::json(nullptr);
     stats["raster"] = rasterJson(run.prepared->rasterStats);
     if (metrics.error)
         stats["error"] = errorJson(run);

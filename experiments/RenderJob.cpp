@@ -133,6 +133,8 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         run.prepared = std::make_unique<lighting::PreparedScene>(
             std::move(plan.scene), options.width, options.height, plan.requirements.exactSurface,
             plan.layout);
+        run.prepared->inputs.isa = plan.isa;
+        run.prepared->inputs.simtWarpLanes = options.simtWarp;
         std::vector<PassTiming> passes =
             shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, step);
 
@@ -162,6 +164,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         run.metrics = measureRun(std::move(passes), run.result.lightsEvaluated, run.oracle,
                                  run.result.lightingSamples, layout.bytesPerPixel(),
                                  layout.allocatedBytesPerPixel(), error);
+        run.metrics.setSimtModel(run.result.parameters);
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;
         run.metrics.flipMs = flipMs;

@@ -96,6 +96,10 @@ CheckedOptions checkOptions(const RenderOptions& options) {
     checkScene(options.scene);
     checkRepetitions(options);
     checked.layoutRequest = layoutRequest(options);
+    checked.isa = usageErrorFrom([&] { return lighting::kernel::KernelIsa::byName(options.isa); });
+    if (options.simtWarp != 32 && options.simtWarp != 64)
+        throw UsageError("--simt-warp " + std::to_string(options.simtWarp) +
+                         " refused: must be 32 (8x4 pixels) or 64 (8x8)");
     return checked;
 }
 
@@ -104,9 +108,23 @@ void validate(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {"scene",        "stage",      "lights",   "seed",   "width",
-            "height",       "resolution", "threads",  "layout", "normals",
-            "normal-space", "depth",      "position", "view",   "scene-option.<key>"};
+    return {"scene",
+            "stage",
+            "lights",
+            "seed",
+            "width",
+            "height",
+            "resolution",
+            "threads",
+            "isa",
+            "simt-warp",
+            "layout",
+            "normals",
+            "normal-space",
+            "depth",
+            "position",
+            "view",
+            "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -127,6 +145,10 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.height = parseNumber<int>(key, value);
     else if (key == "threads")
         options.threads = parseNumber<int>(key, value);
+    else if (key == "isa")
+        options.isa = value;
+    else if (key == "simt-warp")
+        options.simtWarp = parseNumber<int>(key, value);
     else if (key == "layout")
         options.layout = value;
     else if (key == "normals")

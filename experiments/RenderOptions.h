@@ -34,6 +34,10 @@ struct RenderOptions {
     int width = 1280;
     int height = 720;
     int threads = 0; // 0 = every hardware thread
+    // The shading kernel's instruction set (lighting/kernel/KernelIsa.h): "auto" (the widest this
+    // CPU runs), "scalar" (evaluateLight per pixel), or a target name (sse4, avx2, avx3...).
+    std::string isa = "auto";
+    int simtWarp = 32; // lanes of the SIMT cost model's warp: 32 (8x4 pixels) or 64 (8x8)
     bool compareReference = false;
     // G-buffer: a preset name ("" = derived from the scene and the stage,
     // gbuffer/LayoutDerivation.h), then overrides of its normal encoding ("NAME:BITS"), depth
@@ -48,10 +52,10 @@ struct RenderOptions {
 };
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
-// seed, width, height, resolution (WxH), threads, layout, normals, normal-space, depth, position,
-// view, and scene-option.KEY. Values are checked later by validate(); a malformed number or an
-// unknown key throws UsageError naming it. The sweep runner goes through this, so every stage,
-// encoding or scene added later is reachable without touching the runner.
+// seed, width, height, resolution (WxH), threads, isa, simt-warp, layout, normals, normal-space,
+// depth, position, view, and scene-option.KEY. Values are checked later by validate(); a malformed
+// number or an unknown key throws UsageError naming it. The sweep runner goes through this, so
+// every stage, encoding or scene added later is reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();
@@ -74,6 +78,7 @@ struct UsageError : std::runtime_error {
 struct CheckedOptions {
     std::unique_ptr<lighting::ShadingStage> stage;
     gbuffer::LayoutRequest layoutRequest;
+    lighting::kernel::KernelIsa isa = lighting::kernel::KernelIsa::scalar(); // options.isa resolved
 };
 
 // Checks every option in a fixed order (size, lights, threads, stage, scene, repetitions, G-buffer

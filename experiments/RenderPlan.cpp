@@ -30,6 +30,7 @@ RenderPlan planRender(const RenderOptions& options) {
     plan.threads = effectiveThreads(options.threads);
     plan.scene = loadRequestedScene(options);
     plan.stage = std::move(checked.stage);
+    plan.isa = checked.isa;
     plan.requirements = plan.stage->requirements();
     plan.layout = usageErrorFrom([&] {
         return gbuffer::makeLayout(plan.scene, plan.requirements.channels, plan.stage->name(),

@@ -25,6 +25,7 @@ struct RenderPlan {
     std::unique_ptr<lighting::ShadingStage> stage;
     lighting::StageRequirements requirements; // stage->requirements()
     gbuffer::GBufferLayout layout;            // derived, or the requested preset with overrides
+    lighting::kernel::KernelIsa isa = lighting::kernel::KernelIsa::scalar(); // options.isa
 };
 
 RenderPlan planRender(const RenderOptions& options);

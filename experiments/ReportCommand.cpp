@@ -25,10 +25,10 @@
 #include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
 #include "experiments/ImageOutput.h"
-#include "scenes/Limits.h"
-#include "scenes/NestingDepth.h"
 #include "experiments/RenderCommand.h"
 #include "experiments/RunMetrics.h"
+#include "scenes/Limits.h"
+#include "scenes/NestingDepth.h"
 
 namespace experiments {
 

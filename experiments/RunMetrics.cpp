@@ -120,6 +120,18 @@ RunMetrics measureRun(std::vector<PassTiming> passes, const std::vector<uint32_t
     return metrics;
 }
 
+void RunMetrics::setSimtModel(const std::map<std::string, std::string>& stageParameters) {
+    const auto slots = stageParameters.find(metric::kSimtLaneSlots);
+    if (slots == stageParameters.end()) {
+        simtLaneSlots.reset();
+        simtEfficiency.reset();
+        return;
+    }
+    simtLaneSlots = std::stoull(slots->second);
+    simtEfficiency =
+        *simtLaneSlots > 0 ? double(oracleLightEvaluations) / double(*simtLaneSlots) : 1.0;
+}
+
 std::vector<NamedFigure> RunMetrics::errorFigures() const {
     if (!error)
         return {};
@@ -133,8 +145,9 @@ std::vector<NamedFigure> RunMetrics::errorFigures() const {
 }
 
 std::vector<std::string> runFigureColumns() {
-    std::vector<std::string> columns = {metric::kLightEvaluations, metric::kOracleLightEvaluations,
+    std::vector<std::string> columns = {metric::kLightEvaluations,  metric::kOracleLightEvaluations,
                                         metric::kCullingEfficiency, metric::kCountedPixels,
+                                        metric::kSimtLaneSlots,     metric::kSimtEfficiency,
                                         metric::kBytesPerPixel};
     RunMetrics withError;
     withError.error = ErrorMetrics{};

@@ -15,6 +15,11 @@
 //                 or for a stage that lights at reduced resolution (inferred) the pixels it lit
 //                 (StageResult::lightingSamples); counted_pixels says how many, and
 //                 light_counts_note says why when that is not the whole image.
+//   SIMT cost model     lane slots a SIMT GPU would spend on the stage's light evaluations (warps
+//                 of 32 or 64 lanes pay every lane for each light any lane evaluates; reported by
+//                 the stages on lighting/LightAccumulation.h as the parameter simt_lane_slots,
+//                 lighting/README.md); simt efficiency = oracle evaluations / lane slots. Both
+//                 null for stages without the model.
 //   bytes per pixel     the layout's bits as a GPU packs them, and what this run allocates.
 //   error         against the double-precision reference, when compared (compareImages), and
 //                 the mean HDR-ꟻLIP (FlipMetric.h), null with flip_unavailable saying why when
@@ -23,6 +28,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -38,6 +44,8 @@ inline constexpr const char* kLightEvaluations = "light_evaluations";
 inline constexpr const char* kOracleLightEvaluations = "oracle_light_evaluations";
 inline constexpr const char* kCullingEfficiency = "culling_efficiency";
 inline constexpr const char* kCountedPixels = "counted_pixels";
+inline constexpr const char* kSimtLaneSlots = "simt_lane_slots";
+inline constexpr const char* kSimtEfficiency = "simt_efficiency";
 inline constexpr const char* kBytesPerPixel = "bytes_per_pixel";
 inline constexpr const char* kAllocatedBytesPerPixel = "allocated_bytes_per_pixel";
 inline constexpr const char* kRmse = "rmse";
@@ -97,6 +105,11 @@ struct RunMetrics {
     double cullingEfficiency = 1.0;
     uint64_t countedPixels = 0;  // pixels the two counts are summed over
     std::string lightCountsNote; // why countedPixels is not the whole image ("" when it is)
+    std::optional<uint64_t> simtLaneSlots; // absent: the stage does not run the SIMT model
+    std::optional<double> simtEfficiency;  // oracle / lane slots (1 when no slot was spent)
+
+    // Sets the SIMT figures from a stage's parameters (simt_lane_slots) and the oracle count.
+    void setSimtModel(const std::map<std::string, std::string>& stageParameters);
     double bytesPerPixel = 0.0;
     double allocatedBytesPerPixel = 0.0;
     std::optional<ErrorMetrics> error;
@@ -121,7 +134,8 @@ RunMetrics measureRun(std::vector<PassTiming> passes, const std::vector<uint32_t
 
 // The sweep's metric column names that a RunMetrics fills, after the time columns, in table order:
 // light_evaluations, oracle_light_evaluations, culling_efficiency, counted_pixels,
-// bytes_per_pixel, then the error figures and flip_unavailable (text).
+// simt_lane_slots, simt_efficiency, bytes_per_pixel, then the error figures and flip_unavailable
+// (text).
 std::vector<std::string> runFigureColumns();
 
 } // namespace experiments

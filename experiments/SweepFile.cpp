@@ -510,8 +510,8 @@ SweepSpec applyQuick(const SweepSpec& spec) {
 
 std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys) {
     static const std::vector<std::string> kOrder = {
-        "scene",   "stage",  "lights",  "seed",         "resolution", "width",   "height",
-        "threads", "layout", "normals", "normal-space", "depth",      "position"};
+        "scene", "stage",     "lights", "seed",    "resolution",   "width", "height",  "threads",
+        "isa",   "simt-warp", "layout", "normals", "normal-space", "depth", "position"};
     std::vector<std::string> columns;
     for (const std::string& key : kOrder)
         if (key == "width" || key == "height" ||

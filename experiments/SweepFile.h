@@ -11,10 +11,10 @@
 //   heatmap-max, error-scale, error-max   scales of every job's heatmap.png and error.png (and
 //                                 of the report's maps): display only, not part of a job's id
 // Keys are the names experiments::setRenderOption accepts (scene, stage, lights, seed, width,
-// height, resolution, threads, layout, normals, normal-space, depth, position, scene-option.KEY:
-// whatever renderOptionKeys() lists) plus warmup and repetitions. Values are strings or numbers
-// and reach setRenderOption as text, so this file knows no stage, encoding or scene: anything
-// registered later works unchanged.
+// height, resolution, threads, isa, simt-warp, layout, normals, normal-space, depth, position,
+// scene-option.KEY: whatever renderOptionKeys() lists) plus warmup and repetitions. Values are
+// strings or numbers and reach setRenderOption as text, so this file knows no stage, encoding or
+// scene: anything registered later works unchanged.
 //
 // Jobs: the full expansion (cases x axes) numbers jobs 0..n-1 in that order; a job's id is its
 // zero-padded ordinal and a hash of every setting that makes it ("0007-1a2b3c4d"), identical in

@@ -69,6 +69,14 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
     render.add_option("--height", r.height, "image height in pixels")->capture_default_str();
     render.add_option("--threads", r.threads, "worker threads, 0 = all hardware threads")
         ->capture_default_str();
+    render
+        .add_option("--isa", r.isa,
+                    "shading kernel: auto (widest this CPU runs), scalar, or sse4|avx2|avx3...")
+        ->capture_default_str();
+    render
+        .add_option("--simt-warp", r.simtWarp,
+                    "SIMT cost model warp: 32 (8x4 pixels) or 64 (8x8) lanes")
+        ->capture_default_str();
     render.add_option("--out", options.out, "output folder")->capture_default_str();
     render
         .add_option("--heatmap-max", options.scales.heatmapMax,

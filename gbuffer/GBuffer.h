@@ -103,6 +103,14 @@ public:
     // the far plane's value where nothing was drawn.
     std::span<float> depthPlane() { return mDepth; }
     std::span<const float> depth() const { return mDepth; }
+    // The stored planes, for readers that decode many pixels at once (the shading kernel's
+    // PacketDecoder, lighting/kernel/); an empty span for a plane the layout does not store.
+    // Encoded planes (normal codes, packed albedo or specular) are not exposed: such layouts are
+    // read through decode().
+    std::span<const float> normalPlane(int axis) const { return mNormal[axis]; }
+    std::span<const float> albedoPlane(int channel) const { return mAlbedo[channel]; }
+    std::span<const float> specularPlane(int index) const { return mSpecular[index]; }
+    std::span<const uint16_t> materialPlane() const { return mMaterial; }
 
 private:
     glm::vec3 viewRayOfPixel(size_t pixel) const;

@@ -68,6 +68,7 @@
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/SceneGeometry.h"
 #include "lighting/LightList.h"
+#include "lighting/kernel/KernelIsa.h"
 #include "scenes/Scene.h"
 
 namespace lighting {
@@ -94,6 +95,11 @@ struct StageInputs {
     const gbuffer::GBuffer* gbuffer = nullptr;
     const gbuffer::ExactSurface* exact = nullptr;
     const LightList* lights = nullptr;
+    // How the G-buffer stages' shading loop evaluates lights (LightAccumulation.h): the kernel's
+    // instruction set (`--isa`; scalar = evaluateLight per pixel) and the SIMT cost model's warp
+    // size in lanes (32 = 8x4 pixels, 64 = 8x8).
+    kernel::KernelIsa isa = kernel::KernelIsa::best();
+    int simtWarpLanes = 32;
 };
 
 // What shade() fills (see the file comment for each field's contract).

@@ -1,9 +1,14 @@
 // `brute`: every light at every pixel, in float, from the G-buffer. The baseline every culling
-// stage must match (up to summation order) and the source of the per-pixel oracle count. The
-// loop is shadeWithEveryLight (EveryLight.h), shared with `reference` and the oracle.
+// stage must match (bitwise, for the same ISA, when its lists are ascending) and the source of
+// the per-pixel oracle count. The loop is accumulateLights (LightAccumulation.h) with every light
+// as the list of every packet, on the kernel's ISA (`--isa`); pass "shading".
 #include "lighting/stages/Stages.h"
 
-#include "lighting/EveryLight.h"
+#include <chrono>
+#include <optional>
+
+#include "lighting/LightAccumulation.h"
+#include "lighting/PassNames.h"
 
 namespace lighting {
 
@@ -15,10 +20,19 @@ public:
     StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        shadeWithEveryLight(
-            gb.width(), gb.height(), inputs.lights->lights,
-            [&gb](int x, int y, gbuffer::Surface& s) { return gb.surfaceAt(x, y, s); }, result);
+        result.resize(gb.width(), gb.height(), true);
+        const auto start = std::chrono::steady_clock::now();
+        if (!mEveryLight || mLightCount != inputs.lights->size()) {
+            mLightCount = inputs.lights->size();
+            mEveryLight.emplace(mLightCount);
+        }
+        accumulateLights(inputs, *mEveryLight, {.countOracle = true}, result);
+        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
     }
+
+private:
+    size_t mLightCount = 0;
+    std::optional<EveryLightSource> mEveryLight; // the list 0..n-1, kept across frames
 };
 
 } // namespace

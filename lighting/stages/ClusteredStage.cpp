@@ -2,7 +2,8 @@
 // variant of Örtegren). The frustum is cut into a fixed grid of screen tiles x depth slices
 // (lighting/culling/ClusterGrid.h); each frame the lights' conservative spheres are assigned to
 // the clusters they may touch, then every covered pixel finds its cluster from its tile and view
-// depth and shades with that cluster's ascending light list (same image as `brute`).
+// depth and shades with that cluster's ascending light list (same image as `brute`), through
+// accumulateLights (LightAccumulation.h) by 4x4 packets whose lanes are grouped by cluster.
 //
 // Options (defaults first):
 //   grid=24x12x32        tile columns x tile rows x depth slices (each 1..1024, <= 2^20 clusters)
@@ -24,8 +25,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
-#include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 #include "lighting/culling/ClusterGrid.h"
 #include "lighting/stages/Stages.h"
@@ -33,6 +34,29 @@
 namespace lighting {
 
 namespace {
+
+// A packet's lanes grouped by cluster (tile from the pixel, slice from the view depth of the
+// decoded position, bitwise GBuffer::decode's), each group shaded with its cluster's ascending
+// list under its lane mask: every lane walks exactly its own cluster's list, so the image and
+// lights.evaluated are those of a per-pixel loop (and `brute`'s image, same ISA). A packet that
+// crosses clusters costs one kernel call per cluster.
+class ClusterListSource final : public PacketListSource {
+public:
+    explicit ClusterListSource(const ClusterGrid& grid) : mGrid(grid) {}
+    void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
+        lists.addByKey(
+            packet,
+            [&](int lane) {
+                return mGrid.clusterIndex(mGrid.tileXOfPixel(packet.x0 + kernel::laneX(lane)),
+                                          mGrid.tileYOfPixel(packet.y0 + kernel::laneY(lane)),
+                                          mGrid.sliceOfDepth(-packet.positionView[2][lane]));
+            },
+            [&](size_t cluster) { return mGrid.lightsOf(cluster); });
+    }
+
+private:
+    const ClusterGrid& mGrid;
+};
 
 class ClusteredStage final : public ShadingStage {
 public:
@@ -82,24 +106,7 @@ public:
             pairs = std::to_string(grid.pairCount());
 
             const auto shadingStart = std::chrono::steady_clock::now();
-            const std::vector<LightInView<float>>& lights = inputs.lights->lights;
-            std::vector<int> tileXOfPixel(width);
-            for (int x = 0; x < width; ++x)
-                tileXOfPixel[x] = grid.tileXOfPixel(x);
-            // A pixel's cluster comes from the view depth of the position it is shaded at (the
-            // layout's decoder, decoded once), so it lies in its cluster up to the slack.
-            tbb::parallel_for(0, height, [&](int y) {
-                const int tileY = grid.tileYOfPixel(y);
-                for (int x = 0; x < width; ++x) {
-                    gbuffer::Surface point;
-                    if (!gb.surfaceAt(x, y, point))
-                        continue;
-                    const size_t cluster = grid.clusterIndex(
-                        tileXOfPixel[x], tileY, grid.sliceOfDepth(-point.positionView.z));
-                    shadeWithLightList(point, size_t(y) * width + x, lights, grid.lightsOf(cluster),
-                                       result);
-                }
-            });
+            accumulateLights(inputs, ClusterListSource(grid), {}, result);
             result.timingsMs.emplace_back(pass::kShading, millisecondsSince(shadingStart));
         } else {
             result.timingsMs.emplace_back(pass::kAssign, millisecondsSince(assignStart));

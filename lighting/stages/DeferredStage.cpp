@@ -21,6 +21,10 @@
 // Every volume ends with the depth-bounds test (surface view depth within centre +- radius, and
 // within the pyramid's depth range for cones).
 // Passes: "cull" (view-frustum culling), "shading" (volume rasterization and shading, interleaved).
+//
+// Shading stays scalar (evaluateLight per pixel, not lighting/LightAccumulation.h): the stage sums
+// light by light over each light volume's pixels, decoding the G-buffer once per light, so there is
+// no per-pixel list for a packet to walk; its pass structure is what the stage measures.
 #include "lighting/stages/Stages.h"
 
 #include <chrono>

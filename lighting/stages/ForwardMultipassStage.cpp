@@ -17,6 +17,9 @@
 // brute's. lightsEvaluated counts one per (light, visible fragment) drawn. Reads no G-buffer
 // channel. Deterministic: draws run one after another; within a draw each pixel is written only
 // by the thread owning its tile.
+//
+// Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments light
+// by light, not 4x4 packets decoded from a G-buffer.
 #include "lighting/stages/Stages.h"
 
 #include <chrono>

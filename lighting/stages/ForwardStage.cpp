@@ -16,6 +16,9 @@
 // `brute`'s. Reads no G-buffer channel: it rasterizes the scene itself (inputs.scene, .geometry).
 // Deterministic: one draw, each pixel written only by the thread owning its tile, in submission
 // order.
+//
+// Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments as they
+// are drawn, not 4x4 packets decoded from a G-buffer.
 #include "lighting/stages/Stages.h"
 
 #include <chrono>

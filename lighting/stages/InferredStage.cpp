@@ -60,6 +60,9 @@
 // twice the per-light work in "lighting" (a GPU light buffer pays nothing comparable).
 // Threads: tiles in parallel for culling and lighting, rows for the material pass; every sample
 // and pixel written by one task only, light sums in ascending order: deterministic.
+//
+// Shading stays scalar (not lighting/LightAccumulation.h): lighting is accumulated into split
+// diffuse/specular buffers at a lower resolution (splitLighting), not the kernel's radiance sum.
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>

@@ -2,8 +2,9 @@
 // Pass "index": the light volumes of LightVolumes.h (the same proxies and tests as `deferred`)
 // are rasterized in ascending light order into a per-pixel light-index list of at most `max`
 // entries; directional and ambient lights enter every covered pixel's list. Pass "shading": each
-// pixel is shaded once over its list with shadeWithLightList (the G-buffer is decoded once per
-// pixel, not once per light as in `deferred`).
+// pixel is shaded once over its list with accumulateLights (LightAccumulation.h; the G-buffer is
+// decoded once per pixel, not once per light as in `deferred`), by 4x4 packets whose lanes are
+// grouped by equal lists (neighbouring pixels usually share theirs).
 //
 // Overflow never drops a light: a pixel whose list would exceed `max` is marked and shaded with
 // the light list of its 16x16 screen tile (basicTileLightLists in culling/TileFrusta.h: the
@@ -27,8 +28,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
-#include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/culling/TileFrusta.h"
@@ -43,6 +44,38 @@ constexpr uint16_t kOverflowed = 0xFFFF;
 // Tile size of the overflow fallback's lists: `tiled`'s default.
 constexpr int kOverflowTileSize = 16;
 
+// A packet's lanes grouped by equal per-pixel lists (an overflowed pixel uses its tile's list),
+// each group shaded under its lane mask with its ascending list: every lane walks exactly its own
+// list, as the per-pixel loop did.
+class PerPixelListSource final : public PacketListSource {
+public:
+    PerPixelListSource(int width, const uint16_t* counts, const uint32_t* lists, size_t capacity,
+                       const TileGrid& overflowGrid,
+                       const std::vector<std::vector<uint32_t>>& overflowLists)
+        : mWidth(width), mCounts(counts), mLists(lists), mCapacity(capacity),
+          mOverflowGrid(overflowGrid), mOverflowLists(overflowLists) {}
+    void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
+        lists.addByContent(packet, [&](int lane) {
+            const int x = packet.x0 + kernel::laneX(lane), y = packet.y0 + kernel::laneY(lane);
+            const size_t pixel = size_t(y) * size_t(mWidth) + size_t(x);
+            if (mCounts[pixel] == kOverflowed) {
+                const size_t tile = size_t(y / kOverflowTileSize) * mOverflowGrid.tileCountX +
+                                    size_t(x / kOverflowTileSize);
+                return std::span<const uint32_t>(mOverflowLists[tile]);
+            }
+            return std::span<const uint32_t>(mLists + pixel * mCapacity, mCounts[pixel]);
+        });
+    }
+
+private:
+    int mWidth;
+    const uint16_t* mCounts;
+    const uint32_t* mLists;
+    size_t mCapacity;
+    const TileGrid& mOverflowGrid;
+    const std::vector<std::vector<uint32_t>>& mOverflowLists;
+};
+
 class LightIndexedStage final : public ShadingStage {
 public:
     LightIndexedStage(int maxLights, const VolumeStageOptions& volume)
@@ -53,7 +86,6 @@ public:
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int width = gb.width(), height = gb.height();
         const size_t capacity = size_t(mMaxLights);
         result.resize(width, height, false);
@@ -87,29 +119,14 @@ public:
             std::vector<TileSurfaceBounds> bounds;
             overflowLists = basicTileLightLists(gb, overflowGrid, cull.spheres, bounds);
         }
-        std::vector<uint32_t> overflowPerRow(size_t(height), 0);
-        tbb::parallel_for(0, height, [&](int y) {
-            uint32_t overflowed = 0;
-            for (int x = 0; x < width; ++x) {
-                const size_t pixel = size_t(y) * width + x;
-                if (counts[pixel] == kOverflowed) {
-                    ++overflowed;
-                    const size_t tile = size_t(y / kOverflowTileSize) * overflowGrid.tileCountX +
-                                        size_t(x / kOverflowTileSize);
-                    shadeWithLightList(gb, x, y, lights, overflowLists[tile], result);
-                } else {
-                    shadeWithLightList(
-                        gb, x, y, lights,
-                        std::span<const uint32_t>(lists + pixel * capacity, counts[pixel]), result);
-                }
-            }
-            overflowPerRow[size_t(y)] = overflowed;
-        });
+        const PerPixelListSource source(width, counts, lists, capacity, overflowGrid,
+                                        overflowLists);
+        accumulateLights(inputs, source, {}, result);
+        uint64_t overflowPixels = 0;
+        for (uint16_t count : mCounts)
+            overflowPixels += count == kOverflowed ? 1 : 0;
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
 
-        uint64_t overflowPixels = 0;
-        for (uint32_t n : overflowPerRow)
-            overflowPixels += n;
         result.parameters["max"] = std::to_string(mMaxLights);
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
         result.parameters["overflow_pixels"] = std::to_string(overflowPixels);

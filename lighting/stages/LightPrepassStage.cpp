@@ -34,6 +34,9 @@
 // twice the per-light work in "lighting" (a GPU light buffer pays nothing comparable).
 // Threads: tiles in parallel for culling and lighting, rows for the material pass; every pixel
 // written by one task only, light sums in ascending light order: deterministic.
+//
+// Shading stays scalar (not lighting/LightAccumulation.h): the light buffer holds diffuse and
+// specular sums apart (splitLighting), which the kernel's one radiance sum does not produce.
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>

@@ -27,6 +27,9 @@
 // Deterministic: tiles' lists are built in parallel, each by one task; the shading draw writes each
 // pixel from the thread owning its raster tile, and only one fragment per pixel passes the
 // visible-triangle test.
+//
+// Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments with
+// their tile's list as they are drawn, not 4x4 packets decoded from a G-buffer.
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>

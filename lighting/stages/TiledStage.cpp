@@ -6,7 +6,8 @@
 // pixels bounds a frustum (4 side planes through the eye along the tile's pixel edges, near/far
 // at the min/max depth); every light whose conservative sphere (LightBounds.h) may touch it goes
 // into the tile's list, in ascending light index; then every pixel is shaded with its tile's
-// list (shadeWithLightList), which makes the image bitwise equal to `brute`. Tiles without a
+// list (accumulateLights, LightAccumulation.h), which makes the image bitwise equal to `brute`
+// with the same ISA. Tiles without a
 // covered pixel get no lights.
 // tiled-backface: as tiled, plus a normal cone per tile and a light cone per (tile, light); a
 // light that faces the back of every normal in the tile is dropped (lightBackFacesTile in
@@ -31,14 +32,36 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
-#include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 #include "lighting/culling/TileFrusta.h"
 
 namespace lighting {
 
 namespace {
+
+// A packet's lanes grouped by tile (a 4x4 packet spans several tiles when the tile size is not a
+// multiple of 4), each with its tile's ascending list.
+class TileListSource final : public PacketListSource {
+public:
+    TileListSource(const TileGrid& grid, const std::vector<std::vector<uint32_t>>& tileLights)
+        : mGrid(grid), mTileLights(tileLights) {}
+    void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
+        const int size = mGrid.tileSizePixels;
+        lists.addByKey(
+            packet,
+            [&](int lane) {
+                return ((packet.y0 + kernel::laneY(lane)) / size) * mGrid.tileCountX +
+                       (packet.x0 + kernel::laneX(lane)) / size;
+            },
+            [&](int tile) { return std::span<const uint32_t>(mTileLights[size_t(tile)]); });
+    }
+
+private:
+    const TileGrid& mGrid;
+    const std::vector<std::vector<uint32_t>>& mTileLights;
+};
 
 struct TiledOptions {
     int tileSizePixels = 16;
@@ -86,16 +109,7 @@ public:
             std::chrono::duration<double, std::milli>(Clock::now() - cullStart).count();
 
         const auto shadeStart = Clock::now();
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            const std::vector<uint32_t>& list = tileLights[size_t(tile)];
-            if (!bounds[size_t(tile)].covered)
-                return;
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
-                for (int x = grid.x0(tx); x < grid.x1(tx); ++x)
-                    shadeWithLightList(gb, x, y, lights, std::span<const uint32_t>(list), result);
-        });
+        accumulateLights(inputs, TileListSource(grid, tileLights), {}, result);
         const double shadeMs =
             std::chrono::duration<double, std::milli>(Clock::now() - shadeStart).count();
 

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
@@ -21,8 +22,9 @@ using experiments::renderReference;
 using experiments::RenderRun;
 using experiments::runRender;
 
-RenderOptions smallAtrium(int threads) {
+RenderOptions smallAtrium(int threads, const char* isa = "auto") {
     RenderOptions options;
+    options.isa = isa;
     options.scene = "atrium";
     options.stage = "brute";
     options.lights = 64;
@@ -54,10 +56,13 @@ bool sameDecodedGBuffer(const gbuffer::GBuffer& a, const gbuffer::GBuffer& b) {
     return true;
 }
 
-TEST(RenderJob, BitwiseIdenticalForAnyThreadCount) {
-    const RenderRun one = runRender(planRender(smallAtrium(1)));
+// On the kernel's scalar path and on its widest vector target alike.
+class RenderJobIsa : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(RenderJobIsa, BitwiseIdenticalForAnyThreadCount) {
+    const RenderRun one = runRender(planRender(smallAtrium(1, GetParam())));
     for (int threads : {2, 7}) {
-        const RenderRun many = runRender(planRender(smallAtrium(threads)));
+        const RenderRun many = runRender(planRender(smallAtrium(threads, GetParam())));
         EXPECT_TRUE(bitwiseEqual(one.gbuffer().depth(), many.gbuffer().depth())) << threads;
         EXPECT_TRUE(sameDecodedGBuffer(one.gbuffer(), many.gbuffer())) << threads;
         for (int c = 0; c < 3; ++c)
@@ -66,15 +71,25 @@ TEST(RenderJob, BitwiseIdenticalForAnyThreadCount) {
         EXPECT_TRUE(bitwiseEqual(one.oracle, many.oracle));
         EXPECT_EQ(one.prepared->rasterStats.samplesPassed,
                   many.prepared->rasterStats.samplesPassed);
+        EXPECT_EQ(one.metrics.simtLaneSlots, many.metrics.simtLaneSlots);
     }
 }
 
-TEST(RenderJob, BruteMatchesReferenceOnAtrium) {
-    RenderOptions options = smallAtrium(0);
+TEST_P(RenderJobIsa, BruteMatchesReferenceOnAtrium) {
+    RenderOptions options = smallAtrium(0, GetParam());
     options.compareReference = true;
     const RenderRun run = runRender(planRender(options));
     ASSERT_TRUE(run.metrics.error.has_value());
     EXPECT_LT(run.metrics.error->relativeRmse, 1e-4) << "rmse " << run.metrics.error->rmse;
+    std::cout << "[measured] brute (isa " << GetParam() << ") vs reference relative RMSE "
+              << run.metrics.error->relativeRmse << "\n";
+    // The SIMT model: a warp pays at least what its lanes evaluate, and every lane pays for every
+    // light under brute force (all 32 lanes of every warp with a covered pixel).
+    ASSERT_TRUE(run.metrics.simtLaneSlots.has_value());
+    EXPECT_GE(*run.metrics.simtLaneSlots, run.metrics.lightEvaluations);
+    EXPECT_EQ(*run.metrics.simtLaneSlots % (32 * run.scene().lights.size()), 0u);
+    EXPECT_GT(*run.metrics.simtEfficiency, 0.0);
+    EXPECT_LE(*run.metrics.simtEfficiency, run.metrics.cullingEfficiency);
     EXPECT_GT(run.metrics.error->relativeRmse, 0.0) << "float and double should differ a little";
     // The scene is lit: not a black image compared with a black image.
     double sum = 0.0;
@@ -82,6 +97,8 @@ TEST(RenderJob, BruteMatchesReferenceOnAtrium) {
         sum += v;
     EXPECT_GT(sum / run.reference.radiance[1].size(), 1e-3);
 }
+
+INSTANTIATE_TEST_SUITE_P(ScalarAndAuto, RenderJobIsa, ::testing::Values("scalar", "auto"));
 
 TEST(RenderJob, BruteEvaluatesEveryLightAndCountsTheOracle) {
     const RenderRun run = runRender(planRender(smallAtrium(0)));

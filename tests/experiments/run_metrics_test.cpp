@@ -117,8 +117,9 @@ TEST(RunMetrics, TheTableColumnsAreTheRecordsFigures) {
     EXPECT_EQ(columns, figures);
     EXPECT_EQ(figures, (std::vector<std::string>{
                            "light_evaluations", "oracle_light_evaluations", "culling_efficiency",
-                           "counted_pixels", "bytes_per_pixel", "rmse", "relative_rmse", "psnr",
-                           "max_abs", "relative_mean", "p99_abs", "flip", "flip_unavailable"}));
+                           "counted_pixels", "simt_lane_slots", "simt_efficiency",
+                           "bytes_per_pixel", "rmse", "relative_rmse", "psnr", "max_abs",
+                           "relative_mean", "p99_abs", "flip", "flip_unavailable"}));
 }
 
 } // namespace

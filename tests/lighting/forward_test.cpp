@@ -26,9 +26,13 @@ struct TestScene : lighting::PreparedScene {
         : lighting::PreparedScene(std::move(s), width, height) {}
 };
 
+// On the kernel's scalar path: the forward stages shade with evaluateLight per fragment, which
+// `brute` matches bitwise on that path (its vector path differs by a few ulps in pow).
 lighting::StageResult run(const std::string& stage, const TestScene& f) {
     lighting::StageResult result;
-    lighting::makeStage(stage)->shade(f.inputs, result);
+    lighting::StageInputs inputs = f.inputs;
+    inputs.isa = lighting::kernel::KernelIsa::scalar();
+    lighting::makeStage(stage)->shade(inputs, result);
     return result;
 }
 

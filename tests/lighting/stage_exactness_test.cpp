@@ -1,10 +1,12 @@
 // Every stage registered as Exact, on atrium, wall (with lights behind it), spheres and atrium
-// with spot lights: the same image as `brute`, BITWISE for stages that sum in ascending light
-// order (StageInfo::ascendingLightOrder; within 1e-5 of the image's peak otherwise), and the
-// identity check: at every pixel every contributing light is among the lights the stage evaluated
-// there (its light trace, LightIdentity.h), which implies evaluated >= oracle. New stages are
-// covered as soon as they are registered; nothing here names them. `ideal` must also evaluate
-// exactly the oracle's count at every pixel.
+// with spot lights, with the shading kernel's scalar path and its widest vector target (`--isa
+// scalar` and `auto`): the same image as `brute` on the same ISA, BITWISE for stages that sum in
+// ascending light order (StageInfo::ascendingLightOrder) when they run the same arithmetic as
+// brute (on accumulateLights, or on the scalar ISA), within 1e-5 of the image's peak otherwise;
+// and the identity check: at every pixel every contributing light is among the lights the stage
+// evaluated there (its light trace, LightIdentity.h), which implies evaluated >= oracle. New
+// stages are covered as soon as they are registered; nothing here names them. `ideal` must also
+// evaluate exactly the oracle's count at every pixel.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -64,11 +66,15 @@ void makeSpots(scenes::Scene& scene) {
 }
 
 // One frame per scene case, its oracle and brute's image, shared by every stage's test.
+// The ISAs every case runs on: the scalar path and the widest vector target of this CPU.
+const lighting::kernel::KernelIsa kIsas[] = {lighting::kernel::KernelIsa::scalar(),
+                                             lighting::kernel::KernelIsa::best()};
+
 struct PreparedCase {
     std::unique_ptr<lighting::PreparedScene> prepared;
     std::vector<uint32_t> oracle;
     lighting::ContributingLights contributing;
-    lighting::StageResult brute;
+    lighting::StageResult brute[std::size(kIsas)];
 };
 
 const PreparedCase& prepared(const SceneCase& c) {
@@ -88,7 +94,11 @@ const PreparedCase& prepared(const SceneCase& c) {
     slot->oracle = lighting::countContributingLights(slot->prepared->inputs);
     slot->contributing.build(*slot->prepared->inputs.gbuffer,
                              slot->prepared->inputs.lights->lights);
-    lighting::makeStage("brute")->shade(slot->prepared->inputs, slot->brute);
+    for (size_t isa = 0; isa < std::size(kIsas); ++isa) {
+        slot->prepared->inputs.isa = kIsas[isa];
+        lighting::makeStage("brute")->shade(slot->prepared->inputs, slot->brute[isa]);
+    }
+    slot->prepared->inputs.isa = kIsas[0];
     return *slot;
 }
 
@@ -108,34 +118,45 @@ const lighting::StageInfo& stageInfo(const std::string& name) {
     throw std::runtime_error("no stage " + name);
 }
 
-class ExactStage : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+class ExactStage : public ::testing::TestWithParam<std::tuple<std::string, int, int>> {};
 
 TEST_P(ExactStage, MatchesBruteAndEvaluatesEveryContributingLight) {
-    const auto& [stageName, sceneIndex] = GetParam();
+    const auto& [stageName, sceneIndex, isaIndex] = GetParam();
     const SceneCase& c = kScenes[sceneIndex];
     const PreparedCase& f = prepared(c);
     const bool ascending = stageInfo(stageName).ascendingLightOrder;
+    lighting::StageInputs inputs = f.prepared->inputs;
+    inputs.isa = kIsas[isaIndex];
+    const lighting::StageResult& brute = f.brute[isaIndex];
     const std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage(stageName);
-    const lighting::StageResult result = stagecheck::shadeTraced(*stage, f.prepared->inputs);
+    const lighting::StageResult result = stagecheck::shadeTraced(*stage, inputs);
     ASSERT_EQ(result.width, kWidth);
     ASSERT_EQ(result.height, kHeight);
+    // Stages on accumulateLights record the ISA that ran: the requested one (these layouts are
+    // the packet decoder's and the materials Blinn-Phong).
+    const auto isa = result.parameters.find("isa");
+    const bool onKernel = isa != result.parameters.end();
+    if (onKernel)
+        EXPECT_EQ(isa->second, kIsas[isaIndex].name());
+    EXPECT_EQ(brute.parameters.at("isa"), kIsas[isaIndex].name());
+    const bool sameArithmetic = onKernel || isaIndex == 0;
 
     EXPECT_TRUE(stagecheck::everyContributingLightEvaluated(result, f.contributing, ascending))
         << stageName << " on " << c.name;
-    if (ascending) {
-        EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, f.brute))
+    if (ascending && sameArithmetic) {
+        EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, brute))
             << stageName << " on " << c.name << " (ascending light order: bitwise brute's)";
     } else {
         float peak = 0.0f;
         for (int ch = 0; ch < 3; ++ch)
-            for (float v : f.brute.radiance[ch])
+            for (float v : brute.radiance[ch])
                 peak = std::max(peak, v);
         ASSERT_GT(peak, 0.0f);
         int imageFailures = 0;
         for (size_t pixel = 0; pixel < f.oracle.size(); ++pixel)
             for (int ch = 0; ch < 3; ++ch) {
                 const float difference =
-                    std::abs(result.radiance[ch][pixel] - f.brute.radiance[ch][pixel]);
+                    std::abs(result.radiance[ch][pixel] - brute.radiance[ch][pixel]);
                 if (!(difference <= 1e-5f * peak) && imageFailures++ < 5)
                     ADD_FAILURE() << stageName << " on " << c.name << ": pixel (" << pixel % kWidth
                                   << ", " << pixel / kWidth << ") channel " << ch
@@ -165,7 +186,7 @@ TEST_P(ExactStage, MatchesBruteAndEvaluatesEveryContributingLight) {
     if (std::string(c.name) != "spheres")
         return;
     lighting::StageResult untraced;
-    stage->shade(f.prepared->inputs, untraced);
+    stage->shade(inputs, untraced);
     EXPECT_TRUE(untraced.lightTrace.empty());
     EXPECT_TRUE(stagecheck::bitwiseEqualImages(untraced, result)) << stageName << " untraced";
     EXPECT_EQ(untraced.lightsEvaluated, result.lightsEvaluated) << stageName << " untraced";
@@ -173,10 +194,12 @@ TEST_P(ExactStage, MatchesBruteAndEvaluatesEveryContributingLight) {
 
 INSTANTIATE_TEST_SUITE_P(AllExactStages, ExactStage,
                          ::testing::Combine(::testing::ValuesIn(exactStageNames()),
-                                            ::testing::Range(0, int(std::size(kScenes)))),
+                                            ::testing::Range(0, int(std::size(kScenes))),
+                                            ::testing::Range(0, int(std::size(kIsas)))),
                          [](const auto& info) {
                              std::string name = std::get<0>(info.param) + "_" +
-                                                kScenes[std::get<1>(info.param)].name;
+                                                kScenes[std::get<1>(info.param)].name + "_" +
+                                                (std::get<2>(info.param) == 0 ? "scalar" : "auto");
                              std::replace(name.begin(), name.end(), '-', '_');
                              return name;
                          });
@@ -203,7 +226,7 @@ TEST_P(IdealStage, EvaluatesExactlyTheOracleAndTimesOnlyTheShading) {
     }
     EXPECT_EQ(mismatches, 0);
     EXPECT_GT(oracleTotal, 0u);
-    EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, f.brute)) << c.name;
+    EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, f.brute[0])) << c.name; // scalar brute
     ASSERT_EQ(result.timingsMs.size(), 1u);
     EXPECT_EQ(result.timingsMs[0].first, lighting::pass::kShading);
     EXPECT_EQ(result.parameters.count("untimed_list_build_ms"), 1u);

@@ -42,6 +42,9 @@ makeTestScene(const std::string& sceneName, int lightCount, int width, int heigh
     f->prepared = std::make_unique<lighting::PreparedScene>(
         scenes::buildProceduralScene(sceneName, request), width, height, false, depth);
     f->inputs = f->prepared->inputs;
+    // tiled-forward shades with evaluateLight per fragment: compared with brute's scalar path,
+    // which gives the per-pixel loop's sums bitwise.
+    f->inputs.isa = lighting::kernel::KernelIsa::scalar();
     f->view = f->prepared->view;
     f->gbuffer = f->prepared->gbuffer.get();
     f->oracle = lighting::countContributingLights(f->inputs);

@@ -1,0 +1,233 @@
+#include "lighting/LightAccumulation.h"
+
+#include <algorithm>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "lighting/Brdf.h"
+#include "lighting/kernel/KernelLights.h"
+#include "lighting/kernel/LightKernel.h"
+#include "lighting/kernel/PacketDecoder.h"
+
+namespace lighting {
+
+using kernel::kPacketHeight;
+using kernel::kPacketLanes;
+using kernel::kPacketWidth;
+
+EveryLightSource::EveryLightSource(size_t lightCount) : mIndices(lightCount) {
+    for (size_t i = 0; i < lightCount; ++i)
+        mIndices[i] = uint32_t(i);
+}
+
+namespace {
+
+constexpr int kWarpWidth = 8; // pixels; a warp is 8x4 (32 lanes) or 8x8 (64 lanes)
+
+// The one check of which path a frame takes (see the header): the packet decoder must read the
+// layout, and the kernel implements only the Blinn-Phong lighting function.
+bool packetPathFits(const StageInputs& inputs) {
+    if (!kernel::PacketDecoder::supports(inputs.gbuffer->layout()))
+        return false;
+    if (inputs.scene)
+        for (const scenes::Material& material : inputs.scene->materials)
+            if (material.model != scenes::MaterialModel::BlinnPhong)
+                return false;
+    return true;
+}
+
+kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb) {
+    kernel::GBufferPlanes planes;
+    planes.depth = gb.depth().data();
+    for (int k = 0; k < 3; ++k) {
+        planes.normal[k] = gb.normalPlane(k).empty() ? nullptr : gb.normalPlane(k).data();
+        planes.albedo[k] = gb.albedoPlane(k).empty() ? nullptr : gb.albedoPlane(k).data();
+    }
+    for (int k = 0; k < 2; ++k)
+        planes.specular[k] = gb.specularPlane(k).empty() ? nullptr : gb.specularPlane(k).data();
+    planes.material = gb.materialPlane().empty() ? nullptr : gb.materialPlane().data();
+    return planes;
+}
+
+// The per-pixel path's packet: the lanes' surfaces from GBuffer::surfaceAt, and the packet rows
+// the list sources read (positions, mask).
+void decodePerPixel(const gbuffer::GBuffer& gb, int x0, int y0, kernel::ShadingPacket& packet,
+                    gbuffer::Surface (&surfaces)[kPacketLanes]) {
+    packet.clear(x0, y0);
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        const int x = x0 + kernel::laneX(lane), y = y0 + kernel::laneY(lane);
+        if (x >= gb.width() || y >= gb.height())
+            continue;
+        gbuffer::Surface& s = surfaces[lane];
+        if (gb.surfaceAt(x, y, s))
+            packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
+                           s.specularPower);
+    }
+}
+
+// evaluateLight over each lane's list, as the stages' per-pixel loops did (shadeWithLightList).
+void shadePerPixel(const gbuffer::Surface (&surfaces)[kPacketLanes], const PacketLightLists& lists,
+                   const std::vector<LightInView<float>>& lights, bool countOracle,
+                   kernel::PacketAccumulator& accumulator) {
+    for (int g = 0; g < lists.size(); ++g)
+        for (uint32_t lanes = lists[g].laneMask; lanes != 0; lanes &= lanes - 1) {
+            const int lane = __builtin_ctz(lanes);
+            const gbuffer::Surface& point = surfaces[lane];
+            const glm::vec3 toViewer = glm::normalize(-point.positionView);
+            glm::vec3 sum(0.0f);
+            uint32_t contributing = 0;
+            for (uint32_t index : lists[g].lights) {
+                const glm::vec3 radiance = evaluateLight(point, toViewer, lights[index]);
+                sum += radiance;
+                if (countOracle)
+                    contributing += contributes(radiance) ? 1u : 0u;
+            }
+            for (int c = 0; c < 3; ++c)
+                accumulator.radiance[c][lane] = sum[c];
+            accumulator.lightsEvaluated[lane] = uint32_t(lists[g].lights.size());
+            accumulator.lightsContributing[lane] = contributing;
+        }
+}
+
+// Lights in the union of a warp's lists: the common case (one list for the whole warp) directly,
+// otherwise by stamping each light index with the warp's number.
+class WarpUnion {
+public:
+    explicit WarpUnion(size_t lightCount) : mStamp(lightCount, 0) {}
+    void begin() {
+        ++mWarp;
+        mFirst = {};
+        mHasFirst = false;
+        mSingle = true;
+        mCount = 0;
+    }
+    void add(std::span<const uint32_t> list) {
+        if (mSingle) {
+            if (!mHasFirst) {
+                mFirst = list;
+                mHasFirst = true;
+                return;
+            }
+            if (list.data() == mFirst.data() && list.size() == mFirst.size())
+                return;
+            mSingle = false;
+            stamp(mFirst);
+        }
+        stamp(list);
+    }
+    uint64_t count() const { return mSingle ? mFirst.size() : mCount; }
+
+private:
+    void stamp(std::span<const uint32_t> list) {
+        for (uint32_t index : list)
+            if (mStamp[index] != mWarp) {
+                mStamp[index] = mWarp;
+                ++mCount;
+            }
+    }
+    std::vector<uint32_t> mStamp;
+    uint32_t mWarp = 0;
+    std::span<const uint32_t> mFirst;
+    bool mHasFirst = false;
+    bool mSingle = true;
+    uint64_t mCount = 0;
+};
+
+} // namespace
+
+void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
+                      const AccumulationOptions& options, StageResult& result) {
+    const gbuffer::GBuffer& gb = *inputs.gbuffer;
+    const int width = gb.width(), height = gb.height();
+    if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
+        throw std::invalid_argument("accumulateLights: simtWarpLanes must be 32 or 64, not " +
+                                    std::to_string(inputs.simtWarpLanes));
+    const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
+    const std::vector<LightInView<float>>& lights = inputs.lights->lights;
+
+    const bool packets = packetPathFits(inputs);
+    const kernel::KernelIsa isa = packets ? inputs.isa : kernel::KernelIsa::scalar();
+    std::optional<kernel::PacketDecoder> decoder;
+    std::optional<kernel::KernelLights> kernelLights;
+    if (packets) {
+        decoder.emplace(gb.layout(), gb.view(), planesOf(gb));
+        kernelLights.emplace(lights);
+    }
+
+    const int warpRows = (height + warpHeight - 1) / warpHeight;
+    std::vector<uint64_t> laneSlotsPerRow(size_t(warpRows), 0);
+    tbb::parallel_for(0, warpRows, [&](int warpRow) {
+        kernel::ShadingPacket packet;
+        kernel::PacketAccumulator accumulator;
+        PacketLightLists lists;
+        gbuffer::Surface surfaces[kPacketLanes];
+        WarpUnion warpUnion(lights.size());
+        uint64_t laneSlots = 0;
+        for (int wx = 0; wx < width; wx += kWarpWidth) {
+            warpUnion.begin();
+            bool anyLane = false;
+            for (int y0 = warpRow * warpHeight; y0 < std::min(height, (warpRow + 1) * warpHeight);
+                 y0 += kPacketHeight)
+                for (int x0 = wx; x0 < std::min(width, wx + kWarpWidth); x0 += kPacketWidth) {
+                    if (packets)
+                        decoder->decode(isa, x0, y0, packet);
+                    else
+                        decodePerPixel(gb, x0, y0, packet, surfaces);
+                    if (packet.laneMask == 0)
+                        continue;
+                    lists.clear();
+                    source.listsOf(packet, lists);
+                    accumulator.clear();
+                    if (packets) {
+                        for (int g = 0; g < lists.size(); ++g)
+                            kernel::shadePacket(isa, packet, lists[g].laneMask, *kernelLights,
+                                                lists[g].lights, accumulator, options.countOracle);
+                    } else {
+                        shadePerPixel(surfaces, lists, lights, options.countOracle, accumulator);
+                    }
+                    for (int g = 0; g < lists.size(); ++g) {
+                        warpUnion.add(lists[g].lights);
+                        anyLane = true;
+                    }
+                    // The test-only light trace (StageResult::traceLights): each lane summed
+                    // exactly its group's list.
+                    if (result.tracing())
+                        for (int g = 0; g < lists.size(); ++g)
+                            for (uint32_t lanes = lists[g].laneMask & packet.laneMask; lanes != 0;
+                                 lanes &= lanes - 1) {
+                                const int lane = __builtin_ctz(lanes);
+                                result.traceLightList(size_t(y0 + kernel::laneY(lane)) *
+                                                              size_t(width) +
+                                                          size_t(x0 + kernel::laneX(lane)),
+                                                      lists[g].lights);
+                            }
+                    for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+                        const int lane = __builtin_ctz(lanes);
+                        const size_t pixel = size_t(y0 + kernel::laneY(lane)) * size_t(width) +
+                                             size_t(x0 + kernel::laneX(lane));
+                        for (int c = 0; c < 3; ++c)
+                            result.radiance[c][pixel] = accumulator.radiance[c][lane];
+                        result.lightsEvaluated[pixel] = accumulator.lightsEvaluated[lane];
+                        if (options.countOracle)
+                            result.lightsOracle[pixel] = accumulator.lightsContributing[lane];
+                    }
+                }
+            if (anyLane)
+                laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
+        }
+        laneSlotsPerRow[size_t(warpRow)] = laneSlots;
+    });
+
+    uint64_t laneSlots = 0;
+    for (uint64_t slots : laneSlotsPerRow)
+        laneSlots += slots;
+    result.parameters["isa"] = isa.name();
+    result.parameters["simt_warp"] = std::to_string(inputs.simtWarpLanes);
+    result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
+}
+
+} // namespace lighting

@@ -1,0 +1,137 @@
+// accumulateLights: the one "sum the lights, store the pixel" loop of the G-buffer stages (issue
+// 14, section 1): brute, tiled, tiled-backface, clustered and light-indexed call it with their
+// light lists instead of each copying a per-pixel loop.
+//
+// The frame is walked in SIMT warps (8x4 pixels, or 8x8), each made of 4x4-pixel packets. Per
+// packet: decode the G-buffer (lighting/kernel/PacketDecoder.h), ask the stage's PacketListSource
+// which light list each lane uses (lanes grouped by list: a mask per list), shade each group
+// with the kernel (lighting/kernel/LightKernel.h, the StageInputs' KernelIsa), and store every
+// covered lane's radiance and lights.evaluated (and, when asked, the oracle count). Each lane is
+// summed over its own list in list order, so an ascending list gives bitwise the image `brute`
+// gives with the same ISA whenever the culled lights contribute exactly zero.
+//
+// Two paths, chosen once per frame by packetPathFits in LightAccumulation.cpp (the one place that
+// check lives):
+// - packets: the G-buffer layout is one PacketDecoder reads and every material of the scene uses
+//   the Blinn-Phong model; the kernel runs on the requested ISA (`scalar` = evaluateLight lane by
+//   lane, bitwise the former per-pixel loops; a vector target differs from it by a few ulps,
+//   lighting/kernel/README.md);
+// - per pixel: otherwise (layouts with normal codes or packed albedo/specular; scenes with
+//   metallic-roughness materials, whose lighting function the kernel does not implement):
+//   GBuffer::surfaceAt and evaluateLight pixel by pixel, over the same lists, in the same order.
+//   result.parameters["isa"] then says "scalar" whatever was requested.
+//
+// SIMT cost model (issue 14, section 3; lighting/README.md): a warp pays one lane slot per lane
+// (all of its warpLanes, covered or not) for every light that any of its lanes evaluates, i.e.
+// warpLanes x |union of its lanes' lists|. The loop sums this into "simt_lane_slots"; the runner
+// divides the oracle's evaluations by it (simt_efficiency, experiments/RunMetrics.h).
+//
+// Determinism: warps rows in parallel (TBB), each pixel written by one task, the per-row counters
+// summed in row order after the loop: the result does not depend on the thread count.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <span>
+
+#include "lighting/ShadingStage.h"
+#include "lighting/kernel/ShadingPacket.h"
+
+namespace lighting {
+
+// The lists of one packet: groups of lanes, each with the light indices (ascending for exactness)
+// its lanes are shaded with. A lane in no group gets no light (radiance 0, evaluated 0).
+class PacketLightLists {
+public:
+    // Adds `laneMask`'s lanes (ignored when 0) with `lights`; a lane must be in one group only.
+    void add(uint32_t laneMask, std::span<const uint32_t> lights) {
+        if (laneMask != 0)
+            mGroups[mCount++] = {laneMask, lights};
+    }
+    // Groups the covered lanes of `packet` by the key lane -> keyOf(lane), whose equal values
+    // mean the same list listOf(key); for per-tile or per-cluster lists.
+    template <class KeyOf, class ListOf>
+    void addByKey(const kernel::ShadingPacket& packet, const KeyOf& keyOf, const ListOf& listOf) {
+        uint32_t remaining = packet.laneMask;
+        while (remaining != 0) {
+            const int first = __builtin_ctz(remaining);
+            const auto key = keyOf(first);
+            uint32_t mask = 0;
+            for (uint32_t lanes = remaining; lanes != 0; lanes &= lanes - 1) {
+                const int lane = __builtin_ctz(lanes);
+                if (lane == first || keyOf(lane) == key)
+                    mask |= 1u << lane;
+            }
+            remaining &= ~mask;
+            add(mask, listOf(key));
+        }
+    }
+
+    // Groups the covered lanes of `packet` whose lists listOfLane(lane) hold the same indices
+    // (per-pixel lists, e.g. light-indexed: neighbours often share one).
+    template <class ListOfLane>
+    void addByContent(const kernel::ShadingPacket& packet, const ListOfLane& listOfLane) {
+        uint32_t remaining = packet.laneMask;
+        while (remaining != 0) {
+            const int first = __builtin_ctz(remaining);
+            const std::span<const uint32_t> list = listOfLane(first);
+            uint32_t mask = 1u << first;
+            for (uint32_t lanes = remaining & (remaining - 1); lanes != 0; lanes &= lanes - 1) {
+                const int lane = __builtin_ctz(lanes);
+                const std::span<const uint32_t> other = listOfLane(lane);
+                if (std::equal(list.begin(), list.end(), other.begin(), other.end()))
+                    mask |= 1u << lane;
+            }
+            remaining &= ~mask;
+            add(mask, list);
+        }
+    }
+
+    struct Group {
+        uint32_t laneMask = 0;
+        std::span<const uint32_t> lights;
+    };
+    int size() const { return mCount; }
+    const Group& operator[](int i) const { return mGroups[i]; }
+    void clear() { mCount = 0; }
+
+private:
+    Group mGroups[kernel::kPacketLanes];
+    int mCount = 0;
+};
+
+// What a stage gives the loop: the lists of a packet (its x0, y0, laneMask and decoded
+// view-space positions are set; other rows are unspecified on the per-pixel path). Called once per
+// packet from several threads at once: it must only read shared state.
+class PacketListSource {
+public:
+    virtual ~PacketListSource() = default;
+    virtual void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const = 0;
+};
+
+// Every light of the frame for every covered lane (`brute`).
+class EveryLightSource final : public PacketListSource {
+public:
+    explicit EveryLightSource(size_t lightCount);
+    void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
+        lists.add(packet.laneMask, mIndices);
+    }
+
+private:
+    std::vector<uint32_t> mIndices; // 0 .. n-1
+};
+
+struct AccumulationOptions {
+    // Count the contributing lights into result.lightsOracle (the stage must have resized with
+    // the oracle plane): `brute`, which evaluates every light anyway.
+    bool countOracle = false;
+};
+
+// Shades every covered pixel of inputs.gbuffer with its lists and writes result.radiance,
+// result.lightsEvaluated (and lightsOracle when asked); result must be resized already. Records
+// the parameters "isa" (what ran), "simt_warp" and "simt_lane_slots". Adds no timing: the stage
+// times its own "shading" pass around the call.
+void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
+                      const AccumulationOptions& options, StageResult& result);
+
+} // namespace lighting
