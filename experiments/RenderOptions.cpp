@@ -96,6 +96,8 @@ CheckedOptions checkOptions(const RenderOptions& options) {
     checkScene(options.scene);
     checkRepetitions(options);
     checked.layoutRequest = layoutRequest(options);
+    if (options.brdf != "auto")
+        usageErrorFrom([&] { return scenes::parseMaterialModel(options.brdf); });
     return checked;
 }
 
@@ -104,9 +106,10 @@ void validate(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {"scene",        "stage",      "lights",   "seed",   "width",
-            "height",       "resolution", "threads",  "layout", "normals",
-            "normal-space", "depth",      "position", "view",   "scene-option.<key>"};
+    return {"scene",    "stage",   "lights",       "seed",
+            "width",    "height",  "resolution",   "threads",
+            "layout",   "normals", "normal-space", "depth",
+            "position", "view",    "brdf",         "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -137,6 +140,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.depth = value;
     else if (key == "position")
         options.position = value;
+    else if (key == "brdf")
+        options.brdf = value;
     else if (key == "resolution") {
         const size_t x = value.find('x');
         if (x == std::string::npos)
