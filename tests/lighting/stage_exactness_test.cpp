@@ -1,4 +1,5 @@
-// Every stage registered as Exact, on atrium, wall (with lights behind it) and spheres: the same
+// Every stage registered as Exact, on atrium, wall (with lights behind it), spheres and the
+// DamagedHelmet glTF model (metallic-roughness materials with textures and a normal map): the same
 // image as `brute` (max abs difference <= 1e-5 of the image's peak) and, at every pixel, at
 // least as many lights evaluated as contribute (the oracle). New stages are covered as soon as
 // they are registered; nothing here names them.
@@ -14,6 +15,7 @@
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
+#include "scenes/SceneLoader.h"
 
 namespace {
 
@@ -34,6 +36,8 @@ const SceneCase kScenes[] = {
     {"wall_behind", "wall", 400, {{"behind", "200"}}},
     {"spheres", "spheres", 200, {}},
     {"atrium_spots", "atrium", 300, {}, true},
+    {"helmet", TESTBED_GLTF_DIR "/DamagedHelmet/DamagedHelmet.gltf", 64, {}},
+    {"helmet_spots", TESTBED_GLTF_DIR "/DamagedHelmet/DamagedHelmet.gltf", 64, {}, true},
 };
 
 // Deterministic spot lights from the generated point lights: axes spread over the lower
@@ -73,7 +77,10 @@ const PreparedCase& prepared(const SceneCase& c) {
     request.lightCount = c.lights;
     request.seed = 3;
     request.options = c.options;
-    scenes::Scene scene = scenes::buildProceduralScene(c.scene, request);
+    const std::string source = c.scene;
+    scenes::Scene scene = source.ends_with(".gltf")
+                              ? scenes::loadScene(source, request)
+                              : scenes::buildProceduralScene(c.scene, request);
     if (c.spots)
         makeSpots(scene);
     slot->prepared = std::make_unique<lighting::PreparedScene>(std::move(scene), kWidth, kHeight);
