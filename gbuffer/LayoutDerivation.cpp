@@ -225,6 +225,8 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
             "unorm24 standard Z: the smallest depth under the compact threshold";
         if (layout.roughnessMetallic == RoughnessMetallicEncoding::Float32)
             layout.roughnessMetallic = RoughnessMetallicEncoding::Unorm8;
+        if (layout.occlusion == RoughnessMetallicEncoding::Float32)
+            layout.occlusion = RoughnessMetallicEncoding::Unorm8;
         return layout;
     }
     layout.name = name;
