@@ -314,6 +314,7 @@ nlohmann::json statsJson(const RenderRun& run) {
     nlohmann::json stats;
     stats["scene"] = run.scene().name;
     stats["scene_source"] = run.options.scene;
+    stats["brdf"] = run.options.brdf;
     stats["scene_options"] = run.options.sceneOptions;
     stats["view"] = run.scene().cameras.front().name;
     stats["stage"] = run.options.stage;

@@ -100,6 +100,8 @@ CheckedOptions checkOptions(const RenderOptions& options) {
     if (options.simtWarp != 32 && options.simtWarp != 64)
         throw UsageError("--simt-warp " + std::to_string(options.simtWarp) +
                          " refused: must be 32 (8x4 pixels) or 64 (8x8)");
+    if (options.brdf != "auto")
+        usageErrorFrom([&] { return scenes::parseMaterialModel(options.brdf); });
     return checked;
 }
 
@@ -108,23 +110,9 @@ void validate(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {"scene",
-            "stage",
-            "lights",
-            "seed",
-            "width",
-            "height",
-            "resolution",
-            "threads",
-            "isa",
-            "simt-warp",
-            "layout",
-            "normals",
-            "normal-space",
-            "depth",
-            "position",
-            "view",
-            "scene-option.<key>"};
+    return {"scene",        "stage",   "lights",   "seed",      "width",  "height",
+            "resolution",   "threads", "isa",      "simt-warp", "layout", "normals",
+            "normal-space", "depth",   "position", "view",      "brdf",   "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -159,6 +147,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.depth = value;
     else if (key == "position")
         options.position = value;
+    else if (key == "brdf")
+        options.brdf = value;
     else if (key == "resolution") {
         const size_t x = value.find('x');
         if (x == std::string::npos)

@@ -47,15 +47,18 @@ struct RenderOptions {
     std::string depth;
     std::string position;
     std::string normalSpace; // "view" (default) or "world"
+    // Material model every material is shaded with: "auto" (what each material says),
+    // "blinn-phong" or "metallic-roughness" (forced, for studies; scenes::forceMaterialModel).
+    std::string brdf = "auto";
     int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
     int repetitions = 1; // timed runs; timings are reported as median, min and max over them
 };
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, layout, normals, normal-space,
-// depth, position, view, and scene-option.KEY. Values are checked later by validate(); a malformed
-// number or an unknown key throws UsageError naming it. The sweep runner goes through this, so
-// every stage, encoding or scene added later is reachable without touching the runner.
+// depth, position, view, brdf, and scene-option.KEY. Values are checked later by validate(); a
+// malformed number or an unknown key throws UsageError naming it. The sweep runner goes through
+// this, so every stage, encoding or scene added later is reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();

@@ -20,6 +20,11 @@ scenes::Scene loadRequestedScene(const RenderOptions& options) {
     scenes::Scene scene = scenes::loadScene(options.scene, request);
     if (!options.view.empty())
         scenes::selectView(scene, options.view);
+    if (options.brdf != "auto") {
+        const scenes::MaterialModel model = scenes::parseMaterialModel(options.brdf);
+        for (scenes::Material& material : scene.materials)
+            scenes::forceMaterialModel(material, model);
+    }
     return scene;
 }
 

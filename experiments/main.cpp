@@ -109,6 +109,11 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         "depth format: f32, f32-reversed, unorm24, unorm16, f16-linear, optionally :infinite");
     render.add_option("--position", r.position,
                       "position reconstruction: inverse-projection or view-ray");
+    render
+        .add_option("--brdf", r.brdf,
+                    "material model: auto (each material's own), blinn-phong or "
+                    "metallic-roughness (every material forced to it, for studies)")
+        ->capture_default_str();
     render.add_option("--normal-space", r.normalSpace,
                       "space normals are encoded in: view (default) or world");
     render.add_flag(

@@ -2,6 +2,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "gbuffer/NormalMapping.h"
+
 namespace gbuffer {
 
 void ExactSurface::resize(int w, int h) {
@@ -12,11 +14,15 @@ void ExactSurface::resize(int w, int h) {
     backFacing.assign(n, 0);
     albedo.assign(n, glm::vec3(0.0f));
     specular.assign(n, glm::vec2(0.0f));
+    roughnessMetallic.assign(n, glm::vec2(1.0f, 0.0f));
+    model.assign(n, scenes::MaterialModel::BlinnPhong);
+    occlusion.assign(n, 1.0f);
     positionView.assign(n, glm::dvec3(0.0));
     normalView.assign(n, glm::dvec3(0.0));
 }
 
-void ExactSurface::computeGeometry(const SceneGeometry& geometry, const CameraView& view) {
+void ExactSurface::computeGeometry(const scenes::Scene& scene, const SceneGeometry& geometry,
+                                   const CameraView& view) {
     const glm::dmat3 normalViewFromWorld(view.viewFromWorldExact);
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {
@@ -54,7 +60,28 @@ void ExactSurface::computeGeometry(const SceneGeometry& geometry, const CameraVi
             for (int i = 0; i < 3; ++i)
                 n += w[i] * glm::dvec3(geometry.normalWorld[geometry.indices[3 * t + i]]);
             n = glm::normalize(normalViewFromWorld * n);
-            normalView[pixel] = backFacing[pixel] ? -n : n;
+            const bool backFace = backFacing[pixel] != 0;
+            normalView[pixel] = backFace ? -n : n;
+            const scenes::Material& material = scene.materials[geometry.triangleMaterial[t]];
+            if (material.normalTexture < 0 || geometry.tangentWorld.empty())
+                continue;
+            glm::dvec3 tangent(0.0), uv0(0.0), uv1(0.0);
+            double sign = 0.0;
+            for (int i = 0; i < 3; ++i) {
+                const uint32_t vertex = geometry.indices[3 * t + i];
+                tangent += w[i] * glm::dvec3(glm::vec3(geometry.tangentWorld[vertex]));
+                sign += w[i] * double(geometry.tangentWorld[vertex].w);
+                uv0 += w[i] * glm::dvec3(glm::dvec2(geometry.uv[vertex]), 0.0);
+                if (!geometry.uv1.empty())
+                    uv1 += w[i] * glm::dvec3(glm::dvec2(geometry.uv1[vertex]), 0.0);
+            }
+            const scenes::TextureMapping& mapping = material.normalMapping;
+            const glm::vec2 uv = mapping.apply(
+                glm::vec2(mapping.texCoord == 1 && !geometry.uv1.empty() ? uv1 : uv0));
+            const glm::vec4 texel = scene.textures[size_t(material.normalTexture)].sample(uv);
+            normalView[pixel] = normalMapped(
+                normalView[pixel], backFace, normalViewFromWorld * tangent, sign < 0.0 ? -1.0 : 1.0,
+                glm::dvec3(glm::vec3(texel)), double(material.normalScale));
         }
     });
 }

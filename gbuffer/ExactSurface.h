@@ -2,8 +2,10 @@
 // The rasterizer records which triangle covers each pixel; position and normal are then
 // recomputed in double by intersecting the pixel centre's view ray with that triangle's
 // unrounded world-space vertices, so no float rounding of depth, interpolation or G-buffer
-// encoding reaches the reference. Material values (albedo, specular) come straight from the
-// material and texture lookup, never through a G-buffer encoding.
+// encoding reaches the reference. Material values (albedo, specular, model, roughness, metallic)
+// come straight from the material and texture lookup, never through a G-buffer encoding. Normal
+// maps are applied here again, in double (NormalMapping.h, the resolve's formula), at the uv of
+// the double-precision intersection.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +16,7 @@
 #include "gbuffer/CameraView.h"
 #include "gbuffer/SceneGeometry.h"
 #include "gbuffer/Surface.h"
+#include "scenes/Scene.h"
 
 namespace gbuffer {
 
@@ -26,6 +29,9 @@ struct ExactSurface {
     std::vector<uint8_t> backFacing; // 1 where the visible side is the back face (normal flipped)
     std::vector<glm::vec3> albedo;
     std::vector<glm::vec2> specular; // intensity, power
+    std::vector<glm::vec2> roughnessMetallic;
+    std::vector<scenes::MaterialModel> model;
+    std::vector<float> occlusion;
     std::vector<glm::dvec3> positionView;
     std::vector<glm::dvec3> normalView;
 
@@ -42,10 +48,16 @@ struct ExactSurface {
         s.albedo = glm::dvec3(albedo[pixel]);
         s.specularIntensity = double(specular[pixel].x);
         s.specularPower = double(specular[pixel].y);
+        s.roughness = double(roughnessMetallic[pixel].x);
+        s.metallic = double(roughnessMetallic[pixel].y);
+        s.model = model[pixel];
+        s.occlusion = double(occlusion[pixel]);
         return true;
     }
-    // Fills positionView and normalView from `triangle` (parallel over rows, deterministic).
-    void computeGeometry(const SceneGeometry& geometry, const CameraView& view);
+    // Fills positionView and normalView from `triangle` (parallel over rows, deterministic),
+    // normal mapped where the triangle's material has a normal texture.
+    void computeGeometry(const scenes::Scene& scene, const SceneGeometry& geometry,
+                         const CameraView& view);
 };
 
 } // namespace gbuffer

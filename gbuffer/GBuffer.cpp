@@ -72,6 +72,15 @@ GBuffer::GBuffer(const GBufferLayout& layout, const CameraView& view)
     if (layout.specular == SpecularEncoding::Unorm8Half ||
         layout.specular == SpecularEncoding::Unorm8Log8)
         mSpecularPacked.assign(n, 0);
+    if (layout.roughnessMetallic == RoughnessMetallicEncoding::Float32)
+        for (auto& plane : mRoughnessMetallic)
+            plane.assign(n, 0.0f);
+    if (layout.roughnessMetallic == RoughnessMetallicEncoding::Unorm8)
+        mRoughnessMetallicPacked.assign(n, 0);
+    if (layout.occlusion == RoughnessMetallicEncoding::Float32)
+        mOcclusion.assign(n, 0.0f);
+    if (layout.occlusion == RoughnessMetallicEncoding::Unorm8)
+        mOcclusionPacked.assign(n, 0);
     if (layout.hasMaterialIndex())
         mMaterial.assign(n, 0);
 }
@@ -100,15 +109,19 @@ GBuffer::Writer::Writer(GBuffer& target) {
         mNormal[c] = pointer(target.mNormal[c]);
         mAlbedo[c] = pointer(target.mAlbedo[c]);
     }
-    for (int c = 0; c < 2; ++c)
+    for (int c = 0; c < 2; ++c) {
         mSpecular[c] = pointer(target.mSpecular[c]);
+        mRoughnessMetallic[c] = pointer(target.mRoughnessMetallic[c]);
+    }
+    mOcclusion = pointer(target.mOcclusion);
     mMaterial = pointer(target.mMaterial);
     mEncoded = target.hasEncodedPlanes() ? &target : nullptr;
 }
 
 bool GBuffer::hasEncodedPlanes() const {
     return !mNormalCode32.empty() || !mNormalCode64.empty() || !mAlbedoPacked.empty() ||
-           !mSpecularPacked.empty();
+           !mSpecularPacked.empty() || !mRoughnessMetallicPacked.empty() ||
+           !mOcclusionPacked.empty();
 }
 
 void GBuffer::writeEncoded(size_t pixel, const Surface& s) {
@@ -136,6 +149,10 @@ void GBuffer::writeEncoded(size_t pixel, const Surface& s) {
         }
         mSpecularPacked[pixel] = unorm8(s.specularIntensity) | power << 8;
     }
+    if (!mRoughnessMetallicPacked.empty())
+        mRoughnessMetallicPacked[pixel] = uint16_t(unorm8(s.roughness) | unorm8(s.metallic) << 8);
+    if (!mOcclusionPacked.empty())
+        mOcclusionPacked[pixel] = uint8_t(unorm8(s.occlusion));
 }
 
 Surface GBuffer::decode(int x, int y) const {
@@ -209,6 +226,38 @@ Surface GBuffer::decode(int x, int y) const {
     case SpecularEncoding::None:
         break;
     }
+    if (mLayout.modelPerMaterial)
+        s.model = material ? material->model : scenes::MaterialModel::BlinnPhong;
+    else
+        s.model = mLayout.constant.model;
+    switch (mLayout.roughnessMetallic) {
+    case RoughnessMetallicEncoding::Float32:
+        s.roughness = mRoughnessMetallic[0][pixel];
+        s.metallic = mRoughnessMetallic[1][pixel];
+        break;
+    case RoughnessMetallicEncoding::Unorm8: {
+        const uint16_t packed = mRoughnessMetallicPacked[pixel];
+        s.roughness = float(packed & 0xff) / 255.0f;
+        s.metallic = float(packed >> 8) / 255.0f;
+        break;
+    }
+    case RoughnessMetallicEncoding::Material:
+        if (material) {
+            s.roughness = material->roughness;
+            s.metallic = material->metallic;
+        }
+        break;
+    case RoughnessMetallicEncoding::Constant:
+        s.roughness = mLayout.constant.roughness;
+        s.metallic = mLayout.constant.metallic;
+        break;
+    case RoughnessMetallicEncoding::None:
+        break;
+    }
+    if (!mOcclusion.empty())
+        s.occlusion = mOcclusion[pixel];
+    else if (!mOcclusionPacked.empty())
+        s.occlusion = float(mOcclusionPacked[pixel]) / 255.0f;
     return s;
 }
 

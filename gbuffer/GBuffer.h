@@ -11,8 +11,10 @@
 // - Normals: three float planes for float32, else one array of codes (32- or 64-bit words).
 //   pixel-view codes are built on the pixel's view ray, which encode and decode compute.
 // - Albedo: three float planes (f32), one packed RGB8 sRGB word, or nothing (material index,
-//   constant, none). Specular: two float planes, one packed word, or nothing. Material index:
-//   one 16-bit array when albedo or specular decode from the material table.
+//   constant, none). Specular: two float planes, one packed word, or nothing. Roughness and
+//   metallic: two float planes, one packed 16-bit word (8 bits each), or nothing. Material index:
+//   one 16-bit array when something decodes from the material table. The material model is not
+//   stored per pixel: it is the layout's constant or the material's (GBufferLayout.h).
 // View-space position is reconstructed from depth by the layout's DepthDecoder (DepthFormat.h:
 // inverse projection or view ray). Decoding is const and thread-safe; writing a pixel is safe
 // concurrently with writing other pixels.
@@ -70,6 +72,12 @@ public:
                 mSpecular[0][pixel] = s.specularIntensity;
                 mSpecular[1][pixel] = s.specularPower;
             }
+            if (mRoughnessMetallic[0]) {
+                mRoughnessMetallic[0][pixel] = s.roughness;
+                mRoughnessMetallic[1][pixel] = s.metallic;
+            }
+            if (mOcclusion)
+                mOcclusion[pixel] = s.occlusion;
             if (mMaterial)
                 mMaterial[pixel] = uint16_t(s.material);
             if (mEncoded)
@@ -82,6 +90,8 @@ public:
         float* mNormal[3] = {};
         float* mAlbedo[3] = {};
         float* mSpecular[2] = {};
+        float* mRoughnessMetallic[2] = {};
+        float* mOcclusion = nullptr;
         uint16_t* mMaterial = nullptr;
         GBuffer* mEncoded = nullptr; // the target when it has encoded planes
     };
@@ -124,14 +134,18 @@ private:
         1.0f}; // for world-space normal codes (viewFromWorldNormal is a rotation)
     float mClearDepth;
     Plane<float> mDepth;
-    Plane<float> mNormal[3];         // float32 normals
-    Plane<uint32_t> mNormalCode32;   // codes of up to 32 bits
-    Plane<uint64_t> mNormalCode64;   // longer codes (xyz:48)
-    Plane<float> mAlbedo[3];         // f32
-    Plane<uint32_t> mAlbedoPacked;   // rgb8-srgb
-    Plane<float> mSpecular[2];       // f32
-    Plane<uint32_t> mSpecularPacked; // unorm8+f16, unorm8+log8
-    Plane<uint16_t> mMaterial;       // material index
+    Plane<float> mNormal[3];                  // float32 normals
+    Plane<uint32_t> mNormalCode32;            // codes of up to 32 bits
+    Plane<uint64_t> mNormalCode64;            // longer codes (xyz:48)
+    Plane<float> mAlbedo[3];                  // f32
+    Plane<uint32_t> mAlbedoPacked;            // rgb8-srgb
+    Plane<float> mSpecular[2];                // f32
+    Plane<uint32_t> mSpecularPacked;          // unorm8+f16, unorm8+log8
+    Plane<float> mRoughnessMetallic[2];       // f32 roughness, metallic
+    Plane<uint16_t> mRoughnessMetallicPacked; // unorm8 roughness | unorm8 metallic << 8
+    Plane<float> mOcclusion;                  // f32 ambient occlusion
+    Plane<uint8_t> mOcclusionPacked;          // unorm8 ambient occlusion
+    Plane<uint16_t> mMaterial;                // material index
 };
 
 } // namespace gbuffer

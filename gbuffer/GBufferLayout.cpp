@@ -30,6 +30,18 @@ constexpr SpecularInfo kSpecularEncodings[] = {
     {SpecularEncoding::Float32, "f32"},
 };
 
+struct RoughnessMetallicInfo {
+    RoughnessMetallicEncoding encoding;
+    const char* name;
+};
+constexpr RoughnessMetallicInfo kRoughnessMetallicEncodings[] = {
+    {RoughnessMetallicEncoding::None, "none"},
+    {RoughnessMetallicEncoding::Constant, "constant"},
+    {RoughnessMetallicEncoding::Material, "material"},
+    {RoughnessMetallicEncoding::Unorm8, "unorm8"},
+    {RoughnessMetallicEncoding::Float32, "f32"},
+};
+
 // Bytes of the CPU array that holds a plane of `bits` bits (the next power-of-two word).
 int storageBytes(int bits) {
     return bits <= 8 ? 1 : bits <= 16 ? 2 : bits <= 32 ? 4 : 8;
@@ -81,6 +93,13 @@ const char* specularEncodingName(SpecularEncoding encoding) {
     return "?";
 }
 
+const char* roughnessMetallicEncodingName(RoughnessMetallicEncoding encoding) {
+    for (const RoughnessMetallicInfo& info : kRoughnessMetallicEncodings)
+        if (info.encoding == encoding)
+            return info.name;
+    return "?";
+}
+
 bool GBufferLayout::provides(Channel channel) const {
     switch (channel) {
     case Channel::Depth:
@@ -90,7 +109,8 @@ bool GBufferLayout::provides(Channel channel) const {
     case Channel::Albedo:
         return albedo != AlbedoEncoding::None;
     case Channel::Specular:
-        return specular != SpecularEncoding::None;
+        return specular != SpecularEncoding::None ||
+               roughnessMetallic != RoughnessMetallicEncoding::None;
     }
     return false;
 }
@@ -137,6 +157,22 @@ std::vector<PlaneDesc> GBufferLayout::planes() const {
     default:
         break;
     }
+    switch (roughnessMetallic) {
+    case RoughnessMetallicEncoding::Float32:
+        result.push_back({"roughness", "f32", 32, "specular"});
+        result.push_back({"metallic", "f32", 32, "specular"});
+        break;
+    case RoughnessMetallicEncoding::Unorm8:
+        result.push_back({"roughness", "unorm8", 8, "specular"});
+        result.push_back({"metallic", "unorm8", 8, "specular"});
+        break;
+    default:
+        break;
+    }
+    if (occlusion == RoughnessMetallicEncoding::Float32)
+        result.push_back({"occlusion", "f32", 32, "specular"});
+    if (occlusion == RoughnessMetallicEncoding::Unorm8)
+        result.push_back({"occlusion", "unorm8", 8, "specular"});
     if (hasMaterialIndex())
         result.push_back({"material", "uint" + std::to_string(materialIndexBits()),
                           materialIndexBits(), "material"});
@@ -189,7 +225,10 @@ std::string GBufferLayout::explain() const {
                         ? " and "
                         : "")
                 << (specular == SpecularEncoding::Material ? "specular" : "")
-                << " from the material table (" << materials.size() << " materials)";
+                << (roughnessMetallic == RoughnessMetallicEncoding::Material ? " roughness-metallic"
+                                                                             : "")
+                << (modelPerMaterial ? " material-model" : "") << " from the material table ("
+                << materials.size() << " materials)";
         else
             out << reasonOf(plane.channel);
         out << "\n";
@@ -200,8 +239,10 @@ std::string GBufferLayout::explain() const {
                 if (plane.channel == channelName(channel))
                     return true;
             return channel != Channel::Normal && hasMaterialIndex() &&
-                   (channel == Channel::Albedo ? albedo == AlbedoEncoding::Material
-                                               : specular == SpecularEncoding::Material);
+                   (channel == Channel::Albedo
+                        ? albedo == AlbedoEncoding::Material
+                        : specular == SpecularEncoding::Material ||
+                              roughnessMetallic == RoughnessMetallicEncoding::Material);
         }();
         if (!stored)
             out << "  (no " << channelName(channel) << " plane)  " << reasonOf(channelName(channel))

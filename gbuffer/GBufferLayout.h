@@ -9,10 +9,17 @@
 //   albedo    f32 (3 x float), rgb8-srgb (24 bits), material (decoded from the per-pixel material
 //             index and the layout's material table), constant (one value for the whole scene,
 //             0 bits), none
-//   specular  f32 (intensity, power as floats), unorm8+f16 (8-bit intensity, half power: the
-//             thesis' layout), unorm8+log8 (8-bit intensity, 8-bit log power: Killzone 2's),
-//             material, constant, none
-// A material index plane (8 or 16 bits) exists when albedo or specular is `material`.
+//   specular  the parameters of the material model's specular lobe, one encoding per model:
+//             Blinn-Phong  f32 (intensity, power as floats), unorm8+f16 (8-bit intensity, half
+//                          power: the thesis' layout), unorm8+log8 (8-bit intensity, 8-bit log
+//                          power: Killzone 2's), material, constant, none
+//             metallic-roughness (roughnessMetallic)  f32 (roughness, metallic as floats), unorm8
+//                          (8 bits each), material, constant, none
+//             A scene that uses only one model stores only that model's parameters.
+//   The material model of a pixel (MaterialConstants::model) is the constant's when every used
+//   material has the same model, else it is decoded from the material index (modelPerMaterial).
+// A material index plane (8 or 16 bits) exists when albedo, specular or roughness-metallic is
+// `material`, or when the model is per material.
 // Historical presets also carry `unmodelled` planes: data the original layout stored that no stage
 // here reads (ambient occlusion, motion vectors, stencil...). They count in bytesPerPixel, so the
 // preset's size is the published one, but are never allocated.
@@ -28,6 +35,7 @@
 
 #include "gbuffer/DepthFormat.h"
 #include "gbuffer/NormalCodec.h"
+#include "scenes/Material.h"
 
 namespace gbuffer {
 
@@ -46,14 +54,19 @@ bool codecWorksInWorldSpace(NormalCodecKind kind);
 
 enum class AlbedoEncoding { None, Constant, Material, Rgb8Srgb, Float32 };
 enum class SpecularEncoding { None, Constant, Material, Unorm8Log8, Unorm8Half, Float32 };
+enum class RoughnessMetallicEncoding { None, Constant, Material, Unorm8, Float32 };
 const char* albedoEncodingName(AlbedoEncoding encoding); // "none", "constant", ...
 const char* specularEncodingName(SpecularEncoding encoding);
+const char* roughnessMetallicEncodingName(RoughnessMetallicEncoding encoding);
 
 // Per-material values the `material` and `constant` encodings decode from.
 struct MaterialConstants {
     glm::vec3 albedo{0.0f};
     float specularIntensity = 0.0f;
     float specularPower = 1.0f;
+    scenes::MaterialModel model = scenes::MaterialModel::BlinnPhong;
+    float roughness = 1.0f; // the factors (metallic-roughness; the texture multiplies them)
+    float metallic = 0.0f;
     friend bool operator==(const MaterialConstants&, const MaterialConstants&) = default;
 };
 
@@ -75,6 +88,12 @@ struct GBufferLayout {
     NormalSpace normalSpace = NormalSpace::View;
     AlbedoEncoding albedo = AlbedoEncoding::Float32;
     SpecularEncoding specular = SpecularEncoding::Float32;
+    RoughnessMetallicEncoding roughnessMetallic = RoughnessMetallicEncoding::None;
+    bool modelPerMaterial = false; // the model comes from the material index (mixed scenes)
+    // Ambient occlusion of metallic-roughness materials (Surface::occlusion, ambient light only):
+    // stored only when a used material has an occlusion texture and the scene an ambient light;
+    // else it decodes to 1. f32 (derived, lossless) or unorm8 (presets).
+    RoughnessMetallicEncoding occlusion = RoughnessMetallicEncoding::None;
     std::vector<MaterialConstants> materials; // index = scene material, for `material`
     MaterialConstants constant;               // for `constant`
     std::vector<PlaneDesc> unmodelled;        // historical presets only
@@ -84,7 +103,8 @@ struct GBufferLayout {
     // Whether a reader can decode this channel (a `constant` channel can, with no plane).
     bool provides(Channel channel) const;
     bool hasMaterialIndex() const {
-        return albedo == AlbedoEncoding::Material || specular == SpecularEncoding::Material;
+        return albedo == AlbedoEncoding::Material || specular == SpecularEncoding::Material ||
+               roughnessMetallic == RoughnessMetallicEncoding::Material || modelPerMaterial;
     }
     int materialIndexBits() const { return materials.size() <= 256 ? 8 : 16; }
     // Every plane of the layout, including unmodelled ones.
@@ -102,7 +122,8 @@ struct GBufferLayout {
     DepthDecoder depthDecoder(const CameraView& view) const { return {depth, position, view}; }
 
     // float32 reversed-Z depth, float32 view-space normal, float32 albedo RGB, float32 specular
-    // (intensity, power): lossless with respect to what the rasterizer computes.
+    // (intensity, power): lossless with respect to what the rasterizer computes for Blinn-Phong
+    // scenes (LayoutDerivation.h's addMaterialModels adds what metallic-roughness materials need).
     static GBufferLayout reference();
     // The reference layout with float depth in the given convention and far plane: what the
     // rasterizer computes, kept as is (the surface forward stages shade).

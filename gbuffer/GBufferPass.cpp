@@ -41,6 +41,9 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
                 exact->backFacing[pixel] = VisibilityPass::backFaceOf(code) ? 1 : 0;
                 exact->albedo[pixel] = surface.albedo;
                 exact->specular[pixel] = {surface.specularIntensity, surface.specularPower};
+                exact->roughnessMetallic[pixel] = {surface.roughness, surface.metallic};
+                exact->model[pixel] = surface.model;
+                exact->occlusion[pixel] = surface.occlusion;
             }
         }
     });
@@ -67,7 +70,7 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
 
     if (exact) {
         start = std::chrono::steady_clock::now();
-        exact->computeGeometry(mGeometry, view);
+        exact->computeGeometry(mScene, mGeometry, view);
         timings.exactMs = millisecondsSince(start);
     }
     return timings;

@@ -32,6 +32,17 @@ std::string describe(const glm::vec3& v) {
 constexpr NormalCodecSpec kCompactNormals{NormalCodecKind::OctahedralPrecise, 24};
 constexpr DepthFormatSpec kCompactDepth{DepthFormatKind::Unorm24, false};
 
+// Whether every used material has the same model.
+bool oneModel(const scenes::Scene& scene, const std::set<uint32_t>& used) {
+    bool blinnPhong = false, metallicRoughness = false;
+    for (uint32_t index : used)
+        if (index < scene.materials.size())
+            (scene.materials[index].model == scenes::MaterialModel::BlinnPhong
+                 ? blinnPhong
+                 : metallicRoughness) = true;
+    return !(blinnPhong && metallicRoughness);
+}
+
 } // namespace
 
 std::vector<std::string> layoutPresetNames() {
@@ -41,8 +52,72 @@ std::vector<std::string> layoutPresetNames() {
 std::vector<MaterialConstants> materialTable(const scenes::Scene& scene) {
     std::vector<MaterialConstants> table;
     for (const scenes::Material& m : scene.materials)
-        table.push_back({glm::vec3(m.baseColorFactor), m.specularIntensity, m.specularPower});
+        table.push_back({glm::vec3(m.baseColorFactor), m.specularIntensity, m.specularPower,
+                         m.model, m.roughness, m.metallic});
     return table;
+}
+
+void addMaterialModels(GBufferLayout& layout, const scenes::Scene& scene, bool readsSpecular,
+                       bool eightBitPlanes) {
+    using scenes::MaterialModel;
+    const std::set<uint32_t> used = usedMaterials(scene);
+    bool anyMetallicRoughness = false, anyBlinnPhong = false, textured = false, oneValue = true;
+    bool occlusionTextured = false;
+    const scenes::Material* first = nullptr;
+    for (uint32_t index : used) {
+        if (index >= scene.materials.size())
+            continue;
+        const scenes::Material& m = scene.materials[index];
+        if (m.model == MaterialModel::BlinnPhong) {
+            anyBlinnPhong = true;
+            continue;
+        }
+        anyMetallicRoughness = true;
+        textured = textured || m.metallicRoughnessTexture >= 0;
+        occlusionTextured = occlusionTextured || m.occlusionTexture >= 0;
+        if (!first)
+            first = &m;
+        oneValue = oneValue && m.roughness == first->roughness && m.metallic == first->metallic;
+    }
+    layout.modelPerMaterial = anyMetallicRoughness && anyBlinnPhong;
+    layout.constant.model = anyMetallicRoughness && !anyBlinnPhong
+                                ? MaterialModel::MetallicRoughness
+                                : MaterialModel::BlinnPhong;
+    if (layout.modelPerMaterial)
+        layout.notes.push_back("both material models are used: the model is decoded from the "
+                               "material index");
+    if (!anyMetallicRoughness || !readsSpecular)
+        return;
+    layout.constant.roughness = first->roughness;
+    layout.constant.metallic = first->metallic;
+    std::string& reason = layout.reasons[Channel::Specular];
+    reason += reason.empty() ? "" : "; ";
+    if (textured) {
+        layout.roughnessMetallic =
+            eightBitPlanes ? RoughnessMetallicEncoding::Unorm8 : RoughnessMetallicEncoding::Float32;
+        reason += eightBitPlanes ? "metallic-roughness textures: roughness and metallic vary per "
+                                   "pixel (8 bits each)"
+                                 : "metallic-roughness textures: roughness and metallic vary per "
+                                   "pixel (float32, lossless)";
+    } else if (oneValue) {
+        layout.roughnessMetallic = RoughnessMetallicEncoding::Constant;
+        reason += "every metallic-roughness material has roughness " +
+                  std::to_string(first->roughness) + " and metallic " +
+                  std::to_string(first->metallic) + ": a constant, no plane";
+    } else {
+        layout.roughnessMetallic = RoughnessMetallicEncoding::Material;
+        reason += "roughness and metallic differ between materials but not inside one: material "
+                  "index";
+    }
+    const bool ambient =
+        std::any_of(scene.lights.begin(), scene.lights.end(), [](const scenes::Light& light) {
+            return light.type == scenes::LightType::Ambient;
+        });
+    if (occlusionTextured && ambient) {
+        layout.occlusion =
+            eightBitPlanes ? RoughnessMetallicEncoding::Unorm8 : RoughnessMetallicEncoding::Float32;
+        reason += "; occlusion textures and an ambient light: ambient occlusion per pixel";
+    }
 }
 
 GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel>& stageReads) {
@@ -61,8 +136,9 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
                                           ? "the stage reads normals (float32, lossless)"
                                           : "the stage does not read normals";
 
-    bool textured = false, oneAlbedo = true, oneSpecular = true;
+    bool textured = false, oneAlbedo = true, oneSpecular = true, anyBlinnPhong = false;
     const MaterialConstants* first = nullptr;
+    const MaterialConstants* firstBlinnPhong = nullptr;
     for (uint32_t index : used) {
         if (index >= layout.materials.size())
             continue; // validated by the scene loader
@@ -71,8 +147,13 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
         if (!first)
             first = &m;
         oneAlbedo = oneAlbedo && m.albedo == first->albedo;
-        oneSpecular = oneSpecular && m.specularIntensity == first->specularIntensity &&
-                      m.specularPower == first->specularPower;
+        if (m.model != scenes::MaterialModel::BlinnPhong)
+            continue; // its Blinn-Phong stand-in is not read
+        anyBlinnPhong = true;
+        if (!firstBlinnPhong)
+            firstBlinnPhong = &m;
+        oneSpecular = oneSpecular && m.specularIntensity == firstBlinnPhong->specularIntensity &&
+                      m.specularPower == firstBlinnPhong->specularPower;
     }
     if (first)
         layout.constant = *first;
@@ -99,17 +180,25 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
     if (!reads(stageReads, Channel::Specular)) {
         layout.specular = SpecularEncoding::None;
         layout.reasons[Channel::Specular] = "the stage does not read specular";
-    } else if (oneSpecular && first) {
+    } else if (first && !anyBlinnPhong) {
+        layout.specular = SpecularEncoding::None;
+        layout.reasons[Channel::Specular] = "no used material is Blinn-Phong";
+    } else if (oneSpecular && firstBlinnPhong) {
         layout.specular = SpecularEncoding::Constant;
-        layout.reasons[Channel::Specular] = "every used material has specular intensity " +
-                                            std::to_string(first->specularIntensity) +
-                                            " and power " + std::to_string(first->specularPower) +
-                                            ": a constant, no plane";
+        layout.constant.specularIntensity = firstBlinnPhong->specularIntensity;
+        layout.constant.specularPower = firstBlinnPhong->specularPower;
+        layout.reasons[Channel::Specular] =
+            std::string(!oneModel(scene, used) ? "every used Blinn-Phong material"
+                                               : "every used material") +
+            " has specular intensity " + std::to_string(firstBlinnPhong->specularIntensity) +
+            " and power " + std::to_string(firstBlinnPhong->specularPower) +
+            ": a constant, no plane";
     } else {
         layout.specular = SpecularEncoding::Material;
         layout.reasons[Channel::Specular] =
             "specular differs between the " + materialCount + " but not inside one: material index";
     }
+    addMaterialModels(layout, scene, reads(stageReads, Channel::Specular), false);
     return layout;
 }
 
@@ -121,6 +210,7 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
     if (name == "reference") {
         layout = GBufferLayout::reference();
         layout.materials = materialTable(scene);
+        addMaterialModels(layout, scene, true, false);
         return layout;
     }
     if (name == "compact") {
@@ -133,6 +223,10 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
             "compact error threshold (gbuffer/README.md)";
         layout.reasons[Channel::Depth] =
             "unorm24 standard Z: the smallest depth under the compact threshold";
+        if (layout.roughnessMetallic == RoughnessMetallicEncoding::Float32)
+            layout.roughnessMetallic = RoughnessMetallicEncoding::Unorm8;
+        if (layout.occlusion == RoughnessMetallicEncoding::Float32)
+            layout.occlusion = RoughnessMetallicEncoding::Unorm8;
         return layout;
     }
     layout.name = name;
@@ -209,6 +303,10 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
                                     " (or none, to derive it from the scene and the stage)");
     }
     layout.reasons[Channel::Albedo] = "RGB8 diffuse colour, as in the original";
+    addMaterialModels(layout, scene, true, true);
+    if (layout.roughnessMetallic == RoughnessMetallicEncoding::Unorm8)
+        layout.notes.push_back("+16 bits: roughness and metallic (8 bits each) for the scene's "
+                               "metallic-roughness materials, which the original did not model");
     return layout;
 }
 

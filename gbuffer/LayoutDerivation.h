@@ -8,8 +8,13 @@
 //   albedo    absent when the stage does not read it; else `constant` when every used material
 //             has one colour and none is textured; `material` (8/16-bit index into the material
 //             table) when no used material is textured; f32 when textures make it vary per pixel
-//   specular  absent when not read; `constant` when all used materials share intensity and power;
-//             else `material` (specular never varies inside a material here)
+//   specular  absent when not read; Blinn-Phong intensity and power (when some used material is
+//             Blinn-Phong): `constant` when all used materials share intensity and power, else
+//             `material` (they never vary inside a material); metallic-roughness roughness and
+//             metallic (when some used material is metallic-roughness, addMaterialModels): f32
+//             when a metallic-roughness texture makes them vary per pixel, `constant` when every
+//             used material has the same factors, else `material`
+//   model     a constant when every used material has one model, else from the material index
 // The derived layout is lossless with respect to what the rasterizer computes: brute on it gives
 // bitwise the image of brute on `reference`. Lossy choices are opt-in (overrides, presets).
 //
@@ -39,6 +44,15 @@ std::vector<std::string> layoutPresetNames();
 
 // Albedo and specular of every scene material, as the G-buffer pass would write them untextured.
 std::vector<MaterialConstants> materialTable(const scenes::Scene& scene);
+
+// Sets what the metallic-roughness model needs in `layout` (whose `materials` must be the scene's
+// materialTable): the material model's source (constant or per material) and, when the stage
+// reads specular and some used material is metallic-roughness, the roughness-metallic encoding
+// (f32, or unorm8 when `eightBitPlanes`, where textures vary it per pixel; else constant or
+// material). Blinn-Phong-only scenes leave the layout as it was. Called by deriveLayout and
+// presetLayout, and by whoever builds a lossless layout for a scene.
+void addMaterialModels(GBufferLayout& layout, const scenes::Scene& scene, bool readsSpecular,
+                       bool eightBitPlanes);
 
 GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel>& stageReads);
 // Throws std::invalid_argument for an unknown name, listing the valid ones.

@@ -7,9 +7,13 @@ namespace gbuffer {
 SceneGeometry SceneGeometry::build(const scenes::Scene& scene) {
     SceneGeometry g;
     size_t vertexCount = 0, indexCount = 0;
+    bool anyUv1 = false, anyTangents = false;
     for (const scenes::Instance& instance : scene.instances) {
-        vertexCount += scene.meshes[instance.mesh].positions.size();
-        indexCount += scene.meshes[instance.mesh].indices.size();
+        const scenes::Mesh& mesh = scene.meshes[instance.mesh];
+        vertexCount += mesh.positions.size();
+        indexCount += mesh.indices.size();
+        anyUv1 = anyUv1 || !mesh.uvs1.empty();
+        anyTangents = anyTangents || !mesh.tangents.empty();
     }
     if (vertexCount > UINT32_MAX || indexCount / 3 > UINT32_MAX)
         throw std::length_error(scene.name + ": too many vertices for 32-bit indices");
@@ -39,6 +43,21 @@ SceneGeometry SceneGeometry::build(const scenes::Scene& scene) {
             const double length = glm::length(n);
             g.normalWorld.push_back(length > 0.0 ? glm::vec3(n / length) : glm::vec3(0, 0, 1));
             g.uv.push_back(mesh.uvs.empty() ? glm::vec2(0.0f) : mesh.uvs[v]);
+            if (anyUv1)
+                g.uv1.push_back(mesh.uvs1.empty() ? glm::vec2(0.0f) : mesh.uvs1[v]);
+            if (anyTangents) {
+                glm::vec4 tangent(0.0f);
+                if (!mesh.tangents.empty()) {
+                    // Tangents are surface directions: they transform with the matrix itself.
+                    const glm::dvec3 t =
+                        glm::dmat3(worldFromObject) * glm::dvec3(glm::vec3(mesh.tangents[v]));
+                    const double tLength = glm::length(t);
+                    const float sign = (mesh.tangents[v].w < 0.0f) != mirrored ? -1.0f : 1.0f;
+                    if (tLength > 0.0)
+                        tangent = glm::vec4(glm::vec3(t / tLength), sign);
+                }
+                g.tangentWorld.push_back(tangent);
+            }
         }
         for (size_t t = 0; t < mesh.triangleCount(); ++t) {
             const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1],

@@ -6,8 +6,10 @@
 // along a pixel row the perspective-correct barycentric weights are affine in the pixel's NDC x
 // (RowWeights), so a run of pixels showing the same triangle costs three multiply-adds per pixel
 // plus the normal's normalisation. Homogeneous: valid for triangles crossing the near plane.
-// Extending the surface (tangents for normal mapping, more material parameters) means loading
-// the new per-vertex or per-material data in load() and interpolating it in updateSurfaceAt().
+// Extending the surface means loading the new per-vertex or per-material data in load() and
+// interpolating it in updateSurfaceAt(). Textures (base colour, metallic-roughness, normal) are
+// read with their own uv set and KHR_texture_transform (scenes::TextureMapping); normal maps
+// through NormalMapping.h, the formula the reference shares.
 #pragma once
 
 #include <cmath>
@@ -16,6 +18,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gbuffer/NormalMapping.h"
 #include "gbuffer/SceneGeometry.h"
 #include "gbuffer/Surface.h"
 #include "raster/Rasterizer.h"
@@ -34,13 +37,20 @@ struct TriangleCorners {
     bool flatNormalIsZero;    // flat with zero-length normals: the (0, 0, +-1) fallback
     glm::vec3 flatNormalView; // unit, valid when flat and not zero
     glm::vec2 uv[3];          // loaded only for textured materials
+    glm::vec2 uv1[3];         // loaded only when a texture reads TEXCOORD_1
+    glm::vec4 tangentView[3]; // loaded only with a normal texture (w = bitangent sign)
     uint32_t materialIndex;
     const scenes::Material* material;
-    const scenes::Texture* baseColorTexture; // null when untextured
+    const scenes::Texture* baseColorTexture;         // null when untextured
+    const scenes::Texture* metallicRoughnessTexture; // null when absent or Blinn-Phong
+    const scenes::Texture* normalTexture;            // null when absent or no tangents
+    const scenes::Texture* occlusionTexture;         // null when absent or Blinn-Phong
+    bool textured;                                   // one of the four is present
 
     static TriangleCorners load(const SceneGeometry& geometry, const scenes::Scene& scene,
                                 std::span<const glm::vec4> clipPositions,
-                                std::span<const glm::vec3> normalsView, uint32_t triangle) {
+                                std::span<const glm::vec3> normalsView,
+                                std::span<const glm::vec4> tangentsView, uint32_t triangle) {
         const uint32_t* index = geometry.indices.data() + 3 * size_t(triangle);
         TriangleCorners corners;
         corners.materialIndex = geometry.triangleMaterial[triangle];
@@ -48,13 +58,31 @@ struct TriangleCorners {
         corners.baseColorTexture = corners.material->baseColorTexture >= 0
                                        ? &scene.textures[size_t(corners.material->baseColorTexture)]
                                        : nullptr;
+        const scenes::Material& m = *corners.material;
+        corners.metallicRoughnessTexture =
+            m.model == scenes::MaterialModel::MetallicRoughness && m.metallicRoughnessTexture >= 0
+                ? &scene.textures[size_t(m.metallicRoughnessTexture)]
+                : nullptr;
+        corners.normalTexture = m.normalTexture >= 0 && !tangentsView.empty()
+                                    ? &scene.textures[size_t(m.normalTexture)]
+                                    : nullptr;
+        corners.occlusionTexture =
+            m.model == scenes::MaterialModel::MetallicRoughness && m.occlusionTexture >= 0
+                ? &scene.textures[size_t(m.occlusionTexture)]
+                : nullptr;
+        corners.textured = corners.baseColorTexture || corners.metallicRoughnessTexture ||
+                           corners.normalTexture || corners.occlusionTexture;
+        const bool secondUvSet = corners.textured && !geometry.uv1.empty();
         for (int i = 0; i < 3; ++i) {
             const glm::vec4& clip = clipPositions[index[i]];
             corners.clipX[i] = clip.x;
             corners.clipY[i] = clip.y;
             corners.clipW[i] = clip.w;
             corners.normalView[i] = normalsView[index[i]];
-            corners.uv[i] = corners.baseColorTexture ? geometry.uv[index[i]] : glm::vec2(0.0f);
+            corners.uv[i] = corners.textured ? geometry.uv[index[i]] : glm::vec2(0.0f);
+            corners.uv1[i] = secondUvSet ? geometry.uv1[index[i]] : corners.uv[i];
+            corners.tangentView[i] =
+                corners.normalTexture ? tangentsView[index[i]] : glm::vec4(0.0f);
         }
         corners.flat = corners.normalView[0] == corners.normalView[1] &&
                        corners.normalView[0] == corners.normalView[2];
@@ -83,9 +111,10 @@ struct RowWeights {
     }
 };
 
-// The parts of a triangle's surface that do not vary over it: material index, albedo factor
-// (the whole albedo when untextured) and specular. Normal and textured albedo come per pixel from
-// updateSurfaceAt. positionView stays zero: it comes from depth (DepthDecoder).
+// The parts of a triangle's surface that do not vary over it: material index and model, albedo
+// factor (the whole albedo when untextured), specular, roughness and metallic factors. Normal and
+// textured albedo come per pixel from updateSurfaceAt. positionView stays zero: it comes from depth
+// (DepthDecoder).
 inline Surface triangleSurface(const TriangleCorners& corners) {
     const scenes::Material& material = *corners.material;
     Surface surface;
@@ -93,13 +122,51 @@ inline Surface triangleSurface(const TriangleCorners& corners) {
     surface.albedo = glm::vec3(material.baseColorFactor);
     surface.specularIntensity = material.specularIntensity;
     surface.specularPower = material.specularPower;
+    surface.model = material.model;
+    surface.roughness = material.roughness;
+    surface.metallic = material.metallic;
     return surface;
+}
+
+// The texture lookups of updateSurfaceAt at barycentric weights `weights` (summing to 1).
+inline void updateTexturedSurfaceAt(Surface& surface, const TriangleCorners& corners,
+                                    const glm::vec3& weights, bool backFace) {
+    const scenes::Material& material = *corners.material;
+    const glm::vec2 uv0 = raster::interpolate(corners.uv[0], corners.uv[1], corners.uv[2], weights);
+    const glm::vec2 uv1 =
+        raster::interpolate(corners.uv1[0], corners.uv1[1], corners.uv1[2], weights);
+    auto uvOf = [&](const scenes::TextureMapping& mapping) {
+        return mapping.apply(mapping.texCoord == 1 ? uv1 : uv0);
+    };
+    if (corners.baseColorTexture)
+        surface.albedo =
+            glm::vec3(material.baseColorFactor) *
+            glm::vec3(corners.baseColorTexture->sample(uvOf(material.baseColorMapping)));
+    if (corners.metallicRoughnessTexture) {
+        const glm::vec4 texel =
+            corners.metallicRoughnessTexture->sample(uvOf(material.metallicRoughnessMapping));
+        surface.roughness = material.roughness * texel.g;
+        surface.metallic = material.metallic * texel.b;
+    }
+    if (corners.occlusionTexture) {
+        const float r = corners.occlusionTexture->sample(uvOf(material.occlusionMapping)).r;
+        surface.occlusion = 1.0f + material.occlusionStrength * (r - 1.0f);
+    }
+    if (corners.normalTexture) {
+        const glm::vec4 tangent = raster::interpolate(
+            corners.tangentView[0], corners.tangentView[1], corners.tangentView[2], weights);
+        const glm::vec4 texel = corners.normalTexture->sample(uvOf(material.normalMapping));
+        surface.normalView =
+            normalMapped(surface.normalView, backFace, glm::vec3(tangent),
+                         tangent.w < 0.0f ? -1.0f : 1.0f, glm::vec3(texel), material.normalScale);
+    }
 }
 
 // Sets the pixel-varying parts of `surface` (from triangleSurface of the same corners) at the
 // pixel centre ndcX of the row `row` describes: the interpolated, normalised view-space normal
-// (negated when the back face is visible: two-sided draws light the visible side) and the albedo
-// times the base colour texture.
+// (negated when the back face is visible: two-sided draws light the visible side; then normal
+// mapped), the albedo times the base colour texture, roughness and metallic times the
+// metallic-roughness texture's G and B, the occlusion texture's R (with occlusionStrength).
 [[gnu::always_inline]] inline void updateSurfaceAt(Surface& surface, const TriangleCorners& corners,
                                                    const RowWeights& row, bool backFace,
                                                    float ndcX) {
@@ -126,12 +193,8 @@ inline Surface triangleSurface(const TriangleCorners& corners) {
         surface.normalView =
             length2 > 0.0f ? normal * (sign / std::sqrt(length2)) : zeroNormalFallback;
     }
-    if (corners.baseColorTexture) {
-        const glm::vec2 uv =
-            raster::interpolate(corners.uv[0], corners.uv[1], corners.uv[2], b * (1.0f / sum));
-        surface.albedo = glm::vec3(corners.material->baseColorFactor) *
-                         glm::vec3(corners.baseColorTexture->sample(uv));
-    }
+    if (corners.textured)
+        updateTexturedSurfaceAt(surface, corners, b * (1.0f / sum), backFace);
 }
 
 } // namespace gbuffer

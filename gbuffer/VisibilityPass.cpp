@@ -23,11 +23,18 @@ void VisibilityPass::transform(const scenes::Scene& scene, const SceneGeometry& 
     const size_t count = geometry.positionWorld.size();
     mClipPositions.resize(count);
     mNormalsView.resize(count);
+    mTangentsView.resize(geometry.tangentWorld.size());
+    const bool tangents = !geometry.tangentWorld.empty();
     const glm::mat4 clipFromWorld = view.clipFromWorld();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 4096), [&](const auto& range) {
         for (size_t v = range.begin(); v != range.end(); ++v) {
             mClipPositions[v] = clipFromWorld * glm::vec4(geometry.positionWorld[v], 1.0f);
             mNormalsView[v] = view.viewFromWorldNormal * geometry.normalWorld[v];
+            // viewFromWorldNormal is a rotation: tangents turn with it too.
+            if (tangents)
+                mTangentsView[v] =
+                    glm::vec4(view.viewFromWorldNormal * glm::vec3(geometry.tangentWorld[v]),
+                              geometry.tangentWorld[v].w);
         }
     });
     mNdcXOfColumn.resize(size_t(view.width));

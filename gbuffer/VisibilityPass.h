@@ -5,8 +5,8 @@
 // bitwise the same clip positions, hence the same coverage, depth and surfaces.
 //
 // Per frame:
-//   transform(scene, geometry, view)  vertices to clip space, normals to view space (parallel
-//                                     over vertices);
+//   transform(scene, geometry, view)  vertices to clip space, normals (and tangents, when the
+//                                     geometry has them) to view space (parallel over vertices);
 //   draw(rasterizer, depth)           back faces culled, closer-than test in the view's depth
 //                                     convention, depth written, and per pixel the visibility
 //                                     code of the visible triangle (the visibility buffer,
@@ -98,6 +98,7 @@ private:
     CameraView mView;
     std::vector<glm::vec4> mClipPositions;
     std::vector<glm::vec3> mNormalsView;
+    std::vector<glm::vec4> mTangentsView; // empty when the geometry has no tangents
     std::vector<float> mNdcXOfColumn; // view.ndcOfPixel(x, y).x per column: no division per pixel
     Plane<uint32_t> mCodes;
 };
@@ -119,7 +120,7 @@ public:
         const uint32_t triangle = triangleOf(code);
         if (triangle != mCornersOf) {
             mCorners = TriangleCorners::load(*mPass.mGeometry, *mPass.mScene, mPass.mClipPositions,
-                                             mPass.mNormalsView, triangle);
+                                             mPass.mNormalsView, mPass.mTangentsView, triangle);
             mRow = RowWeights::of(mCorners, mNdcY);
             mSurface = triangleSurface(mCorners);
             mCornersOf = triangle;

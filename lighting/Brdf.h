@@ -1,83 +1,67 @@
-// The one lighting model of the testbed (DESIGN.md), in one function used by every stage and by
-// the reference: Lambert diffuse plus normalised Blinn-Phong specular, for point, spot,
-// directional and ambient lights. Templated on the scalar type so that the reference runs the
-// very same formula in double.
+// The one lighting function of the testbed (DESIGN.md), used by every stage and by the reference:
+// evaluateLight shades a surface sample with the material model the sample carries
+// (Surface::model): Lambert diffuse plus normalised Blinn-Phong specular (this file), or the glTF
+// 2.0 metallic-roughness model (MetallicRoughness.h: GGX, Smith, Schlick), for point, spot,
+// directional and ambient lights. Templated on the scalar type so that the reference runs the very
+// same formulas in double.
 //
-// Point and spot lights use the windowed inverse-square falloff
+// Point and spot lights use the windowed inverse-square falloff and the spot smoothstep of
+// LightIncidence.h, shared by both models,
 //     attenuation(d) = saturate(1 - (d/r)^4)^2 / (d^2 + 1)
-// which is exactly zero at and beyond the range r: culling by the light's sphere is exact.
-// A light CONTRIBUTES at a sample when the radiance it adds there is non-zero.
+// which is exactly zero at and beyond the range r: culling by the light's sphere is exact for
+// either model. A light CONTRIBUTES at a sample when the radiance it adds there is non-zero.
 // Conventions: view space, camera at the origin looking down -Z; light.directionView is the
 // direction light travels (from a spot light along its axis, from the sun towards the ground).
+// Cost: the metallic-roughness branch recomputes its per-sample lobes (a few multiplies) per light,
+// which keeps the one entry point; the Blinn-Phong branch is operation for operation the function
+// it has always been (its outputs are bitwise those of the code before the dispatch existed).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/glm.hpp>
 
 #include "gbuffer/Surface.h"
+#include "lighting/LightInView.h"
+#include "lighting/LightIncidence.h"
+#include "lighting/MetallicRoughness.h"
 #include "scenes/Scene.h"
 
 namespace lighting {
 
-template <class T> using Vec3 = glm::vec<3, T, glm::defaultp>;
-
-// A scene light in view space, with its colour and intensity folded into one radiance.
-template <class T> struct LightInView {
-    scenes::LightType type = scenes::LightType::Point;
-    Vec3<T> positionView{T(0)};
-    Vec3<T> directionView{T(0), T(0), T(-1)};
-    Vec3<T> radiance{T(0)};
-    T rangeMetres = T(0);
-    T spotInnerCos = T(1);
-    T spotOuterCos = T(1);
-};
-
-inline constexpr double kPi = 3.14159265358979323846;
-
-// Radiance towards the camera from one light at one surface point. Zero (exactly) when the point
-// is at or beyond the light's range, outside a spot cone, or facing away from the light.
+// Lambert + normalised Blinn-Phong: radiance towards the camera from one light. Zero (exactly)
+// when the point is at or beyond the light's range, outside a spot cone, or facing away from it.
 template <class T>
-inline Vec3<T> evaluateLight(const gbuffer::BasicSurface<T>& s, const Vec3<T>& toViewer,
-                             const LightInView<T>& light) {
-    using scenes::LightType;
-    if (light.type == LightType::Ambient)
+inline Vec3<T> evaluateLightBlinnPhong(const gbuffer::BasicSurface<T>& s, const Vec3<T>& toViewer,
+                                       const LightInView<T>& light) {
+    if (light.type == scenes::LightType::Ambient)
         return light.radiance * s.albedo;
-
-    Vec3<T> toLight;
-    T attenuation = T(1);
-    if (light.type == LightType::Directional) {
-        toLight = -light.directionView;
-    } else {
-        const Vec3<T> offset = light.positionView - s.positionView;
-        const T distance2 = glm::dot(offset, offset);
-        const T range2 = light.rangeMetres * light.rangeMetres;
-        if (!(distance2 < range2))
-            return Vec3<T>(T(0));
-        // A light exactly on the surface has no direction; treat it as overhead.
-        toLight = distance2 > T(0) ? offset / std::sqrt(distance2) : s.normalView;
-        const T ratio2 = distance2 / range2;
-        const T window = T(1) - ratio2 * ratio2;
-        attenuation = window * window / (distance2 + T(1));
-        if (light.type == LightType::Spot) {
-            const T cosAngle = -glm::dot(toLight, light.directionView);
-            if (!(cosAngle > light.spotOuterCos))
-                return Vec3<T>(T(0));
-            const T width = light.spotInnerCos - light.spotOuterCos;
-            const T t = width > T(0)
-                            ? glm::clamp((cosAngle - light.spotOuterCos) / width, T(0), T(1))
-                            : T(1);
-            attenuation *= t * t * (T(3) - T(2) * t);
-        }
-    }
-    const T nDotL = glm::dot(s.normalView, toLight);
+    const Incidence<T> incidence = lightIncidence(s.positionView, s.normalView, light);
+    if (!(incidence.attenuation > T(0)))
+        return Vec3<T>(T(0));
+    const T nDotL = glm::dot(s.normalView, incidence.toLight);
     if (!(nDotL > T(0)))
         return Vec3<T>(T(0));
-    const Vec3<T> halfway = glm::normalize(toLight + toViewer);
+    const Vec3<T> halfway = glm::normalize(incidence.toLight + toViewer);
     const T nDotH = std::max(glm::dot(s.normalView, halfway), T(0));
     const T specular = s.specularIntensity * (s.specularPower + T(8)) * T(1.0 / (8.0 * kPi)) *
                        std::pow(nDotH, s.specularPower);
-    return light.radiance * (attenuation * nDotL) * (s.albedo * T(1.0 / kPi) + Vec3<T>(specular));
+    return light.radiance * (incidence.attenuation * nDotL) *
+           (s.albedo * T(1.0 / kPi) + Vec3<T>(specular));
+}
+
+// The one entry: radiance towards the camera from one light at one surface sample, with the
+// sample's material model. toViewer is the unit vector from the sample to the camera.
+template <class T>
+inline Vec3<T> evaluateLight(const gbuffer::BasicSurface<T>& s, const Vec3<T>& toViewer,
+                             const LightInView<T>& light) {
+    if (s.model == scenes::MaterialModel::MetallicRoughness) {
+        const MetallicRoughnessSurface<T> material{s.albedo, s.metallic, s.roughness, s.occlusion};
+        return evaluateLightMetallicRoughness(s.positionView, s.normalView,
+                                              metallicRoughnessLobes(material), toViewer, light);
+    }
+    return evaluateLightBlinnPhong(s, toViewer, light);
 }
 
 template <class T> inline bool contributes(const Vec3<T>& radiance) {

@@ -47,7 +47,7 @@
 
 #include <glm/glm.hpp>
 
-#include "lighting/Brdf.h"
+#include "lighting/LightInView.h"
 #include "lighting/LightIncidence.h"
 
 namespace lighting {

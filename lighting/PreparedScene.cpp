@@ -1,6 +1,23 @@
 #include "lighting/PreparedScene.h"
 
+#include "gbuffer/LayoutDerivation.h"
+
 namespace lighting {
+
+namespace {
+
+// GBufferLayout::reference() and lossless() know no scene: they get the scene's material table
+// and what its metallic-roughness materials need (model, roughness and metallic in float32).
+gbuffer::GBufferLayout withSceneMaterials(gbuffer::GBufferLayout layout,
+                                          const scenes::Scene& scene) {
+    if (!layout.materials.empty())
+        return layout;
+    layout.materials = gbuffer::materialTable(scene);
+    gbuffer::addMaterialModels(layout, scene, layout.provides(gbuffer::Channel::Specular), false);
+    return layout;
+}
+
+} // namespace
 
 PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
                              const gbuffer::GBufferLayout& layout)
@@ -8,7 +25,7 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
     geometry = gbuffer::SceneGeometry::build(scene);
     view = gbuffer::CameraView::fromCamera(scene.cameras.front(), width, height,
                                            layout.depth.convention(), layout.depth.infiniteFar);
-    gbuffer = std::make_unique<gbuffer::GBuffer>(layout, view);
+    gbuffer = std::make_unique<gbuffer::GBuffer>(withSceneMaterials(layout, scene), view);
     if (withExactSurface)
         exact = std::make_unique<gbuffer::ExactSurface>();
     mRasterizer = std::make_unique<raster::Rasterizer>(width, height);
@@ -45,7 +62,9 @@ void PreparedScene::addExactSurface() {
 
 std::unique_ptr<gbuffer::GBuffer> PreparedScene::renderLosslessGBuffer() {
     auto lossless = std::make_unique<gbuffer::GBuffer>(
-        gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar), view);
+        withSceneMaterials(gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar),
+                           scene),
+        view);
     mPass->render(*mRasterizer, *lossless, nullptr);
     return lossless;
 }

@@ -35,7 +35,9 @@ struct PreparedScene {
     int exactSurfacePasses = 0; // G-buffer passes so far that also computed the exact surface
 
     // Renders `scene` from its first camera at width x height into `layout`; the view's depth
-    // convention and far plane follow the layout's depth format.
+    // convention and far plane follow the layout's depth format. A layout without a material
+    // table (GBufferLayout::reference(), lossless()) gets the scene's, and the float32 roughness
+    // and metallic its metallic-roughness materials need (gbuffer::addMaterialModels).
     PreparedScene(scenes::Scene scene, int width, int height, bool withExactSurface,
                   const gbuffer::GBufferLayout& layout);
     // The reference layout (float32 everything), with standard or reversed float depth.

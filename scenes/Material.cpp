@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace scenes {
 
@@ -16,6 +17,14 @@ constexpr float kMinRoughness4 = 1e-4f;
 
 const char* materialModelName(MaterialModel model) {
     return model == MaterialModel::BlinnPhong ? "blinn-phong" : "metallic-roughness";
+}
+
+MaterialModel parseMaterialModel(const std::string& name) {
+    for (MaterialModel model : {MaterialModel::BlinnPhong, MaterialModel::MetallicRoughness})
+        if (name == materialModelName(model))
+            return model;
+    throw std::invalid_argument("unknown material model '" + name +
+                                "'; valid: blinn-phong, metallic-roughness");
 }
 
 glm::vec2 TextureMapping::apply(glm::vec2 uv) const {

@@ -32,6 +32,8 @@ enum class MaterialModel {
 
 // "blinn-phong" or "metallic-roughness": the names used in files and on the command line.
 const char* materialModelName(MaterialModel model);
+// The inverse of materialModelName; throws std::invalid_argument naming the valid names.
+MaterialModel parseMaterialModel(const std::string& name);
 
 // glTF alphaMode. Opaque ignores alpha; Mask keeps a sample when alpha >= alphaCutoff and drops
 // it otherwise; Blend composites the surface over what is behind it with its alpha.
@@ -114,6 +116,14 @@ struct Material {
 // (1 is the broadest lobe that is still a lobe; beyond 2048 the highlight is narrower than a texel
 // of any texture we load; roughness^4 is floored at 1e-4, a mirror for our purposes).
 void setBlinnPhongFromMetallicRoughness(Material& material);
+
+// Shades `material` with `model` (a study's --brdf): both parameter sets are always present
+// (a Blinn-Phong material carries an informative roughness, a metallic-roughness one its
+// Blinn-Phong stand-in), so forcing only switches which one the lighting function reads.
+// Textures of the other model stay in the material but are not read.
+inline void forceMaterialModel(Material& material, MaterialModel model) {
+    material.model = model;
+}
 
 // The roughness whose Blinn-Phong exponent (above, before clamping) is specularPower:
 // (2 / (specularPower + 2))^(1/4). Keeps a Blinn-Phong material's informative roughness truthful.

@@ -1,5 +1,6 @@
 // The one BRDF: finite support (exactly zero at and beyond the range), closed-form values,
-// and the float and double instantiations agreeing.
+// the float and double instantiations agreeing, and the one entry (evaluateLight) dispatching on
+// the surface's material model to the model's own function.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -115,6 +116,36 @@ TEST(Brdf, FloatMatchesDouble) {
         const double expected = evaluateLight(pd, toViewer, ld).x;
         const double actual = evaluateLight(pf, glm::vec3(toViewer), lf).x;
         EXPECT_NEAR(actual, expected, 1e-5 * std::abs(expected) + 1e-9) << i;
+    }
+}
+
+// evaluateLight is the Blinn-Phong function on Blinn-Phong surfaces and the metallic-roughness
+// function on metallic-roughness ones (bitwise: the same call), and the two models differ.
+TEST(Brdf, TheOneEntryDispatchesOnTheMaterialModel) {
+    gbuffer::BasicSurface<double> s = matteFloorPoint<double>();
+    s.specularIntensity = 0.5;
+    s.specularPower = 40.0;
+    s.roughness = 0.4;
+    s.metallic = 0.3;
+    s.occlusion = 0.7;
+    const lighting::Vec3<double> toViewer = glm::normalize(glm::dvec3(0.3, 0.8, 0.2));
+    std::vector<LightInView<double>> lights(3, pointLightAbove<double>(2.0, 6.0));
+    lights[1].positionView = {1.0, 1.5, -4.0};
+    lights[2].type = LightType::Ambient;
+    lights[2].radiance = {0.2, 0.3, 0.4};
+    for (const LightInView<double>& light : lights) {
+        s.model = scenes::MaterialModel::BlinnPhong;
+        const lighting::Vec3<double> blinnPhong = evaluateLight(s, toViewer, light);
+        EXPECT_EQ(blinnPhong, lighting::evaluateLightBlinnPhong(s, toViewer, light));
+        s.model = scenes::MaterialModel::MetallicRoughness;
+        const lighting::Vec3<double> metallicRoughness = evaluateLight(s, toViewer, light);
+        const lighting::MetallicRoughnessSurface<double> m{s.albedo, s.metallic, s.roughness,
+                                                           s.occlusion};
+        EXPECT_EQ(metallicRoughness, lighting::evaluateLightMetallicRoughness(
+                                         s.positionView, s.normalView,
+                                         lighting::metallicRoughnessLobes(m), toViewer, light));
+        EXPECT_NE(blinnPhong, metallicRoughness);
+        EXPECT_TRUE(lighting::contributes(metallicRoughness));
     }
 }
 
