@@ -45,7 +45,10 @@ const Frame& atriumFrame() {
         f.lights = std::make_unique<lighting::kernel::KernelLights>(f.prepared->lights.lights);
         f.everyLight.resize(f.lights->size());
         std::iota(f.everyLight.begin(), f.everyLight.end(), 0u);
-        lighting::makeStage("brute")->shade(f.prepared->inputs, f.brute);
+        // brute on the scalar ISA: the loop the scalar packet path must reproduce bit for bit.
+        lighting::StageInputs inputs = f.prepared->inputs;
+        inputs.isa = KernelIsa::scalar();
+        lighting::makeStage("brute")->shade(inputs, f.brute);
         f.oracle = lighting::countContributingLights(f.prepared->inputs);
         return f;
     }();
