@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "lighting/StageRegistry.h"
+#include "scenes/ClosestName.h"
 #include "scenes/ProceduralScenes.h"
 
 namespace experiments {
@@ -48,8 +49,10 @@ void checkScene(const std::string& scene) {
     const std::filesystem::path path(scene);
     const std::string extension = path.extension().string();
     if (extension != ".gltf" && extension != ".glb" && extension != ".json")
-        throw UsageError("unknown scene '" + scene + "': not a built-in scene (" +
-                         joined(scenes::proceduralSceneNames()) + ") nor a .gltf/.glb/.json file");
+        throw UsageError("unknown scene '" + scene + "'" +
+                         scenes::didYouMean(scene, scenes::proceduralSceneNames()) +
+                         ": not a built-in scene (" + joined(scenes::proceduralSceneNames()) +
+                         ") nor a .gltf/.glb/.json file");
     if (!std::filesystem::is_regular_file(path))
         throw UsageError("scene file '" + scene + "' not found");
 }

@@ -8,6 +8,7 @@
 //   normals normal-encoding precision study -> normals.csv, normals.json, plots
 //   depth   depth-format / position-reconstruction study -> depth.csv, depth.json, plots
 // Every option's default is stated by --help; unknown options are errors.
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <iostream>
@@ -28,6 +29,7 @@
 #include "experiments/studies/NormalStudy.h"
 #include "gbuffer/NormalCodec.h"
 #include "lighting/StageRegistry.h"
+#include "scenes/ClosestName.h"
 #include "scenes/ProceduralScenes.h"
 #include "scenes/Viewpoints.h"
 
@@ -156,6 +158,49 @@ int listEverything() {
         std::cout << (first ? "" : "|") << specs[i].bits << (last ? "\n" : "");
     }
     return 0;
+}
+
+// A name of the command line that is not one: the closest valid one, if any is close (a
+// subcommand for the first argument, else an option of the subcommand given).
+std::string suggestionFor(CLI::App& app, int argc, char** argv) {
+    std::vector<std::string> subcommands;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+        if (!sub->get_group().empty())
+            subcommands.push_back(sub->get_name());
+    if (argc < 2)
+        return "";
+    const std::string first = argv[1];
+    if (first.rfind("-", 0) != 0 &&
+        std::find(subcommands.begin(), subcommands.end(), first) == subcommands.end())
+        return scenes::didYouMean(first, subcommands);
+    const CLI::App* sub = nullptr;
+    for (const CLI::App* candidate : app.get_subcommands([](const CLI::App*) { return true; }))
+        if (candidate->get_name() == first)
+            sub = candidate;
+    if (!sub)
+        return "";
+    std::vector<std::string> options;
+    for (const CLI::Option* option : sub->get_options())
+        for (const std::string& name : option->get_lnames())
+            options.push_back("--" + name);
+    for (int i = 2; i < argc; ++i) {
+        std::string arg = argv[i];
+        if (arg.rfind("--", 0) != 0)
+            continue;
+        arg = arg.substr(0, arg.find('='));
+        if (std::find(options.begin(), options.end(), arg) == options.end())
+            return scenes::didYouMean(arg, options);
+    }
+    return "";
+}
+
+// CLI11's message as one line (its messages may hold line breaks), with a suggestion for a typo.
+std::string parseErrorMessage(CLI::App& app, const CLI::ParseError& error, int argc, char** argv) {
+    std::string message = error.what();
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    while (!message.empty() && message.back() == ' ')
+        message.pop_back();
+    return message + suggestionFor(app, argc, argv) + "; see testbed --help";
 }
 
 } // namespace
@@ -293,7 +338,13 @@ int main(int argc, char** argv) {
     merge->add_option("dirs", mergeInputs, "sweep output folders")->required();
     merge->add_option("--out", mergeOut, "merged output folder (may be one of the inputs)")
         ->required();
-    CLI11_PARSE(app, argc, argv);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success))
+            return app.exit(e); // --help
+        return experiments::reportError(parseErrorMessage(app, e, argc, argv));
+    }
     if (render->parsed()) {
         for (const std::string& text : sceneOptionTexts) {
             const size_t equals = text.find('=');

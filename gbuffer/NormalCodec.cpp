@@ -14,6 +14,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "scenes/ClosestName.h"
+
 namespace gbuffer {
 
 namespace {
@@ -490,8 +492,13 @@ NormalCodecSpec NormalCodecSpec::parse(const std::string& text) {
         throw std::invalid_argument(message);
     };
     const std::size_t colon = text.rfind(':');
-    if (colon == std::string::npos)
+    if (colon == std::string::npos) {
+        // A codec with one bit depth needs no ':BITS' (`--normals float32`).
+        for (const CodecInfo& info : codecTable())
+            if (text == info.name && info.bits.size() == 1)
+                return {info.kind, info.bits.front()};
         return fail("missing ':BITS'");
+    }
     const std::string name = text.substr(0, colon);
     const std::string bitsText = text.substr(colon + 1);
     for (const CodecInfo& info : codecTable()) {
@@ -506,7 +513,10 @@ NormalCodecSpec NormalCodecSpec::parse(const std::string& text) {
             return fail(std::string(info.name) + " does not support " + bitsText + " bits");
         return {info.kind, bits};
     }
-    return fail("unknown name '" + name + "'");
+    std::vector<std::string> names;
+    for (const CodecInfo& info : codecTable())
+        names.push_back(info.name);
+    return fail("unknown name '" + name + "'" + scenes::didYouMean(name, names));
 }
 
 double normalAngleRadians(glm::vec3 a, glm::vec3 b) {

@@ -77,7 +77,8 @@ struct NormalCodecSpec {
     int bits = 24; // total bits of the code
 
     std::string text() const; // "NAME:BITS", parse(text()) == *this
-    // Parses "NAME:BITS"; throws std::invalid_argument naming the input and listing every valid
+    // Parses "NAME:BITS", or a bare NAME for a codec with one bit count (float32); throws
+    // std::invalid_argument naming the input, suggesting the closest name and listing every valid
     // NAME with its BITS. Called once per configuration, not per pixel.
     static NormalCodecSpec parse(const std::string& text);
     friend bool operator==(const NormalCodecSpec&, const NormalCodecSpec&) = default;

@@ -3,6 +3,7 @@
 #include <functional>
 
 #include "lighting/stages/Stages.h"
+#include "scenes/ClosestName.h"
 
 namespace lighting {
 
@@ -166,12 +167,15 @@ std::vector<StageInfo> stageInfos() {
 std::unique_ptr<ShadingStage> makeStage(const std::string& text) {
     const StageSpec spec = StageSpec::parse(text);
     std::string valid;
+    std::vector<std::string> names;
     for (const StageEntry& entry : registry()) {
         if (entry.info.name == spec.name)
             return entry.make(spec);
         valid += (valid.empty() ? "" : ", ") + entry.info.name;
+        names.push_back(entry.info.name);
     }
-    throw StageError("unknown stage '" + spec.name + "' (valid: " + valid + ")");
+    throw StageError("unknown stage '" + spec.name + "'" + scenes::didYouMean(spec.name, names) +
+                     " (valid: " + valid + ")");
 }
 
 } // namespace lighting

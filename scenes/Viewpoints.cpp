@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "scenes/ClosestName.h"
 #include "scenes/SceneLoader.h"
 
 namespace scenes {
@@ -23,7 +24,8 @@ void selectView(Scene& scene, const std::string& name) {
         std::string valid;
         for (const std::string& view : viewNames(scene))
             valid += (valid.empty() ? "" : ", ") + view;
-        throw SceneError(scene.name + ": no view '" + name + "'; views: " + valid);
+        throw SceneError(scene.name + ": no view '" + name + "'" +
+                         didYouMean(name, viewNames(scene)) + "; views: " + valid);
     }
     // Rotating [begin, found] keeps the other views in their order.
     std::rotate(scene.cameras.begin(), found, found + 1);

@@ -186,5 +186,29 @@ TEST(DiffCommand, RefusesImagesOfDifferentSizes) {
     EXPECT_NE(testing::internal::GetCapturedStderr().find("cannot read"), std::string::npos);
 }
 
+// A valid EXR whose "channels" attribute is made to declare 1 769 108 595 bytes (as in the input
+// exr_fuzzer found): refused from the header's counts, before OpenEXR allocates that much.
+TEST(DiffCommand, RefusesAnExrAttributeLongerThanTheFile) {
+    const fs::path dir = freshTestFolder();
+    const fs::path path = writeImage(dir / "a.exr", 0.0f, nowhere, 1.0f);
+    std::string bytes = readText(path);
+    const std::string attribute = std::string("channels") + '\0' + "chlist" + '\0';
+    const size_t at = bytes.find(attribute);
+    ASSERT_NE(at, std::string::npos);
+    const uint32_t huge = 1769108595u;
+    for (int i = 0; i < 4; ++i)
+        bytes[at + attribute.size() + size_t(i)] = char((huge >> (8 * i)) & 0xff);
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    try {
+        (void)diffImageFiles(path, path);
+        FAIL() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("corrupt EXR header: attribute 'channels' declares "
+                                             "1769108595 bytes"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 } // namespace
 } // namespace experiments

@@ -44,6 +44,14 @@ TEST(Viewpoints, UnknownViewIsAnErrorListingTheViews) {
         const std::string message = error.what();
         EXPECT_NE(message.find("'roof'"), std::string::npos) << message;
         EXPECT_NE(message.find("nave, gallery"), std::string::npos) << message;
+        EXPECT_EQ(message.find("did you mean"), std::string::npos) << message; // nothing close
+    }
+    try {
+        scenes::selectView(scene, "galery");
+        ADD_FAILURE() << "no error";
+    } catch (const scenes::SceneError& error) {
+        EXPECT_NE(std::string(error.what()).find("did you mean 'gallery'?"), std::string::npos)
+            << error.what();
     }
 }
 
