@@ -3,6 +3,8 @@
 // that the derived layout is lossless (brute on it gives bitwise the image of brute on reference).
 #include <gtest/gtest.h>
 
+#include "TwoQuads.h"
+
 #include <cstring>
 
 #include "gbuffer/LayoutDerivation.h"
@@ -21,28 +23,7 @@ using gbuffer::SpecularEncoding;
 const std::vector<Channel> kEverything = {Channel::Depth, Channel::Normal, Channel::Albedo,
                                           Channel::Specular};
 
-// Two quads side by side, one material each, facing a camera at the origin.
-scenes::Scene twoQuads(scenes::Material left, scenes::Material right) {
-    scenes::Scene scene;
-    scene.name = "two-quads";
-    for (int i = 0; i < 2; ++i) {
-        scenes::Mesh mesh;
-        const float x0 = i == 0 ? -2.0f : 0.0f, x1 = x0 + 2.0f;
-        mesh.positions = {{x0, -1, -4}, {x1, -1, -4}, {x1, 1, -4}, {x0, 1, -4}};
-        mesh.normals.assign(4, glm::vec3(0, 0, 1));
-        mesh.uvs = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
-        mesh.indices = {0, 1, 2, 0, 2, 3};
-        mesh.material = uint32_t(i);
-        scene.meshes.push_back(mesh);
-        scene.instances.push_back({uint32_t(i), glm::mat4(1.0f)});
-    }
-    scene.materials = {left, right};
-    scenes::Camera camera;
-    camera.forwardWorld = {0, 0, -1};
-    scene.cameras.push_back(camera);
-    scenes::validate(scene);
-    return scene;
-}
+using gbuffertest::twoQuads;
 
 scenes::Material material(glm::vec3 albedo, float intensity, float power) {
     scenes::Material m;
