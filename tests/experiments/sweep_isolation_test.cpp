@@ -9,6 +9,8 @@
 // SIGABRT and resumes it; the process dies of the signal exactly as it would of its own fault.
 #include <gtest/gtest.h>
 
+#include "SpawnTestbed.h"
+
 #include <algorithm>
 #include <chrono>
 #include <csignal>
@@ -44,21 +46,7 @@ fs::path freshDir(const std::string& name) {
 
 // Starts testbed with args, stdout and stderr to `log`; returns the child's pid.
 pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
-    const pid_t pid = fork();
-    if (pid == 0) {
-        const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fd >= 0) {
-            dup2(fd, STDOUT_FILENO);
-            dup2(fd, STDERR_FILENO);
-        }
-        std::vector<char*> argv = {const_cast<char*>(kTestbed.c_str())};
-        for (const std::string& arg : args)
-            argv.push_back(const_cast<char*>(arg.c_str()));
-        argv.push_back(nullptr);
-        execv(kTestbed.c_str(), argv.data());
-        _exit(127);
-    }
-    return pid;
+    return experimentstest::spawnTestbed(args, log, experimentstest::LogMode::Truncate);
 }
 
 // Waits for pid; its exit code, or -signal when a signal ended it.

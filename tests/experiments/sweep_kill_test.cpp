@@ -3,6 +3,8 @@
 // "skipped" in its progress output), redo the rest, and end with every job exactly once.
 #include <gtest/gtest.h>
 
+#include "SpawnTestbed.h"
+
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -26,23 +28,9 @@ using Json = nlohmann::ordered_json;
 
 const fs::path kTestbed = fs::path(TESTBED_BINARY_DIR) / "bin" / "testbed";
 
-// Starts testbed with args, stdout and stderr appended to `log`; returns the child's pid.
+// Starts testbed with args, stdout and stderr to `log`; returns the child's pid.
 pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
-    const pid_t pid = fork();
-    if (pid == 0) {
-        const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-        if (fd >= 0) {
-            dup2(fd, STDOUT_FILENO);
-            dup2(fd, STDERR_FILENO);
-        }
-        std::vector<char*> argv = {const_cast<char*>(kTestbed.c_str())};
-        for (const std::string& arg : args)
-            argv.push_back(const_cast<char*>(arg.c_str()));
-        argv.push_back(nullptr);
-        execv(kTestbed.c_str(), argv.data());
-        _exit(127);
-    }
-    return pid;
+    return experimentstest::spawnTestbed(args, log, experimentstest::LogMode::Append);
 }
 
 std::vector<fs::path> markers(const fs::path& out) {
