@@ -1,6 +1,7 @@
 #include "experiments/RenderOptions.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <filesystem>
 
@@ -35,8 +36,8 @@ void checkSizes(const RenderOptions& options) {
                          std::to_string(options.height) + " refused: each side must be 1.." +
                          std::to_string(kMaxImageSide) + " and at most " +
                          std::to_string(kMaxPixels) + " pixels in all");
-    if (options.lights < 0 || options.lights > kMaxLights)
-        throw UsageError("--lights " + std::to_string(options.lights) + " refused: must be 0.." +
+    if (options.lights && (*options.lights < 0 || *options.lights > kMaxLights))
+        throw UsageError("--lights " + std::to_string(*options.lights) + " refused: must be 0.." +
                          std::to_string(kMaxLights));
     if (options.threads < 0 || options.threads > kMaxThreads)
         throw UsageError("--threads " + std::to_string(options.threads) +
@@ -110,6 +111,26 @@ CheckedOptions checkOptions(const RenderOptions& options) {
 
 void validate(const RenderOptions& options) {
     checkOptions(options);
+}
+
+bool isJsonSceneFile(const std::string& scene) {
+    std::string extension = std::filesystem::path(scene).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return !scenes::isProceduralScene(scene) && extension == ".json";
+}
+
+std::optional<int> requestedLights(const RenderOptions& options) {
+    if (options.lights)
+        return options.lights;
+    if (isJsonSceneFile(options.scene))
+        return std::nullopt;
+    return kDefaultLights;
+}
+
+std::string lightsText(const RenderOptions& options) {
+    const std::optional<int> lights = requestedLights(options);
+    return lights ? std::to_string(*lights) : "file";
 }
 
 std::vector<std::string> renderOptionKeys() {

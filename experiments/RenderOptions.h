@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,7 +30,10 @@ struct RenderOptions {
     // is resolved by `testbed render` and the sweep into one render per view before planning.
     std::string view;
     std::string stage = "brute";
-    int lights = 256;
+    // Generated point lights. Unset: a JSON scene's own lightGenerator decides (the file wins);
+    // every other scene gets kDefaultLights. Set (--lights, a sweep's `lights`), it replaces a
+    // JSON scene's generator count and seed (requestedLights).
+    std::optional<int> lights;
     uint64_t seed = 1;
     int width = 1280;
     int height = 720;
@@ -53,6 +57,18 @@ struct RenderOptions {
     int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
     int repetitions = 1; // timed runs; timings are reported as median, min and max over them
 };
+
+// The generated lights of a scene whose file does not choose them, when --lights is not given.
+inline constexpr int kDefaultLights = 256;
+
+// Whether the scene is a JSON scene file, whose lightGenerator chooses its generated lights.
+bool isJsonSceneFile(const std::string& scene);
+// The generated lights to ask the scene for: options.lights when set; else none asked for a JSON
+// scene (its file decides), kDefaultLights for the others.
+std::optional<int> requestedLights(const RenderOptions& options);
+// The light count as text for names and keys: the number, or "file" when a JSON scene's
+// generator decides.
+std::string lightsText(const RenderOptions& options);
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, layout, normals, normal-space,

@@ -14,7 +14,7 @@ int effectiveThreads(int requested) {
 
 scenes::Scene loadRequestedScene(const RenderOptions& options) {
     scenes::SceneRequest request;
-    request.lightCount = options.lights;
+    request.lightCount = requestedLights(options);
     request.seed = options.seed;
     request.options = options.sceneOptions;
     scenes::Scene scene = scenes::loadScene(options.scene, request);

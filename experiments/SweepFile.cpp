@@ -257,7 +257,7 @@ std::string referenceKeyOf(const RenderOptions& o) {
     std::string canonical = "scene=" + o.scene + "\n";
     for (const auto& [key, value] : o.sceneOptions)
         canonical += "scene-option." + key + "=" + value + "\n";
-    canonical += "lights=" + std::to_string(o.lights) + "\nseed=" + std::to_string(o.seed) +
+    canonical += "lights=" + lightsText(o) + "\nseed=" + std::to_string(o.seed) +
                  "\nwidth=" + std::to_string(o.width) + "\nheight=" + std::to_string(o.height) +
                  "\n";
     // The view changes the reference image; the default view ("") keeps the keys of sweeps
@@ -268,7 +268,8 @@ std::string referenceKeyOf(const RenderOptions& o) {
         stem += "-" + safeName(o.view);
     }
     return stem + "-" + std::to_string(o.width) + "x" + std::to_string(o.height) + "-" +
-           std::to_string(o.lights) + "l-s" + std::to_string(o.seed) + "-" + hex8(fnv1a(canonical));
+           (requestedLights(o) ? lightsText(o) + "l" : "file-lights") + "-s" +
+           std::to_string(o.seed) + "-" + hex8(fnv1a(canonical));
 }
 
 // TOML to JSON keeping the file's key order (toml::table sorts keys; the axes' order matters:

@@ -240,8 +240,8 @@ Scene JsonSceneReader::read() {
     if (!mRequest.options.empty())
         fail("", "option '" + mRequest.options.begin()->first +
                      "' is not valid: a JSON scene takes its options from the file");
-    if (mRequest.lightCount < 0)
-        fail("", "light count must be >= 0, got " + std::to_string(mRequest.lightCount));
+    if (mRequest.lightCount.value_or(0) < 0)
+        fail("", "light count must be >= 0, got " + std::to_string(*mRequest.lightCount));
     std::error_code error;
     if (!fs::exists(mPath, error))
         fail("", "file not found");
@@ -674,8 +674,9 @@ void JsonSceneReader::applyMaterial(const Json& value, const std::string& field,
 }
 
 // Unset generator fields take defaultScatterFor(scene)'s values. The request's lightCount and
-// seed, when lightCount > 0, replace the file's count and seed, and generate lights even when
-// the file has no generator. Every field is checked even when no light is generated.
+// seed, when the lightCount is set (0 included), replace the file's count and seed, and generate
+// lights even when the file has no generator; unset, the file's generator decides (no generator:
+// no generated lights). Every field is checked even when no light is generated.
 void JsonSceneReader::generateLights(const Json* generator, Scene& scene) const {
     const std::string field = "lightGenerator";
     int count = 0;
@@ -720,8 +721,8 @@ void JsonSceneReader::generateLights(const Json* generator, Scene& scene) const 
         optionalPositive("minIntensity", minIntensity);
         optionalPositive("maxIntensity", maxIntensity);
     }
-    if (mRequest.lightCount > 0) {
-        count = mRequest.lightCount;
+    if (mRequest.lightCount) {
+        count = *mRequest.lightCount;
         seed = mRequest.seed;
     }
     // Explicit and object lights count against the same limit as generated ones.

@@ -85,6 +85,7 @@ void scatterPointLights(Scene& scene, const PointLightScatter& scatter, int coun
         light.color = saturatedColour(hue, saturation);
         scene.lights.push_back(light);
     }
+    scene.generatedLightCount += count;
 }
 
 PointLightScatter defaultScatterFor(const Scene& scene) {

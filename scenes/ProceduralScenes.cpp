@@ -28,17 +28,9 @@ namespace {
 // ---------------------------------------------------------------------------------------------
 // Options
 
-struct OptionSpec {
-    std::string key;
-    int defaultValue;
-    int minValue;
-    int maxValue;
-    std::string meaning;
-};
-
-std::string describe(const std::vector<OptionSpec>& specs) {
+std::string describe(const std::vector<SceneOption>& specs) {
     std::string text;
-    for (const OptionSpec& spec : specs) {
+    for (const SceneOption& spec : specs) {
         if (!text.empty())
             text += ", ";
         const std::string values =
@@ -54,17 +46,17 @@ std::string describe(const std::vector<OptionSpec>& specs) {
 // Every spec's value (the default when not given). Throws for a key without a spec, or a value
 // that is not a plain decimal integer in the spec's range.
 std::map<std::string, int> readOptions(const std::string& sceneName, const SceneRequest& request,
-                                       const std::vector<OptionSpec>& specs) {
+                                       const std::vector<SceneOption>& specs) {
     for (const auto& [key, value] : request.options) {
         const bool known =
             std::any_of(specs.begin(), specs.end(),
-                        [&name = key](const OptionSpec& spec) { return spec.key == name; });
+                        [&name = key](const SceneOption& spec) { return spec.key == name; });
         if (!known)
             throw SceneError(sceneName + ": unknown option '" + key +
                              "'; valid options: " + describe(specs));
     }
     std::map<std::string, int> values;
-    for (const OptionSpec& spec : specs) {
+    for (const SceneOption& spec : specs) {
         const auto given = request.options.find(spec.key);
         if (given == request.options.end()) {
             values[spec.key] = spec.defaultValue;
@@ -159,10 +151,25 @@ void addAmbientAndSun(Scene& scene, bool ambient, bool sun) {
 }
 
 // A scene's own options plus the ambient and sun switches every scene has.
-std::vector<OptionSpec> withAmbientAndSun(std::vector<OptionSpec> specs, int defaultValue) {
+std::vector<SceneOption> withAmbientAndSun(std::vector<SceneOption> specs, int defaultValue) {
     specs.push_back({"ambient", defaultValue, 0, 1, "add one weak ambient light"});
     specs.push_back({"sun", defaultValue, 0, 1, "add one directional sun light"});
     return specs;
+}
+
+// The option tables of the scenes, for a request of `lightCount` generated lights.
+std::vector<SceneOption> atriumOptions(int) {
+    return withAmbientAndSun(
+        {{"detail", 1, 1, 16, "tessellation multiplier; triangles grow about linearly with it"}},
+        1);
+}
+std::vector<SceneOption> wallOptions(int lightCount) {
+    return withAmbientAndSun(
+        {{"behind", 0, 0, lightCount, "how many of the light count go behind the wall"}}, 0);
+}
+std::vector<SceneOption> spheresOptions(int) {
+    return withAmbientAndSun(
+        {{"segments", 64, 4, 1024, "longitude segments per sphere; latitude gets half"}}, 0);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -224,10 +231,8 @@ int cellsAlong(float lengthMetres, float scale) {
 Scene buildAtrium(const SceneRequest& request) {
     Scene scene;
     scene.name = "atrium";
-    const OptionSpec detail{"detail", 1, 1, 16,
-                            "tessellation multiplier; triangles grow about linearly with it"};
     const std::map<std::string, int> options =
-        readOptions(scene.name, request, withAmbientAndSun({detail}, 1));
+        readOptions(scene.name, request, atriumOptions(request.lightCount.value_or(0)));
     // Cells per unit length grow with sqrt(detail), so cell counts grow with detail.
     const float scale = std::sqrt(float(options.at("detail")));
 
@@ -361,7 +366,7 @@ Scene buildAtrium(const SceneRequest& request) {
     scatter.maxRangeMetres = 5.0f;
     scatter.minIntensity = 0.3f;
     scatter.maxIntensity = 1.5f;
-    scatterPointLights(scene, scatter, request.lightCount, request.seed);
+    scatterPointLights(scene, scatter, request.lightCount.value_or(0), request.seed);
     addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
     // More views (Viewpoints.h): back down the nave from the far end,
     // from gallery height above the nave edge across to the far arcade, and from high above the
@@ -438,15 +443,14 @@ void scatterAccepted(Scene& scene, const PointLightScatter& scatter, int count, 
             throw SceneError(scene.name + ": cannot place lights inside the camera's view");
     }
     scene.lights.insert(scene.lights.end(), accepted.begin(), accepted.end());
+    scene.generatedLightCount += count;
 }
 
 Scene buildWall(const SceneRequest& request) {
     Scene scene;
     scene.name = "wall";
-    const OptionSpec behind{"behind", 0, 0, request.lightCount,
-                            "how many of the light count go behind the wall"};
     const std::map<std::string, int> options =
-        readOptions(scene.name, request, withAmbientAndSun({behind}, 0));
+        readOptions(scene.name, request, wallOptions(request.lightCount.value_or(0)));
 
     const uint32_t brick = addMaterial(scene, "wall-brick", {0.60f, 0.32f, 0.22f}, 0.05f, 16.0f);
     const uint32_t concrete =
@@ -470,7 +474,7 @@ Scene buildWall(const SceneRequest& request) {
     const Camera& camera = scene.cameras[0];
 
     const int behindCount = options.at("behind");
-    const int frontCount = request.lightCount - behindCount;
+    const int frontCount = request.lightCount.value_or(0) - behindCount;
     const float alongMin = -kWallHalfLength + 0.5f, alongMax = kWallHalfLength - 0.5f;
 
     PointLightScatter front;
@@ -540,10 +544,8 @@ constexpr SphereSpec kSpheres[] = {
 Scene buildSpheres(const SceneRequest& request) {
     Scene scene;
     scene.name = "spheres";
-    const OptionSpec segments{"segments", 64, 4, 1024,
-                              "longitude segments per sphere; latitude gets half"};
     const std::map<std::string, int> options =
-        readOptions(scene.name, request, withAmbientAndSun({segments}, 0));
+        readOptions(scene.name, request, spheresOptions(request.lightCount.value_or(0)));
     const int longitudeCount = options.at("segments");
 
     const uint32_t ground =
@@ -571,7 +573,7 @@ Scene buildSpheres(const SceneRequest& request) {
     scatter.maxRangeMetres = 3.0f;
     scatter.minIntensity = 0.3f;
     scatter.maxIntensity = 1.5f;
-    scatterPointLights(scene, scatter, request.lightCount, request.seed);
+    scatterPointLights(scene, scatter, request.lightCount.value_or(0), request.seed);
     addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
     // More views (Viewpoints.h): from above, low from the side (grazing the ground), from behind.
     scene.cameras.push_back(makeCamera("above", {0.0f, 9.0f, 4.5f}, {0.0f, 0.5f, 0.0f}, 40.0f));
@@ -586,12 +588,13 @@ Scene buildSpheres(const SceneRequest& request) {
 struct ProceduralScene {
     std::string_view name;
     Scene (*build)(const SceneRequest&);
+    std::vector<SceneOption> (*options)(int lightCount);
 };
 
 constexpr ProceduralScene kProceduralScenes[] = {
-    {"atrium", buildAtrium},
-    {"wall", buildWall},
-    {"spheres", buildSpheres},
+    {"atrium", buildAtrium, atriumOptions},
+    {"wall", buildWall, wallOptions},
+    {"spheres", buildSpheres, spheresOptions},
 };
 static_assert(kProceduralScenes[0].name == kDefaultSceneName, "the default scene comes first");
 
@@ -609,13 +612,20 @@ bool isProceduralScene(const std::string& name) {
                        [&](const ProceduralScene& scene) { return scene.name == name; });
 }
 
+std::vector<SceneOption> proceduralSceneOptions(const std::string& name, int lightCount) {
+    for (const ProceduralScene& entry : kProceduralScenes)
+        if (entry.name == name)
+            return entry.options(lightCount);
+    throw SceneError("unknown procedural scene '" + name + "'");
+}
+
 Scene buildProceduralScene(const std::string& name, const SceneRequest& request) {
     for (const ProceduralScene& entry : kProceduralScenes) {
         if (entry.name != name)
             continue;
-        if (request.lightCount < 0)
+        if (request.lightCount.value_or(0) < 0)
             throw SceneError(name + ": light count must be >= 0, got " +
-                             std::to_string(request.lightCount));
+                             std::to_string(*request.lightCount));
         Scene scene = entry.build(request);
         validate(scene);
         return scene;

@@ -16,7 +16,21 @@ namespace scenes {
 
 inline constexpr const char* kDefaultSceneName = "atrium";
 
+// One option of a built-in scene (`--scene-option key=value`): an integer in minValue..maxValue,
+// defaultValue when not given (0|1 switches for the ambient and sun lights).
+struct SceneOption {
+    std::string key;
+    int defaultValue;
+    int minValue;
+    int maxValue;
+    std::string meaning;
+};
+
 std::vector<std::string> proceduralSceneNames();
+// The options of a built-in scene, in its table's order, as its builder reads them for a request
+// of `lightCount` generated lights (wall's behind is at most the light count). Throws SceneError
+// for an unknown name.
+std::vector<SceneOption> proceduralSceneOptions(const std::string& name, int lightCount);
 bool isProceduralScene(const std::string& name);
 // Throws SceneError for an unknown name (listing the valid ones) or an unknown/invalid option.
 Scene buildProceduralScene(const std::string& name, const SceneRequest& request);

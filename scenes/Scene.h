@@ -99,6 +99,10 @@ struct Scene {
     std::vector<Instance> instances;
     std::vector<Camera> cameras; // cameras[0] is the one rendered
     std::vector<Light> lights;
+    // How many of `lights` a light generator placed (scatterPointLights: the requested count, a
+    // JSON scene's lightGenerator); the others came with the scene (a file's lights, a built-in
+    // scene's ambient and sun). For the record of where a render's lights came from.
+    int generatedLightCount = 0;
     std::vector<std::string> warnings; // non-fatal problems met while building (missing textures)
 
     uint64_t triangleCount() const; // over instances

@@ -74,9 +74,10 @@ Scene loadScene(const std::string& nameOrPath, const SceneRequest& request) {
         if (!request.options.empty())
             throw SceneError(nameOrPath + ": option '" + request.options.begin()->first +
                              "' is not valid: glTF files take no options");
-        if (request.lightCount < 0)
+        const int lightCount = request.lightCount.value_or(0);
+        if (lightCount < 0)
             throw SceneError(nameOrPath + ": light count must be >= 0, got " +
-                             std::to_string(request.lightCount));
+                             std::to_string(lightCount));
         Scene scene = loadGltf(path);
         const bool fileHasLights = !scene.lights.empty();
         if (!fileHasLights) {
@@ -95,17 +96,16 @@ Scene loadScene(const std::string& nameOrPath, const SceneRequest& request) {
             key.intensity = 2.0f;
             scene.lights = {ambient, key};
         }
-        if (request.lightCount > 0 && !fileHasLights) {
+        if (lightCount > 0 && !fileHasLights) {
             try {
-                scatterPointLights(scene, defaultScatterFor(scene), request.lightCount,
-                                   request.seed);
+                scatterPointLights(scene, defaultScatterFor(scene), lightCount, request.seed);
             } catch (const SceneError& error) {
                 throw SceneError(nameOrPath + ": " + error.what());
             }
-        } else if (request.lightCount > 0) {
+        } else if (lightCount > 0) {
             // The file's own lights define the scene; adding random ones would change it.
             const std::string warning = nameOrPath + ": the file has its own lights; the " +
-                                        std::to_string(request.lightCount) +
+                                        std::to_string(lightCount) +
                                         " requested generated lights were not added";
             std::cerr << "warning: " << warning << '\n';
             scene.warnings.push_back(warning);

@@ -4,12 +4,16 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
 namespace scenes {
 
 struct SceneRequest {
-    int lightCount = 0; // generated point lights, placed deterministically from seed
+    // Generated point lights, placed deterministically from seed. Unset: the source decides: none
+    // for built-in scenes and glTF models, a JSON scene's own lightGenerator (count and seed).
+    // Set (0 included): that many, replacing a JSON scene's generator count and seed.
+    std::optional<int> lightCount;
     uint64_t seed = 1;
     // Scene-specific options as key=value. A builder must reject keys it does not know
     // (SceneError naming the key and the valid ones), never silently ignore them.
