@@ -1,6 +1,7 @@
 #include "experiments/DiffCommand.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -91,13 +92,65 @@ void checkExrAttributeSizes(const fs::path& path) {
     }
 }
 
+std::string lowercase(std::string text) {
+    std::transform(text.begin(), text.end(), text.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return text;
+}
+
+// The metrics compare radiance, so both inputs must hold linear colour (see DiffCommand.h): an
+// OpenEXR file whose beauty channels are half or float and whose colour-space attribute, if any,
+// names a linear space. Anything else (a PNG or JPEG preview, 8-bit or integer channels, an EXR
+// tagged sRGB or log) is refused, saying what it is, rather than compared as if linear.
+void checkLinearExr(const fs::path& path, const OIIO::ImageBuf& image) {
+    const std::string format = image.file_format_name();
+    const OIIO::ImageSpec& header = image.spec();
+    auto refuse = [&](const std::string& what) {
+        throw std::runtime_error(path.string() + " is not a linear EXR: " + what +
+                                 "; diff compares linear HDR renders (render.exr, a "
+                                 "sweep's references/*.exr), not display images");
+    };
+    if (format != "openexr")
+        refuse("it is a " + (format.empty() ? std::string("non-image") : format) + " file (" +
+               header.format.c_str() + " channels" +
+               (format == "png" || format == "jpeg" ? ", display-encoded, e.g. sRGB" : "") + ")");
+    for (const char* name : kBeauty) {
+        const int channel = header.channelindex(name);
+        if (channel < 0)
+            continue; // reported later, with the other file
+        const OIIO::TypeDesc type = header.channelformat(channel);
+        if (type != OIIO::TypeDesc::HALF && type != OIIO::TypeDesc::FLOAT)
+            refuse(std::string("channel ") + name + " is " + type.c_str() +
+                   " (linear colour is stored as half or float)");
+    }
+    // OpenEXR has no transfer-function field: its pixels are linear by the format's convention.
+    // Some writers tag a colour space anyway (a string attribute such as `colorspace`); a tag
+    // naming a non-linear one (sRGB, Rec.709 display, ACEScct, log) is refused.
+    for (const OIIO::ParamValue& attribute : header.extra_attribs) {
+        const std::string name = lowercase(attribute.name().string());
+        if (attribute.type() != OIIO::TypeDesc::STRING || name.size() < 10 ||
+            name.compare(name.size() - 10, 10, "colorspace") != 0)
+            continue;
+        const std::string value = attribute.get_string();
+        const std::string space = lowercase(value);
+        const bool linear = space.empty() || space.find("linear") != std::string::npos ||
+                            space.rfind("lin_", 0) == 0 || space == "acescg" ||
+                            space == "aces2065-1" || space == "raw";
+        if (!linear)
+            refuse("its " + attribute.name().string() + " attribute says '" + value +
+                   "', not a linear colour space");
+    }
+}
+
 // The header is read first, so a file that declares an absurd size is refused before its pixels
-// are allocated (scenes/Limits.h: the render limits, and limits::kMaxImageChannels).
+// are allocated (scenes/Limits.h: the render limits, and limits::kMaxImageChannels), and a file
+// that holds no linear colour before anything is compared (checkLinearExr).
 OIIO::ImageBuf readImage(const fs::path& path) {
     checkExrAttributeSizes(path);
     OIIO::ImageBuf image(path.string());
     if (!image.init_spec(path.string(), 0, 0))
         throw std::runtime_error("cannot read " + path.string() + ": " + image.geterror());
+    checkLinearExr(path, image);
     const OIIO::ImageSpec& header = image.spec();
     if (header.width <= 0 || header.height <= 0 || header.depth != 1 ||
         header.width > scenes::limits::kMaxImageSide ||

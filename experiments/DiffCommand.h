@@ -29,8 +29,16 @@
 // lights.evaluated, ...), through ImageBufAlgo::computePixelStats on A, B, A - B and |A - B|;
 // min/max/mean are over the finite values, nan/inf count the others.
 //
-// Errors (one line "testbed: error: ...", exit code 1, nothing written): unreadable file, images
-// of different sizes, beauty channel missing, python3 with matplotlib missing.
+// Inputs must be linear colour: OpenEXR files whose R, G, B are half or float and whose colour
+// space tag (a string attribute named *colorspace, which some writers add; OpenEXR itself has
+// none and means linear), when present, names a linear space (linear, lin_srgb, scene_linear,
+// ACEScg, ...). A PNG or JPEG (a tone-mapped, display-encoded preview), an EXR with
+// integer beauty channels or one tagged sRGB or log is refused, not converted: its values are not
+// radiance, and undoing a tone map is not possible.
+//
+// Errors (one line "testbed: error: ...", exit code 1, nothing written): unreadable file, an input
+// that is not linear EXR (above), images of different sizes, beauty channel missing, python3 with
+// matplotlib missing.
 // Thread safety: the functions share no state.
 #pragma once
 
@@ -80,7 +88,7 @@ struct ImageDiff {
 };
 
 // Reads both files and compares them. Throws std::runtime_error naming the file and the problem
-// (unreadable, sizes differ, R/G/B missing).
+// (unreadable, not linear EXR, sizes differ, R/G/B missing).
 ImageDiff diffImageFiles(const std::filesystem::path& a, const std::filesystem::path& b);
 
 nlohmann::json diffJson(const ImageDiff& diff, const std::filesystem::path& a,

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
@@ -15,11 +14,11 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <tbb/parallel_for.h>
 
-#include <unistd.h>
-
 #include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
 #include "experiments/ImageOutput.h"
+#include "experiments/LightOrigins.h"
+#include "experiments/Progress.h"
 #include "lighting/PassNames.h"
 #include "scenes/Scene.h"
 #include "scenes/Viewpoints.h"
@@ -123,8 +122,12 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
               << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
               << " lights) at " << run.options.width << "x" << run.options.height << ", "
               << run.threads << " threads\n";
+    std::cout << "  lights: " << lightOrigins(run.options, run.scene()).summary() << "\n";
     const bool several = run.options.repetitions > 1;
-    std::cout << "  timings: " << timingFigure(run.options) << "\n";
+    std::cout << "  timings: " << timingFigure(run.options) << "; CPU " << std::fixed
+              << std::setprecision(2) << run.metrics.cpuLoad.cpuWallRatio
+              << " s per wall second on " << run.threads << " threads"
+              << (run.metrics.cpuLoad.loaded ? " (loaded machine: see the warning)" : "") << "\n";
     for (const PassTiming& timing : run.metrics.passes) {
         std::cout << "  " << timing.pass << ": " << std::fixed << std::setprecision(2)
                   << timing.medianMs() << " ms";
@@ -277,6 +280,7 @@ void addTimings(nlohmann::json& stats, const RenderRun& run) {
                                  {"raster", steps.rasterMs},
                                  {"resolve", steps.resolveMs},
                                  {lighting::pass::kExactSurface, steps.exactMs}};
+    stats["cpu_load"] = run.metrics.cpuLoad.toJson();
     stats["measurement_ms"] = {{"oracle", run.metrics.oracleMs},
                                {"reference", run.metrics.referenceMs},
                                {"flip", run.metrics.flipMs}};
@@ -332,7 +336,9 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["commit"] = kBuildCommit;
     stats["triangles"] = run.scene().triangleCount();
     stats["lights"] = run.scene().lights.size();
-    stats["generated_lights"] = run.options.lights;
+    const LightOrigins origins = lightOrigins(run.options, run.scene());
+    stats["generated_lights"] = origins.generated;
+    stats["light_origins"] = origins.toJson();
     stats["seed"] = run.options.seed;
     stats["layout"] = layoutJson(run.gbuffer().layout(), metrics);
     stats[metric::kBytesPerPixel] = metrics.bytesPerPixel;
@@ -417,16 +423,9 @@ int runRenderCommand(const RenderCommandOptions& options) {
         }
     }
     try {
-        const bool terminal = isatty(STDERR_FILENO);
-        const auto start = std::chrono::steady_clock::now();
-        auto progress = [&](const std::string& step) {
-            if (!terminal)
-                return;
-            const double seconds =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            std::cerr << "[" << std::fixed << std::setprecision(1) << seconds << " s] " << step
-                      << "\n";
-        };
+        // Progress on stderr as sweeps print it, but only for a render longer than 2 s.
+        DelayedProgress delayed(std::cerr, kLongRenderSeconds);
+        auto progress = [&](const std::string& step) { delayed.step(step); };
         progress("loading scene " + options.render.scene);
         RenderPlan plan = planRender(options.render); // every input error stops here
         if (options.explainLayout) {
@@ -438,7 +437,10 @@ int runRenderCommand(const RenderCommandOptions& options) {
         const RenderRun run = runRender(std::move(plan), progress);
         progress("writing outputs");
         writeRenderOutputs(run, options.out, options.scales);
+        delayed.finish();
         printSummary(run, options.out);
+        if (run.metrics.cpuLoad.loaded)
+            std::cerr << "testbed: warning: " << run.metrics.cpuLoad.warning << "\n";
         return 0;
     } catch (const std::exception& e) {
         return reportError(e);

@@ -1,9 +1,11 @@
 #include "experiments/RenderJob.h"
 
 #include <chrono>
+#include <thread>
 
 #include <tbb/task_arena.h>
 
+#include "experiments/CpuLoad.h"
 #include "experiments/FlipMetric.h"
 #include "lighting/Oracle.h"
 #include "lighting/PassNames.h"
@@ -23,16 +25,23 @@ double millisecondsSince(Clock::time_point start) {
 }
 
 // The warm-up runs, then the timed repetitions of the G-buffer pass and the stage; run.result
-// keeps the last repetition's image. Returns the timed passes.
+// keeps the last repetition's image. Returns the timed passes, and sets run.metrics.cpuLoad from
+// the process's CPU time and the wall time summed over the timed repetitions (each from its
+// G-buffer pass to the end of its stage; the first run's G-buffer pass ran in PreparedScene's
+// constructor, among the serial preparation of the scene, so without warm-up the first timed
+// repetition counts its stage only).
 std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage& stage,
                                          bool exactSurface, const Progress& step) {
     const RenderOptions& options = run.options;
     const int runs = options.warmup + options.repetitions;
     std::vector<PassTiming> passes;
+    double cpuSeconds = 0.0, wallSeconds = 0.0;
     for (int i = 0; i < runs; ++i) {
         const bool timed = i >= options.warmup;
         step(std::string(timed ? "" : "warm-up ") + "shading: " + options.stage +
              (runs > 1 ? " (" + std::to_string(i + 1) + "/" + std::to_string(runs) + ")" : ""));
+        const double cpuStart = processCpuSeconds();
+        const Clock::time_point wallStart = Clock::now();
         if (i > 0)
             run.prepared->renderGBuffer();
         const gbuffer::GBufferPassTimings& gbufferTimings = run.prepared->gbufferTimings;
@@ -44,6 +53,10 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
             repetition.emplace_back(lighting::pass::kExactSurface, gbufferTimings.exactMs);
         lighting::StageResult result;
         stage.shade(run.prepared->inputs, result);
+        if (timed) {
+            cpuSeconds += processCpuSeconds() - cpuStart;
+            wallSeconds += std::chrono::duration<double>(Clock::now() - wallStart).count();
+        }
         for (const auto& timing : result.timingsMs)
             repetition.push_back(timing);
         double total = 0.0;
@@ -54,6 +67,8 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
             addRepetition(passes, repetition);
         run.result = std::move(result);
     }
+    run.metrics.cpuLoad = judgeCpuLoad(cpuSeconds, wallSeconds, run.threads,
+                                       int(std::thread::hardware_concurrency()));
     return passes;
 }
 
@@ -161,10 +176,12 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
             run.flipParameters = std::move(flip.parameters);
         }
         const gbuffer::GBufferLayout& layout = run.gbuffer().layout();
+        const CpuLoad cpuLoad = run.metrics.cpuLoad;
         run.metrics = measureRun(std::move(passes), run.result.lightsEvaluated, run.oracle,
                                  run.result.lightingSamples, layout.bytesPerPixel(),
                                  layout.allocatedBytesPerPixel(), error);
         run.metrics.setSimtModel(run.result.parameters);
+        run.metrics.cpuLoad = cpuLoad;
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;
         run.metrics.flipMs = flipMs;

@@ -21,6 +21,8 @@
 //                 lighting/README.md); simt efficiency = oracle evaluations / lane slots. Both
 //                 null for stages without the model.
 //   bytes per pixel     the layout's bits as a GPU packs them, and what this run allocates.
+//   CPU load      process CPU seconds per wall second over the timed repetitions, against the
+//                 threads (CpuLoad.h): whether the machine was loaded while the times were taken.
 //   error         against the double-precision reference, when compared (compareImages), and
 //                 the mean HDR-ꟻLIP (FlipMetric.h), null with flip_unavailable saying why when
 //                 the package is missing.
@@ -34,6 +36,7 @@
 #include <utility>
 #include <vector>
 
+#include "experiments/CpuLoad.h"
 #include "lighting/ShadingStage.h"
 
 namespace experiments {
@@ -100,6 +103,9 @@ struct RunMetrics {
     double oracleMs = 0.0;          // measurement, not part of the stage
     double referenceMs = 0.0;
     double flipMs = 0.0;
+    // CPU time against wall time over the timed repetitions (CpuLoad.h): in stats.json, not in
+    // the sweep's columns (each job's stats.json has it).
+    CpuLoad cpuLoad;
     uint64_t lightEvaluations = 0;
     uint64_t oracleLightEvaluations = 0;
     double cullingEfficiency = 1.0;

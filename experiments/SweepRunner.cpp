@@ -1,8 +1,6 @@
 #include "experiments/SweepRunner.h"
 
 #include <chrono>
-#include <cmath>
-#include <cstdio>
 #include <ctime>
 #include <fstream>
 #include <iostream>
@@ -12,6 +10,7 @@
 #include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
 #include "experiments/JobProcess.h"
+#include "experiments/Progress.h"
 #include "experiments/ResultsTable.h"
 #include "experiments/SweepFile.h"
 #include "experiments/SweepJobRun.h"
@@ -27,21 +26,6 @@ namespace {
 
 double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-std::string formatDuration(double seconds) {
-    char text[32];
-    if (seconds < 60.0) {
-        std::snprintf(text, sizeof text, "%.1fs", seconds);
-    } else {
-        const long whole = std::lround(seconds);
-        if (whole < 3600)
-            std::snprintf(text, sizeof text, "%ldm%02lds", whole / 60, whole % 60);
-        else
-            std::snprintf(text, sizeof text, "%ldh%02ldm%02lds", whole / 3600, whole / 60 % 60,
-                          whole % 60);
-    }
-    return text;
 }
 
 std::string utcNow() {
@@ -155,16 +139,12 @@ public:
                 continue;
             }
             const SweepJob job = mExpansion.job(first + i);
-            const size_t left = toRun - mSummary.ran;
-            const std::string remaining =
-                mSummary.ran == 0
-                    ? "?"
-                    : formatDuration(runSeconds / double(mSummary.ran) * double(left));
             mLog << position << " running " << job.id << ": " << describeSettings(job.settings)
                  << " | done " << (mSummary.ran + mSummary.skipped) << "/" << shardSize
-                 << ", skipped " << mSummary.skipped << ", failed " << mSummary.failed
-                 << " | elapsed " << formatDuration(secondsSince(start)) << ", remaining ~"
-                 << remaining << "\n";
+                 << ", skipped " << mSummary.skipped << ", failed " << mSummary.failed << " | "
+                 << elapsedAndRemaining(secondsSince(start), runSeconds, mSummary.ran,
+                                        toRun - mSummary.ran)
+                 << "\n";
             mLog.flush();
             const auto jobStart = Clock::now();
             const std::string error = runJob(job);

@@ -1,6 +1,7 @@
 // testbed: the command-line front end. Subcommands:
 //   render  one scene, one stage -> render.exr, preview.png, heatmap.png, stats.json
-//   list    scenes, stages and normal encodings known to this build
+//   list    scenes (with their options), stages, normal encodings, layout presets, depth
+//           formats, position methods and normal spaces known to this build (ListCommand.h)
 //   report  a sweep's results folder -> DIR/report.html (tables, plots, thumbnails)
 //   diff    two EXRs -> an image-diff report (metrics, side by side, |A-B|, per-channel stats)
 //   sweep   a sweep file -> one job folder per job, results.csv/json (resumable, shardable)
@@ -20,6 +21,7 @@
 #include "experiments/CommandErrors.h"
 #include "experiments/DiffCommand.h"
 #include "experiments/JobProcess.h"
+#include "experiments/ListCommand.h"
 #include "experiments/RenderCommand.h"
 #include "experiments/RenderPlan.h"
 #include "experiments/ReportCommand.h"
@@ -27,11 +29,7 @@
 #include "experiments/SweepRunner.h"
 #include "experiments/studies/DepthStudy.h"
 #include "experiments/studies/NormalStudy.h"
-#include "gbuffer/NormalCodec.h"
-#include "lighting/StageRegistry.h"
 #include "scenes/ClosestName.h"
-#include "scenes/ProceduralScenes.h"
-#include "scenes/Viewpoints.h"
 
 namespace {
 
@@ -49,7 +47,7 @@ std::string checkSeed(std::string& text) {
 const CLI::Validator kSeedValidator(checkSeed, "UINT64");
 
 void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& options,
-                      std::vector<std::string>& sceneOptionTexts) {
+                      std::vector<std::string>& sceneOptionTexts, int& lights) {
     experiments::RenderOptions& r = options.render;
     render.add_option("--scene", r.scene, "built-in scene name or .gltf/.glb/.json file")
         ->capture_default_str();
@@ -63,7 +61,10 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
                       "the scene's named view (camera) to render, or `all` for one render per "
                       "view in OUT/views/NAME/ (default: the scene's first view; `testbed list "
                       "--views SCENE` lists them)");
-    render.add_option("--lights", r.lights, "generated point lights")->capture_default_str();
+    render.add_option("--lights", lights,
+                      "generated point lights (default: a JSON scene's own lightGenerator, else " +
+                          std::to_string(experiments::kDefaultLights) +
+                          "); given, it replaces a JSON scene's generator count and seed");
     render.add_option("--seed", r.seed, "seed of the light generator")
         ->check(kSeedValidator)
         ->capture_default_str();
@@ -127,39 +128,6 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
 }
 
-// `testbed list --views SCENE`: the scene's named views, the first being the default.
-int listViews(const std::string& scene) {
-    try {
-        experiments::RenderOptions options;
-        options.scene = scene;
-        for (const std::string& view : scenes::viewNames(experiments::loadRequestedScene(options)))
-            std::cout << view << "\n";
-        return 0;
-    } catch (const std::exception& e) {
-        return experiments::reportError(e);
-    }
-}
-
-int listEverything() {
-    std::cout << "scenes (default " << scenes::kDefaultSceneName << "):\n";
-    for (const std::string& name : scenes::proceduralSceneNames())
-        std::cout << "  " << name << "\n";
-    std::cout << "  <file>.gltf | <file>.glb | <file>.json\n";
-    std::cout << "stages:\n";
-    for (const lighting::StageInfo& info : lighting::stageInfos())
-        std::cout << "  " << info.name << "  - " << info.description << "\n";
-    std::cout << "normal encodings (NAME:BITS, total bits; gbuffer/NormalCodec.h):\n";
-    const std::vector<gbuffer::NormalCodecSpec> specs = gbuffer::allNormalCodecSpecs();
-    for (size_t i = 0; i < specs.size(); ++i) { // grouped by codec, in registry order
-        const bool first = i == 0 || specs[i - 1].kind != specs[i].kind;
-        const bool last = i + 1 == specs.size() || specs[i + 1].kind != specs[i].kind;
-        if (first)
-            std::cout << "  " << gbuffer::normalCodecName(specs[i].kind) << ":";
-        std::cout << (first ? "" : "|") << specs[i].bits << (last ? "\n" : "");
-    }
-    return 0;
-}
-
 // A name of the command line that is not one: the closest valid one, if any is close (a
 // subcommand for the first argument, else an option of the subcommand given).
 std::string suggestionFor(CLI::App& app, int argc, char** argv) {
@@ -209,21 +177,26 @@ int main(int argc, char** argv) {
     // Before anything of ours starts a thread: sweep jobs fork only while none has
     // (experiments/JobProcess.h).
     experiments::noteStartupThreads();
-    CLI::App app{"testbed: CPU rasterizer research testbed for deferred shading"};
+    // Named, so that help texts say `testbed`, not the path the binary was started by.
+    CLI::App app{"testbed: CPU rasterizer research testbed for deferred shading", "testbed"};
     app.require_subcommand(1);
     experiments::RenderCommandOptions renderOptions;
     std::vector<std::string> sceneOptionTexts;
+    int renderLights = experiments::kDefaultLights;
     CLI::App* render = app.add_subcommand("render", "render one scene with one shading stage");
-    addRenderOptions(*render, renderOptions, sceneOptionTexts);
-    CLI::App* list = app.add_subcommand("list", "list scenes and stages");
+    addRenderOptions(*render, renderOptions, sceneOptionTexts, renderLights);
+    CLI::App* list = app.add_subcommand(
+        "list", "list scenes (with their options), stages, normal encodings, layout presets, "
+                "depth formats, position methods and normal spaces");
     std::string listViewsScene;
     list->add_option("--views", listViewsScene, "list the named views (cameras) of this scene");
     experiments::ReportCommandOptions reportOptions;
     CLI::App* report =
         app.add_subcommand("report", "write DIR/report.html for a sweep's results folder DIR");
     report->add_option("dir", reportOptions.dir, "results folder (holds results.json)")->required();
-    report->add_option("--plots-script", reportOptions.plotsScript, "matplotlib script")
-        ->default_str(experiments::defaultPlotsScript().string());
+    report->add_option(
+        "--plots-script", reportOptions.plotsScript,
+        "matplotlib script (default: experiments/plots/report.py of the source tree)");
     report->add_option("--python", reportOptions.python,
                        "Python with matplotlib (default: /usr/bin/python3, else python3 on PATH)");
     report
@@ -252,8 +225,8 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     diff->add_option("--exposure", diffOptions.exposure, "linear exposure of the previews")
         ->capture_default_str();
-    diff->add_option("--plots-script", diffOptions.plotsScript, "matplotlib script")
-        ->default_str(experiments::defaultPlotsScript().string());
+    diff->add_option("--plots-script", diffOptions.plotsScript,
+                     "matplotlib script (default: experiments/plots/report.py of the source tree)");
     diff->add_option("--python", diffOptions.python,
                      "Python with matplotlib (default: /usr/bin/python3, else python3 on PATH)");
     experiments::DepthCommandOptions depthOptions;
@@ -346,6 +319,8 @@ int main(int argc, char** argv) {
         return experiments::reportError(parseErrorMessage(app, e, argc, argv));
     }
     if (render->parsed()) {
+        if (render->count("--lights") > 0)
+            renderOptions.render.lights = renderLights;
         for (const std::string& text : sceneOptionTexts) {
             const size_t equals = text.find('=');
             if (equals == std::string::npos || equals == 0)
@@ -355,7 +330,7 @@ int main(int argc, char** argv) {
         return experiments::runRenderCommand(renderOptions);
     }
     if (list->parsed())
-        return listViewsScene.empty() ? listEverything() : listViews(listViewsScene);
+        return experiments::runListCommand(listViewsScene);
     if (report->parsed())
         return experiments::runReportCommand(reportOptions);
     if (diff->parsed())

@@ -1,7 +1,9 @@
 // The command-line contract (issue 16): every error of `testbed`, the argument parser's own
 // included (unknown option, missing subcommand, a value it cannot convert), is one line
 // "testbed: error: ..." on stderr and exit code 1, and a mistyped name (subcommand, option, stage,
-// scene, normal codec) gets the closest valid one suggested. Runs build/bin/testbed.
+// scene, normal codec) gets the closest valid one suggested; `testbed list` lists every choice of
+// the render options; help texts name no path of the machine the binary was built on; a JSON
+// scene's light generator is not replaced by the --lights default. Runs build/bin/testbed.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +12,11 @@
 #include <filesystem>
 #include <string>
 
+#include <fstream>
+
 #include <sys/wait.h>
+
+#include "experiments/PlotScript.h"
 
 namespace {
 
@@ -80,6 +86,66 @@ TEST(CliContract, CodecWithOneBitDepthAcceptsItsBareName) {
     EXPECT_EQ(bare.exitCode, 0) << bare.output;
     expectOneErrorLine("render --normals octahedral --explain-layout --out " + out.string(),
                        "missing ':BITS'");
+}
+
+TEST(CliContract, ListShowsEveryChoiceOfTheRenderOptions) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const CliRun list = run("list");
+    EXPECT_EQ(list.exitCode, 0) << list.output;
+    for (const char* expected :
+         {// scenes and their option tables (default, range, meaning)
+          "atrium", "detail=1..16  default 1", "wall", "behind=0..the light count  default 0",
+          "spheres", "segments=4..1024  default 64", "ambient=0|1", "sun=0|1",
+          // stages, normal encodings
+          "tiled-backface", "octahedral-precise:",
+          // layout presets, depth formats, position methods, normal spaces, with defaults
+          "layout presets", "thesis", "killzone2", "compact",
+          "depth formats (--depth NAME or NAME:infinite; default f32-reversed)", "unorm24",
+          "f16-linear", "position methods (--position; default inverse-projection)", "view-ray",
+          "normal spaces (--normal-space; default view)", "world"})
+        EXPECT_NE(list.output.find(expected), std::string::npos) << expected << "\n" << list.output;
+}
+
+TEST(CliContract, HelpTextsNameNoPathOfTheBuildMachine) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const std::string source = fs::weakly_canonical(experiments::sourceDirectory()).string();
+    const std::string build = fs::weakly_canonical(TESTBED_BINARY_DIR).string();
+    for (const char* command :
+         {"", "render", "list", "report", "diff", "sweep", "merge", "normals", "depth"}) {
+        // Started by its absolute path, which the usage line must not repeat either.
+        const CliRun help = run(std::string(command) + " --help");
+        SCOPED_TRACE(std::string("testbed ") + command + " --help");
+        EXPECT_EQ(help.exitCode, 0) << help.output;
+        EXPECT_EQ(help.output.find(source), std::string::npos) << help.output;
+        EXPECT_EQ(help.output.find(build), std::string::npos) << help.output;
+        EXPECT_NE(help.output.find("Usage: testbed"), std::string::npos) << help.output;
+    }
+}
+
+TEST(CliContract, AJsonScenesLightGeneratorIsNotReplacedByTheDefault) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const fs::path dir =
+        fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / "cli-lights";
+    fs::create_directories(dir);
+    const fs::path scene = dir / "five.json";
+    std::ofstream(scene) << R"({"objects": [{"procedural": "spheres"}],
+                               "lightGenerator": {"count": 5}})";
+    const std::string common = "render --scene " + scene.string() +
+                               " --width 32 --height 18 --threads 1 --out " +
+                               (dir / "out").string();
+    const CliRun fromFile = run(common);
+    EXPECT_EQ(fromFile.exitCode, 0) << fromFile.output;
+    EXPECT_NE(fromFile.output.find("lights: 5 = 5 generated (the file's lightGenerator)"),
+              std::string::npos)
+        << fromFile.output;
+    const CliRun given = run(common + " --lights 7");
+    EXPECT_EQ(given.exitCode, 0) << given.output;
+    EXPECT_NE(given.output.find("lights: 7 = 7 generated (--lights 7)"), std::string::npos)
+        << given.output;
+    std::ifstream stats(dir / "out" / "stats.json");
+    const std::string text((std::istreambuf_iterator<char>(stats)), {});
+    EXPECT_NE(text.find("\"light_origins\""), std::string::npos) << text;
+    EXPECT_NE(text.find("\"generated_by\": \"--lights\""), std::string::npos) << text;
 }
 
 } // namespace

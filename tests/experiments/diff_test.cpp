@@ -2,6 +2,7 @@
 // offset, an offset on part of the image), per-channel statistics of the layers both files
 // share, the written report, and refusal of mismatched sizes. Images are written with
 // writeMultiLayerExr into <build>/test-output/experiments/<test>/ and left there.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -208,6 +210,87 @@ TEST(DiffCommand, RefusesAnExrAttributeLongerThanTheFile) {
                   std::string::npos)
             << e.what();
     }
+}
+
+// The message diffImageFiles refuses `path` with, or "" when it compares it.
+std::string refusalOf(const fs::path& path, const fs::path& other) {
+    try {
+        (void)diffImageFiles(path, other);
+        return "";
+    } catch (const std::runtime_error& e) {
+        return e.what();
+    }
+}
+
+// Inputs that are not linear EXR are refused, naming the file and what it is (issue 16), in either
+// position; a linear EXR tagged linear is compared.
+TEST(DiffCommand, RefusesInputsThatAreNotLinearExr) {
+    const fs::path dir = freshTestFolder();
+    const fs::path exr = writeImage(dir / "linear.exr", 0.0f, nowhere, 1.0f);
+    const size_t n = size_t(kWidth) * kHeight;
+    const std::vector<float> grey(n, 0.5f);
+
+    // A tone-mapped PNG preview (8-bit, sRGB-encoded).
+    const fs::path png = dir / "preview.png";
+    writePreviewPng(png, kWidth, kHeight, grey.data(), grey.data(), grey.data());
+    for (const auto& [a, b] : {std::pair{png, exr}, std::pair{exr, png}}) {
+        const std::string message = refusalOf(a, b);
+        EXPECT_NE(message.find(png.string() + " is not a linear EXR: it is a png file (uint8"),
+                  std::string::npos)
+            << message;
+    }
+
+    // A JPEG.
+    const fs::path jpeg = dir / "preview.jpg";
+    {
+        auto out = OIIO::ImageOutput::create(jpeg.string());
+        ASSERT_TRUE(out);
+        std::vector<unsigned char> pixels(n * 3, 128);
+        ASSERT_TRUE(
+            out->open(jpeg.string(), OIIO::ImageSpec(kWidth, kHeight, 3, OIIO::TypeDesc::UINT8)));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+        out->close();
+    }
+    EXPECT_NE(refusalOf(jpeg, exr).find("it is a jpeg file"), std::string::npos);
+
+    // An EXR with 32-bit unsigned integer beauty channels.
+    const fs::path integers = dir / "integers.exr";
+    {
+        auto out = OIIO::ImageOutput::create(integers.string());
+        ASSERT_TRUE(out);
+        std::vector<uint32_t> pixels(n * 3, 1);
+        ASSERT_TRUE(out->open(integers.string(),
+                              OIIO::ImageSpec(kWidth, kHeight, 3, OIIO::TypeDesc::UINT32)));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT32, pixels.data()));
+        out->close();
+    }
+    EXPECT_NE(refusalOf(integers, exr).find("channel R is uint"), std::string::npos)
+        << refusalOf(integers, exr);
+
+    // An EXR tagged with a display colour space, and one tagged linear.
+    const std::vector<ImagePlane> planes = {
+        {"R", grey.data()}, {"G", grey.data()}, {"B", grey.data()}};
+    const fs::path srgb = dir / "srgb.exr";
+    writeMultiLayerExr(srgb, kWidth, kHeight, planes, {{"colorspace", "sRGB"}});
+    EXPECT_NE(refusalOf(exr, srgb).find("its colorspace attribute says 'sRGB', not a linear "
+                                        "colour space"),
+              std::string::npos)
+        << refusalOf(exr, srgb);
+    const fs::path tagged = dir / "tagged-linear.exr";
+    writeMultiLayerExr(tagged, kWidth, kHeight, planes, {{"colorspace", "lin_rec709"}});
+    EXPECT_EQ(refusalOf(exr, tagged), "");
+
+    // The command: one error line, exit code 1, nothing written.
+    DiffCommandOptions options;
+    options.a = png;
+    options.b = exr;
+    options.out = dir / "report";
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(runDiffCommand(options), 1);
+    const std::string error = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(error.rfind("testbed: error: ", 0), 0u) << error;
+    EXPECT_EQ(std::count(error.begin(), error.end(), '\n'), 1) << error;
+    EXPECT_FALSE(fs::exists(options.out / "index.html"));
 }
 
 } // namespace
