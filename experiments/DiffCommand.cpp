@@ -104,7 +104,8 @@ std::string lowercase(std::string text) {
 // tagged sRGB or log) is refused, saying what it is, rather than compared as if linear.
 void checkLinearExr(const fs::path& path, const OIIO::ImageBuf& image) {
     const std::string format = image.file_format_name();
-    const OIIO::ImageSpec& header = image.spec();
+    // The file's own channel formats (spec() may already be converted for reading).
+    const OIIO::ImageSpec& header = image.nativespec();
     auto refuse = [&](const std::string& what) {
         throw std::runtime_error(path.string() + " is not a linear EXR: " + what +
                                  "; diff compares linear HDR renders (render.exr, a "

@@ -40,12 +40,11 @@ std::string LightOrigins::summary() const {
     std::string text = std::to_string(total) + " =";
     std::string terms;
     auto add = [&](const std::string& term) { terms += (terms.empty() ? " " : " + ") + term; };
-    if (generated > 0 || asked.value_or(0) > 0 || !asked) {
-        const std::string by = generatedBy == "lightGenerator"
-                                   ? "the file's lightGenerator"
-                                   : generatedBy + (asked ? " " + std::to_string(*asked) : "");
-        add(std::to_string(generated) + " generated (" + by + ")");
-    }
+    const std::string by = generatedBy != "lightGenerator"
+                               ? generatedBy + " " + std::to_string(asked.value_or(0))
+                           : generated > 0 ? "the file's lightGenerator"
+                                           : "the file has no lightGenerator";
+    add(std::to_string(generated) + " generated (" + by + ")");
     std::string own;
     auto addOwn = [&](int count, const char* type) {
         if (count > 0)
@@ -57,8 +56,6 @@ std::string LightOrigins::summary() const {
     addOwn(ambient, "ambient");
     if (!own.empty())
         add(own + " (" + ownLightsFrom + "'s own)");
-    if (terms.empty())
-        terms = " no light";
     text += terms;
     if (asked && *asked > generated)
         text += "; " + std::to_string(*asked - generated) +
