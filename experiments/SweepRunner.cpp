@@ -8,6 +8,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
@@ -114,6 +115,13 @@ public:
         if (mOptions.quick)
             spec = applyQuick(spec);
         mSpec = spec;
+        mTimeLimitSeconds = mOptions.jobTimeoutSeconds.value_or(spec.jobTimeoutSeconds);
+        if (const std::string error = jobTimeoutError(mTimeLimitSeconds, "the job time limit");
+            !error.empty())
+            throw std::invalid_argument(error);
+        if (mTimeLimitSeconds > 0.0 && mOptions.isolation == JobIsolation::InProcess)
+            throw std::invalid_argument("a job time limit needs jobs in their own process (a job "
+                                        "in this process cannot be killed alone)");
         mExpansion = expandSweep(spec, mOptions.threads);
         const auto [first, last] =
             shardRange(mExpansion.size(), mOptions.shardIndex, mOptions.shardCount);
@@ -133,6 +141,8 @@ public:
                  << mExpansion.size() << ")";
         mLog << ", output " << mOptions.out.string()
              << (mOptions.isolation == JobIsolation::InProcess ? ", jobs in this process" : "")
+             << (mTimeLimitSeconds > 0.0 ? ", job time limit " + formatTimeLimit(mTimeLimitSeconds)
+                                         : std::string())
              << "\n";
 
         std::vector<bool> finished(shardSize);
@@ -252,7 +262,7 @@ private:
         const JobProcessOutcome outcome = runJobProcess(
             job, mOptions.out,
             mOptions.isolation == JobIsolation::Fork ? JobStart::Fork : JobStart::Spawn,
-            mOptions.jobExecutable);
+            mOptions.jobExecutable, mTimeLimitSeconds);
         if (outcome.referenceRendered)
             onReference(ReferenceStore::Event::Rendered, job.referenceKey);
         if (outcome.referenceLoaded)
@@ -297,6 +307,7 @@ private:
     SweepSpec mSpec;
     SweepExpansion mExpansion;
     SweepSummary mSummary;
+    double mTimeLimitSeconds = 0.0; // of each job's process; 0 = none
     ReferenceStore mReferences;
     std::map<std::string, std::string> mReferenceErrors; // isolated jobs: key -> error
     std::optional<Clock::time_point> mLastRebuild;
