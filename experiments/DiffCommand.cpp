@@ -33,65 +33,6 @@ namespace {
 
 constexpr const char* kBeauty[3] = {"R", "G", "B"};
 
-// An OpenEXR header is a list of attributes (name, type name, int32 byte count, bytes) ending
-// in an empty name, one such list per part of a multi-part file. OpenEXR allocates each
-// attribute's declared count before reading it, so a 4 KB file declaring a 1.7 GB attribute made
-// a 1.7 GB allocation (and 37 s under AddressSanitizer; found by exr_fuzzer). Every count is
-// checked here against the bytes the file has left, before OpenImageIO opens it. Files that are
-// not EXR, and headers this walk cannot follow (a name over 255 bytes), are left to the reader.
-void checkExrAttributeSizes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    unsigned char magic[8] = {};
-    if (!in.read(reinterpret_cast<char*>(magic), 8) || magic[0] != 0x76 || magic[1] != 0x2f ||
-        magic[2] != 0x31 || magic[3] != 0x01)
-        return;
-    std::error_code error;
-    const uint64_t fileSize = fs::file_size(path, error);
-    if (error)
-        return;
-    const bool multiPart = (magic[5] & 0x10) != 0; // version flag 0x1000
-    auto readName = [&](std::string& name) {
-        name.clear();
-        for (char c; in.get(c);) {
-            if (c == '\0')
-                return true;
-            if (name.size() >= 255)
-                return false;
-            name += c;
-        }
-        return false;
-    };
-    std::string name, type;
-    for (;;) { // one header (part)
-        if (!readName(name))
-            return;
-        if (name.empty())
-            return; // the end of a single-part header, or the empty header ending the parts
-        while (!name.empty()) {
-            if (!readName(type))
-                return;
-            unsigned char count[4];
-            if (!in.read(reinterpret_cast<char*>(count), 4))
-                return;
-            const int32_t size = int32_t(uint32_t(count[0]) | uint32_t(count[1]) << 8 |
-                                         uint32_t(count[2]) << 16 | uint32_t(count[3]) << 24);
-            const uint64_t left = fileSize - std::min<uint64_t>(fileSize, uint64_t(in.tellg()));
-            if (size < 0 || uint64_t(size) > left)
-                throw std::runtime_error("cannot read " + path.string() +
-                                         ": corrupt EXR header: attribute '" + name +
-                                         "' declares " + std::to_string(size) +
-                                         " bytes, the file has " + std::to_string(left) + " left");
-            in.seekg(size, std::ios::cur);
-            if (!in)
-                return;
-            if (!readName(name))
-                return;
-        }
-        if (!multiPart)
-            return;
-    }
-}
-
 std::string lowercase(std::string text) {
     std::transform(text.begin(), text.end(), text.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
@@ -349,6 +290,65 @@ std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
 }
 
 } // namespace
+
+// An OpenEXR header is a list of attributes (name, type name, int32 byte count, bytes) ending
+// in an empty name, one such list per part of a multi-part file. OpenEXR allocates each
+// attribute's declared count before reading it, so a 4 KB file declaring a 1.7 GB attribute made
+// a 1.7 GB allocation (and 37 s under AddressSanitizer; found by exr_fuzzer). Every count is
+// checked here against the bytes the file has left, before OpenImageIO opens it. Files that are
+// not EXR, and headers this walk cannot follow (a name over 255 bytes), are left to the reader.
+void checkExrAttributeSizes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    unsigned char magic[8] = {};
+    if (!in.read(reinterpret_cast<char*>(magic), 8) || magic[0] != 0x76 || magic[1] != 0x2f ||
+        magic[2] != 0x31 || magic[3] != 0x01)
+        return;
+    std::error_code error;
+    const uint64_t fileSize = fs::file_size(path, error);
+    if (error)
+        return;
+    const bool multiPart = (magic[5] & 0x10) != 0; // version flag 0x1000
+    auto readName = [&](std::string& name) {
+        name.clear();
+        for (char c; in.get(c);) {
+            if (c == '\0')
+                return true;
+            if (name.size() >= 255)
+                return false;
+            name += c;
+        }
+        return false;
+    };
+    std::string name, type;
+    for (;;) { // one header (part)
+        if (!readName(name))
+            return;
+        if (name.empty())
+            return; // the end of a single-part header, or the empty header ending the parts
+        while (!name.empty()) {
+            if (!readName(type))
+                return;
+            unsigned char count[4];
+            if (!in.read(reinterpret_cast<char*>(count), 4))
+                return;
+            const int32_t size = int32_t(uint32_t(count[0]) | uint32_t(count[1]) << 8 |
+                                         uint32_t(count[2]) << 16 | uint32_t(count[3]) << 24);
+            const uint64_t left = fileSize - std::min<uint64_t>(fileSize, uint64_t(in.tellg()));
+            if (size < 0 || uint64_t(size) > left)
+                throw std::runtime_error("cannot read " + path.string() +
+                                         ": corrupt EXR header: attribute '" + name +
+                                         "' declares " + std::to_string(size) +
+                                         " bytes, the file has " + std::to_string(left) + " left");
+            in.seekg(size, std::ios::cur);
+            if (!in)
+                return;
+            if (!readName(name))
+                return;
+        }
+        if (!multiPart)
+            return;
+    }
+}
 
 ImageDiff diffImageFiles(const fs::path& aPath, const fs::path& bPath) {
     const OIIO::ImageBuf a = readImage(aPath), b = readImage(bPath);

@@ -91,6 +91,13 @@ struct ImageDiff {
 // (unreadable, not linear EXR, sizes differ, R/G/B missing).
 ImageDiff diffImageFiles(const std::filesystem::path& a, const std::filesystem::path& b);
 
+// Checks the byte count of every attribute of an OpenEXR header against the bytes the file has
+// left, before any reader opens it: OpenEXR allocates each attribute's declared count first, so a
+// 4 KB file declaring a 1.7 GB attribute made a 1.7 GB allocation. diffImageFiles calls it; code
+// that opens an image outside it (exr_fuzzer's size check) must call it first. Throws
+// std::runtime_error naming the file and the attribute; files that are not EXR pass.
+void checkExrAttributeSizes(const std::filesystem::path& path);
+
 nlohmann::json diffJson(const ImageDiff& diff, const std::filesystem::path& a,
                         const std::filesystem::path& b);
 

@@ -418,7 +418,10 @@ void writeScalarMapPng(const fs::path& path, int width, int height, const float*
         throw std::invalid_argument("cannot write " + path.string() +
                                     ": the scale maximum must be finite and >= 0");
     const size_t pixelCount = size_t(width) * height;
-    const auto [bottom, top] = scalarMapRange(values, pixelCount, style);
+    // Not a structured binding: the lambda below captures both, which clang 14 (the sanitizer
+    // and fuzzer builds) refuses for bindings.
+    const std::pair<float, float> range = scalarMapRange(values, pixelCount, style);
+    const float bottom = range.first, top = range.second;
     const double logBottom = std::log10(double(bottom)), logTop = std::log10(double(top));
     // Position on the colour bar, 0..1, of a value inside (0, top].
     auto position = [&](double v) -> float {

@@ -2,14 +2,20 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
+#include <climits>
+#include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 
 #include <fcntl.h>
+#include <poll.h>
 #include <spawn.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -153,7 +159,34 @@ pid_t spawnJob(const fs::path& executable, const SweepJob& job, const fs::path& 
     return child;
 }
 
+// Waits until fd is readable (or at its end) or the deadline passes; false when the deadline
+// passed first. No deadline: waits as long as it takes.
+bool waitReadable(int fd, std::optional<std::chrono::steady_clock::time_point> deadline) {
+    for (;;) {
+        int timeoutMs = -1;
+        if (deadline) {
+            const auto left = std::chrono::ceil<std::chrono::milliseconds>(
+                *deadline - std::chrono::steady_clock::now());
+            if (left.count() <= 0)
+                return false;
+            timeoutMs = int(std::min<long long>(left.count(), INT_MAX));
+        }
+        pollfd entry{fd, POLLIN, 0};
+        const int ready = poll(&entry, 1, timeoutMs);
+        if (ready > 0)
+            return true;
+        if (ready < 0 && errno != EINTR)
+            return true; // cannot poll: let read() report the descriptor's state
+    }
+}
+
 } // namespace
+
+std::string formatTimeLimit(double seconds) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g s", seconds);
+    return text;
+}
 
 void noteStartupThreads() {
     gStartupThreads = std::max(1, threadsOfThisProcess());
@@ -174,7 +207,10 @@ std::string describeProcessEnd(int status) {
 }
 
 JobProcessOutcome runJobProcess(const SweepJob& job, const fs::path& out, JobStart start,
-                                const fs::path& executable) {
+                                const fs::path& executable, double timeLimitSeconds) {
+    if (!(timeLimitSeconds >= 0.0) || !std::isfinite(timeLimitSeconds))
+        throw std::invalid_argument("job time limit " + std::to_string(timeLimitSeconds) +
+                                    " s: expected a finite number >= 0 (0 = no limit)");
     int ends[2];
     if (pipe2(ends, O_CLOEXEC) != 0)
         throw std::runtime_error(std::string("cannot create a pipe for a job process: ") +
@@ -197,6 +233,12 @@ JobProcessOutcome runJobProcess(const SweepJob& job, const fs::path& out, JobSta
     if (!useFork && executable.empty())
         throw std::runtime_error("cannot start a job process: this process started threads "
                                  "and no testbed executable was given");
+    // The time limit counts from the start of the child, loading its libraries (Spawn) included.
+    std::optional<std::chrono::steady_clock::time_point> deadline;
+    if (timeLimitSeconds > 0.0)
+        deadline = std::chrono::steady_clock::now() +
+                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                       std::chrono::duration<double>(timeLimitSeconds));
     pid_t child = 0;
     if (useFork) {
         std::cout.flush();
@@ -248,7 +290,15 @@ JobProcessOutcome runJobProcess(const SweepJob& job, const fs::path& out, JobSta
             }
         }
     };
+    bool timedOut = false;
     for (;;) {
+        if (!waitReadable(readEnd.fd, deadline)) {
+            // Past the limit: SIGKILL, which a hung, stopped or signal-blocking process cannot
+            // ignore. Its report pipe is not read further: what it said so far is all we use.
+            kill(child, SIGKILL);
+            timedOut = true;
+            break;
+        }
         const ssize_t n = read(readEnd.fd, buffer, sizeof buffer);
         if (n < 0 && errno == EINTR)
             continue;
@@ -265,6 +315,10 @@ JobProcessOutcome runJobProcess(const SweepJob& job, const fs::path& out, JobSta
         if (errno != EINTR)
             throw std::runtime_error(std::string("cannot wait for a job process: ") +
                                      std::strerror(errno));
+    // A status line means the job's files are written: a process killed at the limit after it
+    // (while exiting) keeps its result.
+    if (finished && timedOut)
+        return outcome;
     const bool cleanExit = WIFEXITED(status) && (WEXITSTATUS(status) == 0 || finished);
     if (finished && cleanExit)
         return outcome;
@@ -272,7 +326,14 @@ JobProcessOutcome runJobProcess(const SweepJob& job, const fs::path& out, JobSta
     outcome.ok = false;
     outcome.metrics = Json();
     const std::string end = describeProcessEnd(status);
-    if (inReference) {
+    if (timedOut) {
+        const std::string limit = "timed out after " + formatTimeLimit(timeLimitSeconds) +
+                                  " (the sweep's job time limit) and was killed";
+        outcome.referenceFailed = inReference;
+        outcome.error = inReference ? "reference " + job.referenceKey +
+                                          ": the job process rendering it " + limit
+                                    : "the job process " + limit;
+    } else if (inReference) {
         outcome.referenceFailed = true;
         outcome.error =
             "reference " + job.referenceKey + ": the job process rendering it crashed: " + end;

@@ -23,6 +23,12 @@
 // after "rendering" and before "rendered", the reference is what crashed, and the runner fails
 // the key's other jobs at once instead of crashing on it again.
 //
+// Time limit: with a limit, the parent waits for the pipe with poll() until the limit after the
+// child's start, then kills the child (SIGKILL: a hung or stopped process cannot ignore it) and
+// reports "the job process timed out after N s ... and was killed"; a limit that passes while the
+// child renders a reference fails the reference as a crash there does. A child that sent its
+// status line keeps its result even when killed at the limit while exiting.
+//
 // The child first asks the kernel to kill it when the parent dies (PR_SET_PDEATHSIG), so kill -9
 // of `testbed sweep` stops its job too, as it did when jobs ran in-process; then it runs the job
 // (SweepJobRun.h) with the reference read from DIR/references or rendered and cached there,
@@ -58,10 +64,16 @@ enum class JobStart {
 // Runs the job in a child process writing into out/jobs/<job id>/ (which must exist) and
 // out/references/. `executable` is the testbed binary for Spawn ("/proc/self/exe" runs the very
 // binary of this process even if the file was replaced since); it may be empty for Fork when this
-// process has started no thread. Never throws for a failure of the job; throws std::runtime_error
-// when the process cannot be started at all.
+// process has started no thread. timeLimitSeconds > 0: the child is killed that long after its
+// start (wall time) and the job fails; 0: no limit. Never throws for a failure of the job; throws
+// std::runtime_error when the process cannot be started at all, std::invalid_argument for a
+// negative or non-finite limit.
 JobProcessOutcome runJobProcess(const SweepJob& job, const std::filesystem::path& out,
-                                JobStart start, const std::filesystem::path& executable);
+                                JobStart start, const std::filesystem::path& executable,
+                                double timeLimitSeconds = 0.0);
+
+// A time limit in the words of the timeout error: "2 s", "0.5 s", "3600 s".
+std::string formatTimeLimit(double seconds);
 
 // Records how many threads this process has now: call it first in main(), before any code of the
 // testbed starts a thread. Without it, Fork forks only a process of one thread.

@@ -71,23 +71,25 @@ double PassTiming::maxMs() const {
 
 void addRepetition(std::vector<PassTiming>& passes,
                    const std::vector<std::pair<std::string, double>>& repetition) {
+    // Pairs, not structured bindings: the lambdas capture the name, which clang 14 (the
+    // sanitizer and fuzzer builds) refuses for bindings.
     std::vector<std::pair<std::string, double>> merged;
-    for (const auto& [name, ms] : repetition) {
+    for (const std::pair<std::string, double>& timing : repetition) {
         auto it = std::find_if(merged.begin(), merged.end(),
-                               [&](const auto& m) { return m.first == name; });
+                               [&](const auto& m) { return m.first == timing.first; });
         if (it == merged.end())
-            merged.emplace_back(name, ms);
+            merged.push_back(timing);
         else
-            it->second += ms;
+            it->second += timing.second;
     }
-    for (const auto& [name, ms] : merged) {
+    for (const std::pair<std::string, double>& timing : merged) {
         auto it = std::find_if(passes.begin(), passes.end(),
-                               [&](const PassTiming& t) { return t.pass == name; });
+                               [&](const PassTiming& t) { return t.pass == timing.first; });
         if (it == passes.end()) {
-            passes.push_back({name, {}});
+            passes.push_back({timing.first, {}});
             it = passes.end() - 1;
         }
-        it->samplesMs.push_back(ms);
+        it->samplesMs.push_back(timing.second);
     }
 }
 

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <set>
@@ -22,8 +23,9 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 const std::vector<std::string> kTopLevelKeys = {
-    "name",        "description", "notes", "fixed",     "axes",        "cases",     "warmup",
-    "repetitions", "reference",   "quick", "published", "heatmap-max", "error-max", "error-scale"};
+    "name",      "description", "notes",       "fixed",       "axes",
+    "cases",     "warmup",      "repetitions", "reference",   "quick",
+    "published", "heatmap-max", "error-max",   "error-scale", "job-timeout"};
 const std::vector<std::string> kQuickKeys = {"fixed",  "axes",        "cases",
                                              "warmup", "repetitions", "reference"};
 // Settings the runner applies itself (RenderOptions fields that setRenderOption may not know).
@@ -406,6 +408,16 @@ SweepSpec parseSweep(const Json& object, const std::string& origin) {
             fail(origin, "'error-scale' must be \"linear\" or \"log\", got " + value.dump());
         spec.errorScale = parseMapScale(value.get<std::string>());
     }
+    if (object.contains("job-timeout")) {
+        const Json& value = object["job-timeout"];
+        const std::string error =
+            value.is_number()
+                ? jobTimeoutError(value.get<double>(), "'job-timeout'")
+                : "'job-timeout' must be a number of seconds (0 = no limit), got " + value.dump();
+        if (!error.empty())
+            fail(origin, error);
+        spec.jobTimeoutSeconds = value.get<double>();
+    }
     checkDisjoint(spec, "");
     std::set<std::string> keys = settingKeys(spec);
     if (object.contains("quick")) {
@@ -422,6 +434,15 @@ SweepSpec parseSweep(const Json& object, const std::string& origin) {
         checkPublished(object["published"], origin,
                        axisColumns(std::vector<std::string>(keys.begin(), keys.end())));
     return spec;
+}
+
+std::string jobTimeoutError(double seconds, const std::string& where) {
+    if (std::isfinite(seconds) && seconds >= 0.0 && seconds <= kMaxJobTimeoutSeconds)
+        return "";
+    char limit[32], got[32];
+    std::snprintf(limit, sizeof limit, "%g", kMaxJobTimeoutSeconds);
+    std::snprintf(got, sizeof got, "%g", seconds);
+    return where + " must be a number of seconds 0.." + limit + " (0 = no limit), got " + got;
 }
 
 SweepSpec readSweepFile(const std::filesystem::path& file) {

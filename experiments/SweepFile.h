@@ -10,6 +10,8 @@
 //   published: [...]              published figures of a reproduction (schema in the README)
 //   heatmap-max, error-scale, error-max   scales of every job's heatmap.png and error.png (and
 //                                 of the report's maps): display only, not part of a job's id
+//   job-timeout                   wall-time limit of one job in seconds (0 = none, the
+//                                 default): the runner's, not part of a job's id
 // Keys are the names experiments::setRenderOption accepts (scene, stage, lights, seed, width,
 // height, resolution, threads, isa, simt-warp, layout, normals, normal-space, depth, position,
 // scene-option.KEY: whatever renderOptionKeys() lists) plus warmup and repetitions. Values are
@@ -76,7 +78,18 @@ struct SweepSpec {
     uint32_t heatmapMax = 0;
     MapScale errorScale = MapScale::Linear;
     double errorMax = 0.0;
+    // Wall-time limit of each job's process in seconds (JobProcess.h); 0 = no limit. The sweep
+    // command's --job-timeout overrides it.
+    double jobTimeoutSeconds = 0.0;
 };
+
+// Upper bound of a job time limit: 10^8 s (over three years) stays far inside the range of the
+// nanosecond steady clock the deadline is kept in (~292 years), and no real limit is near it.
+inline constexpr double kMaxJobTimeoutSeconds = 1e8;
+
+// Checks a job time limit (seconds, 0 = none) from the sweep file or the command line; the error
+// text names `where` and what is expected. Returns "" when valid.
+std::string jobTimeoutError(double seconds, const std::string& where);
 
 // Reads FILE (.toml as TOML, anything else as JSON) and checks its structure. Throws SweepError
 // naming the file (and line for syntax errors, key for unknown or mistyped keys).

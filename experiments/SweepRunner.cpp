@@ -6,6 +6,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
@@ -98,6 +99,13 @@ public:
         if (mOptions.quick)
             spec = applyQuick(spec);
         mSpec = spec;
+        mTimeLimitSeconds = mOptions.jobTimeoutSeconds.value_or(spec.jobTimeoutSeconds);
+        if (const std::string error = jobTimeoutError(mTimeLimitSeconds, "the job time limit");
+            !error.empty())
+            throw std::invalid_argument(error);
+        if (mTimeLimitSeconds > 0.0 && mOptions.isolation == JobIsolation::InProcess)
+            throw std::invalid_argument("a job time limit needs jobs in their own process (a job "
+                                        "in this process cannot be killed alone)");
         mExpansion = expandSweep(spec, mOptions.threads);
         const auto [first, last] =
             shardRange(mExpansion.size(), mOptions.shardIndex, mOptions.shardCount);
@@ -117,6 +125,8 @@ public:
                  << mExpansion.size() << ")";
         mLog << ", output " << mOptions.out.string()
              << (mOptions.isolation == JobIsolation::InProcess ? ", jobs in this process" : "")
+             << (mTimeLimitSeconds > 0.0 ? ", job time limit " + formatTimeLimit(mTimeLimitSeconds)
+                                         : std::string())
              << "\n";
 
         std::vector<bool> finished(shardSize);
@@ -232,7 +242,7 @@ private:
         const JobProcessOutcome outcome = runJobProcess(
             job, mOptions.out,
             mOptions.isolation == JobIsolation::Fork ? JobStart::Fork : JobStart::Spawn,
-            mOptions.jobExecutable);
+            mOptions.jobExecutable, mTimeLimitSeconds);
         if (outcome.referenceRendered)
             onReference(ReferenceStore::Event::Rendered, job.referenceKey);
         if (outcome.referenceLoaded)
@@ -277,6 +287,7 @@ private:
     SweepSpec mSpec;
     SweepExpansion mExpansion;
     SweepSummary mSummary;
+    double mTimeLimitSeconds = 0.0; // of each job's process; 0 = none
     ReferenceStore mReferences;
     std::map<std::string, std::string> mReferenceErrors; // isolated jobs: key -> error
     std::optional<Clock::time_point> mLastRebuild;

@@ -4,6 +4,8 @@
 //   - isolation: the CLI runs each job in a child process (JobProcess.h), so a job that crashes,
 //     aborts or is killed (SIGKILL by the out-of-memory killer) is recorded as failed with its
 //     signal and the sweep goes on; tests may run jobs in this process (JobIsolation::InProcess);
+//   - time limit: with --job-timeout (or the file's job-timeout), a job's process still running
+//     that long after its start is killed and the job fails ("timed out after N s");
 //   - reference: one double-precision reference per (scene, scene options, lights, seed, size),
 //     cached as DIR/references/<key>.exr (float R,G,B, bit-exact) by the first job that needs
 //     it, and read back by the key's later jobs (kept in memory between them when in-process),
@@ -52,6 +54,10 @@ struct SweepOptions {
     // has several threads. The CLI passes "/proc/self/exe".
     std::filesystem::path jobExecutable;
     bool waitForLock = false; // --wait: wait for a sweep running the same jobs into out
+    // --job-timeout: wall-time limit of each job's process in seconds, 0 = none; overrides the
+    // file's job-timeout (SweepFile.h). A job past it is killed and fails ("timed out after N s").
+    // Needs isolated jobs: InProcess with a limit is refused.
+    std::optional<double> jobTimeoutSeconds;
 };
 
 struct SweepSummary {

@@ -294,6 +294,11 @@ int main(int argc, char** argv) {
     sweep->add_option(
         "--threads", sweepThreads,
         "worker threads of every job, 0 = all hardware threads (default: the file's)");
+    double sweepJobTimeout = -1.0;
+    sweep->add_option("--job-timeout", sweepJobTimeout,
+                      "wall-time limit of one job in seconds: a job still running is killed and "
+                      "recorded as failed, the sweep goes on, a rerun retries it; 0 = no limit "
+                      "(default: the file's job-timeout, else no limit)");
     sweep->add_flag("--wait", sweepOptions.waitForLock,
                     "when another sweep is running the same jobs into --out, wait for it to end "
                     "(default: refuse, naming its process)");
@@ -346,6 +351,13 @@ int main(int argc, char** argv) {
         }
         if (sweepThreads >= 0)
             sweepOptions.threads = sweepThreads;
+        if (sweep->count("--job-timeout") > 0) {
+            if (const std::string error =
+                    experiments::jobTimeoutError(sweepJobTimeout, "--job-timeout");
+                !error.empty())
+                return experiments::reportError(error);
+            sweepOptions.jobTimeoutSeconds = sweepJobTimeout;
+        }
         // Every job in a child process (experiments/JobProcess.h): forked, or this very binary
         // (even if the file is rebuilt meanwhile).
         sweepOptions.isolation = experiments::JobIsolation::Fork;

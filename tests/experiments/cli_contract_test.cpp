@@ -59,6 +59,9 @@ TEST(CliContract, ParserErrorsAreOneLineAndExitCodeOne) {
     expectOneErrorLine("render --width abc", "abc");
     expectOneErrorLine("render --no-such-option", "--no-such-option");
     expectOneErrorLine("merge", "required");
+    expectOneErrorLine("sweep no-such.json --job-timeout -5",
+                       "--job-timeout must be a number of seconds");
+    expectOneErrorLine("sweep no-such.json --job-timeout soon", "soon");
     const CliRun help = run("--help");
     EXPECT_EQ(help.exitCode, 0) << help.output;
     EXPECT_NE(help.output.find("render"), std::string::npos) << help.output;

@@ -258,6 +258,30 @@ TEST(SweepFile, MapScalesApplyToEveryJobAndKeepTheIds) {
     }
 }
 
+// job-timeout: the runner's limit per job (SweepRunner.h), not a setting: it keeps the ids.
+TEST(SweepFile, JobTimeoutIsReadAndChecked) {
+    Json file = baseSweep();
+    EXPECT_EQ(experiments::parseSweep(file, "unit.json").jobTimeoutSeconds, 0.0); // no limit
+    const auto plainJobs = experiments::expandSweep(experiments::parseSweep(file, "unit.json"));
+    file["job-timeout"] = 90.5;
+    const auto spec = experiments::parseSweep(file, "unit.json");
+    EXPECT_EQ(spec.jobTimeoutSeconds, 90.5);
+    const auto limitedJobs = experiments::expandSweep(spec);
+    ASSERT_EQ(limitedJobs.size(), plainJobs.size());
+    for (size_t i = 0; i < plainJobs.size(); ++i)
+        EXPECT_EQ(limitedJobs.jobId(i), plainJobs.jobId(i));
+    const auto toml = experiments::readSweepText(
+        "name = \"t\"\njob-timeout = 600\n[fixed]\nscene = \"wall\"\n", "t.toml", true);
+    EXPECT_EQ(toml.jobTimeoutSeconds, 600.0);
+    for (const Json& value : {Json(-1), Json("60"), Json(2e8), Json(nullptr)}) {
+        Json bad = baseSweep();
+        bad["job-timeout"] = value;
+        const std::string message = errorOf([&] { experiments::parseSweep(bad, "unit.json"); });
+        EXPECT_NE(message.find("'job-timeout' must be a number of seconds"), std::string::npos)
+            << value.dump() << ": " << message;
+    }
+}
+
 TEST(SweepFile, ChecksPublishedTables) {
     Json file = baseSweep();
     file["published"] = Json::parse(R"([{"title": "t", "metric": "time_total_median_ms",

@@ -7,6 +7,8 @@
 // The crash is delivered from outside: the test stops a job's process (SIGSTOP, so that a job
 // that just finished cannot turn the signal into a no-op on a zombie), sends it SIGSEGV or
 // SIGABRT and resumes it; the process dies of the signal exactly as it would of its own fault.
+// A hang is made the same way, without a hook in the testbed: a job process stopped and never
+// resumed makes no progress, exactly like one stuck in a loop or a wait, until --job-timeout.
 #include <gtest/gtest.h>
 
 #include "SpawnTestbed.h"
@@ -179,6 +181,76 @@ TEST(SweepIsolation, CrashedAndAbortedJobsFailAloneAndTheSweepGoesOn) {
               dir / "rerun.log");
     EXPECT_EQ(waitExit(rerun), 0) << readText(dir / "rerun.log");
     EXPECT_NE(readText(dir / "rerun.log").find("8 jobs, 2 ran, 6 skipped, 0 failed"),
+              std::string::npos)
+        << readText(dir / "rerun.log");
+}
+
+TEST(SweepIsolation, AJobPastTheTimeLimitIsKilledAndTheSweepGoesOn) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const fs::path dir = freshDir("sweep-isolation-timeout");
+    // 4 of the smallest jobs: every job runs under the limit, which must stay far above a healthy
+    // job's time on a loaded machine (0.7 s each in Release at a load of 16 on 2 cores).
+    std::ofstream(dir / "sweep.json") << R"({
+        "name": "timeout",
+        "fixed": {"scene": "wall", "resolution": "64x36", "lights": 1},
+        "axes": {"seed": [1, 2, 3, 4]},
+        "reference": false
+    })";
+    const fs::path out = dir / "out";
+    const std::vector<std::string> args = {"sweep",         (dir / "sweep.json").string(),
+                                           "--out",         out.string(),
+                                           "--threads",     "1",
+                                           "--job-timeout", "15"};
+    const auto start = Clock::now();
+    const pid_t sweep = spawn(args, dir / "sweep.log");
+    ASSERT_GT(sweep, 0);
+    std::set<pid_t> seen;
+    const std::optional<pid_t> hung = stopNextJobProcess(sweep, seen);
+    if (!hung) {
+        kill(sweep, SIGKILL);
+        waitExit(sweep);
+        FAIL() << "no job process of the sweep appeared; log:\n" << readText(dir / "sweep.log");
+    }
+    // Without the limit the sweep would wait for its stopped job for ever: give up after 5 min.
+    std::optional<int> code;
+    while (!code && Clock::now() - start < std::chrono::minutes(5)) {
+        int status = 0;
+        if (waitpid(sweep, &status, WNOHANG) == sweep)
+            code = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+        else
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    if (!code) {
+        kill(sweep, SIGKILL); // its stopped job dies with it (PR_SET_PDEATHSIG)
+        waitExit(sweep);
+        FAIL() << "the sweep did not end with a job stopped; log:\n" << readText(dir / "sweep.log");
+    }
+    const std::string log = readText(dir / "sweep.log");
+    EXPECT_EQ(*code, 1) << log;
+    EXPECT_NE(log.find("job time limit 15 s"), std::string::npos) << log;
+    EXPECT_NE(log.find("timed out after 15 s"), std::string::npos) << log;
+    EXPECT_NE(log.find("4 jobs, 4 ran, 0 skipped, 1 failed"), std::string::npos) << log;
+    EXPECT_GE(seconds, 15.0); // the stopped job held the sweep until its limit, no shorter
+
+    const Json results = Json::parse(readText(out / "results.json"));
+    ASSERT_EQ(results["jobs"].size(), 4u);
+    int failed = 0;
+    for (const Json& row : results["jobs"]) {
+        if (row["status"] == "ok")
+            continue;
+        ++failed;
+        EXPECT_EQ(row["error"].get<std::string>(),
+                  "the job process timed out after 15 s (the sweep's job time limit) and was "
+                  "killed")
+            << row.dump();
+    }
+    EXPECT_EQ(failed, 1);
+
+    // A rerun retries the timed-out job and skips the rest.
+    const pid_t rerun = spawn(args, dir / "rerun.log");
+    EXPECT_EQ(waitExit(rerun), 0) << readText(dir / "rerun.log");
+    EXPECT_NE(readText(dir / "rerun.log").find("4 jobs, 1 ran, 3 skipped, 0 failed"),
               std::string::npos)
         << readText(dir / "rerun.log");
 }
