@@ -53,9 +53,6 @@ nlohmann::json statsJson(const RenderRun& run);
 void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
                         const RenderOutputScales& scales = {});
 
-// The --view value that renders every view of the scene (OUT/views/NAME/ and OUT/views.json).
-inline constexpr const char* kEveryView = "all";
-
 // Plans, renders, writes; returns the process exit code (0 on success). Errors are reported on
 // stderr as one line starting with "testbed: error:" (CommandErrors.h) before any file is written.
 int runRenderCommand(const RenderCommandOptions& options);

@@ -22,6 +22,10 @@
 
 namespace experiments {
 
+// The view value that stands for every view of the scene: `render --view all` renders each into
+// OUT/views/NAME/ (and OUT/views.json), a sweep makes one job per view (SweepFile.h).
+inline constexpr const char* kEveryView = "all";
+
 // Every option of a render, with its default in one place (the CLI's --help shows these).
 struct RenderOptions {
     std::string scene = "atrium";

@@ -13,8 +13,10 @@
 
 #include <toml++/toml.h>
 
+#include "experiments/RenderPlan.h"
 #include "scenes/Limits.h"
 #include "scenes/NestingDepth.h"
+#include "scenes/Viewpoints.h"
 
 namespace experiments {
 
@@ -314,6 +316,26 @@ Json tomlToJson(const toml::node& node) {
     return other.str();
 }
 
+bool isEveryView(const SweepSetting& setting) {
+    return setting.key == "view" && setting.value.is_string() &&
+           setting.value.get<std::string>() == kEveryView;
+}
+
+// view = "all" stands for every view of a scene, so it cannot sit beside named views in one
+// axis (the named ones would run twice).
+void checkEveryViewAlone(const SweepSpec& spec) {
+    for (const auto& [key, values] : spec.axes) {
+        if (key != "view" || values.size() < 2)
+            continue;
+        for (const Json& value : values)
+            if (value.is_string() && value.get<std::string>() == kEveryView)
+                fail(spec.origin, std::string("'axes.view' lists \"") + kEveryView +
+                                      "\" beside other views; \"" + kEveryView +
+                                      "\" already stands for every view of the scene, so it "
+                                      "must be the axis' only value");
+    }
+}
+
 } // namespace
 
 std::string settingText(const Json& value, const std::string& where) {
@@ -566,6 +588,88 @@ Json axisValue(const SweepJob& job, const std::string& column) {
     return nullptr;
 }
 
+// view=all: every unresolved job that has it gets the view list of its scene (loaded once per
+// distinct scene and scene options: views do not depend on lights, seed, size or method), and
+// the ordinal blocks are laid out. `total` is the unresolved job count on entry, the resolved
+// one on return. Scenes that cannot be loaded are reported together, once each.
+void SweepExpansion::resolveEveryView(SweepExpansion& expansion, const std::string& origin,
+                                      size_t& total) {
+    bool any = false;
+    for (const SweepSetting& s : expansion.mFixed)
+        any = any || isEveryView(s);
+    for (const auto& caseSettings : expansion.mCases)
+        for (const SweepSetting& s : caseSettings)
+            any = any || isEveryView(s);
+    for (const auto& [key, values] : expansion.mAxes)
+        if (key == "view")
+            for (const Json& value : values)
+                any = any || isEveryView({key, value});
+    if (!any)
+        return;
+    std::map<std::string, uint32_t> listOfScene;
+    std::map<std::string, std::string> failedScenes; // scene key -> reason
+    expansion.mViewListOf.assign(total, kNoViewList);
+    expansion.mFirstOrdinal.assign(total + 1, 0);
+    uint64_t resolved = 0;
+    for (size_t u = 0; u < total; ++u) {
+        const std::vector<SweepSetting> settings = expansion.unresolvedSettingsOf(u);
+        expansion.mFirstOrdinal[u] = uint32_t(std::min<uint64_t>(resolved, UINT32_MAX));
+        if (std::none_of(settings.begin(), settings.end(), isEveryView)) {
+            ++resolved;
+            continue;
+        }
+        RenderOptions options;
+        std::string sceneKey;
+        try {
+            for (const SweepSetting& s : settings)
+                if (s.key != "view")
+                    applySetting(options, s);
+            validate(options); // input errors before the scene is loaded
+        } catch (const std::exception&) {
+            ++resolved; // the job stays one (invalid) job: expandSweep's check reports it
+            continue;
+        }
+        sceneKey = options.scene;
+        for (const auto& [key, value] : options.sceneOptions)
+            sceneKey += "\n" + key + "=" + value;
+        auto it = listOfScene.find(sceneKey);
+        if (it == listOfScene.end() && !failedScenes.count(sceneKey)) {
+            try {
+                std::vector<std::string> views = scenes::viewNames(loadRequestedScene(options));
+                if (views.empty())
+                    throw std::runtime_error("the scene has no views");
+                it = listOfScene.emplace(sceneKey, uint32_t(expansion.mViewLists.size())).first;
+                expansion.mViewLists.push_back(std::move(views));
+            } catch (const std::exception& e) {
+                failedScenes.emplace(sceneKey, e.what());
+            }
+        }
+        if (it == listOfScene.end()) {
+            ++resolved;
+            continue;
+        }
+        expansion.mViewListOf[u] = it->second;
+        resolved += expansion.mViewLists[it->second].size();
+        if (resolved > scenes::limits::kMaxSweepJobs)
+            fail(origin, "view=all makes more than " +
+                             std::to_string(scenes::limits::kMaxSweepJobs) +
+                             " jobs; refused (list fewer views or scenes)");
+    }
+    if (!failedScenes.empty()) {
+        std::string message = origin + ": view=" + kEveryView + " needs the views of " +
+                              std::to_string(failedScenes.size()) + " scene" +
+                              (failedScenes.size() == 1 ? "" : "s") + " that cannot be loaded:";
+        for (const auto& [scene, reason] : failedScenes) {
+            std::string name = scene;
+            std::replace(name.begin(), name.end(), '\n', ' ');
+            message += "\n  " + name + ": " + reason;
+        }
+        throw SweepError(message);
+    }
+    expansion.mFirstOrdinal[total] = uint32_t(resolved);
+    total = size_t(resolved);
+}
+
 SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads) {
     SweepSpec effective = spec;
     if (threads) {
@@ -602,7 +706,9 @@ SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads) {
                  " jobs refused (at most " + std::to_string(scenes::limits::kMaxSweepJobs) + ")");
     static_assert(scenes::limits::kMaxSweepJobs <= UINT32_MAX, "run order entries are 32-bit");
     expansion.mCombinations = size_t(combinations);
-    const size_t total = size_t(jobCount);
+    size_t total = size_t(jobCount);
+    checkEveryViewAlone(effective);
+    SweepExpansion::resolveEveryView(expansion, spec.origin, total);
     expansion.mJobCount = total;
     expansion.mIdDigits = std::max<size_t>(4, std::to_string(total ? total - 1 : 0).size());
 
@@ -657,6 +763,22 @@ SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads) {
 }
 
 std::vector<SweepSetting> SweepExpansion::settingsOf(size_t ordinal) const {
+    if (mFirstOrdinal.empty())
+        return unresolvedSettingsOf(ordinal);
+    // The unresolved job u whose block of jobs holds the ordinal, and the view inside the block.
+    const size_t u =
+        size_t(std::upper_bound(mFirstOrdinal.begin(), mFirstOrdinal.end(), uint32_t(ordinal)) -
+               mFirstOrdinal.begin()) -
+        1;
+    std::vector<SweepSetting> settings = unresolvedSettingsOf(u);
+    if (mViewListOf[u] != kNoViewList)
+        for (SweepSetting& s : settings)
+            if (isEveryView(s))
+                s.value = mViewLists[mViewListOf[u]][ordinal - mFirstOrdinal[u]];
+    return settings;
+}
+
+std::vector<SweepSetting> SweepExpansion::unresolvedSettingsOf(size_t ordinal) const {
     const size_t caseIndex = ordinal / mCombinations;
     std::vector<SweepSetting> settings = mFixed;
     settings.insert(settings.end(), mCases[caseIndex].begin(), mCases[caseIndex].end());

@@ -20,9 +20,18 @@
 //
 // Jobs: the full expansion (cases x axes) numbers jobs 0..n-1 in that order; a job's id is its
 // zero-padded ordinal and a hash of every setting that makes it ("0007-1a2b3c4d"), identical in
-// every shard and every rerun of the same file, and different when a setting changes. Jobs are
-// then run grouped by reference key (scene, scene options, lights, seed, size), so that one
-// reference image serves a run of adjacent jobs. Jobs are made on demand (SweepExpansion), so
+// every shard and every rerun of the same file, and different when a setting changes.
+//
+// Views: the setting view = "all" (in fixed, a case, or as the only value of the view axis)
+// stands for every view of the job's scene (scenes/Viewpoints.h, `testbed list --views SCENE`),
+// resolved per scene (and scene options) by loading each distinct scene once at expansion: a
+// job with view=all becomes one job per view, in the scene's view order, at its place in the
+// expansion (so the views are the fastest-varying setting of those jobs). Each resulting job
+// has the view's name as its setting, hence its own id and reference key (a reference per view),
+// exactly as if the views had been listed.
+//
+// Jobs are then run grouped by reference key (scene, scene options, lights, seed, size), so that
+// one reference image serves a run of adjacent jobs. Jobs are made on demand (SweepExpansion), so
 // memory does not grow with the job count beyond 4 bytes a job.
 //
 // Errors: SweepError with a message naming the file and the key; expandSweep reports the invalid
@@ -149,6 +158,13 @@ public:
 private:
     friend SweepExpansion expandSweep(const SweepSpec& spec, std::optional<int> threads);
     std::vector<SweepSetting> settingsOf(size_t ordinal) const;
+    // The settings of a job of the expansion before view=all is resolved (cases x axes).
+    std::vector<SweepSetting> unresolvedSettingsOf(size_t unresolvedOrdinal) const;
+    // Resolves view=all (see the top of the file): fills the view members below; `total` is the
+    // unresolved job count on entry, the resolved one on return. Throws SweepError naming the
+    // scenes that cannot be loaded, or when the jobs would exceed limits::kMaxSweepJobs.
+    static void resolveEveryView(SweepExpansion& expansion, const std::string& origin,
+                                 size_t& total);
     std::string idOf(size_t ordinal, const std::vector<SweepSetting>& settings) const;
 
     std::vector<SweepSetting> mFixed;
@@ -156,7 +172,14 @@ private:
     std::vector<std::pair<std::string, std::vector<nlohmann::ordered_json>>> mAxes;
     size_t mJobCount = 0;
     size_t mCombinations = 1; // product of the axes' sizes
-    size_t mIdDigits = 4;     // zero padding of the ordinal in ids
+    // view=all (see the top of the file); all three empty when no job has it. Unresolved job u
+    // becomes the jobs mFirstOrdinal[u] .. mFirstOrdinal[u+1]-1, with the views of
+    // mViewLists[mViewListOf[u]] (kNoViewList: u has a view of its own, one job). 8 bytes a job.
+    static constexpr uint32_t kNoViewList = UINT32_MAX;
+    std::vector<uint32_t> mFirstOrdinal;
+    std::vector<uint32_t> mViewListOf;
+    std::vector<std::vector<std::string>> mViewLists;
+    size_t mIdDigits = 4; // zero padding of the ordinal in ids
     int mWarmup = 0;
     int mRepetitions = 1;
     bool mReference = true;

@@ -4,11 +4,14 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <set>
 #include <tuple>
 
+#include "experiments/RenderPlan.h"
 #include "experiments/SweepFile.h"
+#include "scenes/Viewpoints.h"
 
 namespace {
 
@@ -34,6 +37,18 @@ Json baseSweep() {
         "warmup": 0, "repetitions": 2,
         "quick": {"fixed": {"resolution": "80x45"}, "axes": {"stage": ["brute"]}, "repetitions": 1}
     })");
+}
+
+// A job's settings as sorted "key=value" text, to compare jobs made in different orders.
+std::string describeSettingsSorted(const SweepJob& job) {
+    std::vector<std::string> parts;
+    for (const experiments::SweepSetting& s : job.settings)
+        parts.push_back(s.key + "=" + experiments::settingText(s.value, s.key));
+    std::sort(parts.begin(), parts.end());
+    std::string text;
+    for (const std::string& part : parts)
+        text += part + ";";
+    return text;
 }
 
 std::string errorOf(const std::function<void()>& f) {
@@ -121,6 +136,94 @@ TEST(SweepFile, EveryViewHasItsOwnReference) {
     EXPECT_EQ(keys.size(), 8u); // (segments, lights) x view
     for (const SweepJob& job : plain.jobs())
         EXPECT_EQ(job.referenceKey.find("front"), std::string::npos);
+}
+
+// "view": "all" stands for every view of each job's scene, resolved per scene: the jobs are those
+// of the sweep that lists each scene's views, with the same settings, ids (hash part) and one
+// reference per view.
+TEST(SweepFile, EveryViewOfEachSceneIsOneJobWithItsOwnReference) {
+    Json all = Json::parse(R"({
+        "fixed": {"resolution": "80x45", "seed": 3, "lights": 4},
+        "axes": {"scene": ["spheres", "wall"], "view": ["all"], "stage": ["brute", "tiled"]}
+    })");
+    const auto expansion = experiments::expandSweep(experiments::parseSweep(all, "all.json"));
+    std::map<std::string, std::vector<std::string>> viewsOf;
+    for (const std::string scene : {"spheres", "wall"}) {
+        experiments::RenderOptions options;
+        options.scene = scene;
+        viewsOf[scene] = scenes::viewNames(experiments::loadRequestedScene(options));
+        ASSERT_GE(viewsOf[scene].size(), 2u) << scene;
+    }
+    const size_t expected = 2 * (viewsOf["spheres"].size() + viewsOf["wall"].size());
+    ASSERT_EQ(expansion.size(), expected);
+
+    // The same sweep with the views listed, one case per scene (the scenes' lists differ).
+    Json listed = Json::parse(R"({
+        "fixed": {"resolution": "80x45", "seed": 3, "lights": 4},
+        "axes": {"stage": ["brute", "tiled"]}
+    })");
+    std::set<std::string> listedJobs, listedKeys;
+    for (const std::string scene : {"spheres", "wall"}) {
+        Json one = listed;
+        one["fixed"]["scene"] = scene;
+        one["axes"]["view"] = viewsOf[scene];
+        for (const SweepJob& job :
+             experiments::expandSweep(experiments::parseSweep(one, "listed.json")).jobs()) {
+            listedJobs.insert(describeSettingsSorted(job) + " " + job.id.substr(job.id.find('-')));
+            listedKeys.insert(job.referenceKey);
+        }
+    }
+    std::set<std::string> jobs, keys, ids;
+    for (const SweepJob& job : expansion.jobs()) {
+        const auto& views = viewsOf[job.options.scene];
+        EXPECT_NE(std::find(views.begin(), views.end(), job.options.view), views.end())
+            << job.options.scene << " has no view '" << job.options.view << "'";
+        jobs.insert(describeSettingsSorted(job) + " " + job.id.substr(job.id.find('-')));
+        keys.insert(job.referenceKey);
+        ids.insert(job.id);
+        // The job handed to a child process comes back the same.
+        EXPECT_EQ(experiments::sweepJobFromJson(experiments::sweepJobJson(job)).referenceKey,
+                  job.referenceKey);
+    }
+    EXPECT_EQ(ids.size(), expected);
+    EXPECT_EQ(jobs, listedJobs);
+    EXPECT_EQ(keys, listedKeys);
+    EXPECT_EQ(keys.size(), viewsOf["spheres"].size() + viewsOf["wall"].size())
+        << "one reference per scene and view";
+    // Ordinals 0..n-1, each job at its own ordinal, and the views of one unresolved job adjacent
+    // in the scene's order.
+    for (size_t ordinal = 0; ordinal < expansion.size(); ++ordinal)
+        EXPECT_EQ(expansion.jobAtOrdinal(ordinal).ordinal, ordinal);
+    const SweepJob first = expansion.jobAtOrdinal(0), second = expansion.jobAtOrdinal(1);
+    EXPECT_EQ(first.options.scene, "spheres");
+    EXPECT_EQ(first.options.view, viewsOf["spheres"][0]);
+    EXPECT_EQ(second.options.view, viewsOf["spheres"][0]) << "stage is the fastest axis";
+    EXPECT_EQ(expansion.jobAtOrdinal(2).options.view, viewsOf["spheres"][1]);
+
+    // "view": "all" as a fixed setting does the same for the one scene.
+    Json fixedAll = Json::parse(R"({
+        "fixed": {"scene": "wall", "view": "all", "resolution": "80x45", "lights": 4},
+        "axes": {"stage": ["brute"]}
+    })");
+    EXPECT_EQ(experiments::expandSweep(experiments::parseSweep(fixedAll, "fixed.json")).size(),
+              viewsOf["wall"].size());
+}
+
+TEST(SweepFile, EveryViewBesideNamedViewsOrOnABadSceneIsRefused) {
+    Json both = Json::parse(R"({
+        "fixed": {"scene": "spheres"}, "axes": {"view": ["all", "front"]}
+    })");
+    EXPECT_NE(errorOf([&] {
+                  experiments::expandSweep(experiments::parseSweep(both, "b.json"));
+              }).find("must be the axis' only value"),
+              std::string::npos);
+    Json missing = Json::parse(R"({
+        "fixed": {"view": "all"}, "axes": {"scene": ["spheres", "/no/such/scene.gltf"]}
+    })");
+    const std::string message =
+        errorOf([&] { experiments::expandSweep(experiments::parseSweep(missing, "m.json")); });
+    EXPECT_NE(message.find("cannot be loaded"), std::string::npos) << message;
+    EXPECT_NE(message.find("/no/such/scene.gltf"), std::string::npos) << message;
 }
 
 TEST(SweepFile, AxisColumnsInCanonicalOrder) {
