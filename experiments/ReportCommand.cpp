@@ -219,6 +219,8 @@ figcaption { font-size: 0.8em; max-width: 640px; }
 #page-check { font-size: 0.7em; color: #888; }
 table.results.compact .extra { display: none; }
 section.group { border-left: 4px solid #9bd; padding-left: 0.8em; margin: 1.5em 0; }
+details.per-view { margin: 0.3em 0 1em 0; } details.per-view summary { cursor: pointer; }
+section.view-family { border-left: 4px solid #bd9; padding-left: 0.8em; margin: 1.5em 0; }
 .flip-note, .counts-note { background: #fff4e0; border-left: 4px solid #e90; padding: 0.5em;
   max-width: 60em; }
 </style>
@@ -736,6 +738,116 @@ std::vector<JobGroup> comparableGroups(const json& jobs, const std::vector<std::
     return groups;
 }
 
+json aggregateOverViews(const json& jobs, const std::vector<JobGroup>& groups,
+                        const std::vector<std::string>& axes, const std::string& errorMetric) {
+    std::vector<std::string> metrics = {"time_total_median_ms", errorMetric};
+    if (errorMetric != metric::kFlip)
+        metrics.push_back(metric::kFlip);
+    json result = {{"aggregated_over", "view"},
+                   {"statistic", "median, min and max over the views"},
+                   {"metrics", metrics},
+                   {"families", json::array()}};
+    if (std::find(axes.begin(), axes.end(), "view") == axes.end())
+        return result;
+    // Families: the comparable groups of the same jobs without the view as a grouping column.
+    std::vector<std::string> withoutView;
+    for (const std::string& column : axes)
+        if (column != "view")
+            withoutView.push_back(column);
+    std::vector<std::string> groupOf(jobs.size());
+    for (const JobGroup& group : groups)
+        for (size_t j : group.jobs)
+            groupOf[j] = group.id;
+    std::vector<std::string> methodColumns;
+    for (const std::string& column : axes)
+        if (isMethodColumn(column))
+            methodColumns.push_back(column);
+    int familyNumber = 0;
+    for (const JobGroup& family : comparableGroups(jobs, withoutView)) {
+        std::vector<std::string> views, familyGroups;
+        for (size_t j : family.jobs) {
+            const std::string view = normalisedSelectValue(jobs[j].value("view", json()));
+            if (std::find(views.begin(), views.end(), view) == views.end())
+                views.push_back(view);
+            if (std::find(familyGroups.begin(), familyGroups.end(), groupOf[j]) ==
+                familyGroups.end())
+                familyGroups.push_back(groupOf[j]);
+        }
+        if (views.size() < 2)
+            continue; // one view: nothing to aggregate, the group says it all
+        // Methods in order of first appearance; the label names the method columns that vary
+        // in the family (stage always).
+        std::vector<std::string> varying;
+        for (const std::string& column : methodColumns) {
+            std::set<std::string> values;
+            for (size_t j : family.jobs)
+                values.insert(normalisedSelectValue(jobs[j].value(column, json())));
+            if (column == "stage" || values.size() > 1)
+                varying.push_back(column);
+        }
+        std::vector<std::string> methodKeys;
+        std::map<std::string, json> methods;
+        for (size_t j : family.jobs) {
+            const json& job = jobs[j];
+            std::string key, label;
+            json settings = json::object();
+            for (const std::string& column : methodColumns) {
+                key += column + "=" + normalisedSelectValue(job.value(column, json())) + "\n";
+                settings[column] = job.value(column, json());
+            }
+            for (const std::string& column : varying)
+                label += (label.empty() ? "" : ", ") + (column == "stage" ? "" : column + " ") +
+                         normalisedSelectValue(job.value(column, json()));
+            if (!methods.count(key)) {
+                methodKeys.push_back(key);
+                methods[key] = {{"label", label},
+                                {"settings", settings},
+                                {"views_ok", 0},
+                                {"views_failed", 0},
+                                {"rows", json::array()}};
+            }
+            json& method = methods[key];
+            json row = {{"view", job.value("view", json())},
+                        {"job_id", job.value("job_id", json())},
+                        {"group", groupOf[j]},
+                        {"status", job.value("status", json())}};
+            for (const std::string& m : metrics) {
+                const std::optional<double> value = jobMetric(job, json(m));
+                row[m] = value && jobOk(job) ? json(*value) : json();
+            }
+            method[jobOk(job) ? "views_ok" : "views_failed"] =
+                method[jobOk(job) ? "views_ok" : "views_failed"].get<int>() + 1;
+            method["rows"].push_back(row);
+        }
+        json familyJson = {{"id", "v" + std::to_string(++familyNumber)},
+                           {"label", family.label},
+                           {"fixed", family.fixed},
+                           {"views", views},
+                           {"groups", familyGroups},
+                           {"methods", json::array()}};
+        for (const std::string& key : methodKeys) {
+            json method = methods[key];
+            for (const std::string& m : metrics) {
+                std::vector<double> values;
+                for (const json& row : method["rows"])
+                    if (row[m].is_number())
+                        values.push_back(row[m].get<double>());
+                if (values.empty()) {
+                    method[m] = nullptr;
+                    continue;
+                }
+                method[m] = {{"median", *median(values)},
+                             {"min", *std::min_element(values.begin(), values.end())},
+                             {"max", *std::max_element(values.begin(), values.end())},
+                             {"count", values.size()}};
+            }
+            familyJson["methods"].push_back(method);
+        }
+        result["families"].push_back(familyJson);
+    }
+    return result;
+}
+
 json comparePublished(const json& published, const json& jobs,
                       const std::vector<std::string>& axisColumns) {
     const std::string title = published.is_object() ? stringField(published, "title") : "";
@@ -889,6 +1001,108 @@ RenderOutputScales mapScales(const json& sweep, const ReportCommandOptions& opti
     return scales;
 }
 
+// "median (min–max)" of one aggregate, or a dash when no view has the figure.
+std::string aggregateCell(const json& aggregate) {
+    if (!aggregate.is_object())
+        return "&mdash;";
+    return formatNumber(aggregate["median"].get<double>()) + " (" +
+           formatNumber(aggregate["min"].get<double>()) + "&ndash;" +
+           formatNumber(aggregate["max"].get<double>()) + ")";
+}
+
+// The "Across views" section: per view family, the aggregate per method, then the per-view rows
+// behind a toggle (a closed <details>).
+void appendViewsSection(std::ostringstream& html, const json& aggregates,
+                        const std::string& errorMetric) {
+    const json& families = aggregates["families"];
+    const auto metrics = aggregates["metrics"].get<std::vector<std::string>>();
+    auto metricHeader = [&](const std::string& m) {
+        return m == "time_total_median_ms" ? std::string("total time (ms)")
+               : m == metric::kFlip        ? std::string("ꟻLIP")
+                                           : "<code>" + htmlEscape(m) + "</code>";
+    };
+    html << "<h2 id=\"views\">Across views</h2>\n<p>Each view is its own comparable group above: "
+            "a camera changes the image, the light counts and the error, so no Pareto plot "
+            "pools views. Here the views are aggregated <b>explicitly</b>: for each family of "
+            "groups that differ only in the view, and each method, the <b>median and the "
+            "min&ndash;max over the views</b> (one job per view) of the job's median total time "
+            "over its repetitions, of <code>"
+         << htmlEscape(errorMetric)
+         << "</code> and of ꟻLIP. &ldquo;views&rdquo; counts the views whose job is ok and has "
+            "the figure; failed views are named. The rows behind each aggregate are under "
+            "&ldquo;per-view rows&rdquo;.</p>\n";
+    for (const json& family : families) {
+        const std::string id = family["id"].get<std::string>();
+        const size_t viewCount = family["views"].size();
+        std::string viewNames;
+        for (const json& view : family["views"])
+            viewNames += (viewNames.empty() ? "" : ", ") + htmlEscape(view.get<std::string>());
+        std::string groupLinks;
+        for (const json& group : family["groups"])
+            groupLinks += (groupLinks.empty() ? "" : " ") + std::string("<a href=\"#group-") +
+                          group.get<std::string>() + "\">" + group.get<std::string>() + "</a>";
+        size_t rowCount = 0;
+        for (const json& method : family["methods"])
+            rowCount += method["rows"].size();
+        html << "<section class=\"view-family\" id=\"views-" << id << "\" data-family=\"" << id
+             << "\" data-views=\"" << viewCount << "\" data-methods=\"" << family["methods"].size()
+             << "\">\n<h3>" << id << ": " << htmlEscape(family["label"].get<std::string>())
+             << ", over " << viewCount << " views</h3>\n<p>Views: " << viewNames << " (groups "
+             << groupLinks
+             << ").</p>\n<table class=\"views-aggregate\">\n<tr><th class=\"text\">method</th>"
+             << "<th>views</th>";
+        for (const std::string& m : metrics)
+            html << "<th data-metric=\"" << htmlEscape(m) << "\">" << metricHeader(m)
+                 << "<br>median (min&ndash;max) over views</th>";
+        html << "</tr>\n";
+        for (const json& method : family["methods"]) {
+            const int ok = method["views_ok"].get<int>(),
+                      failed = method["views_failed"].get<int>();
+            html << "<tr data-method=\"" << htmlEscape(method["label"].get<std::string>())
+                 << "\"><td class=\"text\">" << htmlEscape(method["label"].get<std::string>())
+                 << "</td><td>" << ok << " of " << ok + failed;
+            if (failed > 0) {
+                std::string names;
+                for (const json& row : method["rows"])
+                    if (row["status"] != "ok")
+                        names += (names.empty() ? "" : ", ") + formatCell(row["view"]);
+                html << " <span class=\"error\">(failed: " << names << ")</span>";
+            }
+            html << "</td>";
+            for (const std::string& m : metrics) {
+                const json& aggregate = method[m];
+                html << "<td>" << aggregateCell(aggregate);
+                if (aggregate.is_object() && aggregate["count"].get<int>() < ok)
+                    html << " <span class=\"note\">(" << aggregate["count"].get<int>()
+                         << " views)</span>";
+                html << "</td>";
+            }
+            html << "</tr>\n";
+        }
+        html << "</table>\n<details class=\"per-view\" id=\"per-view-" << id
+             << "\"><summary>Per-view rows (" << rowCount
+             << " jobs)</summary>\n<table class=\"per-view-rows\">\n<tr><th class=\"text\">"
+                "method</th><th class=\"text\">view</th><th class=\"text\">group</th><th "
+                "class=\"text\">job</th>";
+        for (const std::string& m : metrics)
+            html << "<th>" << metricHeader(m) << "</th>";
+        html << "</tr>\n";
+        for (const json& method : family["methods"])
+            for (const json& row : method["rows"]) {
+                const std::string group = row["group"].get<std::string>();
+                html << "<tr" << (row["status"] == "ok" ? "" : " class=\"failed\"")
+                     << "><td class=\"text\">" << htmlEscape(method["label"].get<std::string>())
+                     << "</td><td class=\"text\">" << formatCell(row["view"])
+                     << "</td><td class=\"text\"><a href=\"#group-" << group << "\">" << group
+                     << "</a></td><td class=\"text\">" << formatCell(row["job_id"]) << "</td>";
+                for (const std::string& m : metrics)
+                    html << "<td>" << formatCell(row[m]) << "</td>";
+                html << "</tr>\n";
+            }
+        html << "</table></details>\n</section>\n";
+    }
+}
+
 // A visible note when ꟻLIP is missing from some ok jobs: why (each distinct reason once).
 void appendFlipNote(std::ostringstream& html, const json& jobs,
                     const std::vector<std::string>& columns) {
@@ -991,6 +1205,9 @@ int runReportCommand(const ReportCommandOptions& options) {
                 {{"id", group.id}, {"label", group.label}, {"fixed", group.fixed}, {"jobs", ids}});
         }
         writeTextAtomically(reportDir / "groups.json", groupsJson.dump(2) + "\n");
+        const json viewAggregates = aggregateOverViews(jobs, groups, axes, options.errorMetric);
+        writeTextAtomically(reportDir / "views.json", viewAggregates.dump(2) + "\n");
+        const bool anyViewFamily = !viewAggregates["families"].empty();
 
         const fs::path script = requirePlotScript(options.plotsScript, "report.py");
         const std::string python = requirePythonWithMatplotlib(options.python);
@@ -1033,8 +1250,11 @@ int runReportCommand(const ReportCommandOptions& options) {
         html << "<p>Contents: ";
         if (!publishedTables.empty())
             html << "<a href=\"#published\">published vs measured</a> &middot; ";
-        html << "<a href=\"#groups\">comparable groups</a> &middot; <a href=\"#across\">across "
-                "groups</a> &middot; <a href=\"#results\">results table</a></p>\n";
+        html << "<a href=\"#groups\">comparable groups</a> &middot; ";
+        if (anyViewFamily)
+            html << "<a href=\"#views\">across views</a> &middot; ";
+        html << "<a href=\"#across\">across groups</a> &middot; <a href=\"#results\">results "
+                "table</a></p>\n";
         if (!publishedTables.empty()) {
             html << "<h2 id=\"published\">Published vs measured</h2>\n";
             for (size_t i = 0; i < publishedTables.size(); ++i)
@@ -1045,13 +1265,18 @@ int runReportCommand(const ReportCommandOptions& options) {
         html << "<h2 id=\"groups\">Comparable groups</h2>\n<p>Jobs are compared only with jobs of "
                 "their group: the same value of every setting but the method ("
              << "stage, layout, normals, normal-space, depth, position); jobs of different "
-                "scenes, light counts, sizes or thread counts are never pooled. Error axis: <code>"
-             << htmlEscape(options.errorMetric)
+                "scenes, views, light counts, sizes or thread counts are never pooled"
+             << (anyViewFamily ? " (the views are aggregated explicitly under <a "
+                                 "href=\"#views\">across views</a>)"
+                               : "")
+             << ". Error axis: <code>" << htmlEscape(options.errorMetric)
              << "</code> against the double-precision reference (<code>testbed report "
                 "--error-metric</code> chooses another).</p>\n";
         for (const JobGroup& group : groups)
             appendGroupSection(html, dir, jobs, group, manifest, varyingMethods, scales,
                                options.thumbnailWidth);
+        if (anyViewFamily)
+            appendViewsSection(html, viewAggregates, options.errorMetric);
         html << "<h2 id=\"across\">Across groups</h2>\n<p>One line per method; each plot holds "
                 "the jobs that share every other setting, and its caption says what varies with "
                 "the x axis.</p>\n";

@@ -3,6 +3,7 @@
 // DIR/report.html, with everything it shows under DIR/report/:
 //   report/published.json     the published-vs-measured tables (input of the plot script)
 //   report/groups.json        the comparable groups (input of the plot script, see below)
+//   report/views.json         the aggregates over views (see Views below)
 //   report/plots.json         the plot script's manifest: plots drawn and plots skipped (why),
 //                             each with its group ("" for plots across groups) and kind
 //   report/*.png              matplotlib plots (experiments/plots/report.py): per group, time
@@ -19,11 +20,19 @@
 //
 // Comparable groups: jobs are compared (Pareto fronts, shared map scales) only with jobs of the
 // same group: the same value of every setting that is not a method column (method columns:
-// stage, layout, normals, normal-space, depth, position; everything else -- scene, scene
+// stage, layout, normals, normal-space, depth, position; everything else -- scene, view, scene
 // options, lights, seed, width, height, threads, repetitions, warmup, and any setting added
 // later -- makes the group). Jobs of different sizes are never pooled. Plots across groups (vs
 // light count, vs resolution) draw one line per method and one plot per remaining context, and
 // say which settings vary with the x axis; any median says over which jobs it is taken.
+//
+// Views: a view (camera) is a setting like the scene, so each view is its own comparable group
+// (its own Pareto plot and map scales): views are never pooled silently. The "Across views"
+// section then aggregates explicitly: jobs whose groups differ only in the view form a view
+// family; per family and method, the median and the min-max over the views of each job's median
+// total time, of the error metric and of ꟻLIP, with the number of views that count (ok jobs with
+// the figure) and the per-view rows behind a toggle. The aggregates also go to
+// report/views.json (aggregateOverViews).
 //
 // Published figures: every entry of results.json's sweep.published becomes a table with, per
 // cell, the published value, the measured value, and both ratios to the baseline column
@@ -87,6 +96,23 @@ struct JobGroup {
 // every axis column that is not a method column nor "resolution" (width and height carry it).
 std::vector<JobGroup> comparableGroups(const nlohmann::json& jobs,
                                        const std::vector<std::string>& axisColumns);
+
+// The aggregates over views (see Views above) as JSON, empty "families" when no family has two
+// views or more:
+//   { "aggregated_over": "view", "statistic": "median, min and max over the views",
+//     "metrics": ["time_total_median_ms", ERROR_METRIC, "flip"],
+//     "families": [ { "id": "v1", "label", "fixed": {column: value but view},
+//                     "views": [names in order of appearance], "groups": [group ids],
+//                     "methods": [ { "label", "settings": {method column: value},
+//                                    "views_ok": n, "views_failed": n,
+//                                    METRIC: {"median", "min", "max", "count"} (null: no view
+//                                            has the figure),
+//                                    "rows": [ {"view", "job_id", "group", "status",
+//                                               METRIC: value} ] } ] } ] }
+// The duplicate metric when errorMetric is flip is listed once.
+nlohmann::json aggregateOverViews(const nlohmann::json& jobs, const std::vector<JobGroup>& groups,
+                                  const std::vector<std::string>& axisColumns,
+                                  const std::string& errorMetric);
 
 // The text a value is compared as when matching "select" entries: numbers (and strings that
 // parse completely as numbers) in their shortest round-trip form with integers printed without

@@ -4,16 +4,18 @@
 # tests/CMakeLists.txt; by hand:
 #   tests/experiments/report_chromium_test.sh build/bin/testbed /tmp/report-chromium-test
 #
-# Input: made here by `testbed sweep tests/experiments/fixtures/report-smoke.json` (eight tiny
-# jobs, four stages x two light counts, i.e. two comparable groups, with a published-figures
-# entry), then `testbed report`.
+# Input: made here by `testbed sweep tests/experiments/fixtures/report-smoke.json` (16 tiny
+# jobs, four stages x two light counts x two views, i.e. four comparable groups, with a
+# published-figures entry), then `testbed report`.
 #
 # What the loaded page must show (checked on the DOM Chromium dumps): one section per comparable
-# group (two) with exactly one Pareto plot each (img data-kind="pareto"), the shared-scale maps
-# of every job of the group, the results table with the flip (ꟻLIP) column among the main
-# columns and the others behind the toggle, and -- when ꟻLIP is unavailable on this machine (no
-# flip-evaluator) -- the visible note saying why; inferred's reduced-resolution light counts
-# are explained in a note.
+# group (four: a view is a setting like the light count, never pooled) with exactly one Pareto
+# plot each (img data-kind="pareto"), the shared-scale maps of every job of the group; the
+# "Across views" section with one family per light count, each aggregating the four stages over
+# the two views (a row per stage) with its per-view rows in a closed toggle (<details>, eight
+# rows); the results table with the flip (ꟻLIP) column among the main columns and the others
+# behind the toggle, and -- when ꟻLIP is unavailable on this machine (no flip-evaluator) -- the
+# visible note saying why; inferred's reduced-resolution light counts are explained in a note.
 # Failed jobs, null metrics and single-valued axes are covered by tests/experiments/report_test.cpp.
 #
 # The page's inline script (experiments/ReportCommand.h, pageCheckScript) writes
@@ -97,6 +99,9 @@ class Page(HTMLParser):
         self.in_results = False
         self.ids = set()
         self.table_attrs = {}
+        self.families = []        # [{"id", "views", "aggregate_rows", "details_open", "view_rows"}]
+        self.family_depth = 0
+        self.table_class = None
     VOID = {"img", "br", "meta", "input", "link", "hr", "wbr", "source", "area", "col"}
     def handle_starttag(self, tag, attrs):
         a = dict(attrs)
@@ -111,6 +116,19 @@ class Page(HTMLParser):
             self.groups[-1]["images"] += 1
             if a.get("data-kind") == "pareto":
                 self.groups[-1]["pareto"] += 1
+        if tag == "section" and "view-family" in (a.get("class") or "").split():
+            self.families.append({"id": a.get("data-family"), "views": a.get("data-views"),
+                                  "aggregate_rows": 0, "details_open": None, "view_rows": 0})
+            self.family_depth = self.depth
+        if self.family_depth:
+            if tag == "table":
+                self.table_class = a.get("class")
+            if tag == "details":
+                self.families[-1]["details_open"] = "open" in a
+            if tag == "tr" and a.get("data-method") is not None and self.table_class == "views-aggregate":
+                self.families[-1]["aggregate_rows"] += 1
+            if tag == "td" and self.table_class == "per-view-rows":
+                self.families[-1]["view_rows"] += 1  # cells, divided below
         if tag == "table" and a.get("id") == "results-table":
             self.in_results = True
             self.table_attrs = a
@@ -119,6 +137,8 @@ class Page(HTMLParser):
     def handle_endtag(self, tag):
         if tag == "section" and self.section_depth == self.depth:
             self.section_depth = 0
+        if tag == "section" and self.family_depth == self.depth:
+            self.family_depth = 0
         if tag == "table":
             self.in_results = False
         self.depth -= 1
@@ -129,13 +149,26 @@ results_json = json.load(open(os.path.join(results, "results.json")))
 ok_jobs = [j for j in results_json["jobs"] if j["status"] == "ok"]
 problems = []
 print("  groups on the page: %s" % page.groups)
-if len(page.groups) != 2:
-    problems.append("expected 2 comparable groups (16 and 64 lights), found %d" % len(page.groups))
+if len(page.groups) != 4:
+    problems.append("expected 4 comparable groups (16 and 64 lights x 2 views), found %d" % len(page.groups))
 for group in page.groups:
     if group["pareto"] != 1:
         problems.append("group %s has %d Pareto plots, expected exactly 1" % (group["id"], group["pareto"]))
     if group["images"] < 1 + 4 * 3:  # the plot and preview, heatmap, error (+ flip) of 4 jobs
         problems.append("group %s shows only %d images" % (group["id"], group["images"]))
+print("  view families on the page: %s" % page.families)
+if len(page.families) != 2 or "views" not in page.ids:
+    problems.append("expected an Across views section with 2 families (16 and 64 lights), found %d" % len(page.families))
+for family in page.families:
+    if family["views"] != "2":
+        problems.append("family %s aggregates %s views, expected 2" % (family["id"], family["views"]))
+    if family["aggregate_rows"] != 4:
+        problems.append("family %s has %d aggregate rows, expected one per stage (4)" % (family["id"], family["aggregate_rows"]))
+    if family["details_open"] is not False:
+        problems.append("family %s: the per-view rows are not behind a closed toggle (%s)" % (family["id"], family["details_open"]))
+    cells_per_row = 4 + 3  # method, view, group, job + time, error, FLIP
+    if family["view_rows"] != 8 * cells_per_row:
+        problems.append("family %s has %d per-view cells, expected 8 rows of %d" % (family["id"], family["view_rows"], cells_per_row))
 columns = dict(page.headers)
 if "flip" not in columns:
     problems.append("the results table has no flip (FLIP) column: %s" % list(columns))

@@ -497,6 +497,116 @@ TEST(ReportCommand, TheErrorMetricIsTheUsersChoiceAndFlipSaysWhyItIsMissing) {
         << error;
 }
 
+// Views: each view is its own comparable group (no Pareto plot pools views), and the views are
+// aggregated explicitly per family (groups differing only in the view) and method: known times
+// and errors give known medians and min-max over the views, a failed view is counted apart.
+TEST(ReportViews, EachViewIsAGroupAndTheAggregatesOverViewsAreKnownNumbers) {
+    const std::vector<std::string> views = {"nave", "far-end", "gallery"};
+    json jobs = json::array();
+    int ordinal = 0;
+    const double bruteTimes[] = {10.0, 30.0, 20.0}, bruteErrors[] = {1e-6, 3e-6, 2e-6};
+    for (int lights : {16, 64})
+        for (size_t v = 0; v < views.size(); ++v)
+            for (const std::string stage : {"brute", "tiled"}) {
+                const std::string& view = views[v];
+                // brute: 10, 30, 20 ms (x lights/16), errors 1e-6, 3e-6, 2e-6; tiled: 5 ms
+                // everywhere, errors 4e-5, 1e-5, failed at gallery with 64 lights.
+                const double scale = lights / 16.0;
+                json job = okJob("j" + std::to_string(ordinal++), stage, lights,
+                                 json(stage == "brute" ? scale * bruteTimes[v] : 5.0));
+                job["scene"] = "atrium";
+                job["view"] = view;
+                job["width"] = 32;
+                job["height"] = 18;
+                job["relative_rmse"] = stage == "brute" ? bruteErrors[v] : (v == 0 ? 4e-5 : 1e-5);
+                job["flip"] = nullptr;
+                if (stage == "tiled" && lights == 64 && view == "gallery") {
+                    job["status"] = "failed";
+                    job["error"] = "out of memory <test>";
+                    job["time_total_median_ms"] = nullptr;
+                    job["relative_rmse"] = nullptr;
+                }
+                jobs.push_back(job);
+            }
+    const std::vector<std::string> axes = {"scene", "stage", "lights", "width", "height", "view"};
+    const std::vector<JobGroup> groups = comparableGroups(jobs, axes);
+    ASSERT_EQ(groups.size(), 6u) << "one group per (lights, view): views are never pooled";
+    for (const JobGroup& group : groups) {
+        EXPECT_EQ(group.jobs.size(), 2u);
+        EXPECT_NE(group.label.find("view "), std::string::npos) << group.label;
+    }
+
+    const json aggregates = aggregateOverViews(jobs, groups, axes, "relative_rmse");
+    EXPECT_EQ(aggregates["aggregated_over"], "view");
+    ASSERT_EQ(aggregates["families"].size(), 2u);
+    const json& family16 = aggregates["families"][0];
+    EXPECT_EQ(family16["views"], json(views));
+    EXPECT_EQ(family16["groups"], json({"g1", "g2", "g3"}));
+    EXPECT_FALSE(family16["fixed"].contains("view"));
+    ASSERT_EQ(family16["methods"].size(), 2u);
+    const json& brute = family16["methods"][0];
+    EXPECT_EQ(brute["label"], "brute");
+    EXPECT_EQ(brute["views_ok"], 3);
+    EXPECT_DOUBLE_EQ(brute["time_total_median_ms"]["median"].get<double>(), 20.0);
+    EXPECT_DOUBLE_EQ(brute["time_total_median_ms"]["min"].get<double>(), 10.0);
+    EXPECT_DOUBLE_EQ(brute["time_total_median_ms"]["max"].get<double>(), 30.0);
+    EXPECT_DOUBLE_EQ(brute["relative_rmse"]["median"].get<double>(), 2e-6);
+    EXPECT_TRUE(brute["flip"].is_null()) << "no view has ꟻLIP";
+    EXPECT_EQ(brute["rows"].size(), 3u);
+    const json& tiled64 = aggregates["families"][1]["methods"][1];
+    EXPECT_EQ(tiled64["label"], "tiled");
+    EXPECT_EQ(tiled64["views_ok"], 2);
+    EXPECT_EQ(tiled64["views_failed"], 1);
+    EXPECT_EQ(tiled64["relative_rmse"]["count"], 2);
+    EXPECT_DOUBLE_EQ(tiled64["relative_rmse"]["median"].get<double>(), 2.5e-5)
+        << "the mean of the two middle values of an even count";
+    EXPECT_DOUBLE_EQ(
+        aggregates["families"][1]["methods"][0]["time_total_median_ms"]["median"].get<double>(),
+        80.0);
+
+    // Without a view column, or with one view only, there is nothing to aggregate.
+    EXPECT_TRUE(
+        aggregateOverViews(jobs, groups, {"scene", "stage", "lights"}, "relative_rmse")["families"]
+            .empty());
+    json oneView = json::array();
+    for (const json& job : jobs)
+        if (job["view"] == "nave")
+            oneView.push_back(job);
+    EXPECT_TRUE(aggregateOverViews(oneView, comparableGroups(oneView, axes), axes,
+                                   "relative_rmse")["families"]
+                    .empty());
+
+    // The page: the section says what is aggregated, the per-view rows sit in a closed toggle.
+    const fs::path dir = freshTestFolder();
+    const json columns = {"job_id",        "status", "error",  "scene", "stage",
+                          "lights",        "width",  "height", "view",  "time_total_median_ms",
+                          "relative_rmse", "flip"};
+    std::ofstream(dir / "results.json")
+        << json{{"sweep", {{"name", "views"}}}, {"columns", columns}, {"jobs", jobs}}.dump(1);
+    ReportCommandOptions options;
+    options.dir = dir;
+    ASSERT_EQ(runReportCommand(options), 0);
+    const std::string html = readText(dir / "report.html");
+    EXPECT_EQ(json::parse(readText(dir / "report" / "views.json")), aggregates);
+    EXPECT_NE(html.find("<h2 id=\"views\">Across views</h2>"), std::string::npos);
+    EXPECT_NE(html.find("median and the min&ndash;max over the views"), std::string::npos);
+    EXPECT_NE(html.find("<td>20 (10&ndash;30)</td>"), std::string::npos) << "brute, 16 lights";
+    EXPECT_NE(html.find("2 of 3 <span class=\"error\">(failed: gallery)</span>"),
+              std::string::npos);
+    size_t details = 0;
+    for (size_t at = html.find("<details class=\"per-view\""); at != std::string::npos;
+         at = html.find("<details class=\"per-view\"", at + 1)) {
+        ++details;
+        const size_t end = html.find("</details>", at);
+        EXPECT_EQ(html.substr(at, html.find('>', at) - at).find("open"), std::string::npos)
+            << "the per-view rows are behind the toggle";
+        const std::string block = html.substr(at, end - at);
+        EXPECT_NE(block.find("Per-view rows (6 jobs)"), std::string::npos) << block;
+    }
+    EXPECT_EQ(details, 2u);
+    EXPECT_NE(html.find("views, light counts"), std::string::npos);
+}
+
 TEST(ReportCommand, MissingResultsOrPythonIsOneClearError) {
     const fs::path dir = freshTestFolder();
     ReportCommandOptions options;
