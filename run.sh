@@ -27,6 +27,7 @@ packages=(
     clang-14 libclang-rt-14-dev
     python3-matplotlib chromium
     python3-venv python3-pip
+    slurm-wlm munge parallel # the sweep recipes run for real (tests/experiments/cluster_*_test.sh)
 )
 missing=()
 for p in "${packages[@]}"; do
