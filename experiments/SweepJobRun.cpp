@@ -118,6 +118,11 @@ Json metricColumnsOf(const RunMetrics& metrics) {
     row[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
     row[metric::kCullingEfficiency] = metrics.cullingEfficiency;
     row[metric::kCountedPixels] = metrics.countedPixels;
+    // The SIMT cost model (null for stages without it), as stats.json has it.
+    row[metric::kSimtLaneSlots] =
+        metrics.simtLaneSlots ? Json(*metrics.simtLaneSlots) : Json(nullptr);
+    row[metric::kSimtEfficiency] =
+        metrics.simtEfficiency ? number(*metrics.simtEfficiency) : Json(nullptr);
     row[metric::kBytesPerPixel] = metrics.bytesPerPixel;
     for (const NamedFigure& figure : metrics.errorFigures())
         row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null

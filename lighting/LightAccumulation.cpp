@@ -28,6 +28,15 @@ namespace {
 
 constexpr int kWarpWidth = 8; // pixels; a warp is 8x4 (32 lanes) or 8x8 (64 lanes)
 
+// Packet-level work of a frame (the packet path only): kernel calls, and each packet-wide light
+// iteration by where it ended (PacketAccumulator's counters).
+struct PacketCounts {
+    uint64_t groups = 0;
+    uint64_t skippedAtRange = 0;
+    uint64_t skippedAtConeOrFacing = 0;
+    uint64_t shaded = 0;
+};
+
 // The one check of which path a frame takes (see the header): the packet decoder must read the
 // layout, and the kernel implements only the Blinn-Phong lighting function.
 bool packetPathFits(const StageInputs& inputs) {
@@ -80,15 +89,20 @@ void shadePerPixel(const gbuffer::Surface (&surfaces)[kPacketLanes], const Packe
             const glm::vec3 toViewer = glm::normalize(-point.positionView);
             glm::vec3 sum(0.0f);
             uint32_t contributing = 0;
-            for (uint32_t index : lists[g].lights) {
-                const glm::vec3 radiance = evaluateLight(point, toViewer, lights[index]);
+            uint32_t evaluated = 0;
+            for (size_t i = 0; i < lists[g].lights.size(); ++i) {
+                if (!lists[g].evaluates(lane, i))
+                    continue;
+                const glm::vec3 radiance =
+                    evaluateLight(point, toViewer, lights[lists[g].lights[i]]);
                 sum += radiance;
+                ++evaluated;
                 if (countOracle)
                     contributing += contributes(radiance) ? 1u : 0u;
             }
             for (int c = 0; c < 3; ++c)
                 accumulator.radiance[c][lane] = sum[c];
-            accumulator.lightsEvaluated[lane] = uint32_t(lists[g].lights.size());
+            accumulator.lightsEvaluated[lane] = evaluated;
             accumulator.lightsContributing[lane] = contributing;
         }
 }
@@ -116,6 +130,15 @@ public:
                 return;
             mSingle = false;
             stamp(mFirst);
+        }
+        stamp(list);
+    }
+    // A list whose storage does not outlive the packet (PacketLightLists' scratch): stamped now.
+    void addTransient(std::span<const uint32_t> list) {
+        if (mSingle) {
+            mSingle = false;
+            if (mHasFirst)
+                stamp(mFirst);
         }
         stamp(list);
     }
@@ -160,6 +183,11 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
 
     const int warpRows = (height + warpHeight - 1) / warpHeight;
     std::vector<uint64_t> laneSlotsPerRow(size_t(warpRows), 0);
+    // Per warp row: packet-wide light iterations by outcome (PacketAccumulator's counters; the
+    // vector kernel's cost is about proportional to them, lighting/kernel/README.md) and kernel
+    // calls (one per group).
+    const size_t rowCount = size_t(warpRows);
+    std::vector<PacketCounts> countsPerRow(rowCount);
     tbb::parallel_for(0, warpRows, [&](int warpRow) {
         kernel::ShadingPacket packet;
         kernel::PacketAccumulator accumulator;
@@ -167,6 +195,7 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
         gbuffer::Surface surfaces[kPacketLanes];
         WarpUnion warpUnion(lights.size());
         uint64_t laneSlots = 0;
+        PacketCounts counts;
         for (int wx = 0; wx < width; wx += kWarpWidth) {
             warpUnion.begin();
             bool anyLane = false;
@@ -182,28 +211,46 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                     lists.clear();
                     source.listsOf(packet, lists);
                     accumulator.clear();
+                    counts.groups += uint64_t(lists.size());
                     if (packets) {
-                        for (int g = 0; g < lists.size(); ++g)
-                            kernel::shadePacket(isa, packet, lists[g].laneMask, *kernelLights,
-                                                lists[g].lights, accumulator, options.countOracle);
+                        for (int g = 0; g < lists.size(); ++g) {
+                            const PacketLightLists::Group& group = lists[g];
+                            if (group.lightLaneMasks.empty())
+                                kernel::shadePacket(isa, packet, group.laneMask, *kernelLights,
+                                                    group.lights, accumulator, options.countOracle);
+                            else
+                                kernel::shadePacket(isa, packet, group.laneMask, *kernelLights,
+                                                    group.lights, group.lightLaneMasks, accumulator,
+                                                    options.countOracle);
+                        }
                     } else {
                         shadePerPixel(surfaces, lists, lights, options.countOracle, accumulator);
                     }
                     for (int g = 0; g < lists.size(); ++g) {
-                        warpUnion.add(lists[g].lights);
+                        if (lists[g].scratch)
+                            warpUnion.addTransient(lists[g].lights);
+                        else
+                            warpUnion.add(lists[g].lights);
                         anyLane = true;
                     }
+                    counts.skippedAtRange += accumulator.lightsSkippedAtRange;
+                    counts.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
+                    counts.shaded += accumulator.lightsShaded;
                     // The test-only light trace (StageResult::traceLights): each lane summed
-                    // exactly its group's list.
+                    // exactly its group's list (with per-light masks, its lights of it).
                     if (result.tracing())
                         for (int g = 0; g < lists.size(); ++g)
                             for (uint32_t lanes = lists[g].laneMask & packet.laneMask; lanes != 0;
                                  lanes &= lanes - 1) {
                                 const int lane = __builtin_ctz(lanes);
+                                std::vector<uint32_t> own;
+                                for (size_t i = 0; i < lists[g].lights.size(); ++i)
+                                    if (lists[g].evaluates(lane, i))
+                                        own.push_back(lists[g].lights[i]);
                                 result.traceLightList(size_t(y0 + kernel::laneY(lane)) *
                                                               size_t(width) +
                                                           size_t(x0 + kernel::laneX(lane)),
-                                                      lists[g].lights);
+                                                      own);
                             }
                     for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
                         const int lane = __builtin_ctz(lanes);
@@ -220,11 +267,26 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                 laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
         }
         laneSlotsPerRow[size_t(warpRow)] = laneSlots;
+        countsPerRow[size_t(warpRow)] = counts;
     });
 
     uint64_t laneSlots = 0;
     for (uint64_t slots : laneSlotsPerRow)
         laneSlots += slots;
+    PacketCounts counts;
+    for (const PacketCounts& row : countsPerRow) {
+        counts.groups += row.groups;
+        counts.skippedAtRange += row.skippedAtRange;
+        counts.skippedAtConeOrFacing += row.skippedAtConeOrFacing;
+        counts.shaded += row.shaded;
+    }
+    if (packets) {
+        result.parameters["packet_groups"] = std::to_string(counts.groups);
+        result.parameters["packet_lights_skipped_at_range"] = std::to_string(counts.skippedAtRange);
+        result.parameters["packet_lights_skipped_at_cone_or_facing"] =
+            std::to_string(counts.skippedAtConeOrFacing);
+        result.parameters["packet_lights_shaded"] = std::to_string(counts.shaded);
+    }
     result.parameters["isa"] = isa.name();
     result.parameters["simt_warp"] = std::to_string(inputs.simtWarpLanes);
     result.parameters["simt_lane_slots"] = std::to_string(laneSlots);

@@ -33,6 +33,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
+#include <vector>
 
 #include "lighting/ShadingStage.h"
 #include "lighting/kernel/ShadingPacket.h"
@@ -46,7 +48,15 @@ public:
     // Adds `laneMask`'s lanes (ignored when 0) with `lights`; a lane must be in one group only.
     void add(uint32_t laneMask, std::span<const uint32_t> lights) {
         if (laneMask != 0)
-            mGroups[mCount++] = {laneMask, lights};
+            mGroups[mCount++] = {laneMask, lights, {}, false};
+    }
+    // Per-lane lists as one union list: light lights[i] is evaluated on the lanes
+    // laneMask & lightLaneMasks[i] only, so each lane sums its own sub-list in list order (the
+    // kernel's per-light lane masks, LightKernel.h; `ideal`). Sizes must match.
+    void add(uint32_t laneMask, std::span<const uint32_t> lights,
+             std::span<const uint16_t> lightLaneMasks) {
+        if (laneMask != 0)
+            mGroups[mCount++] = {laneMask, lights, lightLaneMasks, false};
     }
     // Groups the covered lanes of `packet` by the key lane -> keyOf(lane), whose equal values
     // mean the same list listOf(key); for per-tile or per-cluster lists.
@@ -65,6 +75,66 @@ public:
             remaining &= ~mask;
             add(mask, listOf(key));
         }
+    }
+
+    // As addByKey, but a packet whose lanes fall under several keys gets ONE group: the union of
+    // their lists (ascending lists give an ascending union) with per-light lane masks, so a light
+    // in several of the lists costs one packet-wide evaluation instead of one per list, and each
+    // lane still sums exactly its own list in its order (bitwise addByKey's result). The union
+    // lives in this object's scratch storage until clear(): at most one such union per packet.
+    // Lists must be ascending.
+    template <class KeyOf, class ListOf>
+    void addByKeyMerged(const kernel::ShadingPacket& packet, const KeyOf& keyOf,
+                        const ListOf& listOf) {
+        using Key = decltype(keyOf(0));
+        Key keys[kernel::kPacketLanes];
+        Key distinct[kernel::kPacketLanes];
+        uint32_t masks[kernel::kPacketLanes];
+        int count = 0;
+        for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+            const int lane = __builtin_ctz(lanes);
+            keys[lane] = keyOf(lane);
+            int k = 0;
+            while (k < count && !(distinct[k] == keys[lane]))
+                ++k;
+            if (k == count) {
+                distinct[count] = keys[lane];
+                masks[count++] = 0;
+            }
+            masks[k] |= 1u << lane;
+        }
+        if (count == 1) {
+            add(masks[0], listOf(distinct[0]));
+            return;
+        }
+        // k-way merge of the (ascending) lists; equal heads merge their lane masks.
+        std::span<const uint32_t> heads[kernel::kPacketLanes];
+        for (int k = 0; k < count; ++k)
+            heads[k] = listOf(distinct[k]);
+        if (!mScratchLights.empty())
+            throw std::logic_error("PacketLightLists: one merged union per packet");
+        const size_t begin = 0;
+        for (;;) {
+            uint32_t smallest = UINT32_MAX;
+            for (int k = 0; k < count; ++k)
+                if (!heads[k].empty() && heads[k].front() < smallest)
+                    smallest = heads[k].front();
+            if (smallest == UINT32_MAX)
+                break;
+            uint32_t mask = 0;
+            for (int k = 0; k < count; ++k)
+                if (!heads[k].empty() && heads[k].front() == smallest) {
+                    mask |= masks[k];
+                    heads[k] = heads[k].subspan(1);
+                }
+            mScratchLights.push_back(smallest);
+            mScratchMasks.push_back(uint16_t(mask));
+        }
+        uint32_t all = 0;
+        for (int k = 0; k < count; ++k)
+            all |= masks[k];
+        mGroups[mCount++] = {all, std::span<const uint32_t>(mScratchLights).subspan(begin),
+                             std::span<const uint16_t>(mScratchMasks).subspan(begin), true};
     }
 
     // Groups the covered lanes of `packet` whose lists listOfLane(lane) hold the same indices
@@ -90,14 +160,29 @@ public:
     struct Group {
         uint32_t laneMask = 0;
         std::span<const uint32_t> lights;
+        std::span<const uint16_t> lightLaneMasks; // empty: every light on every lane of laneMask
+        bool scratch = false; // `lights` lives in the lists' scratch storage (until clear())
+        // Whether lane `lane` of the group evaluates light lights[i].
+        bool evaluates(int lane, size_t i) const {
+            return (laneMask >> lane & 1u) &&
+                   (lightLaneMasks.empty() || (lightLaneMasks[i] >> lane & 1u));
+        }
     };
     int size() const { return mCount; }
     const Group& operator[](int i) const { return mGroups[i]; }
-    void clear() { mCount = 0; }
+    void clear() {
+        mCount = 0;
+        mScratchLights.clear();
+        mScratchMasks.clear();
+    }
 
 private:
     Group mGroups[kernel::kPacketLanes];
     int mCount = 0;
+    // The merged union of addByKeyMerged and its lane masks (one per packet, so no span into them
+    // is invalidated by a later push_back).
+    std::vector<uint32_t> mScratchLights;
+    std::vector<uint16_t> mScratchMasks;
 };
 
 // What a stage gives the loop: the lists of a packet (its x0, y0, laneMask and decoded
@@ -129,8 +214,11 @@ struct AccumulationOptions {
 
 // Shades every covered pixel of inputs.gbuffer with its lists and writes result.radiance,
 // result.lightsEvaluated (and lightsOracle when asked); result must be resized already. Records
-// the parameters "isa" (what ran), "simt_warp" and "simt_lane_slots". Adds no timing: the stage
-// times its own "shading" pass around the call.
+// the parameters "isa" (what ran), "simt_warp" and "simt_lane_slots", and on the packet path the
+// packet-level work: "packet_groups" (kernel calls), "packet_lights_skipped_at_range",
+// "packet_lights_skipped_at_cone_or_facing" and "packet_lights_shaded" (packet-wide light
+// iterations by outcome, the kernel's cost drivers). Adds no timing: the stage times its own
+// "shading" pass around the call.
 void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                       const AccumulationOptions& options, StageResult& result);
 

@@ -139,7 +139,7 @@ HWY_INLINE void shadeAndAdd(const KernelLight& light, const ChunkSurface& s, con
 
 // Phase 1 for one chunk; returns whether any lane is in range.
 HWY_INLINE bool rangeChunk(const KernelLight& light, const ShadingPacket& packet, size_t chunk,
-                           const ChunkSurface& s, ChunkLight& l) {
+                           LaneMask active, ChunkLight& l) {
     const FloatTag d;
     const size_t first = chunk * kLanesPerVector;
     for (int k = 0; k < 3; ++k)
@@ -147,7 +147,7 @@ HWY_INLINE bool rangeChunk(const KernelLight& light, const ShadingPacket& packet
             hn::Sub(hn::Set(d, light.positionView[k]), hn::Load(d, packet.positionView[k] + first));
     l.distance2 =
         dot3(l.offset[0], l.offset[1], l.offset[2], l.offset[0], l.offset[1], l.offset[2]);
-    l.pass = hn::And(s.active, hn::Lt(l.distance2, hn::Set(d, light.rangeSquared)));
+    l.pass = hn::And(active, hn::Lt(l.distance2, hn::Set(d, light.rangeSquared)));
     return !hn::AllFalse(d, l.pass);
 }
 
@@ -186,14 +186,24 @@ HWY_INLINE bool coneAndFacingChunk(const KernelLight& light, bool spot, const Ch
 }
 
 // Phase 2 for one chunk of a directional light (no range, no cone, unit attenuation).
-HWY_INLINE bool facingChunk(const FloatVec toLight[3], const ChunkSurface& s, ChunkLight& l) {
+HWY_INLINE bool facingChunk(const FloatVec toLight[3], const ChunkSurface& s, LaneMask active,
+                            ChunkLight& l) {
     const FloatTag d;
     for (int k = 0; k < 3; ++k)
         l.toLight[k] = toLight[k];
     l.attenuation = hn::Set(d, 1.0f);
     l.nDotL = dot3(s.normal[0], s.normal[1], s.normal[2], toLight[0], toLight[1], toLight[2]);
-    l.pass = hn::And(s.active, hn::Gt(l.nDotL, hn::Zero(d)));
+    l.pass = hn::And(active, hn::Gt(l.nDotL, hn::Zero(d)));
     return !hn::AllFalse(d, l.pass);
+}
+
+// The lanes of `laneMask` (bit l = packet lane l) that fall in vector `chunk`.
+HWY_INLINE LaneMask chunkMask(uint32_t laneMask, size_t chunk) {
+    const FloatTag d;
+    // Little-endian bytes as LoadMaskBits reads them.
+    const uint32_t bits = laneMask >> (chunk * kLanesPerVector);
+    const uint8_t bytes[8] = {uint8_t(bits), uint8_t(bits >> 8)};
+    return hn::LoadMaskBits(d, bytes);
 }
 
 HWY_INLINE void loadSurface(const ShadingPacket& packet, uint32_t laneMask, size_t chunk,
@@ -218,13 +228,12 @@ HWY_INLINE void loadSurface(const ShadingPacket& packet, uint32_t laneMask, size
     s.specularScale = hn::Mul(hn::Mul(hn::Load(d, packet.specularIntensity + first),
                                       hn::Add(s.specularPower, hn::Set(d, 8.0f))),
                               hn::Set(d, float(1.0 / (8.0 * 3.14159265358979323846))));
-    // Mask bits of this chunk's lanes, little-endian bytes as LoadMaskBits reads them.
-    const uint32_t bits = laneMask >> first;
-    const uint8_t bytes[8] = {uint8_t(bits), uint8_t(bits >> 8)};
-    s.active = hn::LoadMaskBits(d, bytes);
+    s.active = chunkMask(laneMask, chunk);
 }
 
-template <bool kCountContributing> void shadeLights(const ShadeArgs& args) {
+// kPerLightMasks: args.lightLaneMasks[i] further restricts light i to some lanes (the `ideal`
+// stage's per-lane lists as one union list); each lane then counts only its own lights.
+template <bool kCountContributing, bool kPerLightMasks> void shadeLights(const ShadeArgs& args) {
     const FloatTag d;
     const IntTag di;
     const ShadingPacket& packet = *args.packet;
@@ -242,6 +251,9 @@ template <bool kCountContributing> void shadeLights(const ShadeArgs& args) {
             sums[c].radiance[k] = hn::Load(d, accumulator.radiance[k] + c * kLanesPerVector);
         sums[c].contributing = hn::Zero(di);
     }
+    IntVec evaluatedCount[kChunks];
+    for (size_t c = 0; c < kChunks; ++c)
+        evaluatedCount[c] = hn::Zero(di);
 
     // With one vector per packet (AVX-512), a light's shading is one long dependency chain (two
     // square roots, three divisions, Log, Exp: ~200 cycles) and the core overlaps too few of
@@ -256,6 +268,21 @@ template <bool kCountContributing> void shadeLights(const ShadeArgs& args) {
     for (size_t i = 0; i < args.count; ++i) {
         const KernelLight& light = args.lights[args.indices[i]];
         const auto type = scenes::LightType(light.type);
+        LaneMask active[kChunks];
+        if (kPerLightMasks) {
+            const uint32_t lightMask = laneMask & args.lightLaneMasks[i];
+            if (lightMask == 0)
+                continue;
+            for (size_t c = 0; c < kChunks; ++c) {
+                active[c] = chunkMask(lightMask, c);
+                // An all-ones lane is -1: subtracting it counts one.
+                evaluatedCount[c] =
+                    hn::Sub(evaluatedCount[c], hn::VecFromMask(di, hn::RebindMask(di, active[c])));
+            }
+        } else {
+            for (size_t c = 0; c < kChunks; ++c)
+                active[c] = surface[c].active;
+        }
         if (type == scenes::LightType::Ambient) {
             if (pending) {
                 for (size_t c = 0; c < kChunks; ++c)
@@ -266,9 +293,8 @@ template <bool kCountContributing> void shadeLights(const ShadeArgs& args) {
                 FloatVec radiance[3];
                 for (int k = 0; k < 3; ++k)
                     radiance[k] = hn::IfThenElseZero(
-                        surface[c].active,
-                        hn::Mul(hn::Set(d, light.radiance[k]),
-                                hn::Load(d, packet.albedo[k] + c * kLanesPerVector)));
+                        active[c], hn::Mul(hn::Set(d, light.radiance[k]),
+                                           hn::Load(d, packet.albedo[k] + c * kLanesPerVector)));
                 accumulate<kCountContributing>(radiance, sums[c]);
             }
             ++accumulator.lightsShaded;
@@ -280,10 +306,10 @@ template <bool kCountContributing> void shadeLights(const ShadeArgs& args) {
                                          hn::Set(d, -light.directionView[1]),
                                          hn::Set(d, -light.directionView[2])};
             for (size_t c = 0; c < kChunks; ++c)
-                any |= facingChunk(toLight, surface[c], chunkLight[c]);
+                any |= facingChunk(toLight, surface[c], active[c], chunkLight[c]);
         } else {
             for (size_t c = 0; c < kChunks; ++c)
-                any |= rangeChunk(light, packet, c, surface[c], chunkLight[c]);
+                any |= rangeChunk(light, packet, c, active[c], chunkLight[c]);
             if (!any) {
                 ++accumulator.lightsSkippedAtRange;
                 continue;
@@ -331,20 +357,26 @@ template <bool kCountContributing> void shadeLights(const ShadeArgs& args) {
         }
         int32_t* contributing = reinterpret_cast<int32_t*>(accumulator.lightsContributing + first);
         hn::Store(hn::Add(hn::Load(di, contributing), sums[c].contributing), di, contributing);
-        // Every active lane walked the whole list.
+        // Every active lane walked the whole list, or with per-light masks its own lights.
         int32_t* evaluated = reinterpret_cast<int32_t*>(accumulator.lightsEvaluated + first);
-        hn::Store(
-            hn::Add(hn::Load(di, evaluated), hn::IfThenElseZero(hn::RebindMask(di, active),
-                                                                hn::Set(di, int32_t(args.count)))),
-            di, evaluated);
+        const IntVec walked = kPerLightMasks ? evaluatedCount[c]
+                                             : hn::IfThenElseZero(hn::RebindMask(di, active),
+                                                                  hn::Set(di, int32_t(args.count)));
+        hn::Store(hn::Add(hn::Load(di, evaluated), walked), di, evaluated);
     }
 }
 
 void shadePacketVector(const ShadeArgs& args) {
-    if (args.countContributing)
-        shadeLights<true>(args);
-    else
-        shadeLights<false>(args);
+    if (args.lightLaneMasks) {
+        if (args.countContributing)
+            shadeLights<true, true>(args);
+        else
+            shadeLights<false, true>(args);
+    } else if (args.countContributing) {
+        shadeLights<true, false>(args);
+    } else {
+        shadeLights<false, false>(args);
+    }
 }
 
 } // namespace lighting::kernel::HWY_NAMESPACE

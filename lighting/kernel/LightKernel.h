@@ -37,10 +37,23 @@ void shadePacket(const KernelIsa& isa, const ShadingPacket& packet, uint32_t lan
                  const KernelLights& lights, std::span<const uint32_t> lightIndices,
                  PacketAccumulator& accumulator, bool countContributing = true);
 
+// Per-lane lists given as one list with a lane mask per light: light lightIndices[i] is evaluated
+// on the lanes laneMask & packet.laneMask & lightLaneMasks[i] only (the other lanes add nothing
+// and do not count it in lightsEvaluated; a light with no lane left is not counted in the early-
+// out counters either). So each lane sums exactly its own sub-list, in list order: one packet-wide
+// evaluation per light of the union of the lanes' lists, as a SIMT warp with per-lane lists pays.
+// lightLaneMasks.size() must equal lightIndices.size().
+void shadePacket(const KernelIsa& isa, const ShadingPacket& packet, uint32_t laneMask,
+                 const KernelLights& lights, std::span<const uint32_t> lightIndices,
+                 std::span<const uint16_t> lightLaneMasks, PacketAccumulator& accumulator,
+                 bool countContributing = true);
+
 // The scalar path, what shadePacket runs for KernelIsa::scalar(): evaluateLight (float) lane by
 // lane, and the early-out counters from the same tests evaluateLight makes.
+// lightLaneMasks: empty, or one lane mask per light as in the overload above.
 void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const KernelLights& lights,
                        std::span<const uint32_t> lightIndices, PacketAccumulator& accumulator,
-                       bool countContributing = true);
+                       bool countContributing = true,
+                       std::span<const uint16_t> lightLaneMasks = {});
 
 } // namespace lighting::kernel

@@ -40,7 +40,7 @@ EarlyExit earlyExit(const gbuffer::Surface& s, const LightInView<float>& light) 
 
 void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const KernelLights& lights,
                        std::span<const uint32_t> lightIndices, PacketAccumulator& accumulator,
-                       bool countContributing) {
+                       bool countContributing, std::span<const uint16_t> lightLaneMasks) {
     laneMask &= packet.laneMask;
     if (laneMask == 0)
         return;
@@ -58,15 +58,21 @@ void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const Ker
         p.specularIntensity = packet.specularIntensity[lane];
         p.specularPower = packet.specularPower[lane];
         toViewer[lane] = glm::normalize(-p.positionView);
-        accumulator.lightsEvaluated[lane] += uint32_t(lightIndices.size());
+        if (lightLaneMasks.empty())
+            accumulator.lightsEvaluated[lane] += uint32_t(lightIndices.size());
     }
     const std::vector<LightInView<float>>& source = lights.source();
-    for (uint32_t index : lightIndices) {
-        const LightInView<float>& light = source[index];
+    for (size_t i = 0; i < lightIndices.size(); ++i) {
+        const LightInView<float>& light = source[lightIndices[i]];
+        const uint32_t lightMask = lightLaneMasks.empty() ? laneMask : laneMask & lightLaneMasks[i];
+        if (lightMask == 0)
+            continue;
         bool anyShaded = false, anyPastRange = false;
         for (int lane = 0; lane < kPacketLanes; ++lane) {
-            if (!(laneMask >> lane & 1u))
+            if (!(lightMask >> lane & 1u))
                 continue;
+            if (!lightLaneMasks.empty())
+                ++accumulator.lightsEvaluated[lane];
             const EarlyExit exit = earlyExit(points[lane], light);
             anyShaded |= exit == EarlyExit::None;
             anyPastRange |= exit != EarlyExit::Range;

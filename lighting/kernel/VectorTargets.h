@@ -29,6 +29,9 @@ struct ShadeArgs {
     size_t count;
     PacketAccumulator* accumulator;
     bool countContributing;
+    // Optional (nullptr: every light on every lane of laneMask): per light of `indices`, the
+    // lanes that evaluate it (LightKernel.h, shadePacket with per-light lane masks).
+    const uint16_t* lightLaneMasks = nullptr;
 };
 
 struct DecodeArgs {

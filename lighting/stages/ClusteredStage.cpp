@@ -3,7 +3,8 @@
 // (lighting/culling/ClusterGrid.h); each frame the lights' conservative spheres are assigned to
 // the clusters they may touch, then every covered pixel finds its cluster from its tile and view
 // depth and shades with that cluster's ascending light list (same image as `brute`), through
-// accumulateLights (LightAccumulation.h) by 4x4 packets whose lanes are grouped by cluster.
+// accumulateLights (LightAccumulation.h) by 4x4 packets whose lanes are grouped by cluster
+// (ClusterListSource below).
 //
 // Options (defaults first):
 //   grid=24x12x32        tile columns x tile rows x depth slices (each 1..1024, <= 2^20 clusters)
@@ -36,15 +37,36 @@ namespace lighting {
 namespace {
 
 // A packet's lanes grouped by cluster (tile from the pixel, slice from the view depth of the
-// decoded position, bitwise GBuffer::decode's), each group shaded with its cluster's ascending
-// list under its lane mask: every lane walks exactly its own cluster's list, so the image and
-// lights.evaluated are those of a per-pixel loop (and `brute`'s image, same ISA). A packet that
-// crosses clusters costs one kernel call per cluster.
+// decoded position, bitwise GBuffer::decode's), and shaded with their clusters' ascending lists:
+// every lane walks exactly its own cluster's list, so the image and lights.evaluated are those of
+// a per-pixel loop (and `brute`'s image, same ISA).
+// - Most packets lie in one cluster: the tile of the first and last column and row, and the slice
+//   of the nearest and farthest lane, agree (tiles and slices are monotonic in x, y and depth), so
+//   two slice searches replace sixteen.
+// - A packet across clusters gets the union of their lists with per-light lane masks
+//   (PacketLightLists::addByKeyMerged): a light in several of them costs one packet-wide
+//   evaluation, not one per cluster.
 class ClusterListSource final : public PacketListSource {
 public:
     explicit ClusterListSource(const ClusterGrid& grid) : mGrid(grid) {}
     void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
-        lists.addByKey(
+        const int tileX = mGrid.tileXOfPixel(packet.x0);
+        const int tileY = mGrid.tileYOfPixel(packet.y0);
+        if (tileX == mGrid.tileXOfPixel(packet.x0 + kernel::kPacketWidth - 1) &&
+            tileY == mGrid.tileYOfPixel(packet.y0 + kernel::kPacketHeight - 1)) {
+            float nearest = INFINITY, farthest = -INFINITY;
+            for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+                const float depth = -packet.positionView[2][__builtin_ctz(lanes)];
+                nearest = std::min(nearest, depth);
+                farthest = std::max(farthest, depth);
+            }
+            const int slice = mGrid.sliceOfDepth(nearest);
+            if (slice == mGrid.sliceOfDepth(farthest)) {
+                lists.add(packet.laneMask, mGrid.lightsOf(mGrid.clusterIndex(tileX, tileY, slice)));
+                return;
+            }
+        }
+        lists.addByKeyMerged(
             packet,
             [&](int lane) {
                 return mGrid.clusterIndex(mGrid.tileXOfPixel(packet.x0 + kernel::laneX(lane)),

@@ -7,18 +7,18 @@
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <memory>
 #include <string>
 
-#include <tbb/parallel_for.h>
-
 #include "gbuffer/GBufferPass.h"
 #include "gbuffer/SceneGeometry.h"
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightList.h"
-#include "lighting/LightListShading.h"
 #include "lighting/Oracle.h"
+#include "lighting/PacketContributingLights.h"
 #include "lighting/StageRegistry.h"
 #include "tests/bench/BenchScenes.h"
 
@@ -165,57 +165,37 @@ BENCHMARK(clusteredVsBrute)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 
-// The ceiling of any exact culling with this BRDF: each pixel shaded with exactly the lights
-// that contribute there (lists precomputed outside the timer, so culling is free and perfect,
-// efficiency 1). brute / this = the largest speed-up an exact stage could reach on this frame.
+// The ceiling of any exact culling with this BRDF and kernel: the `ideal` stage, each pixel
+// shaded with exactly the lights that contribute there (lists precomputed outside its timer, so
+// culling is free and perfect, efficiency 1; per packet one evaluation per light of its lanes'
+// union). Manual time = ideal's shading pass; brute / this = the largest speed-up an exact stage
+// could reach on this frame.
 void clusteredPerfectCullingCeiling(benchmark::State& state) {
     const ClusteredBenchScene& f = benchScene(int(state.range(0)));
-    const gbuffer::GBuffer& gb = *f.gbuffer;
-    const auto& lights = f.lights.lights;
-    const size_t pixelCount = gb.pixelCount();
-    std::vector<std::vector<uint32_t>> perRow(gb.height());
-    std::vector<std::vector<uint32_t>> rowOffsets(gb.height());
-    tbb::parallel_for(0, gb.height(), [&](int y) {
-        rowOffsets[y].push_back(0);
-        for (int x = 0; x < gb.width(); ++x) {
-            gbuffer::Surface point;
-            if (gb.surfaceAt(x, y, point)) {
-                const glm::vec3 toViewer = glm::normalize(-point.positionView);
-                for (uint32_t i = 0; i < lights.size(); ++i)
-                    if (lighting::contributes(lighting::evaluateLight(point, toViewer, lights[i])))
-                        perRow[y].push_back(i);
-            }
-            rowOffsets[y].push_back(uint32_t(perRow[y].size()));
-        }
-    });
-    lighting::StageResult result;
-    double bruteCpu = 0.0, idealCpu = 0.0;
     auto brute = lighting::makeStage("brute");
-    lighting::StageResult bruteResult;
+    auto ideal = lighting::makeStage("ideal");
+    lighting::StageResult bruteResult, result;
+    double bruteSeconds = 0.0, idealSeconds = 0.0;
     for (auto _ : state) {
-        double cpu = processCpuSeconds();
+        auto start = std::chrono::steady_clock::now();
         brute->shade(f.inputs, bruteResult);
-        bruteCpu += processCpuSeconds() - cpu;
-        cpu = processCpuSeconds();
-        const auto start = std::chrono::steady_clock::now();
-        result.resize(gb.width(), gb.height(), false);
-        tbb::parallel_for(0, gb.height(), [&](int y) {
-            for (int x = 0; x < gb.width(); ++x) {
-                if (!gb.covered(size_t(y) * gb.width() + x))
-                    continue;
-                const std::span<const uint32_t> list(perRow[y].data() + rowOffsets[y][x],
-                                                     perRow[y].data() + rowOffsets[y][x + 1]);
-                lighting::shadeWithLightList(gb, x, y, lights, list, result);
-            }
-        });
-        state.SetIterationTime(
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-        idealCpu += processCpuSeconds() - cpu;
+        bruteSeconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        ideal->shade(f.inputs, result);
+        double shadingMs = 0.0;
+        for (const auto& [pass, ms] : result.timingsMs)
+            shadingMs += ms;
+        idealSeconds += 1e-3 * shadingMs;
+        state.SetIterationTime(1e-3 * shadingMs);
     }
-    (void)pixelCount;
-    state.counters["cpu_ms"] = 1e3 * idealCpu / double(state.iterations());
-    state.counters["brute_cpu_ms"] = 1e3 * bruteCpu / double(state.iterations());
-    state.counters["cpu_ratio"] = bruteCpu / std::max(idealCpu, 1e-9);
+    uint64_t evaluated = 0;
+    for (uint32_t n : result.lightsEvaluated)
+        evaluated += n;
+    state.counters["brute_ms"] = 1e3 * bruteSeconds / double(state.iterations());
+    state.counters["ratio"] = bruteSeconds / std::max(idealSeconds, 1e-12);
+    state.counters["efficiency"] =
+        double(f.oracleSamples) / double(std::max<uint64_t>(evaluated, 1));
+    state.counters["packet_light_pairs"] = std::stod(result.parameters.at("packet_light_pairs"));
 }
 BENCHMARK(clusteredPerfectCullingCeiling)
     ->Arg(10)
@@ -223,5 +203,57 @@ BENCHMARK(clusteredPerfectCullingCeiling)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
+
+// The issue-14 target "clustered at least 0.85 of ideal's speed", measured on a shared machine:
+// each iteration runs the whole `clustered` shade() (assignment + shading) and then the `ideal`
+// stage's shading (accumulateLights over the packet lists `ideal` builds, built once outside the
+// loop), and counts both wall time and process CPU time (all threads; other jobs on the machine
+// inflate wall time much more than CPU time). speed_fraction = ideal / clustered, from the
+// minimum of each (wall) and from the CPU totals. Manual time = clustered's wall time.
+//   testbed_bench --benchmark_filter=clusteredVsIdeal --benchmark_counters_tabular=true
+void clusteredVsIdeal(benchmark::State& state) {
+    const ClusteredBenchScene& f = benchScene(int(state.range(0)));
+    static std::map<int, std::unique_ptr<lighting::PacketContributingLights>> idealLists;
+    auto& lists = idealLists[int(state.range(0))];
+    if (!lists) {
+        lighting::ContributingLights pixels;
+        pixels.build(*f.gbuffer, f.lights.lights);
+        lists = std::make_unique<lighting::PacketContributingLights>();
+        lists->build(pixels, f.lights.lights.size());
+    }
+    auto clustered = lighting::makeStage("clustered");
+    lighting::StageResult clusteredResult, idealResult;
+    idealResult.resize(f.gbuffer->width(), f.gbuffer->height(), false);
+    double clusteredMin = 1e30, idealMin = 1e30, clusteredCpu = 0.0, idealCpu = 0.0;
+    for (auto _ : state) {
+        double cpu = processCpuSeconds();
+        auto start = std::chrono::steady_clock::now();
+        clustered->shade(f.inputs, clusteredResult);
+        const double clusteredSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        clusteredCpu += processCpuSeconds() - cpu;
+        cpu = processCpuSeconds();
+        start = std::chrono::steady_clock::now();
+        lighting::accumulateLights(f.inputs, *lists, {}, idealResult);
+        const double idealSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        idealCpu += processCpuSeconds() - cpu;
+        clusteredMin = std::min(clusteredMin, clusteredSeconds);
+        idealMin = std::min(idealMin, idealSeconds);
+        state.SetIterationTime(clusteredSeconds);
+    }
+    const double n = double(state.iterations());
+    state.counters["clustered_min_ms"] = 1e3 * clusteredMin;
+    state.counters["ideal_min_ms"] = 1e3 * idealMin;
+    state.counters["clustered_cpu_ms"] = 1e3 * clusteredCpu / n;
+    state.counters["ideal_cpu_ms"] = 1e3 * idealCpu / n;
+    state.counters["speed_fraction"] = idealMin / clusteredMin;
+    state.counters["cpu_speed_fraction"] = idealCpu / std::max(clusteredCpu, 1e-12);
+}
+BENCHMARK(clusteredVsIdeal)
+    ->Arg(1000)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(10);
 
 } // namespace

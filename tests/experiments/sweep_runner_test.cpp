@@ -88,8 +88,9 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
         // by the same names.
         std::ifstream statsFile(folder / "stats.json");
         const Json stats = Json::parse(statsFile);
-        for (const char* figure : {"light_evaluations", "oracle_light_evaluations",
-                                   "culling_efficiency", "counted_pixels", "bytes_per_pixel"})
+        for (const char* figure :
+             {"light_evaluations", "oracle_light_evaluations", "culling_efficiency",
+              "counted_pixels", "bytes_per_pixel", "simt_lane_slots", "simt_efficiency"})
             EXPECT_EQ(job[figure], stats[figure]) << figure;
         for (const char* figure : {"rmse", "relative_rmse", "max_abs", "relative_mean", "p99_abs",
                                    "flip", "flip_unavailable"})

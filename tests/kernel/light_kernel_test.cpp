@@ -365,6 +365,38 @@ TEST_P(LightKernelTest, SplitListsAndLaneSubsets) {
     }
 }
 
+// Per-light lane masks (the `ideal` stage's union lists): one call equals, lane by lane and
+// bitwise, shading each lane alone with its own sub-list (radiance, evaluated, contributing), on
+// every vector target and on the scalar path.
+TEST_P(LightKernelTest, PerLightLaneMasksShadeEachLaneItsOwnSubList) {
+    RandomScene random(13);
+    for (const KernelIsa& isa : {GetParam(), KernelIsa::scalar()})
+        for (int caseIndex = 0; caseIndex < 200; ++caseIndex) {
+            const RandomCase c = randomCase(random);
+            const KernelLights lights(c.lights);
+            std::vector<uint16_t> masks(c.indices.size());
+            for (uint16_t& mask : masks)
+                mask = caseIndex % 4 == 0 ? uint16_t(kAllLanes) : uint16_t(random.engine()());
+            const uint32_t laneMask =
+                caseIndex % 3 == 0 ? kAllLanes : uint32_t(random.engine()()) & kAllLanes;
+            PacketAccumulator masked;
+            masked.clear();
+            shadePacket(isa, c.packet, laneMask, lights, c.indices, masks, masked);
+            PacketAccumulator perLane;
+            perLane.clear();
+            for (int lane = 0; lane < kPacketLanes; ++lane) {
+                if (!(laneMask >> lane & 1u))
+                    continue;
+                std::vector<uint32_t> own;
+                for (size_t i = 0; i < c.indices.size(); ++i)
+                    if (masks[i] >> lane & 1u)
+                        own.push_back(c.indices[i]);
+                shadePacket(isa, c.packet, 1u << lane, lights, own, perLane);
+            }
+            EXPECT_TRUE(bitwiseEqual(masked, perLane)) << isa.name() << " case " << caseIndex;
+        }
+}
+
 std::string isaName(const ::testing::TestParamInfo<KernelIsa>& info) {
     return info.param.name();
 }

@@ -23,6 +23,7 @@
 #include "lighting/PassNames.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/kernel/ShadingPacket.h"
 #include "scenes/ProceduralScenes.h"
 #include "scenes/SceneLoader.h"
 
@@ -214,16 +215,21 @@ INSTANTIATE_TEST_SUITE_P(AllExactStages, ExactStage,
                              return name;
                          });
 
-// `ideal` shades exactly the contributing lights: evaluated == oracle at every pixel (the oracle
-// counted by lighting/Oracle.h, a loop independent of the ideal stage's lists), its one timed pass
-// is the shading, and the list-building time is recorded as an untimed parameter.
-class IdealStage : public ::testing::TestWithParam<int> {};
+// `ideal` shades exactly the contributing lights on either ISA (on the kernel: the packet's
+// union list with per-light lane masks): evaluated == oracle at every pixel (the oracle counted
+// by lighting/Oracle.h, a loop independent of the ideal stage's lists), bitwise brute's image on
+// the same ISA, its one timed pass is the shading, and the list-building time is recorded as an
+// untimed parameter.
+class IdealStage : public ::testing::TestWithParam<std::tuple<int, int>> {};
 
 TEST_P(IdealStage, EvaluatesExactlyTheOracleAndTimesOnlyTheShading) {
-    const SceneCase& c = kScenes[GetParam()];
+    const auto& [sceneIndex, isaIndex] = GetParam();
+    const SceneCase& c = kScenes[sceneIndex];
     const PreparedCase& f = prepared(c);
+    lighting::StageInputs inputs = f.prepared->inputs;
+    inputs.isa = kIsas[isaIndex];
     lighting::StageResult result;
-    lighting::makeStage("ideal")->shade(f.prepared->inputs, result);
+    lighting::makeStage("ideal")->shade(inputs, result);
     ASSERT_EQ(result.lightsEvaluated.size(), f.oracle.size());
     uint64_t oracleTotal = 0;
     int mismatches = 0;
@@ -236,15 +242,26 @@ TEST_P(IdealStage, EvaluatesExactlyTheOracleAndTimesOnlyTheShading) {
     }
     EXPECT_EQ(mismatches, 0);
     EXPECT_GT(oracleTotal, 0u);
-    EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, f.brute[0])) << c.name; // scalar brute
+    EXPECT_EQ(result.parameters.at("isa"), f.brute[isaIndex].parameters.at("isa"));
+    EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, f.brute[isaIndex])) << c.name;
     ASSERT_EQ(result.timingsMs.size(), 1u);
     EXPECT_EQ(result.timingsMs[0].first, lighting::pass::kShading);
     EXPECT_EQ(result.parameters.count("untimed_list_build_ms"), 1u);
     EXPECT_EQ(result.parameters["contributing_pairs"], std::to_string(oracleTotal));
+    // A packet pays each light of its lanes' union once: between the largest lane's count and
+    // the sum of its lanes' counts.
+    const uint64_t packetPairs = std::stoull(result.parameters.at("packet_light_pairs"));
+    EXPECT_LE(packetPairs, oracleTotal);
+    EXPECT_GE(packetPairs * lighting::kernel::kPacketLanes, oracleTotal);
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, IdealStage, ::testing::Range(0, int(std::size(kScenes))),
-                         [](const auto& info) { return std::string(kScenes[info.param].name); });
+INSTANTIATE_TEST_SUITE_P(Scenes, IdealStage,
+                         ::testing::Combine(::testing::Range(0, int(std::size(kScenes))),
+                                            ::testing::Range(0, int(std::size(kIsas)))),
+                         [](const auto& info) {
+                             return std::string(kScenes[std::get<0>(info.param)].name) + "_" +
+                                    (std::get<1>(info.param) == 0 ? "scalar" : "auto");
+                         });
 
 // The cone bound must cut work: on atrium with spot lights, tiled evaluates markedly fewer lights
 // than it would with the range spheres of point lights at the same places.
