@@ -99,8 +99,9 @@ public:
                 ++result.lightsEvaluated[pixel];
                 result.traceAddedLight(pixel, l);
             };
-            mForward.draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
-                          addLight);
+            mForward.draw(
+                raster::TriangleList{visibility.clipPositions(), indices}, state, addLight,
+                [&](uint32_t drawn) { return globalTriangle ? globalTriangle[drawn] : drawn; });
         }
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
     }
