@@ -20,6 +20,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/ContributingLights.h"
 #include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
@@ -50,11 +51,21 @@ public:
                                    result);
         });
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        // Blended surfaces: each fragment's contributing lights, found by testing every light at
+        // the fragment (the lists above are the opaque surface's), inside the blend pass's time.
+        if (mBlended.prepare(inputs))
+            mBlended.shade(
+                gb.depth(),
+                [&](int, int, const gbuffer::Surface& point, uint32_t) {
+                    return mBlended.contributingLights(point);
+                },
+                result);
         result.parameters["untimed_list_build_ms"] = std::to_string(listBuildMs);
         result.parameters["contributing_pairs"] = std::to_string(mLists.pairCount());
     }
 
 private:
+    BlendedPass mBlended;      // blended surfaces after the opaque pass (BlendedPass.h)
     ContributingLights mLists; // reused across calls
 };
 
