@@ -37,6 +37,7 @@ void VisibilityPass::transform(const scenes::Scene& scene, const SceneGeometry& 
                               geometry.tangentWorld[v].w);
         }
     });
+    mAlpha.build(scene);
     mNdcXOfColumn.resize(size_t(view.width));
     for (int x = 0; x < view.width; ++x)
         mNdcXOfColumn[size_t(x)] = view.ndcOfPixel(x, 0).x;
@@ -69,6 +70,17 @@ void VisibilityPass::draw(raster::Rasterizer& rasterizer, std::span<float> depth
     mCodes.assign(pixelCount, kNoTriangle);
     const size_t width = size_t(mView.width);
     uint32_t* codes = mCodes.data();
+    if (mAlpha.active()) {
+        rasterizer.draw(triangles(), drawState(), depth.data(),
+                        [&](const raster::Fragment& fragment) {
+                            if (!keeps(fragment))
+                                return false;
+                            codes[size_t(fragment.y) * width + size_t(fragment.x)] =
+                                code(fragment.triangle, fragment.frontFacing);
+                            return true;
+                        });
+        return;
+    }
     rasterizer.draw(triangles(), drawState(), depth.data(), [&](const raster::Fragment& fragment) {
         codes[size_t(fragment.y) * width + size_t(fragment.x)] =
             code(fragment.triangle, fragment.frontFacing);

@@ -33,6 +33,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gbuffer/AlphaCoverage.h"
 #include "gbuffer/CameraView.h"
 #include "gbuffer/Plane.h"
 #include "gbuffer/SceneGeometry.h"
@@ -74,8 +75,19 @@ public:
     // equal" test.
     raster::RasterState redrawState() const;
 
+    // The alpha test of the opaque draws (AlphaCoverage.h; inactive when every material is
+    // opaque). Every draw of the scene's opaque surfaces keeps exactly the fragments keeps()
+    // accepts: draw() here, the forward stages' draws through lighting::ForwardGeometry.
+    const AlphaCoverage& alphaCoverage() const { return mAlpha; }
+    bool keeps(const raster::Fragment& fragment) const {
+        return mAlpha.keeps(*mScene, *mGeometry, mClipPositions, mView, fragment.triangle,
+                            fragment.x, fragment.y);
+    }
+    const scenes::Scene& scene() const { return *mScene; }
+
     // Clears `depth` (view width x height floats) to the view's far value and the visibility
-    // buffer to kNoTriangle, then draws the scene with drawState(), recording codes.
+    // buffer to kNoTriangle, then draws the scene with drawState(), recording codes; with an
+    // active alpha test, discarded fragments write neither depth nor code.
     void draw(raster::Rasterizer& rasterizer, std::span<float> depth);
     // The visibility buffer of the last draw(): one code per pixel, row-major.
     std::span<const uint32_t> codes() const { return mCodes; }
@@ -101,6 +113,7 @@ private:
     std::vector<glm::vec4> mTangentsView; // empty when the geometry has no tangents
     std::vector<float> mNdcXOfColumn; // view.ndcOfPixel(x, y).x per column: no division per pixel
     Plane<uint32_t> mCodes;
+    AlphaCoverage mAlpha;
 };
 
 // The surfaces of one pixel row, for loops over the visibility buffer (the G-buffer resolve, the

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -63,11 +64,25 @@ public:
     // Clears depth() to the view's far value, for a first draw without a pre-pass.
     void clearDepth() { std::fill(mDepth.begin(), mDepth.end(), mVisibility.view().clearDepth()); }
     // Draws `triangles` (visibility().triangles(), or a subset indexing its clip positions) with
-    // `state` over depth(), calling fragmentFn per fragment (raster::Rasterizer::draw).
-    template <class FragmentFn>
+    // `state` over depth(), calling fragmentFn per fragment (raster::Rasterizer::draw). With an
+    // alpha test (gbuffer::AlphaCoverage) the fragments the visibility draw discards are
+    // discarded here too, before the depth write; `toSceneTriangle` maps a drawn triangle index
+    // to the scene's (identity for visibility().triangles()).
+    template <class FragmentFn, class ToSceneTriangle = std::identity>
     void draw(const raster::TriangleList& triangles, const raster::RasterState& state,
-              FragmentFn&& fragmentFn) {
-        mRasterizer->draw(triangles, state, mDepth.data(), fragmentFn);
+              FragmentFn&& fragmentFn, ToSceneTriangle toSceneTriangle = {}) {
+        if (!mVisibility.alphaCoverage().active()) {
+            mRasterizer->draw(triangles, state, mDepth.data(), fragmentFn);
+            return;
+        }
+        mRasterizer->draw(triangles, state, mDepth.data(), [&](const raster::Fragment& fragment) {
+            raster::Fragment scene = fragment;
+            scene.triangle = toSceneTriangle(fragment.triangle);
+            if (!mVisibility.keeps(scene))
+                return false;
+            fragmentFn(fragment);
+            return true;
+        });
     }
     // The forward stages' depth plane (the frame's convention), as the last draws left it.
     std::span<const float> depth() const { return mDepth; }

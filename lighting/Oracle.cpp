@@ -1,5 +1,6 @@
 #include "lighting/Oracle.h"
 
+#include "lighting/BlendedPass.h"
 #include "lighting/EveryLight.h"
 
 namespace lighting {
@@ -10,6 +11,9 @@ std::vector<uint32_t> countContributingLights(const StageInputs& inputs) {
     shadeWithEveryLight(
         gb.width(), gb.height(), inputs.lights->lights,
         [&gb](int x, int y, gbuffer::Surface& s) { return gb.surfaceAt(x, y, s); }, scratch);
+    BlendedPass blended;
+    if (blended.prepare(inputs))
+        blended.addOracle(gb.depth(), scratch.lightsOracle);
     return std::move(scratch.lightsOracle);
 }
 

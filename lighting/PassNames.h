@@ -23,10 +23,11 @@ inline constexpr const char* kIndex = "index";         // light-indexed per-pixe
 inline constexpr const char* kShading = "shading";     // evaluating the lights
 inline constexpr const char* kLighting = "lighting";   // light buffer accumulation (pre-pass)
 inline constexpr const char* kMaterial = "material";   // second geometry pass (pre-pass)
+inline constexpr const char* kBlend = "blend"; // blended surfaces, after the opaque (BlendedPass.h)
 
 // The order passes run in within a frame; tables list passes this way, others after by name.
-inline constexpr std::array<std::string_view, 10> kPipelineOrder = {
-    kGBuffer, kExactSurface, kTransform, kPrepass,  kCull,
-    kAssign,  kIndex,        kShading,   kLighting, kMaterial};
+inline constexpr std::array<std::string_view, 11> kPipelineOrder = {
+    kGBuffer, kExactSurface, kTransform, kPrepass,  kCull, kAssign,
+    kIndex,   kShading,      kLighting,  kMaterial, kBlend};
 
 } // namespace lighting::pass

@@ -28,13 +28,17 @@
 //
 // The fragment function is called as fn(const Fragment&) for every covered sample that passes
 // the (early) depth test; it may be called concurrently for different tiles and must only write
-// data belonging to its own pixel. A Rasterizer object keeps scratch memory between draws: one
+// data belonging to its own pixel. A fragment function that returns bool can discard the
+// fragment (an alpha test): false means no depth write and no count in samplesPassed; one that
+// returns void keeps every fragment (the choice is made at compile time, so draws without a
+// discard pay nothing for it). A Rasterizer object keeps scratch memory between draws: one
 // draw at a time per object.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -98,7 +102,7 @@ struct RasterStats {
     uint64_t trianglesClipped = 0; // needed polygon clipping
     uint64_t trianglesSetUp = 0;   // after clipping (a clipped triangle can become several)
     uint64_t samplesCovered = 0;
-    uint64_t samplesPassed = 0; // passed the depth test
+    uint64_t samplesPassed = 0; // passed the depth test and was not discarded
 };
 
 // A triangle after clipping, snapping and orientation fix-up, as the traversal reads it for
@@ -318,6 +322,8 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     const int tileMaxX = std::min(tileMinX + kTileSize, mWidth) - 1;
     const int tileMaxY = std::min(tileMinY + kTileSize, mHeight) - 1;
     constexpr int64_t kHalf = kSubpixelScale / 2;
+    constexpr bool kCanDiscard =
+        std::is_same_v<std::invoke_result_t<FragmentFn&, const Fragment&>, bool>;
 
     // Counted in registers, stored once: a memory increment per sample costs measurably.
     uint64_t samplesCovered = 0, samplesPassed = 0;
@@ -374,9 +380,6 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                         const float z = float(std::clamp(zRow + t.z[1] * pxDouble, 0.0, 1.0));
                         bool pass = !depthRow || detail::depthPasses<kDepthTest>(z, depthRow[px]);
                         if (pass) {
-                            ++samplesPassed;
-                            if (depthRow && state.depthWrite)
-                                depthRow[px] = z;
                             Fragment fragment;
                             fragment.x = px;
                             fragment.y = py;
@@ -385,7 +388,19 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                                 fragment.barycentric = barycentricAt(batch, index, t, px, py);
                             fragment.triangle = t.triangle;
                             fragment.frontFacing = t.frontFacing;
-                            fragmentFn(fragment);
+                            if constexpr (kCanDiscard) {
+                                // Discard (alpha test) before the depth write.
+                                if (fragmentFn(fragment)) {
+                                    ++samplesPassed;
+                                    if (depthRow && state.depthWrite)
+                                        depthRow[px] = z;
+                                }
+                            } else {
+                                ++samplesPassed;
+                                if (depthRow && state.depthWrite)
+                                    depthRow[px] = z;
+                                fragmentFn(fragment);
+                            }
                         }
                     }
                     w0 += stepX0;

@@ -10,7 +10,7 @@
 // lights (a procedural object's ambient/sun options, a glTF file's KHR_lights_punctual), moved
 // by their transform; a procedural object's camera is used when the file sets none. A glTF file
 // placed several times is loaded once and instanced. Material entries then change the objects'
-// materials by name (model, base colour, metallic/roughness or specular, emissive).
+// materials by name (model, base colour, metallic/roughness or specular, emissive, alpha mode).
 // Thread safety: each call is independent.
 #include "scenes/SceneLoader.h"
 
@@ -583,7 +583,7 @@ void JsonSceneReader::applyMaterial(const Json& value, const std::string& field,
                                     Scene& scene) const {
     expectKeys(value, field,
                {"name", "model", "baseColor", "metallic", "roughness", "specularIntensity",
-                "specularPower", "emissive", "emissiveStrength"});
+                "specularPower", "emissive", "emissiveStrength", "alphaMode", "alphaCutoff"});
     const Json* nameValue = member(value, "name");
     if (!nameValue)
         fail(field, "missing key 'name' (a material name, or \"*\" for every material)");
@@ -623,6 +623,20 @@ void JsonSceneReader::applyMaterial(const Json& value, const std::string& field,
     if (const Json* power = member(value, "specularPower"))
         specularPower = positive(*power, fieldOf(field, "specularPower"));
     const std::optional<float> emissiveStrength = nonNegative("emissiveStrength");
+    std::optional<AlphaMode> alphaMode;
+    if (const Json* v = member(value, "alphaMode")) {
+        const std::string modeName = text(*v, fieldOf(field, "alphaMode"));
+        if (modeName == "OPAQUE")
+            alphaMode = AlphaMode::Opaque;
+        else if (modeName == "MASK")
+            alphaMode = AlphaMode::Mask;
+        else if (modeName == "BLEND")
+            alphaMode = AlphaMode::Blend;
+        else
+            fail(fieldOf(field, "alphaMode"),
+                 "unknown alpha mode '" + modeName + "' (valid: OPAQUE, MASK, BLEND)");
+    }
+    const std::optional<float> alphaCutoff = nonNegative("alphaCutoff");
     std::optional<glm::vec4> baseColor, emissive;
     if (const Json* v = member(value, "baseColor"))
         baseColor = colour(*v, fieldOf(field, "baseColor"), true);
@@ -651,6 +665,8 @@ void JsonSceneReader::applyMaterial(const Json& value, const std::string& field,
         if (emissive)
             material.emissiveFactor = glm::vec3(*emissive);
         material.emissiveStrength = emissiveStrength.value_or(material.emissiveStrength);
+        material.alphaMode = alphaMode.value_or(material.alphaMode);
+        material.alphaCutoff = alphaCutoff.value_or(material.alphaCutoff);
         if (metallic || roughness) {
             material.metallic = metallic.value_or(material.metallic);
             material.roughness = roughness.value_or(material.roughness);

@@ -1,4 +1,4 @@
-// ProceduralScenes: the built-in scenes (atrium, wall, spheres) and their registry.
+// ProceduralScenes: the built-in scenes (atrium, wall, spheres, glass) and their registry.
 //
 // Conventions: world space is right-handed, metres, +Y up (Scene.h). Every scene keeps its
 // options in one table (key, default, valid range, meaning); unknown keys and malformed values
@@ -166,6 +166,9 @@ std::vector<SceneOption> atriumOptions(int) {
 std::vector<SceneOption> wallOptions(int lightCount) {
     return withAmbientAndSun(
         {{"behind", 0, 0, lightCount, "how many of the light count go behind the wall"}}, 0);
+}
+std::vector<SceneOption> glassOptions(int) {
+    return withAmbientAndSun({}, 0);
 }
 std::vector<SceneOption> spheresOptions(int) {
     return withAmbientAndSun(
@@ -583,6 +586,103 @@ Scene buildSpheres(const SceneRequest& request) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// glass: the transparency test scene (glTF alphaMode, lighting/README.md "Transparency"). An
+// opaque room corner (ground, back wall, a box) seen through:
+// - a MASK fence (cut-out vertical stripes: a texture whose alpha alternates 1 and 0, cutoff 0.5);
+// - a MASK "ghost" pane whose factor alpha 0.3 is below its cutoff: every stage sees through it;
+// - three overlapping BLEND panes: a parallel pair at different depths (the front one's alpha
+//   from a texture gradient, 0.2 at the left to 0.8 at the right) and a tilted one that cuts
+//   through the second, where no per-object or per-triangle order is right everywhere (the
+//   stages' sorting artefacts show against the reference's per-pixel sort there).
+// The panes are tessellated (cells of ~0.25 m) so that per-triangle sorting has triangles to
+// sort. All materials Blinn-Phong.
+
+// A texture of width x height texels (sRGB colour, linear alpha) from a function of the texel.
+template <class TexelFn>
+int addTexture(Scene& scene, const std::string& name, int width, int height, TexelFn texel) {
+    Texture texture;
+    texture.name = name;
+    texture.width = width;
+    texture.height = height;
+    texture.srgb = true;
+    texture.rgba8.resize(size_t(width) * height * 4);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const glm::u8vec4 value = texel(x, y);
+            for (int c = 0; c < 4; ++c)
+                texture.rgba8[(size_t(y) * width + x) * 4 + size_t(c)] = value[c];
+        }
+    scene.textures.push_back(std::move(texture));
+    return int(scene.textures.size() - 1);
+}
+
+Scene buildGlass(const SceneRequest& request) {
+    Scene scene;
+    scene.name = "glass";
+    const std::map<std::string, int> options =
+        readOptions(scene.name, request, glassOptions(request.lightCount.value_or(0)));
+
+    auto addQuadMesh = [&](const std::string& name, uint32_t material, const glm::vec3& corner,
+                           const glm::vec3& edgeU, const glm::vec3& edgeV) {
+        const uint32_t mesh = addMesh(scene, name, material);
+        const int cellsU = std::max(1, int(std::ceil(glm::length(edgeU) / 0.25f)));
+        const int cellsV = std::max(1, int(std::ceil(glm::length(edgeV) / 0.25f)));
+        appendQuad(scene.meshes[mesh], corner, edgeU, edgeV, cellsU, cellsV);
+        addInstance(scene, mesh);
+    };
+    addQuadMesh("ground", addMaterial(scene, "ground", {0.5f, 0.5f, 0.5f}, 0.04f, 16.0f),
+                {-6.0f, 0.0f, 6.0f}, {12.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -12.0f});
+    addQuadMesh("back-wall", addMaterial(scene, "back-wall", {0.7f, 0.65f, 0.55f}, 0.04f, 8.0f),
+                {-6.0f, 0.0f, -3.0f}, {12.0f, 0.0f, 0.0f}, {0.0f, 4.0f, 0.0f});
+    const uint32_t box =
+        addMesh(scene, "box", addMaterial(scene, "box", {0.3f, 0.5f, 0.7f}, 0.2f, 64.0f));
+    appendBox(scene.meshes[box], Aabb{{-0.5f, 0.0f, -1.2f}, {0.5f, 1.0f, -0.2f}}, 0.25f);
+    addInstance(scene, box);
+
+    // The fence: 8 stripes across, alternately solid (alpha 1) and cut out (alpha 0).
+    const uint32_t fence = addMaterial(scene, "fence", {1.0f, 1.0f, 1.0f}, 0.1f, 32.0f);
+    scene.materials[fence].baseColorTexture =
+        addTexture(scene, "fence-stripes", 8, 2,
+                   [](int x, int) { return glm::u8vec4(150, 110, 70, x % 2 == 0 ? 255 : 0); });
+    scene.materials[fence].alphaMode = AlphaMode::Mask;
+    addQuadMesh("fence", fence, {-4.0f, 0.0f, -1.5f}, {3.0f, 0.0f, 0.0f}, {0.0f, 2.5f, 0.0f});
+    const uint32_t ghost = addMaterial(scene, "ghost", {0.9f, 0.9f, 0.9f}, 0.5f, 64.0f);
+    scene.materials[ghost].baseColorFactor.a = 0.3f;
+    scene.materials[ghost].alphaMode = AlphaMode::Mask;
+    addQuadMesh("ghost", ghost, {1.5f, 0.0f, -0.5f}, {2.5f, 0.0f, 0.0f}, {0.0f, 2.5f, 0.0f});
+
+    auto addPane = [&](const std::string& name, const glm::vec3& tint, float alpha) {
+        const uint32_t material = addMaterial(scene, name, tint, 0.3f, 128.0f);
+        scene.materials[material].baseColorFactor.a = alpha;
+        scene.materials[material].alphaMode = AlphaMode::Blend;
+        return material;
+    };
+    const uint32_t red = addPane("glass-red", {0.9f, 0.25f, 0.2f}, 1.0f);
+    scene.materials[red].baseColorTexture =
+        addTexture(scene, "alpha-gradient", 16, 1, [](int x, int) {
+            return glm::u8vec4(255, 255, 255, uint8_t(51 + x * 153 / 15));
+        });
+    addQuadMesh("glass-red", red, {-2.5f, 0.3f, 0.5f}, {3.0f, 0.0f, 0.0f}, {0.0f, 2.0f, 0.0f});
+    addQuadMesh("glass-blue", addPane("glass-blue", {0.2f, 0.3f, 0.9f}, 0.5f), {-1.0f, 0.6f, 1.2f},
+                {3.0f, 0.0f, 0.0f}, {0.0f, 2.0f, 0.0f});
+    addQuadMesh("glass-green", addPane("glass-green", {0.2f, 0.85f, 0.3f}, 0.55f),
+                {0.2f, 0.2f, 0.4f}, {2.5f, 0.0f, 2.0f}, {0.0f, 2.2f, 0.0f});
+
+    scene.cameras.push_back(makeCamera("front", {0.3f, 1.7f, 6.5f}, {0.0f, 1.1f, 0.0f}, 40.0f));
+    PointLightScatter scatter;
+    scatter.region.min = {-5.0f, 0.1f, -2.8f};
+    scatter.region.max = {5.0f, 3.5f, 3.5f};
+    scatter.minRangeMetres = 1.5f;
+    scatter.maxRangeMetres = 4.0f;
+    scatter.minIntensity = 0.3f;
+    scatter.maxIntensity = 1.5f;
+    scatterPointLights(scene, scatter, request.lightCount, request.seed);
+    addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
+    scene.cameras.push_back(makeCamera("side", {4.5f, 1.5f, 4.5f}, {0.0f, 1.1f, 0.0f}, 40.0f));
+    return scene;
+}
+
+// ---------------------------------------------------------------------------------------------
 // Registry
 
 struct ProceduralScene {
@@ -595,6 +695,7 @@ constexpr ProceduralScene kProceduralScenes[] = {
     {"atrium", buildAtrium, atriumOptions},
     {"wall", buildWall, wallOptions},
     {"spheres", buildSpheres, spheresOptions},
+    {"glass", buildGlass, glassOptions},
 };
 static_assert(kProceduralScenes[0].name == kDefaultSceneName, "the default scene comes first");
 

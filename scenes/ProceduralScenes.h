@@ -2,6 +2,7 @@
 //   atrium  (default) Sponza-like courtyard, >= 250k triangles, camera along the nave
 //   wall    long wall seen at an angle, lights on both sides ("behind=N" lights behind it)
 //   spheres analytic spheres on a plane, for precision tests
+//   glass   alpha-tested (MASK) and overlapping blended (BLEND) panes, for transparency
 // Each builder places request.lightCount point lights itself (scene-appropriate region and radii)
 // and may add one directional and one ambient light.
 #pragma once

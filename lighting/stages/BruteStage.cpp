@@ -7,6 +7,7 @@
 #include <chrono>
 #include <optional>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/LightAccumulation.h"
 #include "lighting/PassNames.h"
 
@@ -28,9 +29,12 @@ public:
         }
         accumulateLights(inputs, *mEveryLight, {.countOracle = true}, result);
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        if (mBlended.prepare(inputs))
+            mBlended.shadeWithEveryLight(gb.depth(), result);
     }
 
 private:
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
     size_t mLightCount = 0;
     std::optional<EveryLightSource> mEveryLight; // the list 0..n-1, kept across frames
 };

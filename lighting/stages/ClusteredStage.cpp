@@ -32,6 +32,8 @@
 #include "lighting/culling/ClusterGrid.h"
 #include "lighting/stages/Stages.h"
 
+#include "lighting/BlendedPass.h"
+
 namespace lighting {
 
 namespace {
@@ -116,8 +118,15 @@ public:
             const gbuffer::DepthDecoder& decoder = gb.depthDecoder();
             const float depthA = decoder.viewDepthMetres(width / 2, height / 2, ndcRange.first);
             const float depthB = decoder.viewDepthMetres(width / 2, height / 2, ndcRange.second);
-            const float nearDepth = std::max(std::min(depthA, depthB) * (1.0f - 1e-5f), 1e-6f);
-            const float farDepth = std::max(std::max(depthA, depthB) * (1.0f + 1e-5f), nearDepth);
+            float nearDepth = std::max(std::min(depthA, depthB) * (1.0f - 1e-5f), 1e-6f);
+            float farDepth = std::max(std::max(depthA, depthB) * (1.0f + 1e-5f), nearDepth);
+            // Blended surfaces lie anywhere in front of the opaque depth, and over background:
+            // the grid then spans the whole view depth range so that their clusters exist.
+            const bool blended = mBlended.prepare(inputs);
+            if (blended) {
+                nearDepth = std::min(nearDepth, gb.view().nearMetres);
+                farDepth = std::max(farDepth, gb.view().farMetres);
+            }
             if (!mGrid)
                 mGrid.emplace(mOptions, gb.view(), nearDepth, farDepth);
             else
@@ -130,9 +139,22 @@ public:
             const auto shadingStart = std::chrono::steady_clock::now();
             accumulateLights(inputs, ClusterListSource(grid), {}, result);
             result.timingsMs.emplace_back(pass::kShading, millisecondsSince(shadingStart));
+            // Blended surfaces: each fragment with its own cluster's list.
+            if (blended)
+                mBlended.shade(
+                    depth,
+                    [&](int x, int y, const gbuffer::Surface& point, uint32_t) {
+                        return grid.lightsOf(
+                            grid.clusterIndex(grid.tileXOfPixel(x), grid.tileYOfPixel(y),
+                                              grid.sliceOfDepth(-point.positionView.z)));
+                    },
+                    result);
         } else {
             result.timingsMs.emplace_back(pass::kAssign, millisecondsSince(assignStart));
             result.timingsMs.emplace_back(pass::kShading, 0.0);
+            // No opaque sample, no grid: blended surfaces with every light.
+            if (mBlended.prepare(inputs))
+                mBlended.shadeWithEveryLight(depth, result);
         }
 
         std::string grid = std::to_string(mOptions.tilesX);
@@ -151,6 +173,7 @@ public:
 private:
     ClusterGridOptions mOptions;
     std::optional<ClusterGrid> mGrid; // reused across frames for its storage
+    BlendedPass mBlended;             // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 } // namespace

@@ -29,6 +29,7 @@
 
 #include <chrono>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
@@ -73,12 +74,16 @@ public:
             cull.spheres, cull.drawn,
             [&](uint32_t light, int x, int y, size_t pixel) { addLight(x, y, pixel, light); });
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        // Blended surfaces: every light (light volumes are tested against the opaque depth).
+        if (mBlended.prepare(inputs))
+            mBlended.shadeWithEveryLight(gb.depth(), result);
 
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
     }
 
 private:
     VolumeStageOptions mVolume;
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 } // namespace

@@ -26,6 +26,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/ForwardGeometry.h"
 #include "lighting/PassNames.h"
 
@@ -99,10 +100,28 @@ public:
                 ++result.lightsEvaluated[pixel];
                 result.traceAddedLight(pixel, l);
             };
-            mForward.draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
-                          addLight);
+            mForward.draw(
+                raster::TriangleList{visibility.clipPositions(), indices}, state, addLight,
+                [&](uint32_t drawn) { return globalTriangle ? globalTriangle[drawn] : drawn; });
         }
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        // Blended surfaces: one fragment at a time with every light whose illumination set holds
+        // the fragment's object (the sets inverted: ascending per object). "Over" does not
+        // distribute over one additive pass per light, so the blended layers are shaded whole.
+        if (mBlended.prepare(inputs)) {
+            start = std::chrono::steady_clock::now();
+            mObjectLights.assign(objects.size(), {});
+            for (uint32_t l = 0; l < mSets.size(); ++l)
+                for (uint32_t o : mSets[l])
+                    mObjectLights[o].push_back(l);
+            mBlended.shade(
+                mForward.depth(),
+                [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
+                    return std::span<const uint32_t>(
+                        mObjectLights[mForward.objectOfTriangle(triangle)]);
+                },
+                result, start);
+        }
     }
 
 private:
@@ -125,6 +144,8 @@ private:
     std::vector<std::vector<uint32_t>> mSets;
     std::vector<uint32_t> mSetIndices;
     std::vector<uint32_t> mSetTriangles;
+    std::vector<std::vector<uint32_t>> mObjectLights; // per object, for the blended pass
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 } // namespace

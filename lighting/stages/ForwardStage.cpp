@@ -25,6 +25,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/ForwardGeometry.h"
 #include "lighting/PassNames.h"
 
@@ -89,6 +90,17 @@ public:
         mForward.draw(visibility.triangles(),
                       mPrepass ? visibility.redrawState() : visibility.drawState(), shadeFragment);
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        // Blended surfaces: each fragment with its object's list.
+        if (mBlended.prepare(inputs))
+            mBlended.shade(
+                mForward.depth(),
+                [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
+                    const uint32_t object = mForward.objectOfTriangle(triangle);
+                    return std::span<const uint32_t>(mLightIndices.data() + mLightOffsets[object],
+                                                     mLightIndices.data() +
+                                                         mLightOffsets[object + 1]);
+                },
+                result);
     }
 
 private:
@@ -116,6 +128,7 @@ private:
     }
 
     bool mPrepass;
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
     ForwardGeometry mForward;
     std::vector<std::vector<uint32_t>> mPerObject;
     std::vector<uint32_t> mLightOffsets;

@@ -26,6 +26,7 @@
 
 #include <chrono>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/ContributingLights.h"
 #include "lighting/PacketContributingLights.h"
 #include "lighting/PassNames.h"
@@ -52,12 +53,22 @@ public:
         start = std::chrono::steady_clock::now();
         accumulateLights(inputs, mPacketLists, {}, result);
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        // Blended surfaces: each fragment's contributing lights, found by testing every light at
+        // the fragment (the lists above are the opaque surface's), inside the blend pass's time.
+        if (mBlended.prepare(inputs))
+            mBlended.shade(
+                gb.depth(),
+                [&](int, int, const gbuffer::Surface& point, uint32_t) {
+                    return mBlended.contributingLights(point);
+                },
+                result);
         result.parameters["untimed_list_build_ms"] = std::to_string(listBuildMs);
         result.parameters["contributing_pairs"] = std::to_string(mPixelLists.pairCount());
         result.parameters["packet_light_pairs"] = std::to_string(mPacketLists.pairCount());
     }
 
 private:
+    BlendedPass mBlended;                  // blended surfaces after the opaque pass (BlendedPass.h)
     ContributingLights mPixelLists;        // reused across calls
     PacketContributingLights mPacketLists; // reused across calls
 };

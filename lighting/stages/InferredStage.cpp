@@ -58,6 +58,9 @@
 // Cost note (CPU): a contributing light costs two evaluateLight calls (diffuse, then specular
 // part) where `tiled` needs one; this keeps a single BRDF definition at the price of roughly
 // twice the per-light work in "lighting" (a GPU light buffer pays nothing comparable).
+// Blended (glTF BLEND) surfaces: stippled into the L-buffer, lit by the light pass, found again
+// through the DSF in the material pass, at most 3 layers (InferredStipple.h); timed as "blend",
+// with stipple_fragments, stipple_fallbacks and stipple_unlit among the parameters.
 // Threads: tiles in parallel for culling and lighting, rows for the material pass; every sample
 // and pixel written by one task only, light sums in ascending order: deterministic.
 //
@@ -72,6 +75,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/BlendedPass.h"
+#include "lighting/InferredStipple.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
@@ -157,6 +162,15 @@ public:
             basicTileLightLists(gb, grid, spheres, bounds);
         const double cullMs = millisecondsSince(cullStart);
 
+        // Blended surfaces: stippled into the L-buffer's samples (InferredStipple.h); all their
+        // work is timed as the pass "blend".
+        auto blendStart = Clock::now();
+        const bool blended = mBlended.prepare(inputs);
+        if (blended)
+            mStipple.stipple(inputs, mBlended, gb.depth(),
+                             {width, height, scale, lowWidth, lowHeight});
+        double blendMs = millisecondsSince(blendStart);
+
         // L-buffer at low resolution.
         const auto lightingStart = Clock::now();
         mSamples.assign(size_t(lowWidth) * lowHeight, LightSample{});
@@ -172,7 +186,8 @@ public:
                 for (int i = tx * tileSamples; i < i1; ++i) {
                     const int x = sampleX(i), y = sampleY(j);
                     gbuffer::Surface point;
-                    if (!gb.surfaceAt(x, y, point))
+                    if ((blended && mStipple.holds(size_t(j) * lowWidth + i)) ||
+                        !gb.surfaceAt(x, y, point))
                         continue;
                     LightSample& sample = mSamples[size_t(j) * lowWidth + i];
                     sample.covered = true;
@@ -185,6 +200,23 @@ public:
                 }
         });
         const double lightingMs = millisecondsSince(lightingStart);
+        if (blended) {
+            blendStart = Clock::now();
+            mStipple.light(inputs, gb.depth(), mOptions.tileSizeSamples * scale);
+            for (int j = 0; j < lowHeight; ++j)
+                for (int i = 0; i < lowWidth; ++i) {
+                    const size_t index = size_t(j) * lowWidth + i;
+                    if (!mStipple.holds(index))
+                        continue;
+                    const InferredStipple::Sample& stippled = mStipple.sample(index);
+                    mSamples[index] = {true, -stippled.surface.positionView.z,
+                                       stippled.surface.normalView, stippled.diffuse,
+                                       stippled.specular};
+                    result.lightsEvaluated[size_t(sampleY(j)) * width + sampleX(i)] =
+                        stippled.lightCount;
+                }
+            blendMs += millisecondsSince(blendStart);
+        }
 
         // Material pass: second geometry pass, DSF upsampling, combine.
         const auto materialStart = Clock::now();
@@ -196,7 +228,9 @@ public:
             for (int j = 0; j < lowHeight; ++j)
                 for (int i = 0; i < lowWidth; ++i)
                     mSampleObjects[size_t(j) * lowWidth + i] =
-                        mMaterials.instanceAt(size_t(sampleY(j)) * width + sampleX(i));
+                        blended && mStipple.holds(size_t(j) * lowWidth + i)
+                            ? mStipple.sample(size_t(j) * lowWidth + i).instance
+                            : mMaterials.instanceAt(size_t(sampleY(j)) * width + sampleX(i));
         // Per row, so that each task counts into its own slot.
         std::vector<uint32_t> rowFallbacks(size_t(height), 0), rowIdFallbacks(size_t(height), 0);
         const float halfScale = float(scale / 2);
@@ -279,6 +313,16 @@ public:
         result.timingsMs.emplace_back(pass::kCull, cullMs);
         result.timingsMs.emplace_back(pass::kLighting, lightingMs);
         result.timingsMs.emplace_back(pass::kMaterial, materialMs);
+        if (blended) {
+            blendStart = Clock::now();
+            const InferredStipple::Counts counts = mStipple.composite(
+                mBlended, gb.depth(),
+                {mOptions.depthThreshold, mOptions.normalThreshold, mOptions.objectIds}, result);
+            result.timingsMs.emplace_back(pass::kBlend, blendMs + millisecondsSince(blendStart));
+            result.parameters["stipple_fragments"] = std::to_string(counts.fragments);
+            result.parameters["stipple_fallbacks"] = std::to_string(counts.fallbacks);
+            result.parameters["stipple_unlit"] = std::to_string(counts.unlit);
+        }
         result.parameters["scale"] = std::to_string(scale);
         result.parameters["depth"] = std::to_string(mOptions.depthThreshold);
         result.parameters["normal"] = std::to_string(mOptions.normalThreshold);
@@ -291,6 +335,8 @@ public:
     }
 
 private:
+    BlendedPass mBlended;     // blended surfaces after the opaque pass (BlendedPass.h)
+    InferredStipple mStipple; // ... lit through the stipple pattern (InferredStipple.h)
     InferredOptions mOptions;
     // Per-frame scratch, kept to avoid reallocation between repetitions.
     std::vector<LightSample> mSamples;

@@ -28,6 +28,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
@@ -126,6 +127,9 @@ public:
         for (uint16_t count : mCounts)
             overflowPixels += count == kOverflowed ? 1 : 0;
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        // Blended surfaces: every light (the per-pixel lists are the opaque surface's).
+        if (mBlended.prepare(inputs))
+            mBlended.shadeWithEveryLight(gb.depth(), result);
 
         result.parameters["max"] = std::to_string(mMaxLights);
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
@@ -138,6 +142,7 @@ private:
     // Kept between frames so steady-state frames do not allocate.
     std::vector<uint16_t> mCounts; // entries used, or kOverflowed
     std::vector<uint32_t> mLists;  // capacity entries per pixel
+    BlendedPass mBlended;          // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 } // namespace

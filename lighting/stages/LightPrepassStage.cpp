@@ -45,6 +45,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
@@ -129,6 +130,9 @@ public:
         result.timingsMs.emplace_back(pass::kCull, cullMs);
         result.timingsMs.emplace_back(pass::kLighting, lightingMs);
         result.timingsMs.emplace_back(pass::kMaterial, materialMs);
+        // Blended surfaces: a forward pass with the whole BRDF over near-to-opaque tile lists.
+        if (mBlended.prepare(inputs))
+            mBlended.shadeWithTileLists(gb.depth(), mTileSizePixels, true, result);
         result.parameters["spec"] = mChroma ? "chroma" : "grey";
         result.parameters["tile"] = std::to_string(mTileSizePixels);
         result.parameters["tile_light_pairs"] = std::to_string(pairs);
@@ -141,6 +145,7 @@ private:
     std::vector<glm::vec3> mDiffuse;
     std::vector<float> mSpecular;
     MaterialPass mMaterials;
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 } // namespace

@@ -3,6 +3,7 @@
 // image is compared with it. The loop is shadeWithEveryLight (EveryLight.h), shared with `brute`.
 #include "lighting/stages/Stages.h"
 
+#include "lighting/BlendedPass.h"
 #include "lighting/EveryLight.h"
 
 namespace lighting {
@@ -21,7 +22,12 @@ public:
                 return exact.surfaceAt(x, y, s);
             },
             result);
+        if (mBlended.prepare(inputs))
+            mBlended.compositeExact(inputs.gbuffer->depth(), result);
     }
+
+private:
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 } // namespace

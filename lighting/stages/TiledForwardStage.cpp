@@ -39,6 +39,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/ForwardGeometry.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
@@ -95,6 +96,9 @@ public:
         };
         mForward.draw(visibility.triangles(), visibility.redrawState(), shadeFragment);
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        if (mBlended.prepare(inputs))
+            mBlended.shadeWithTileLists(mForward.depth(), mOptions.tileSizePixels,
+                                        mOptions.viewFrustumCulling, result);
 
         uint64_t pairs = 0;
         for (const std::vector<uint32_t>& list : mTileLights)
@@ -109,6 +113,7 @@ public:
     }
 
 private:
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
     // Fills mTileLights from the pre-pass depth (mForward.depth()); returns the number of lights
     // kept by view-frustum culling. The same tests (appendTileLights) as `tiled` with the same
     // options.

@@ -32,6 +32,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
@@ -120,6 +121,9 @@ public:
         }
         result.timingsMs.emplace_back(pass::kCull, cullMs);
         result.timingsMs.emplace_back(pass::kShading, shadeMs);
+        if (mBlended.prepare(inputs))
+            mBlended.shadeWithTileLists(gb.depth(), mOptions.tileSizePixels,
+                                        mOptions.viewFrustumCulling, result);
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
@@ -132,6 +136,7 @@ public:
 
 private:
     TiledOptions mOptions;
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 TiledOptions parseTiledOptions(const StageSpec& spec, bool backface) {

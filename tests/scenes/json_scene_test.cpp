@@ -394,6 +394,22 @@ TEST(JsonScene, MaterialEntriesSetModelMetallicRoughnessAndEmissive) {
     EXPECT_EQ(white.model, scenes::MaterialModel::BlinnPhong);
 }
 
+TEST(JsonScene, MaterialEntriesSetAlphaModeAndCutoff) {
+    json document = spheresOnly();
+    document["materials"] = {
+        {{"name", "sphere-gold"}, {"alphaMode", "MASK"}, {"alphaCutoff", 0.25}},
+        {{"name", "sphere-chrome"}, {"alphaMode", "BLEND"}, {"baseColor", {1, 1, 1, 0.4}}}};
+    const Scene scene = loadJson(document);
+    const scenes::Material& gold = materialNamed(scene, "sphere-gold");
+    EXPECT_EQ(gold.alphaMode, scenes::AlphaMode::Mask);
+    EXPECT_EQ(gold.alphaCutoff, 0.25f);
+    const scenes::Material& chrome = materialNamed(scene, "sphere-chrome");
+    EXPECT_EQ(chrome.alphaMode, scenes::AlphaMode::Blend);
+    EXPECT_EQ(chrome.alphaCutoff, 0.5f); // glTF's default
+    EXPECT_EQ(chrome.baseColorFactor.a, 0.4f);
+    EXPECT_EQ(materialNamed(scene, "sphere-matte-white").alphaMode, scenes::AlphaMode::Opaque);
+}
+
 TEST(JsonSceneErrors, BadMaterialEntries) {
     auto with = [](json entry) {
         json document = spheresOnly();
@@ -418,6 +434,10 @@ TEST(JsonSceneErrors, BadMaterialEntries) {
     expectJsonError(with({{"name", "sphere-gold"}, {"shininess", 3}}),
                     {"materials[0]", "unknown key 'shininess'"});
     expectJsonError(with({{"model", "blinn-phong"}}), {"materials[0]", "missing key 'name'"});
+    expectJsonError(with({{"name", "sphere-gold"}, {"alphaMode", "CUTOUT"}}),
+                    {"materials[0].alphaMode", "'CUTOUT'", "MASK"});
+    expectJsonError(with({{"name", "sphere-gold"}, {"alphaCutoff", -1}}),
+                    {"materials[0].alphaCutoff", "negative"});
 }
 
 TEST(JsonSceneErrors, BadObjects) {

@@ -454,7 +454,7 @@ SceneRequest requestWith(std::map<std::string, std::string> options, int lightCo
 
 TEST(ProceduralScenes, RegistryListsTheScenesWithTheDefaultFirst) {
     const std::vector<std::string> names = proceduralSceneNames();
-    EXPECT_EQ(names, (std::vector<std::string>{"atrium", "wall", "spheres"}));
+    EXPECT_EQ(names, (std::vector<std::string>{"atrium", "wall", "spheres", "glass"}));
     EXPECT_EQ(names.front(), kDefaultSceneName);
     for (const std::string& name : names)
         EXPECT_TRUE(isProceduralScene(name));

@@ -1,0 +1,169 @@
+// BlendedPass: the forward pass for blended surfaces (glTF alphaMode BLEND), written once and run
+// by every stage after its opaque pass (lighting/README.md, "Transparency"). The opaque passes
+// never see blended surfaces (gbuffer::AlphaCoverage discards them from every opaque draw); this
+// pass then rasterizes the blended triangles over the frame's opaque depth (closer test, no
+// depth writes), shades each fragment with the lights the stage gives for it, and composites it
+// over the pixel with the "over" operator: radiance = alpha * lit + (1 - alpha) * radiance.
+//
+// Order. Stages composite in the order the literature's forward passes use: blended triangles
+// sorted back to front once per frame by the view depth of their centroid (per-triangle sort,
+// farthest first; ties by triangle index), then drawn in that order, so every pixel composites
+// its fragments in that order (the rasterizer keeps submission order per pixel). Where
+// triangles intersect or overlap out of centroid order, the order is wrong at some pixels: those
+// are the sorting artefacts every stage's error against the reference shows. The reference
+// (compositeExact) instead sorts every pixel's fragments by their exact distance.
+//
+// Light lists. shade() takes lightsAt(x, y, surface, triangle), which returns the stage's
+// light list for that fragment (ascending indices; a std::span<const uint32_t>, valid until the
+// next call from the same thread): every light (everyLight()), the tile's or cluster's list, the
+// object's list. A fragment's radiance sums its list in that order with evaluateLight, so stages
+// whose lists keep every contributing light give bitwise brute's composite.
+//
+// Counting. shade() adds each fragment's list length to lightsEvaluated, and, when
+// lightsOracle is non-empty (stages that count the oracle themselves, brute), its contributing
+// lights to lightsOracle; addOracle() adds the latter for the oracle the runner counts
+// (lighting/Oracle.h); compositeExact() counts both for the reference. The pass is timed as
+// pass::kBlend. The light trace of the tests holds the
+// opaque surface's lights only.
+//
+// Emissive light of blended surfaces is not added (the opaque passes' emissive is the stages'
+// business). Thread safety: one frame at a time per object; parallel inside (the rasterizer's
+// tiles), each pixel composited by the thread owning its tile, in submission order, so the
+// result does not depend on the thread count.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "gbuffer/DepthFormat.h"
+#include "gbuffer/VisibilityPass.h"
+#include "lighting/Brdf.h"
+#include "lighting/PassNames.h"
+#include "lighting/ShadingStage.h"
+#include "raster/Rasterizer.h"
+
+namespace lighting {
+
+class BlendedPass {
+public:
+    // Per frame: false (and nothing else done, O(materials)) when no material of inputs.scene is
+    // BLEND; else transforms the scene (its own gbuffer::VisibilityPass, so the clip positions
+    // are bitwise the opaque pass's) and sorts the blended triangles. Requires inputs.scene,
+    // .geometry, .view, .lights.
+    bool prepare(const StageInputs& inputs);
+    bool active() const { return mActive; }
+    // Number of blended triangles this frame.
+    size_t triangleCount() const { return mSceneTriangle.size(); }
+    // 0 .. lightCount - 1: the list of stages that shade blended surfaces with every light.
+    std::span<const uint32_t> everyLight() const { return mEveryLight; }
+
+    // Composites the blended fragments in front of opaqueDepth (the frame's opaque depth plane,
+    // the view's convention) over result.radiance, in the pass's order, with the lists of
+    // lightsAt (see the file comment). Appends pass::kBlend to result.timingsMs.
+    // `start` is when the pass began (list building that precedes shade() belongs to it).
+    template <class LightsAt>
+    void shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt, StageResult& result,
+               std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now());
+
+    // shade() with every light for every fragment: brute, and the stages that state they use
+    // brute force for blended surfaces (lighting/README.md).
+    void shadeWithEveryLight(std::span<const float> opaqueDepth, StageResult& result) {
+        shade(
+            opaqueDepth,
+            [this](int, int, const gbuffer::Surface&, uint32_t) { return everyLight(); }, result);
+    }
+    // The lights that contribute at a blended fragment's surface (every light tested,
+    // ascending; valid until the calling thread's next call): the lists of `ideal`.
+    std::span<const uint32_t> contributingLights(const gbuffer::Surface& point) const;
+    // shade() with the tile lists of BlendedTileLists.h on tiles of tileSizePixels (the tiled
+    // stages; the list building is timed in the blend pass).
+    void shadeWithTileLists(std::span<const float> opaqueDepth, int tileSizePixels,
+                            bool viewFrustumCulling, StageResult& result);
+
+    // The reference's composite: per pixel every blended fragment in front of opaqueDepth,
+    // sorted by its exact distance (ties by triangle index), each lit with every light in double
+    // at its exact hit (gbuffer::ExactSurface::hit; material values and alpha as the stages
+    // read them), composited back to front over the pixel's opaque radiance in double, then
+    // rounded to float once. Appends pass::kBlend.
+    void compositeExact(std::span<const float> opaqueDepth, StageResult& result);
+
+    // Calls fn(fragment, triangle, surface, alpha) for every blended fragment in front of
+    // opaqueDepth, in the pass's order per pixel (the composite order of shade()), with its scene
+    // triangle and its surface (position from its depth) and alpha; concurrently for pixels of
+    // different raster tiles, so fn writes only data of the fragment's pixel. For stages that
+    // light blended surfaces their own way (inferred's stipple layers).
+    template <class Fn> void forEachFragment(std::span<const float> opaqueDepth, Fn&& fn) {
+        draw(opaqueDepth, [&](const raster::Fragment& fragment) {
+            const uint32_t triangle = mSceneTriangle[fragment.triangle];
+            float alpha = 0.0f;
+            const gbuffer::Surface point = surfaceOf(fragment, triangle, alpha);
+            fn(fragment, triangle, point, alpha);
+        });
+    }
+
+    // Adds the blended fragments' contributing lights (every light tested) to `oracle`.
+    void addOracle(std::span<const float> opaqueDepth, std::vector<uint32_t>& oracle);
+
+private:
+    // The blended surface of a fragment: the visibility pass's surface at the pixel, its
+    // position from the fragment's depth (the lossless decoder, as ForwardGeometry), its alpha.
+    gbuffer::Surface surfaceOf(const raster::Fragment& fragment, uint32_t triangle,
+                               float& alpha) const;
+    // Draws the sorted blended triangles over a copy of opaqueDepth.
+    template <class FragmentFn>
+    void draw(std::span<const float> opaqueDepth, FragmentFn&& fragmentFn);
+
+    bool mActive = false;
+    const StageInputs* mInputs = nullptr;
+    gbuffer::VisibilityPass mVisibility;
+    std::optional<gbuffer::DepthDecoder> mDepthDecoder;
+    std::unique_ptr<raster::Rasterizer> mRasterizer;
+    std::vector<float> mDepth;            // the opaque depth, tested, never written
+    std::vector<uint32_t> mSortedIndices; // vertex indices of the sorted triangles
+    std::vector<uint32_t> mSceneTriangle; // drawn triangle -> scene triangle
+    std::vector<uint32_t> mEveryLight;
+};
+
+template <class FragmentFn>
+void BlendedPass::draw(std::span<const float> opaqueDepth, FragmentFn&& fragmentFn) {
+    mDepth.assign(opaqueDepth.begin(), opaqueDepth.end());
+    raster::RasterState state = mVisibility.drawState();
+    state.depthWrite = false;
+    mRasterizer->draw(raster::TriangleList{mVisibility.clipPositions(), mSortedIndices}, state,
+                      mDepth.data(), fragmentFn);
+}
+
+template <class LightsAt>
+void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
+                        StageResult& result, std::chrono::steady_clock::time_point start) {
+    const std::vector<LightInView<float>>& lights = mInputs->lights->lights;
+    const size_t width = size_t(result.width);
+    const bool countOracle = !result.lightsOracle.empty();
+    draw(opaqueDepth, [&](const raster::Fragment& fragment) {
+        const uint32_t triangle = mSceneTriangle[fragment.triangle];
+        float alpha = 0.0f;
+        const gbuffer::Surface point = surfaceOf(fragment, triangle, alpha);
+        const glm::vec3 toViewer = glm::normalize(-point.positionView);
+        const std::span<const uint32_t> list = lightsAt(fragment.x, fragment.y, point, triangle);
+        glm::vec3 sum(0.0f);
+        uint32_t contributing = 0;
+        for (const uint32_t index : list) {
+            const glm::vec3 radiance = evaluateLight(point, toViewer, lights[index]);
+            sum += radiance;
+            contributing += contributes(radiance) ? 1u : 0u;
+        }
+        const size_t pixel = size_t(fragment.y) * width + size_t(fragment.x);
+        for (int c = 0; c < 3; ++c)
+            result.radiance[c][pixel] = alpha * sum[c] + (1.0f - alpha) * result.radiance[c][pixel];
+        result.lightsEvaluated[pixel] += uint32_t(list.size());
+        if (countOracle)
+            result.lightsOracle[pixel] += contributing;
+    });
+    result.timingsMs.emplace_back(pass::kBlend, millisecondsSince(start));
+}
+
+} // namespace lighting

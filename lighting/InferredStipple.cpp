@@ -1,0 +1,193 @@
+#include "lighting/InferredStipple.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <tbb/parallel_for.h>
+
+#include "lighting/BlendedTileLists.h"
+#include "lighting/LightListShading.h"
+
+namespace lighting {
+
+void InferredStipple::stipple(const StageInputs& inputs, BlendedPass& blended,
+                              std::span<const float> opaqueDepth, const Lattice& lattice) {
+    mLattice = lattice;
+    mGeometry = inputs.geometry;
+    const scenes::Scene& scene = *inputs.scene;
+    const gbuffer::SceneGeometry& geometry = *inputs.geometry;
+    const gbuffer::CameraView& view = *inputs.view;
+
+    // Patterns: blended instances front to back by the view depth of their box centre.
+    const size_t instanceCount = scene.instances.size();
+    std::vector<float> nearest(instanceCount, std::numeric_limits<float>::infinity());
+    std::vector<float> farthest(instanceCount, -std::numeric_limits<float>::infinity());
+    for (uint32_t t = 0; t < geometry.triangleCount(); ++t) {
+        if (scene.materials[geometry.triangleMaterial[t]].alphaMode != scenes::AlphaMode::Blend)
+            continue;
+        const uint32_t instance = geometry.triangleInstance[t];
+        for (int c = 0; c < 3; ++c) {
+            const glm::vec3 p = geometry.positionWorld[geometry.indices[3 * size_t(t) + c]];
+            const float depth = -(view.viewFromWorld * glm::vec4(p, 1.0f)).z;
+            nearest[instance] = std::min(nearest[instance], depth);
+            farthest[instance] = std::max(farthest[instance], depth);
+        }
+    }
+    std::vector<uint32_t> ranked;
+    for (uint32_t i = 0; i < instanceCount; ++i)
+        if (nearest[i] <= farthest[i])
+            ranked.push_back(i);
+    std::stable_sort(ranked.begin(), ranked.end(), [&](uint32_t a, uint32_t b) {
+        return nearest[a] + farthest[a] < nearest[b] + farthest[b];
+    });
+    mPatternOfInstance.assign(instanceCount, -1);
+    for (size_t rank = 0; rank < ranked.size(); ++rank)
+        mPatternOfInstance[ranked[rank]] = int(rank % kTransparentLayers);
+
+    // Which sample each full-res column and row holds (-1: none).
+    std::vector<int> sampleOfColumn(size_t(lattice.width), -1),
+        sampleOfRow(size_t(lattice.height), -1);
+    for (int i = 0; i < lattice.lowWidth; ++i)
+        sampleOfColumn[size_t(lattice.sampleX(i))] = i;
+    for (int j = 0; j < lattice.lowHeight; ++j)
+        sampleOfRow[size_t(lattice.sampleY(j))] = j;
+
+    const size_t sampleCount = size_t(lattice.lowWidth) * size_t(lattice.lowHeight);
+    mSamples.assign(sampleCount, Sample{});
+    mSampleDepth.assign(sampleCount, std::numeric_limits<float>::infinity());
+    blended.forEachFragment(opaqueDepth, [&](const raster::Fragment& fragment, uint32_t triangle,
+                                             const gbuffer::Surface& surface, float) {
+        const int i = sampleOfColumn[size_t(fragment.x)], j = sampleOfRow[size_t(fragment.y)];
+        if (i < 0 || j < 0)
+            return;
+        const int pattern = patternOf(i, j);
+        const uint32_t instance = geometry.triangleInstance[triangle];
+        if (pattern >= kTransparentLayers || mPatternOfInstance[instance] != pattern)
+            return;
+        const size_t index = size_t(j) * size_t(lattice.lowWidth) + size_t(i);
+        const float depth = -surface.positionView.z;
+        if (!(depth < mSampleDepth[index])) // the nearest; the first drawn among equals
+            return;
+        mSampleDepth[index] = depth;
+        Sample& sample = mSamples[index];
+        sample.covered = true;
+        sample.instance = instance;
+        sample.surface = surface;
+    });
+}
+
+void InferredStipple::light(const StageInputs& inputs, std::span<const float> opaqueDepth,
+                            int tileSizePixels) {
+    const TileGrid grid = TileGrid::make(mLattice.width, mLattice.height, tileSizePixels);
+    const std::vector<std::vector<uint32_t>> lists =
+        blendedTileLightLists(inputs, opaqueDepth, grid, true);
+    const std::vector<LightInView<float>>& lights = inputs.lights->lights;
+    tbb::parallel_for(0, mLattice.lowHeight, [&](int j) {
+        for (int i = 0; i < mLattice.lowWidth; ++i) {
+            Sample& sample = mSamples[size_t(j) * size_t(mLattice.lowWidth) + size_t(i)];
+            if (!sample.covered)
+                continue;
+            const int x = mLattice.sampleX(i), y = mLattice.sampleY(j);
+            const std::vector<uint32_t>& list =
+                lists[size_t((y / tileSizePixels) * grid.tileCountX + x / tileSizePixels)];
+            const SplitLighting lighting = splitLighting(sample.surface, lights, list);
+            sample.diffuse = lighting.diffuse;
+            sample.specular = lighting.specular;
+            sample.lightCount = uint32_t(list.size());
+        }
+    });
+}
+
+InferredStipple::Counts InferredStipple::composite(BlendedPass& blended,
+                                                   std::span<const float> opaqueDepth,
+                                                   const DsfOptions& options,
+                                                   StageResult& result) const {
+    const Lattice& l = mLattice;
+    const size_t pixelCount = size_t(l.width) * size_t(l.height);
+    // Per pixel, so that each count is written by the thread owning the pixel.
+    std::vector<uint32_t> fragments(pixelCount, 0), fallbacks(pixelCount, 0), unlit(pixelCount, 0);
+    const float halfScale = float(l.scale / 2);
+    // The two lattice indices of pattern offset `offset` around sample coordinate `u` (in
+    // samples) and the weight of the second; -1 for an index outside the L-buffer.
+    auto taps = [](float u, int offset, int count, int& a, int& b, float& f) {
+        const float m = (u - float(offset)) / 2.0f;
+        const int m0 = int(std::floor(m));
+        f = m - float(m0);
+        a = 2 * m0 + offset;
+        b = a + 2;
+        // Clamp to the pattern's first and last index (keeping the parity).
+        const int last = (count - 1 - offset) >= 0 ? offset + 2 * ((count - 1 - offset) / 2) : -1;
+        a = last < 0 ? -1 : std::clamp(a, offset, last);
+        b = last < 0 ? -1 : std::clamp(b, offset, last);
+    };
+    blended.forEachFragment(opaqueDepth, [&](const raster::Fragment& fragment, uint32_t triangle,
+                                             const gbuffer::Surface& surface, float alpha) {
+        const size_t pixel = size_t(fragment.y) * size_t(l.width) + size_t(fragment.x);
+        ++fragments[pixel];
+        const uint32_t instance = mGeometry->triangleInstance[triangle];
+        const int pattern = mPatternOfInstance[instance];
+        const int ox = pattern & 1, oy = pattern >> 1;
+        int ia, ib, ja, jb;
+        float fx, fy;
+        taps((float(fragment.x) - halfScale) / float(l.scale), ox, l.lowWidth, ia, ib, fx);
+        taps((float(fragment.y) - halfScale) / float(l.scale), oy, l.lowHeight, ja, jb, fy);
+        const int tapI[4] = {ia, ib, ia, ib}, tapJ[4] = {ja, ja, jb, jb};
+        const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+        const float depth = -surface.positionView.z;
+        glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f), surfaceDiffuse(0.0f),
+            surfaceSpecular(0.0f);
+        float sameWeight = 0.0f, surfaceWeight = 0.0f, nearestWeight = -1.0f;
+        const Sample* nearestSample = nullptr;
+        for (int k = 0; k < 4; ++k) {
+            if (tapI[k] < 0 || tapJ[k] < 0)
+                continue;
+            const Sample& t = mSamples[size_t(tapJ[k]) * size_t(l.lowWidth) + size_t(tapI[k])];
+            if (!t.covered)
+                continue;
+            if (bilinear[k] > nearestWeight) {
+                nearestWeight = bilinear[k];
+                nearestSample = &t;
+            }
+            if (std::abs(-t.surface.positionView.z - depth) > options.depthThreshold * depth ||
+                glm::dot(t.surface.normalView, surface.normalView) < options.normalThreshold)
+                continue;
+            surfaceDiffuse += bilinear[k] * t.diffuse;
+            surfaceSpecular += bilinear[k] * t.specular;
+            surfaceWeight += bilinear[k];
+            if (options.objectIds && t.instance != instance)
+                continue;
+            sameDiffuse += bilinear[k] * t.diffuse;
+            sameSpecular += bilinear[k] * t.specular;
+            sameWeight += bilinear[k];
+        }
+        glm::vec3 diffuse(0.0f), specular(0.0f);
+        if (sameWeight > 0.0f) {
+            diffuse = sameDiffuse / sameWeight;
+            specular = sameSpecular / sameWeight;
+        } else if (surfaceWeight > 0.0f) {
+            diffuse = surfaceDiffuse / surfaceWeight;
+            specular = surfaceSpecular / surfaceWeight;
+            ++fallbacks[pixel];
+        } else if (nearestSample) {
+            diffuse = nearestSample->diffuse;
+            specular = nearestSample->specular;
+            ++fallbacks[pixel];
+        } else {
+            ++unlit[pixel];
+        }
+        const glm::vec3 lit = surface.albedo * diffuse + surface.specularIntensity * specular;
+        for (int c = 0; c < 3; ++c)
+            result.radiance[c][pixel] = alpha * lit[c] + (1.0f - alpha) * result.radiance[c][pixel];
+    });
+    Counts counts;
+    for (size_t p = 0; p < pixelCount; ++p) {
+        counts.fragments += fragments[p];
+        counts.fallbacks += fallbacks[p];
+        counts.unlit += unlit[p];
+    }
+    return counts;
+}
+
+} // namespace lighting
