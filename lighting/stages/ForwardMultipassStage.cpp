@@ -27,6 +27,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardGeometry.h"
+#include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
 
 namespace lighting {
@@ -52,7 +53,8 @@ public:
         result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
-        buildIlluminationSets(*inputs.lights);
+        mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
+        mSets = mObjectLights.transposed(inputs.lights->size());
         result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
@@ -62,7 +64,7 @@ public:
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
         const raster::RasterState state = visibility.redrawState();
         for (uint32_t l = 0; l < lights.size(); ++l) {
-            const std::vector<uint32_t>& set = mSets[l];
+            const std::span<const uint32_t> set = mSets[l];
             if (set.empty())
                 continue;
             // The set's triangles as one list; globalTriangle maps a drawn triangle back to the
@@ -106,23 +108,9 @@ public:
     }
 
 private:
-    // Per light, the objects its sphere touches, ascending. Lights in parallel, each into its
-    // own list.
-    void buildIlluminationSets(const LightList& lightList) {
-        const std::vector<LightSphere> spheres = boundingSpheresView(lightList);
-        const std::vector<ForwardObject>& objects = mForward.objects();
-        mSets.resize(spheres.size());
-        tbb::parallel_for(size_t(0), spheres.size(), [&](size_t l) {
-            std::vector<uint32_t>& set = mSets[l];
-            set.clear();
-            for (uint32_t o = 0; o < objects.size(); ++o)
-                if (sphereTouchesObject(spheres[l], objects[o]))
-                    set.push_back(o);
-        });
-    }
-
     ForwardGeometry mForward;
-    std::vector<std::vector<uint32_t>> mSets;
+    LightIndexLists mObjectLights; // per object, the lights touching it, ascending
+    LightIndexLists mSets;         // per light, the objects it touches, ascending (transposed)
     std::vector<uint32_t> mSetIndices;
     std::vector<uint32_t> mSetTriangles;
 };

@@ -26,6 +26,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardGeometry.h"
+#include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
 
 namespace lighting {
@@ -50,7 +51,7 @@ public:
         result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
 
         start = std::chrono::steady_clock::now();
-        buildObjectLightLists(*inputs.lights);
+        mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
         result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
 
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
@@ -69,20 +70,18 @@ public:
             const size_t pixel = size_t(fragment.y) * width + fragment.x;
             if (equalOnly && !visibility.isVisible(fragment, fragment.triangle))
                 return;
-            const uint32_t object = mForward.objectOfTriangle(fragment.triangle);
-            const uint32_t* index = mLightIndices.data() + mLightOffsets[object];
-            const uint32_t* end = mLightIndices.data() + mLightOffsets[object + 1];
+            const std::span<const uint32_t> list =
+                mObjectLights[mForward.objectOfTriangle(fragment.triangle)];
             const gbuffer::Surface point = mForward.surfaceAt(fragment, fragment.triangle);
             const glm::vec3 toViewer = glm::normalize(-point.positionView);
             glm::vec3 sum(0.0f);
-            for (; index != end; ++index)
-                sum += evaluateLight(point, toViewer, lights[*index]);
+            for (uint32_t index : list)
+                sum += evaluateLight(point, toViewer, lights[index]);
             result.radiance[0][pixel] = sum.x;
             result.radiance[1][pixel] = sum.y;
             result.radiance[2][pixel] = sum.z;
-            result.lightsEvaluated[pixel] += mLightOffsets[object + 1] - mLightOffsets[object];
-            result.traceLightList(pixel, {mLightIndices.data() + mLightOffsets[object],
-                                          mLightIndices.data() + mLightOffsets[object + 1]});
+            result.lightsEvaluated[pixel] += uint32_t(list.size());
+            result.traceLightList(pixel, list);
         };
         // Without a pre-pass, the visibility draw's own state (every fragment that passes the
         // closer test is shaded); with one, the redraw that passes each visible fragment once.
@@ -92,34 +91,9 @@ public:
     }
 
 private:
-    // Per object, the lights whose sphere touches its box, ascending; flattened so the fragment
-    // loop reads one contiguous range. Objects in parallel, each into its own list, then
-    // concatenated in object order (deterministic).
-    void buildObjectLightLists(const LightList& lightList) {
-        const std::vector<LightSphere> spheres = boundingSpheresView(lightList);
-        const std::vector<ForwardObject>& objects = mForward.objects();
-        mPerObject.resize(objects.size());
-        tbb::parallel_for(size_t(0), objects.size(), [&](size_t o) {
-            std::vector<uint32_t>& list = mPerObject[o];
-            list.clear();
-            for (uint32_t l = 0; l < spheres.size(); ++l)
-                if (sphereTouchesObject(spheres[l], objects[o]))
-                    list.push_back(l);
-        });
-        mLightOffsets.assign(objects.size() + 1, 0);
-        for (size_t o = 0; o < objects.size(); ++o)
-            mLightOffsets[o + 1] = mLightOffsets[o] + uint32_t(mPerObject[o].size());
-        mLightIndices.resize(mLightOffsets.back());
-        for (size_t o = 0; o < objects.size(); ++o)
-            std::copy(mPerObject[o].begin(), mPerObject[o].end(),
-                      mLightIndices.begin() + mLightOffsets[o]);
-    }
-
     bool mPrepass;
     ForwardGeometry mForward;
-    std::vector<std::vector<uint32_t>> mPerObject;
-    std::vector<uint32_t> mLightOffsets;
-    std::vector<uint32_t> mLightIndices;
+    LightIndexLists mObjectLights; // per object, ascending (ForwardGeometry::objectLightLists)
 };
 
 } // namespace

@@ -152,9 +152,8 @@ public:
         const auto cullStart = Clock::now();
         const TileGrid grid = TileGrid::make(width, height, mOptions.tileSizeSamples * scale);
         const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
-        std::vector<TileSurfaceBounds> bounds;
-        const std::vector<std::vector<uint32_t>> tileLights =
-            basicTileLightLists(gb, grid, spheres, bounds);
+        const std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {});
+        buildTileLightLists(gb.view(), grid, bounds, spheres, {}, mTileLights);
         const double cullMs = millisecondsSince(cullStart);
 
         // L-buffer at low resolution.
@@ -164,7 +163,7 @@ public:
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
             if (!bounds[size_t(tile)].covered)
                 return;
-            const std::vector<uint32_t>& list = tileLights[size_t(tile)];
+            const std::span<const uint32_t> list = mTileLights[size_t(tile)];
             const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
             const int j1 = std::min((ty + 1) * tileSamples, lowHeight);
             const int i1 = std::min((tx + 1) * tileSamples, lowWidth);
@@ -269,9 +268,8 @@ public:
         });
         const double materialMs = millisecondsSince(materialStart);
 
-        uint64_t pairs = 0, fallbacks = 0, idFallbacks = 0;
-        for (const auto& list : tileLights)
-            pairs += list.size();
+        const uint64_t pairs = mTileLights.pairCount();
+        uint64_t fallbacks = 0, idFallbacks = 0;
         for (uint32_t f : rowFallbacks)
             fallbacks += f;
         for (uint32_t f : rowIdFallbacks)
@@ -296,6 +294,7 @@ private:
     std::vector<LightSample> mSamples;
     std::vector<uint32_t> mSampleObjects; // object ID per low-res sample; all kNoObject with ids=0
     MaterialPass mMaterials;
+    LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)
 };
 
 } // namespace

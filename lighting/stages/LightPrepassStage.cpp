@@ -76,9 +76,9 @@ public:
 
         const auto cullStart = Clock::now();
         const TileGrid grid = TileGrid::make(width, height, mTileSizePixels);
-        std::vector<TileSurfaceBounds> bounds;
-        const std::vector<std::vector<uint32_t>> tileLights =
-            basicTileLightLists(gb, grid, boundingSpheresView(*inputs.lights), bounds);
+        const std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {});
+        buildTileLightLists(gb.view(), grid, bounds, boundingSpheresView(*inputs.lights), {},
+                            mTileLights);
         const double cullMs = millisecondsSince(cullStart);
 
         // Light buffer: diffuse RGB + monochromatic specular, per pixel.
@@ -88,7 +88,7 @@ public:
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
             if (!bounds[size_t(tile)].covered)
                 return;
-            const std::vector<uint32_t>& list = tileLights[size_t(tile)];
+            const std::span<const uint32_t> list = mTileLights[size_t(tile)];
             const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
             for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
                 for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
@@ -123,9 +123,7 @@ public:
         });
         const double materialMs = millisecondsSince(materialStart);
 
-        uint64_t pairs = 0;
-        for (const auto& list : tileLights)
-            pairs += list.size();
+        const uint64_t pairs = mTileLights.pairCount();
         result.timingsMs.emplace_back(pass::kCull, cullMs);
         result.timingsMs.emplace_back(pass::kLighting, lightingMs);
         result.timingsMs.emplace_back(pass::kMaterial, materialMs);
@@ -141,6 +139,7 @@ private:
     std::vector<glm::vec3> mDiffuse;
     std::vector<float> mSpecular;
     MaterialPass mMaterials;
+    LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)
 };
 
 } // namespace

@@ -45,7 +45,7 @@ namespace {
 // multiple of 4), each with its tile's ascending list.
 class TileListSource final : public PacketListSource {
 public:
-    TileListSource(const TileGrid& grid, const std::vector<std::vector<uint32_t>>& tileLights)
+    TileListSource(const TileGrid& grid, const LightIndexLists& tileLights)
         : mGrid(grid), mTileLights(tileLights) {}
     void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
         const int size = mGrid.tileSizePixels;
@@ -55,12 +55,12 @@ public:
                 return ((packet.y0 + kernel::laneY(lane)) / size) * mGrid.tileCountX +
                        (packet.x0 + kernel::laneX(lane)) / size;
             },
-            [&](int tile) { return std::span<const uint32_t>(mTileLights[size_t(tile)]); });
+            [&](int tile) { return mTileLights[size_t(tile)]; });
     }
 
 private:
     const TileGrid& mGrid;
-    const std::vector<std::vector<uint32_t>>& mTileLights;
+    const LightIndexLists& mTileLights;
 };
 
 struct TiledOptions {
@@ -85,53 +85,35 @@ public:
         const auto cullStart = Clock::now();
 
         const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
-        const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
         const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
-        const std::vector<CandidateLight> candidates =
-            candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
-
         const std::vector<TileSurfaceBounds> bounds =
             computeTileSurfaceBounds(gb, grid, {mOptions.depthMask, mOptions.backface});
-
-        std::vector<std::vector<uint32_t>> tileLights(size_t(grid.tileCount()));
-        std::vector<uint64_t> tileBackfaceRejected(size_t(grid.tileCount()), 0);
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            const TileSurfaceBounds& b = bounds[size_t(tile)];
-            if (!b.covered)
-                return;
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-            tileBackfaceRejected[size_t(tile)] =
-                appendTileLights(candidates, tx, ty, b, box,
-                                 {mOptions.depthMask, mOptions.backface}, tileLights[size_t(tile)]);
-        });
+        const TileLightListStats lists = buildTileLightLists(
+            view, grid, bounds, spheres,
+            {mOptions.viewFrustumCulling, mOptions.depthMask, mOptions.backface}, mTileLights);
         const double cullMs =
             std::chrono::duration<double, std::milli>(Clock::now() - cullStart).count();
 
         const auto shadeStart = Clock::now();
-        accumulateLights(inputs, TileListSource(grid, tileLights), {}, result);
+        accumulateLights(inputs, TileListSource(grid, mTileLights), {}, result);
         const double shadeMs =
             std::chrono::duration<double, std::milli>(Clock::now() - shadeStart).count();
 
-        uint64_t pairs = 0, backfaceRejected = 0;
-        for (size_t tile = 0; tile < tileLights.size(); ++tile) {
-            pairs += tileLights[tile].size();
-            backfaceRejected += tileBackfaceRejected[tile];
-        }
         result.timingsMs.emplace_back(pass::kCull, cullMs);
         result.timingsMs.emplace_back(pass::kShading, shadeMs);
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
-        result.parameters["lights_after_vfc"] = std::to_string(candidates.size());
-        result.parameters["vfc_culled"] = std::to_string(spheres.size() - candidates.size());
-        result.parameters["tile_light_pairs"] = std::to_string(pairs);
+        result.parameters["lights_after_vfc"] = std::to_string(lists.lightsAfterVfc);
+        result.parameters["vfc_culled"] = std::to_string(spheres.size() - lists.lightsAfterVfc);
+        result.parameters["tile_light_pairs"] = std::to_string(mTileLights.pairCount());
         if (mOptions.backface)
-            result.parameters["backface_rejected"] = std::to_string(backfaceRejected);
+            result.parameters["backface_rejected"] = std::to_string(lists.backfaceRejected);
     }
 
 private:
     TiledOptions mOptions;
+    LightIndexLists mTileLights; // per tile, ascending; storage reused across frames
 };
 
 TiledOptions parseTiledOptions(const StageSpec& spec, bool backface) {
