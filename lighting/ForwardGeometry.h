@@ -34,6 +34,7 @@
 #include "gbuffer/Surface.h"
 #include "gbuffer/VisibilityPass.h"
 #include "lighting/LightBounds.h"
+#include "lighting/PassNames.h"
 #include "lighting/ShadingStage.h"
 #include "lighting/culling/CullingTests.h"
 #include "lighting/culling/LightIndexLists.h"
@@ -55,9 +56,19 @@ public:
     // rasterizer. Requires inputs.scene, inputs.geometry, inputs.view. Cost O(vertices +
     // triangles), parallel.
     void prepare(const StageInputs& inputs);
+    // The same, timed as the pass "transform" in `result` (the forward stages' first pass).
+    void prepare(const StageInputs& inputs, StageResult& result) {
+        PassTimer transform(result, pass::kTransform);
+        prepare(inputs);
+    }
 
     // The depth pre-pass: the visibility draw into depth() and visibility().codes().
     void drawDepthPrepass() { mVisibility.draw(*mRasterizer, mDepth); }
+    // The same, timed as the pass "prepass" in `result`.
+    void drawDepthPrepass(StageResult& result) {
+        PassTimer prepass(result, pass::kPrepass);
+        drawDepthPrepass();
+    }
     // Clears depth() to the view's far value, for a first draw without a pre-pass.
     void clearDepth() { std::fill(mDepth.begin(), mDepth.end(), mVisibility.view().clearDepth()); }
     // Draws `triangles` (visibility().triangles(), or a subset indexing its clip positions) with

@@ -27,8 +27,6 @@
 // no per-pixel list for a packet to walk; its pass structure is what the stage measures.
 #include "lighting/stages/Stages.h"
 
-#include <chrono>
-
 #include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
@@ -52,7 +50,7 @@ public:
         result.resize(width, height, false);
 
         VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
-        const auto start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         float* radiance[3] = {result.radiance[0].data(), result.radiance[1].data(),
                               result.radiance[2].data()};
         uint32_t* evaluated = result.lightsEvaluated.data();
@@ -72,7 +70,7 @@ public:
         cull.volumes.draw(
             cull.spheres, cull.drawn,
             [&](uint32_t light, int x, int y, size_t pixel) { addLight(x, y, pixel, light); });
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
 
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
     }

@@ -22,8 +22,6 @@
 // by light, not 4x4 packets decoded from a G-buffer.
 #include "lighting/stages/Stages.h"
 
-#include <chrono>
-
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardGeometry.h"
@@ -44,20 +42,15 @@ public:
         const int width = view.width;
         result.resize(width, view.height, false);
 
-        auto start = std::chrono::steady_clock::now();
-        mForward.prepare(inputs);
-        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
+        mForward.prepare(inputs, result);
+        mForward.drawDepthPrepass(result);
 
-        start = std::chrono::steady_clock::now();
-        mForward.drawDepthPrepass();
-        result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
-
-        start = std::chrono::steady_clock::now();
+        PassTimer cull(result, pass::kCull);
         mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
         mSets = mObjectLights.transposed(inputs.lights->size());
-        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
+        cull.stop();
 
-        start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const std::vector<ForwardObject>& objects = mForward.objects();
         const std::vector<uint32_t>& allIndices = inputs.geometry->indices;
@@ -104,7 +97,7 @@ public:
             mForward.draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
                           addLight);
         }
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
     }
 
 private:

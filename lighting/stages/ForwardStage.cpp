@@ -21,12 +21,11 @@
 // are drawn, not 4x4 packets decoded from a G-buffer.
 #include "lighting/stages/Stages.h"
 
-#include <chrono>
-
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardGeometry.h"
 #include "lighting/LightBounds.h"
+#include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 
 namespace lighting {
@@ -46,48 +45,36 @@ public:
         result.resize(width, view.height, false);
         result.parameters["prepass"] = mPrepass ? "1" : "0";
 
-        auto start = std::chrono::steady_clock::now();
-        mForward.prepare(inputs);
-        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
-
-        start = std::chrono::steady_clock::now();
-        mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
-        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
-
-        const gbuffer::VisibilityPass& visibility = mForward.visibility();
-        if (mPrepass) {
-            start = std::chrono::steady_clock::now();
-            mForward.drawDepthPrepass();
-            result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
-        } else {
-            mForward.clearDepth();
+        mForward.prepare(inputs, result);
+        {
+            PassTimer cull(result, pass::kCull);
+            mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
         }
 
-        start = std::chrono::steady_clock::now();
+        const gbuffer::VisibilityPass& visibility = mForward.visibility();
+        if (mPrepass)
+            mForward.drawDepthPrepass(result);
+        else
+            mForward.clearDepth();
+
+        PassTimer shading(result, pass::kShading);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const bool equalOnly = mPrepass;
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             const size_t pixel = size_t(fragment.y) * width + fragment.x;
             if (equalOnly && !visibility.isVisible(fragment, fragment.triangle))
                 return;
-            const std::span<const uint32_t> list =
-                mObjectLights[mForward.objectOfTriangle(fragment.triangle)];
-            const gbuffer::Surface point = mForward.surfaceAt(fragment, fragment.triangle);
-            const glm::vec3 toViewer = glm::normalize(-point.positionView);
-            glm::vec3 sum(0.0f);
-            for (uint32_t index : list)
-                sum += evaluateLight(point, toViewer, lights[index]);
-            result.radiance[0][pixel] = sum.x;
-            result.radiance[1][pixel] = sum.y;
-            result.radiance[2][pixel] = sum.z;
-            result.lightsEvaluated[pixel] += uint32_t(list.size());
-            result.traceLightList(pixel, list);
+            // Overdraw: the pixel's radiance is replaced, its evaluations add up.
+            const uint32_t evaluatedBefore = result.lightsEvaluated[pixel];
+            shadeWithLightList(mForward.surfaceAt(fragment, fragment.triangle), pixel, lights,
+                               mObjectLights[mForward.objectOfTriangle(fragment.triangle)], result);
+            result.lightsEvaluated[pixel] += evaluatedBefore;
         };
         // Without a pre-pass, the visibility draw's own state (every fragment that passes the
         // closer test is shaded); with one, the redraw that passes each visible fragment once.
         mForward.draw(visibility.triangles(),
                       mPrepass ? visibility.redrawState() : visibility.drawState(), shadeFragment);
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
     }
 
 private:

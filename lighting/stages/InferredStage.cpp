@@ -66,7 +66,6 @@
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <span>
 
@@ -131,7 +130,6 @@ public:
     StageRequirements requirements() const override { return MaterialPass::gbufferRequirements(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
-        using Clock = std::chrono::steady_clock;
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         const int scale = mOptions.scale;
@@ -149,15 +147,15 @@ public:
 
         // Cull on the full-res grid with tiles of tile*scale pixels: full-res tile (tx, ty) holds
         // exactly the samples of low-res tile (tx, ty), since sample i lies in block i.
-        const auto cullStart = Clock::now();
+        PassTimer cullPass(result, pass::kCull);
         const TileGrid grid = TileGrid::make(width, height, mOptions.tileSizeSamples * scale);
         const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
         const std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {});
         buildTileLightLists(gb.view(), grid, bounds, spheres, {}, mTileLights);
-        const double cullMs = millisecondsSince(cullStart);
+        cullPass.stop();
 
         // L-buffer at low resolution.
-        const auto lightingStart = Clock::now();
+        PassTimer lightingPass(result, pass::kLighting);
         mSamples.assign(size_t(lowWidth) * lowHeight, LightSample{});
         const int tileSamples = mOptions.tileSizeSamples;
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
@@ -183,10 +181,10 @@ public:
                     result.lightsEvaluated[size_t(y) * width + x] = uint32_t(list.size());
                 }
         });
-        const double lightingMs = millisecondsSince(lightingStart);
+        lightingPass.stop();
 
         // Material pass: second geometry pass, DSF upsampling, combine.
-        const auto materialStart = Clock::now();
+        PassTimer materialPass(result, pass::kMaterial);
         mMaterials.draw(inputs);
         // Object IDs: the scene instance of the visible triangle, for every pixel (looked up on
         // the fly) and for every low-res sample (the pixel the sample read in "lighting").
@@ -266,7 +264,7 @@ public:
             result.radiance[1][pixel] = radiance.g;
             result.radiance[2][pixel] = radiance.b;
         });
-        const double materialMs = millisecondsSince(materialStart);
+        materialPass.stop();
 
         const uint64_t pairs = mTileLights.pairCount();
         uint64_t fallbacks = 0, idFallbacks = 0;
@@ -274,9 +272,6 @@ public:
             fallbacks += f;
         for (uint32_t f : rowIdFallbacks)
             idFallbacks += f;
-        result.timingsMs.emplace_back(pass::kCull, cullMs);
-        result.timingsMs.emplace_back(pass::kLighting, lightingMs);
-        result.timingsMs.emplace_back(pass::kMaterial, materialMs);
         result.parameters["scale"] = std::to_string(scale);
         result.parameters["depth"] = std::to_string(mOptions.depthThreshold);
         result.parameters["normal"] = std::to_string(mOptions.normalThreshold);

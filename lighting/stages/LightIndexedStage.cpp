@@ -24,7 +24,6 @@
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 
 #include <tbb/parallel_for.h>
 
@@ -90,7 +89,7 @@ public:
         result.resize(width, height, false);
 
         VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
-        auto start = std::chrono::steady_clock::now();
+        PassTimer index(result, pass::kIndex);
         mCounts.assign(gb.pixelCount(), 0);
         mLists.resize(gb.pixelCount() * capacity);
         uint16_t* counts = mCounts.data();
@@ -107,9 +106,9 @@ public:
         };
         cull.volumes.draw(cull.spheres, cull.drawn,
                           [&](uint32_t light, int, int, size_t pixel) { append(pixel, light); });
-        result.timingsMs.emplace_back(pass::kIndex, millisecondsSince(start));
+        index.stop();
 
-        start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         const bool anyOverflow =
             std::find(mCounts.begin(), mCounts.end(), kOverflowed) != mCounts.end();
         const TileGrid overflowGrid = TileGrid::make(width, height, kOverflowTileSize);
@@ -125,7 +124,7 @@ public:
         uint64_t overflowPixels = 0;
         for (uint16_t count : mCounts)
             overflowPixels += count == kOverflowed ? 1 : 0;
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
 
         result.parameters["max"] = std::to_string(mMaxLights);
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);

@@ -40,7 +40,6 @@
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 #include <span>
 
 #include <tbb/parallel_for.h>
@@ -68,21 +67,20 @@ public:
     StageRequirements requirements() const override { return MaterialPass::gbufferRequirements(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
-        using Clock = std::chrono::steady_clock;
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
-        const auto cullStart = Clock::now();
+        PassTimer cullPass(result, pass::kCull);
         const TileGrid grid = TileGrid::make(width, height, mTileSizePixels);
         const std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {});
         buildTileLightLists(gb.view(), grid, bounds, boundingSpheresView(*inputs.lights), {},
                             mTileLights);
-        const double cullMs = millisecondsSince(cullStart);
+        cullPass.stop();
 
         // Light buffer: diffuse RGB + monochromatic specular, per pixel.
-        const auto lightingStart = Clock::now();
+        PassTimer lightingPass(result, pass::kLighting);
         mDiffuse.assign(gb.pixelCount(), glm::vec3(0.0f));
         mSpecular.assign(gb.pixelCount(), 0.0f);
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
@@ -102,10 +100,10 @@ public:
                     result.lightsEvaluated[pixel] = uint32_t(list.size());
                 }
         });
-        const double lightingMs = millisecondsSince(lightingStart);
+        lightingPass.stop();
 
         // Material pass: second geometry pass into a visibility buffer, then combine.
-        const auto materialStart = Clock::now();
+        PassTimer materialPass(result, pass::kMaterial);
         mMaterials.draw(inputs);
         mMaterials.forEachSurface(gb, [&](int, int, size_t pixel, const gbuffer::Surface& s) {
             const glm::vec3& diffuse = mDiffuse[pixel];
@@ -121,12 +119,9 @@ public:
             result.radiance[1][pixel] = radiance.g;
             result.radiance[2][pixel] = radiance.b;
         });
-        const double materialMs = millisecondsSince(materialStart);
+        materialPass.stop();
 
         const uint64_t pairs = mTileLights.pairCount();
-        result.timingsMs.emplace_back(pass::kCull, cullMs);
-        result.timingsMs.emplace_back(pass::kLighting, lightingMs);
-        result.timingsMs.emplace_back(pass::kMaterial, materialMs);
         result.parameters["spec"] = mChroma ? "chroma" : "grey";
         result.parameters["tile"] = std::to_string(mTileSizePixels);
         result.parameters["tile_light_pairs"] = std::to_string(pairs);

@@ -32,7 +32,6 @@
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 #include <memory>
 #include <span>
 
@@ -67,15 +66,10 @@ public:
         const int width = view.width;
         result.resize(width, view.height, false);
 
-        auto start = std::chrono::steady_clock::now();
-        mForward.prepare(inputs);
-        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
+        mForward.prepare(inputs, result);
+        mForward.drawDepthPrepass(result);
 
-        start = std::chrono::steady_clock::now();
-        mForward.drawDepthPrepass();
-        result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
-
-        start = std::chrono::steady_clock::now();
+        PassTimer cull(result, pass::kCull);
         const TileGrid grid = TileGrid::make(width, view.height, mOptions.tileSizePixels);
         const std::vector<TileSurfaceBounds> bounds = computeTileDepthBounds(
             mForward.depthDecoder(), mForward.depth(), grid, mOptions.depthMask);
@@ -84,9 +78,9 @@ public:
                                 {mOptions.viewFrustumCulling, mOptions.depthMask, false},
                                 mTileLights)
                 .lightsAfterVfc;
-        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
+        cull.stop();
 
-        start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
@@ -99,7 +93,7 @@ public:
                                size_t(fragment.y) * width + fragment.x, lights, list, result);
         };
         mForward.draw(visibility.triangles(), visibility.redrawState(), shadeFragment);
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
 
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";

@@ -27,7 +27,6 @@
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 #include <span>
 
 #include <tbb/parallel_for.h>
@@ -78,11 +77,10 @@ public:
     StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
-        using Clock = std::chrono::steady_clock;
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const gbuffer::CameraView& view = gb.view();
         result.resize(gb.width(), gb.height(), false);
-        const auto cullStart = Clock::now();
+        PassTimer cull(result, pass::kCull);
 
         const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
         const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
@@ -91,16 +89,12 @@ public:
         const TileLightListStats lists = buildTileLightLists(
             view, grid, bounds, spheres,
             {mOptions.viewFrustumCulling, mOptions.depthMask, mOptions.backface}, mTileLights);
-        const double cullMs =
-            std::chrono::duration<double, std::milli>(Clock::now() - cullStart).count();
+        cull.stop();
 
-        const auto shadeStart = Clock::now();
+        PassTimer shading(result, pass::kShading);
         accumulateLights(inputs, TileListSource(grid, mTileLights), {}, result);
-        const double shadeMs =
-            std::chrono::duration<double, std::milli>(Clock::now() - shadeStart).count();
+        shading.stop();
 
-        result.timingsMs.emplace_back(pass::kCull, cullMs);
-        result.timingsMs.emplace_back(pass::kShading, shadeMs);
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
