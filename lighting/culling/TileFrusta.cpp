@@ -179,20 +179,39 @@ TileBox tileBox(const TileEdgePlanes& edges, const TileGrid& grid, int tx, int t
     return box;
 }
 
-bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
-                        const glm::vec3& lightCentreView) {
+BackfaceTileCone backfaceTileCone(const TileBox& box, const TileSurfaceBounds& bounds) {
     constexpr float kHalfPi = 1.57079632679f;
-    if (bounds.normalHalfAngle + kBackfaceSlackRadians >= kHalfPi)
-        return false;
+    BackfaceTileCone cone;
+    cone.enabled = bounds.covered && bounds.normalHalfAngle + kBackfaceSlackRadians < kHalfPi;
+    if (!cone.enabled)
+        return cone;
+    cone.normalAxisView = bounds.normalAxisView;
+    cone.normalHalfAngle = bounds.normalHalfAngle;
+    cone.minAxisCos =
+        std::sin(bounds.normalHalfAngle + kBackfaceSlackRadians) - kBackfaceEarlyOutMargin;
     // Centre in or next to the box: some sample may surround it; delta is undefined or >= pi/2.
     const glm::vec3 pad = 1e-4f * (box.boxMax - box.boxMin) + glm::vec3(1e-5f);
-    if (sphereTouchesBox(lightCentreView, 0.0f, box.boxMin - pad, box.boxMax + pad))
+    cone.padMin = box.boxMin - pad;
+    cone.padMax = box.boxMax + pad;
+    return cone;
+}
+
+bool lightBackFacesTile(const TileBox& box, const BackfaceTileCone& cone,
+                        const glm::vec3& lightCentreView) {
+    constexpr float kHalfPi = 1.57079632679f;
+    if (!cone.enabled)
         return false;
     const glm::vec3 toCentre = box.centre - lightCentreView;
     const float centreDistance = glm::length(toCentre);
     if (!(centreDistance > 0.0f))
         return false;
     const glm::vec3 lightAxis = toCentre / centreDistance;
+    const float axisCos = glm::dot(cone.normalAxisView, lightAxis);
+    // The early-out (header): acos(axisCos) + alpha + slack > pi/2 already, whatever delta is.
+    if (!(axisCos >= cone.minAxisCos))
+        return false;
+    if (sphereTouchesBox(lightCentreView, 0.0f, cone.padMin, cone.padMax))
+        return false;
     float minCos = 1.0f;
     for (const glm::vec3& corner : box.corners) {
         const glm::vec3 toCorner = corner - lightCentreView;
@@ -206,9 +225,8 @@ bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
     const float delta = std::acos(std::min(minCos, 1.0f));
     // Angle between the normal axis and the direction light travels; the thesis' omega (to the
     // light) is pi minus this, and omega > pi/2 + alpha + delta is the same condition.
-    const float axisAngle =
-        std::acos(std::clamp(glm::dot(bounds.normalAxisView, lightAxis), -1.0f, 1.0f));
-    return axisAngle + bounds.normalHalfAngle + delta + kBackfaceSlackRadians <= kHalfPi;
+    const float axisAngle = std::acos(std::clamp(axisCos, -1.0f, 1.0f));
+    return axisAngle + cone.normalHalfAngle + delta + kBackfaceSlackRadians <= kHalfPi;
 }
 
 std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, const TileGrid& grid,
@@ -250,6 +268,7 @@ uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, in
                           const TileSurfaceBounds& b, const TileBox& box,
                           const TileCullOptions& options, std::vector<uint32_t>& list) {
     uint64_t backfaceRejected = 0;
+    const BackfaceTileCone cone = options.backface ? backfaceTileCone(box, b) : BackfaceTileCone{};
     for (const CandidateLight& c : candidates) {
         if (c.unbounded) {
             list.push_back(c.index);
@@ -266,7 +285,7 @@ uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, in
         if (options.depthMask &&
             (depthRangeMask(low, high, b.minDepthMetres, b.maxDepthMetres) & b.depthMask) == 0)
             continue;
-        if (options.backface && lightBackFacesTile(box, b, c.positionView)) {
+        if (cone.enabled && lightBackFacesTile(box, cone, c.positionView)) {
             ++backfaceRejected;
             continue;
         }

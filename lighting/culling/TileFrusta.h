@@ -159,7 +159,24 @@ std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, con
 // the light faces the back of every sample. Returns true when the light can be rejected.
 // Degenerate cases (centre in or on the box, delta >= pi/2, alpha >= pi/2) never reject.
 inline constexpr float kBackfaceSlackRadians = 1e-3f; // >> float error of the angles (~1e-6)
-bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
+// Cost: what the test needs of the tile alone is computed once per tile (BackfaceTileCone), and a
+// tile whose normal cone is too wide to reject anything (alpha + slack >= pi/2) skips the test.
+// Per (tile, light), the angle between the normal axis and the light's direction to the tile is
+// compared first, as a cosine: when it exceeds pi/2 - alpha - slack, no delta >= 0 can make the
+// test reject, so the light is kept after one square root and one dot product (every light in
+// front of a wall, say) instead of the eight corner directions and two arc cosines; the margin of
+// that comparison (kBackfaceEarlyOutMargin, >> the float error of sin and acos) makes it keep only
+// lights the full test keeps too, so the lists are exactly those of the full test.
+inline constexpr float kBackfaceEarlyOutMargin = 1e-5f;
+struct BackfaceTileCone {
+    bool enabled = false; // alpha + slack < pi/2: the test can reject some light
+    glm::vec3 normalAxisView{0.0f, 0.0f, 1.0f};
+    float normalHalfAngle = 0.0f;
+    float minAxisCos = 1.0f; // sin(alpha + slack) - margin: a lower axis cosine never rejects
+    glm::vec3 padMin{0.0f}, padMax{0.0f}; // the box grown by the "centre next to it" pad
+};
+BackfaceTileCone backfaceTileCone(const TileBox& box, const TileSurfaceBounds& bounds);
+bool lightBackFacesTile(const TileBox& box, const BackfaceTileCone& cone,
                         const glm::vec3& lightCentreView);
 
 // Which tests the tile lists use beyond the basic ones (tile-column/row slabs, depth range,

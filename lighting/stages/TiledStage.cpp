@@ -21,9 +21,12 @@
 // "shading". Parameters record the options and counts: lights_after_vfc, vfc_culled,
 // tile_light_pairs and (tiled-backface) backface_rejected.
 // Threads: tiles in parallel; each tile's list and pixels are written by one task only.
-// Cost note (CPU): a light that faces away from a sample is rejected by evaluateLight's n.l test
-// before the specular term, so the samples tiled-backface removes are the cheap ones; the
-// thesis' GPU gains (uniform cost per evaluated light) are larger than what we measure here.
+// Cost note (CPU): a light that faces away from a whole packet is rejected by the kernel's n.l
+// early-out at almost no cost, so the samples tiled-backface removes are the cheap ones; the
+// thesis' GPU gains (uniform cost per evaluated light) are larger than what we measure here. The
+// test itself is made cheap instead (BackfaceTileCone in culling/TileFrusta.h: per-tile data once,
+// a one-dot early-out for lights that cannot be rejected, no test at all in tiles whose normal
+// cone is too wide).
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
