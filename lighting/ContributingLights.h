@@ -5,8 +5,8 @@
 // and the tests use them to check that every contributing light is among the lights a stage
 // evaluated at each pixel (not only that it evaluated as many).
 //
-// Storage: one CSR over the pixels (row-major, y from the top): offsets (pixel count + 1) and
-// light indices. Background pixels have empty lists.
+// Storage: one LightIndexLists (CSR, culling/LightIndexLists.h) over the pixels (row-major, y
+// from the top). Background pixels have empty lists.
 // Cost: every light at every covered pixel (as `brute`), plus 4 bytes per contributing pair.
 // Threads: rows in parallel, each pixel's list written by one task and concatenated in pixel
 // order, so the lists never depend on the thread count. build() is not reentrant; the const
@@ -19,6 +19,7 @@
 
 #include "gbuffer/GBuffer.h"
 #include "lighting/Brdf.h"
+#include "lighting/culling/LightIndexLists.h"
 
 namespace lighting {
 
@@ -30,16 +31,15 @@ public:
 
     int width() const { return mWidth; }
     int height() const { return mHeight; }
-    std::span<const uint32_t> lightsOf(size_t pixel) const {
-        return {mIndices.data() + mOffsets[pixel], mIndices.data() + mOffsets[pixel + 1]};
-    }
-    size_t pairCount() const { return mIndices.size(); }
+    std::span<const uint32_t> lightsOf(size_t pixel) const { return mLists[pixel]; }
+    size_t pairCount() const { return mLists.pairCount(); }
+    const LightIndexLists& lists() const { return mLists; }
 
 private:
     int mWidth = 0;
     int mHeight = 0;
-    std::vector<uint32_t> mOffsets;
-    std::vector<uint32_t> mIndices;
+    LightIndexLists mLists;
+    std::vector<uint32_t> mCounts;                // scratch: per pixel
     std::vector<std::vector<uint32_t>> mRowLists; // scratch: one row's lists, concatenated
 };
 

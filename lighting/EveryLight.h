@@ -6,7 +6,6 @@
 // G-buffer in float, gbuffer::ExactSurface::surfaceAt for the exact surface in double).
 #pragma once
 
-#include <chrono>
 #include <cstdint>
 #include <vector>
 
@@ -26,7 +25,7 @@ template <class T, class SurfaceAt>
 void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>>& lights,
                          const SurfaceAt& surfaceAt, StageResult& result) {
     result.resize(width, height, true);
-    const auto start = std::chrono::steady_clock::now();
+    PassTimer shading(result, pass::kShading);
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             gbuffer::BasicSurface<T> point;
@@ -49,7 +48,7 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
             result.traceEveryLight(pixel, lights.size());
         }
     });
-    result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+    shading.stop();
 }
 
 } // namespace lighting

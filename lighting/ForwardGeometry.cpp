@@ -54,11 +54,21 @@ void ForwardGeometry::prepare(const StageInputs& inputs) {
             lo = glm::min(lo, p);
             hi = glm::max(hi, p);
         }
-        const glm::vec3 magnitude = glm::max(glm::abs(lo), glm::abs(hi));
-        const float pad = kObjectBoxSlack * std::max({magnitude.x, magnitude.y, magnitude.z});
-        object.minView = lo - glm::vec3(pad);
-        object.maxView = hi + glm::vec3(pad);
+        object.boundsView = widenedBox(lo, hi);
     });
+}
+
+void ForwardGeometry::objectLightLists(const std::vector<LightSphere>& spheres,
+                                       LightIndexLists& lists) {
+    mPerObject.resize(mObjects.size());
+    tbb::parallel_for(size_t(0), mObjects.size(), [&](size_t o) {
+        std::vector<uint32_t>& list = mPerObject[o];
+        list.clear();
+        for (uint32_t l = 0; l < spheres.size(); ++l)
+            if (sphereTouchesObject(spheres[l], mObjects[o]))
+                list.push_back(l);
+    });
+    lists.assign(mPerObject);
 }
 
 void fitRasterizer(std::unique_ptr<raster::Rasterizer>& rasterizer,

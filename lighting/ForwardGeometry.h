@@ -13,7 +13,9 @@
 //
 // Conventions: view space right-handed, camera down -Z; depth in the CameraView's convention
 // (reversed by default). Culling is conservative: lights are tested with the widened spheres of
-// LightBounds.h against object boxes padded by kObjectBoxSlack, so rounding only ever adds work.
+// LightBounds.h against object boxes widened by the receiver slack of culling/CullingTests.h
+// (positions reconstructed from float depth stray from the float-transformed vertices by a few
+// ulps of the distance to the camera), so rounding only ever adds work.
 //
 // Thread safety: prepare() is parallel inside and not reentrant per object; the const queries
 // are thread-safe.
@@ -33,23 +35,20 @@
 #include "gbuffer/Surface.h"
 #include "gbuffer/VisibilityPass.h"
 #include "lighting/LightBounds.h"
+#include "lighting/PassNames.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/culling/CullingTests.h"
+#include "lighting/culling/LightIndexLists.h"
 #include "raster/Rasterizer.h"
 
 namespace lighting {
-
-// Relative padding of object boxes (times the largest view-space coordinate magnitude of the
-// box): positions reconstructed from float depth stray from the float-transformed vertices by a
-// few ulps of the distance to the camera; 1e-5 is ~100x that and only ever adds lights.
-inline constexpr float kObjectBoxSlack = 1e-5f;
 
 // A run of consecutive triangles of one instance, drawn as one unit, and its view-space bounds.
 struct ForwardObject {
     uint32_t firstTriangle = 0;
     uint32_t triangleCount = 0;
     uint32_t instance = 0;
-    glm::vec3 minView{0.0f};
-    glm::vec3 maxView{0.0f};
+    ViewBox boundsView; // widened (CullingTests.h)
 };
 
 class ForwardGeometry {
@@ -58,9 +57,19 @@ public:
     // rasterizer. Requires inputs.scene, inputs.geometry, inputs.view. Cost O(vertices +
     // triangles), parallel.
     void prepare(const StageInputs& inputs);
+    // The same, timed as the pass "transform" in `result` (the forward stages' first pass).
+    void prepare(const StageInputs& inputs, StageResult& result) {
+        PassTimer transform(result, pass::kTransform);
+        prepare(inputs);
+    }
 
     // The depth pre-pass: the visibility draw into depth() and visibility().codes().
     void drawDepthPrepass() { mVisibility.draw(*mRasterizer, mDepth); }
+    // The same, timed as the pass "prepass" in `result`.
+    void drawDepthPrepass(StageResult& result) {
+        PassTimer prepass(result, pass::kPrepass);
+        drawDepthPrepass();
+    }
     // Clears depth() to the view's far value, for a first draw without a pre-pass.
     void clearDepth() { std::fill(mDepth.begin(), mDepth.end(), mVisibility.view().clearDepth()); }
     // Draws `triangles` (visibility().triangles(), or a subset indexing its clip positions) with
@@ -91,6 +100,11 @@ public:
     // the pre-pass (codes(), isVisible()) and surfaces.
     const gbuffer::VisibilityPass& visibility() const { return mVisibility; }
     const std::vector<ForwardObject>& objects() const { return mObjects; }
+    // Per object, the lights whose sphere touches its box (sphereTouchesObject), ascending: the
+    // per-object lists of `forward`, and transposed, the illumination sets of
+    // `forward-multipass`. Objects in parallel, each into its own list, concatenated in object
+    // order (deterministic). Not reentrant (scratch storage).
+    void objectLightLists(const std::vector<LightSphere>& spheres, LightIndexLists& lists);
     uint32_t objectOfTriangle(uint32_t triangle) const { return mObjectOfTriangle[triangle]; }
 
     // The fragment's surface as `brute` sees it in the G-buffer (see the file comment).
@@ -111,16 +125,12 @@ private:
     std::vector<glm::vec3> mPositionsView; // for the object bounds only
     std::vector<ForwardObject> mObjects;
     std::vector<uint32_t> mObjectOfTriangle;
+    std::vector<std::vector<uint32_t>> mPerObject; // objectLightLists scratch
 };
 
 // True when the (widened) light sphere may touch the object's box; unbounded lights always do.
 inline bool sphereTouchesObject(const LightSphere& sphere, const ForwardObject& object) {
-    if (sphere.unbounded)
-        return true;
-    const glm::vec3 outside =
-        glm::max(glm::max(object.minView - sphere.centreView, sphere.centreView - object.maxView),
-                 glm::vec3(0.0f));
-    return glm::dot(outside, outside) <= sphere.radius * sphere.radius;
+    return sphereTouchesBox(sphere, object.boundsView);
 }
 
 // Ensures `rasterizer` matches the view's size (recreated only when it changes).

@@ -1,6 +1,7 @@
 // LightBounds: conservative view-space bounding spheres of lights, for culling. Every culling
 // stage tests these and never the raw range, so a light is never dropped by rounding: the radius
-// is widened by kCullingSlack (relative) + kCullingSlackMetres (absolute), far more than the
+// is widened by kCullingSlack (relative) + kCullingSlackMetres (absolute; rule 1 of the one slack
+// policy, culling/README.md), far more than the
 // float error of the positions a stage reconstructs, and the widening only ever adds work.
 // Directional and ambient lights are unbounded (they reach every pixel). A spot light lights only
 // the points within its range AND its outer cone, so its sphere is the smallest sphere around that

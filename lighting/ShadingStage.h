@@ -43,7 +43,7 @@
 //   - lightingSamples: left empty, except by a stage that evaluates lights at some pixels only
 //     and fills the others from them (inferred): 1 at the pixels it lit, 0 elsewhere.
 //   - timingsMs: one entry per pass the stage runs, in execution order, with short lowercase
-//     names ("cull", "shading"...), measured with millisecondsSince; not the G-buffer pass (the
+//     names ("cull", "shading"...), measured with PassTimer; not the G-buffer pass (the
 //     runner adds "gbuffer" and "total").
 //   - parameters: the effective value of every option that applies (defaults included) under its
 //     option key, and the stage's counters (e.g. tile_light_pairs), as strings.
@@ -156,11 +156,40 @@ struct StageResult {
     }
 };
 
-// Milliseconds since `start` on the steady clock: how stages time their passes.
+// Milliseconds since `start` on the steady clock.
 inline double millisecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
         .count();
 }
+
+// How stages time their passes: a pass runs from the timer's construction to stop() (or the end
+// of its scope), and is then appended to result.timingsMs under `pass` (a PassNames.h constant),
+// so passes are recorded in execution order. stop() returns the milliseconds; calls after the
+// first return the same value and record nothing. Not copyable; one timer per pass.
+class PassTimer {
+public:
+    PassTimer(StageResult& result, const char* pass)
+        : mResult(result), mPass(pass), mStart(std::chrono::steady_clock::now()) {}
+    ~PassTimer() { stop(); }
+    PassTimer(const PassTimer&) = delete;
+    PassTimer& operator=(const PassTimer&) = delete;
+
+    double stop() {
+        if (!mStopped) {
+            mStopped = true;
+            mMilliseconds = millisecondsSince(mStart);
+            mResult.timingsMs.emplace_back(mPass, mMilliseconds);
+        }
+        return mMilliseconds;
+    }
+
+private:
+    StageResult& mResult;
+    const char* mPass;
+    std::chrono::steady_clock::time_point mStart;
+    bool mStopped = false;
+    double mMilliseconds = 0.0;
+};
 
 class ShadingStage {
 public:

@@ -135,30 +135,25 @@ void ClusterGrid::build(const ClusterGridOptions& options, const gbuffer::Camera
     for (int k = 1; k <= nz; ++k)
         mSliceDepth[k] = std::max(mSliceDepth[k], mSliceDepth[k - 1]);
 
-    // AABBs of the 8 corners, widened by the slack.
+    // AABBs of the 8 corners, widened by the receiver slack (CullingTests.h).
     mBounds.resize(size_t(nx) * ny * nz);
     tbb::parallel_for(0, nz, [&](int k) {
         const float depths[2] = {mSliceDepth[k], mSliceDepth[k + 1]};
         for (int ty = 0; ty < ny; ++ty)
             for (int tx = 0; tx < nx; ++tx) {
-                ClusterAabb box{glm::vec3(INFINITY), glm::vec3(-INFINITY)};
+                glm::vec3 lo(INFINITY), hi(-INFINITY);
                 for (float d : depths)
                     for (int cx = 0; cx < 2; ++cx)
                         for (int cy = 0; cy < 2; ++cy) {
                             const glm::vec3 corner(mEdgeTanX[tx + cx] * d,
                                                    -mEdgeTanDownY[ty + cy] * d, -d);
-                            box.lo = glm::min(box.lo, corner);
-                            box.hi = glm::max(box.hi, corner);
+                            lo = glm::min(lo, corner);
+                            hi = glm::max(hi, corner);
                         }
-                const glm::vec3 slack = kAabbSlack * glm::max(glm::abs(box.lo), glm::abs(box.hi)) +
-                                        glm::vec3(kAabbSlackMetres);
-                box.lo -= slack;
-                box.hi += slack;
-                mBounds[clusterIndex(tx, ty, k)] = box;
+                mBounds[clusterIndex(tx, ty, k)] = widenedBox(lo, hi);
             }
     });
-    mOffsets.assign(mBounds.size() + 1, 0);
-    mIndices.clear();
+    mLists.assignFromPairs(mBounds.size(), {});
 }
 
 int ClusterGrid::sliceOfDepth(float depthMetres) const {
@@ -178,16 +173,13 @@ int ClusterGrid::sliceOfDepth(float depthMetres) const {
 bool ClusterGrid::mayTouch(const LightSphere& sphere, int tileX, int tileY, int slice) const {
     if (sphere.unbounded)
         return true;
-    const ClusterAabb& box = mBounds[clusterIndex(tileX, tileY, slice)];
-    const glm::vec3 nearest = glm::clamp(sphere.centreView, box.lo, box.hi);
-    const glm::vec3 offset = sphere.centreView - nearest;
-    const float r = sphere.radius;
-    if (glm::dot(offset, offset) > r * r)
+    if (!sphereTouchesBox(sphere, mBounds[clusterIndex(tileX, tileY, slice)]))
         return false;
+    const float r = sphere.radius;
     if (mOptions.test == ClusterTest::Frustum) {
         // Signed distances to the side planes (positive to the right / below the edge).
         const glm::vec3& c = sphere.centreView;
-        const float slack = r + kAabbSlack * glm::length(c) + kAabbSlackMetres;
+        const float slack = r + boundSlackMetres(glm::length(c));
         if (mPlaneX[tileX].x * c.x + mPlaneX[tileX].y * c.z < -slack)
             return false;
         if (mPlaneX[tileX + 1].x * c.x + mPlaneX[tileX + 1].y * c.z > slack)
@@ -230,14 +222,14 @@ bool ClusterGrid::candidateRanges(const LightSphere& sphere, AssignMethod method
     auto range = method == AssignMethod::Walk ? walkRange : binaryRange;
     // The ranges are exact frustum geometry (tighter than the AABBs, which overhang their tiles);
     // widened by the cluster slack so that rounding of reconstructed positions is covered too.
-    const float absoluteSlack = 2.0f * kAabbSlackMetres / depthLo;
+    const float absoluteSlack = 2.0f * kBoundSlackMetres / depthLo;
     const float tanSlack =
-        2.0f * kAabbSlack * (1.0f + std::abs(tanXLo) + std::abs(tanXHi)) + absoluteSlack;
+        2.0f * kBoundSlack * (1.0f + std::abs(tanXLo) + std::abs(tanXHi)) + absoluteSlack;
     const float downSlack =
-        2.0f * kAabbSlack * (1.0f + std::abs(tanDownLo) + std::abs(tanDownHi)) + absoluteSlack;
+        2.0f * kBoundSlack * (1.0f + std::abs(tanDownLo) + std::abs(tanDownHi)) + absoluteSlack;
     columns = range(mEdgeTanX, tanXLo - tanSlack, tanXHi + tanSlack);
     rows = range(mEdgeTanDownY, tanDownLo - downSlack, tanDownHi + downSlack);
-    const float depthSlack = 2.0f * (kAabbSlack * depthHi + kAabbSlackMetres);
+    const float depthSlack = 2.0f * (kBoundSlack * depthHi + kBoundSlackMetres);
     slices = range(mSliceDepth, depthLo - depthSlack, depthHi + depthSlack);
     return !columns.empty() && !rows.empty() && !slices.empty();
 }
@@ -264,22 +256,7 @@ void ClusterGrid::assign(const std::vector<LightSphere>& spheres) {
         }
     });
     // Stable counting sort by cluster, batches in order: each list comes out ascending.
-    size_t total = 0;
-    for (const auto& pairs : batches)
-        total += pairs.size();
-    if (total >= size_t(UINT32_MAX))
-        throw std::length_error("ClusterGrid: too many (cluster, light) pairs");
-    std::fill(mOffsets.begin(), mOffsets.end(), 0u);
-    for (const auto& pairs : batches)
-        for (const auto& pair : pairs)
-            ++mOffsets[pair.first + 1];
-    for (size_t i = 1; i < mOffsets.size(); ++i)
-        mOffsets[i] += mOffsets[i - 1];
-    mIndices.resize(total);
-    std::vector<uint32_t> cursor(mOffsets.begin(), mOffsets.end() - 1);
-    for (const auto& pairs : batches)
-        for (const auto& pair : pairs)
-            mIndices[cursor[pair.first]++] = pair.second;
+    mLists.assignFromPairs(mBounds.size(), batches);
 }
 
 } // namespace lighting

@@ -12,9 +12,11 @@
 // depths [sliceDepth(k), sliceDepth(k+1)]; boundaries are geometric (exponential, self-similar
 // clusters) or uniform between the near and far depth given at construction.
 //
-// Culling volumes. Each cluster has a view-space AABB of its 8 corners, widened by a tiny slack
-// (kAabbSlack) so that a reconstructed position that rounding pushed just outside its cluster
-// is still inside the box; the light spheres (lighting/LightBounds.h) are widened far more.
+// Culling volumes. Each cluster has a view-space AABB of its 8 corners, widened by the receiver
+// slack of culling/CullingTests.h (rule 3: widenedBox) so that a reconstructed position that
+// rounding pushed just outside its cluster is still inside the box; the light spheres
+// (lighting/LightBounds.h) are widened far more. The side planes and the candidate ranges below
+// use the same kBoundSlack.
 // test=aabb tests sphere vs AABB; test=frustum additionally rejects a sphere wholly outside one
 // of the cluster's four side planes (tighter, still conservative).
 //
@@ -23,7 +25,7 @@
 // them by walking the sorted tile planes / slice boundaries from the first one (Örtegren's
 // plane reduction), `binary` by binary search. Both evaluate the same predicates, so they give
 // the same ranges, and every candidate cluster is then tested with the cluster test. Unbounded
-// lights (directional, ambient) go into every cluster. The result is a CSR (offsets + indices)
+// lights (directional, ambient) go into every cluster. The result is a LightIndexLists (CSR)
 // with each cluster's light indices ascending. Parallel over fixed batches of lights, merged by a
 // stable counting sort in batch order: the lists never depend on the thread count, and no
 // atomics are used.
@@ -40,6 +42,8 @@
 
 #include "gbuffer/CameraView.h"
 #include "lighting/LightBounds.h"
+#include "lighting/culling/CullingTests.h"
+#include "lighting/culling/LightIndexLists.h"
 
 namespace lighting {
 
@@ -61,18 +65,8 @@ struct ClusterGridOptions {
 inline constexpr int kMaxClusterDimension = 1024;
 inline constexpr size_t kMaxClusterCount = size_t(1) << 20;
 
-// Relative + absolute widening of every cluster AABB and side-plane test: a few hundred float
-// ulps of the coordinates, the reconstruction error of a G-buffer position.
-inline constexpr float kAabbSlack = 1e-5f;
-inline constexpr float kAabbSlackMetres = 1e-6f;
-
 // Parses "XxYxZ" (e.g. "24x12x32"); returns false when malformed, zero or beyond the limits.
 bool parseClusterGrid(const std::string& text, int& tilesX, int& tilesY, int& slices);
-
-struct ClusterAabb {
-    glm::vec3 lo{0.0f};
-    glm::vec3 hi{0.0f};
-};
 
 class ClusterGrid {
 public:
@@ -106,7 +100,7 @@ public:
     // x / depth of column edge j (0..tilesX), increasing; -y / depth of row edge j, increasing.
     float edgeTanX(int j) const { return mEdgeTanX[j]; }
     float edgeTanDownY(int j) const { return mEdgeTanDownY[j]; }
-    const ClusterAabb& bounds(size_t cluster) const { return mBounds[cluster]; }
+    const ViewBox& bounds(size_t cluster) const { return mBounds[cluster]; }
 
     // The cluster test (the option `test`): may the sphere touch the cluster? Conservative.
     bool mayTouch(const LightSphere& sphere, int tileX, int tileY, int slice) const;
@@ -120,10 +114,9 @@ public:
     // previous lists. Cost: O(lights * candidate clusters + clusters + pairs), parallel over
     // lights.
     void assign(const std::vector<LightSphere>& spheres);
-    std::span<const uint32_t> lightsOf(size_t cluster) const {
-        return {mIndices.data() + mOffsets[cluster], mIndices.data() + mOffsets[cluster + 1]};
-    }
-    size_t pairCount() const { return mIndices.size(); }
+    std::span<const uint32_t> lightsOf(size_t cluster) const { return mLists[cluster]; }
+    size_t pairCount() const { return mLists.pairCount(); }
+    const LightIndexLists& lists() const { return mLists; }
 
 private:
     ClusterGridOptions mOptions;
@@ -135,9 +128,8 @@ private:
     std::vector<glm::vec2> mPlaneY;   // same for rows with y flipped: -y + tanDown*z
     std::vector<float> mSliceDepth;   // slices + 1, non-decreasing
     int mSearchStep = 0;              // largest power of two <= max(slices - 1, 1)
-    std::vector<ClusterAabb> mBounds;
-    std::vector<uint32_t> mOffsets; // clusterCount + 1
-    std::vector<uint32_t> mIndices;
+    std::vector<ViewBox> mBounds;
+    LightIndexLists mLists;                                              // per cluster
     std::vector<std::vector<std::pair<uint32_t, uint32_t>>> mBatchPairs; // assign() scratch
 };
 

@@ -163,31 +163,7 @@ LightVolumeRasterizer::LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, Vo
 
 std::vector<uint32_t> LightVolumeRasterizer::lightsToDraw(const std::vector<LightSphere>& spheres,
                                                           bool frustumCull) const {
-    std::vector<uint32_t> drawn;
-    drawn.reserve(spheres.size());
-    for (uint32_t i = 0; i < uint32_t(spheres.size()); ++i)
-        if (!frustumCull || inViewFrustum(spheres[i]))
-            drawn.push_back(i);
-    return drawn;
-}
-
-bool LightVolumeRasterizer::inViewFrustum(const LightSphere& sphere) const {
-    if (sphere.unbounded)
-        return true;
-    const glm::dvec3 c(sphere.centreView);
-    const double r = double(sphere.radius) * (1.0 + 1e-6);
-    if (c.z - r > -double(mNearMetres))
-        return false; // wholly nearer than the near plane
-    if (c.z + r < -double(mFarMetres))
-        return false; // wholly beyond the far plane
-    // Side planes through the eye: inside when +-p * x + z <= 0 (p = projection scale).
-    const double px = mProjX, py = mProjY;
-    const double lengthX = std::sqrt(px * px + 1.0), lengthY = std::sqrt(py * py + 1.0);
-    if ((px * c.x + c.z) / lengthX > r || (-px * c.x + c.z) / lengthX > r)
-        return false;
-    if ((py * c.y + c.z) / lengthY > r || (-py * c.y + c.z) / lengthY > r)
-        return false;
-    return true;
+    return ViewFrustum(mGBuffer.view()).visibleLights(spheres, frustumCull);
 }
 
 LightVolumeRasterizer::PixelRect

@@ -63,6 +63,7 @@
 
 #include "gbuffer/GBuffer.h"
 #include "lighting/LightBounds.h"
+#include "lighting/culling/CullingTests.h"
 #include "raster/Rasterizer.h"
 
 namespace lighting {
@@ -126,10 +127,9 @@ public:
     LightVolumeRasterizer(const gbuffer::GBuffer& gbuffer, VolumeShape shape, bool stencil,
                           SpotProxy spotProxy);
 
-    // True when the sphere may touch the view frustum (conservative; six planes).
-    bool inViewFrustum(const LightSphere& sphere) const;
     // Indices (ascending) of the lights to draw: all of them, or with `frustumCull` only those
-    // whose sphere may touch the view frustum (CPU view-frustum culling).
+    // whose sphere may touch the view frustum (CPU view-frustum culling, ViewFrustum of
+    // CullingTests.h).
     std::vector<uint32_t> lightsToDraw(const std::vector<LightSphere>& spheres,
                                        bool frustumCull) const;
 

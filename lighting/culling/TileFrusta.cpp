@@ -179,38 +179,39 @@ TileBox tileBox(const TileEdgePlanes& edges, const TileGrid& grid, int tx, int t
     return box;
 }
 
-std::vector<uint32_t> lightsInViewFrustum(const gbuffer::CameraView& view, const TileGrid& grid,
-                                          const TileEdgePlanes& edges,
-                                          const std::vector<LightSphere>& spheres) {
-    // Decoded depths may stray from [near, far] by float rounding; widen by far more than that.
-    const float nearDepth = view.nearMetres * 0.999f, farDepth = view.farMetres * 1.001f;
-    std::vector<uint32_t> kept;
-    kept.reserve(spheres.size());
-    for (uint32_t i = 0; i < spheres.size(); ++i) {
-        const LightSphere& s = spheres[i];
-        const float depth = -s.centreView.z;
-        if (s.unbounded || (depth + s.radius >= nearDepth && depth - s.radius <= farDepth &&
-                            sphereInColumnSlab(edges, 0, grid.tileCountX, s.centreView, s.radius) &&
-                            sphereInRowSlab(edges, 0, grid.tileCountY, s.centreView, s.radius)))
-            kept.push_back(i);
-    }
-    return kept;
-}
-
-bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
-                        const glm::vec3& lightCentreView) {
+BackfaceTileCone backfaceTileCone(const TileBox& box, const TileSurfaceBounds& bounds) {
     constexpr float kHalfPi = 1.57079632679f;
-    if (bounds.normalHalfAngle + kBackfaceSlackRadians >= kHalfPi)
-        return false;
+    BackfaceTileCone cone;
+    cone.enabled = bounds.covered && bounds.normalHalfAngle + kBackfaceSlackRadians < kHalfPi;
+    if (!cone.enabled)
+        return cone;
+    cone.normalAxisView = bounds.normalAxisView;
+    cone.normalHalfAngle = bounds.normalHalfAngle;
+    cone.minAxisCos =
+        std::sin(bounds.normalHalfAngle + kBackfaceSlackRadians) - kBackfaceEarlyOutMargin;
     // Centre in or next to the box: some sample may surround it; delta is undefined or >= pi/2.
     const glm::vec3 pad = 1e-4f * (box.boxMax - box.boxMin) + glm::vec3(1e-5f);
-    if (distanceSquaredToBox(lightCentreView, box.boxMin - pad, box.boxMax + pad) == 0.0f)
+    cone.padMin = box.boxMin - pad;
+    cone.padMax = box.boxMax + pad;
+    return cone;
+}
+
+bool lightBackFacesTile(const TileBox& box, const BackfaceTileCone& cone,
+                        const glm::vec3& lightCentreView) {
+    constexpr float kHalfPi = 1.57079632679f;
+    if (!cone.enabled)
         return false;
     const glm::vec3 toCentre = box.centre - lightCentreView;
     const float centreDistance = glm::length(toCentre);
     if (!(centreDistance > 0.0f))
         return false;
     const glm::vec3 lightAxis = toCentre / centreDistance;
+    const float axisCos = glm::dot(cone.normalAxisView, lightAxis);
+    // The early-out (header): acos(axisCos) + alpha + slack > pi/2 already, whatever delta is.
+    if (!(axisCos >= cone.minAxisCos))
+        return false;
+    if (sphereTouchesBox(lightCentreView, 0.0f, cone.padMin, cone.padMax))
+        return false;
     float minCos = 1.0f;
     for (const glm::vec3& corner : box.corners) {
         const glm::vec3 toCorner = corner - lightCentreView;
@@ -224,23 +225,15 @@ bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
     const float delta = std::acos(std::min(minCos, 1.0f));
     // Angle between the normal axis and the direction light travels; the thesis' omega (to the
     // light) is pi minus this, and omega > pi/2 + alpha + delta is the same condition.
-    const float axisAngle =
-        std::acos(std::clamp(glm::dot(bounds.normalAxisView, lightAxis), -1.0f, 1.0f));
-    return axisAngle + bounds.normalHalfAngle + delta + kBackfaceSlackRadians <= kHalfPi;
+    const float axisAngle = std::acos(std::clamp(axisCos, -1.0f, 1.0f));
+    return axisAngle + cone.normalHalfAngle + delta + kBackfaceSlackRadians <= kHalfPi;
 }
 
 std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, const TileGrid& grid,
                                             const TileEdgePlanes& edges,
                                             const std::vector<LightSphere>& spheres,
                                             bool frustumCull) {
-    std::vector<uint32_t> visible;
-    if (frustumCull) {
-        visible = lightsInViewFrustum(view, grid, edges, spheres);
-    } else {
-        visible.resize(spheres.size());
-        for (uint32_t i = 0; i < visible.size(); ++i)
-            visible[i] = i;
-    }
+    const std::vector<uint32_t> visible = ViewFrustum(view).visibleLights(spheres, frustumCull);
     std::vector<CandidateLight> candidates(visible.size());
     tbb::parallel_for(size_t(0), visible.size(), [&](size_t k) {
         const LightSphere& s = spheres[visible[k]];
@@ -272,9 +265,10 @@ std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, con
 }
 
 uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, int ty,
-                          const TileSurfaceBounds& b, const TileBox& box, TileLightTests tests,
-                          std::vector<uint32_t>& list) {
+                          const TileSurfaceBounds& b, const TileBox& box,
+                          const TileCullOptions& options, std::vector<uint32_t>& list) {
     uint64_t backfaceRejected = 0;
+    const BackfaceTileCone cone = options.backface ? backfaceTileCone(box, b) : BackfaceTileCone{};
     for (const CandidateLight& c : candidates) {
         if (c.unbounded) {
             list.push_back(c.index);
@@ -286,12 +280,12 @@ uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, in
         const float low = centreDepth - c.radius, high = centreDepth + c.radius;
         if (high < b.minDepthMetres || low > b.maxDepthMetres)
             continue;
-        if (distanceSquaredToBox(c.centreView, box.boxMin, box.boxMax) > c.radius * c.radius)
+        if (!sphereTouchesBox(c.centreView, c.radius, box.boxMin, box.boxMax))
             continue;
-        if (tests.depthMask &&
+        if (options.depthMask &&
             (depthRangeMask(low, high, b.minDepthMetres, b.maxDepthMetres) & b.depthMask) == 0)
             continue;
-        if (tests.backface && lightBackFacesTile(box, b, c.positionView)) {
+        if (cone.enabled && lightBackFacesTile(box, cone, c.positionView)) {
             ++backfaceRejected;
             continue;
         }
@@ -300,38 +294,31 @@ uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, in
     return backfaceRejected;
 }
 
-std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb,
-                                                       const TileGrid& grid,
-                                                       const std::vector<LightSphere>& spheres,
-                                                       std::vector<TileSurfaceBounds>& bounds) {
-    const TileEdgePlanes edges = TileEdgePlanes::make(gb.view(), grid);
-    bounds = computeTileSurfaceBounds(gb, grid, {false, false});
-    std::vector<std::vector<uint32_t>> lists(size_t(grid.tileCount()));
+TileLightListStats buildTileLightLists(const gbuffer::CameraView& view, const TileGrid& grid,
+                                       const std::vector<TileSurfaceBounds>& bounds,
+                                       const std::vector<LightSphere>& spheres,
+                                       const TileCullOptions& options, LightIndexLists& lists) {
+    const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
+    const std::vector<CandidateLight> candidates =
+        candidateLights(view, grid, edges, spheres, options.frustumCull);
+    const size_t tileCount = size_t(grid.tileCount());
+    std::vector<std::vector<uint32_t>> tileLights(tileCount);
+    std::vector<uint64_t> tileBackfaceRejected(tileCount, 0);
     tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
         const TileSurfaceBounds& b = bounds[size_t(tile)];
         if (!b.covered)
             return;
         const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
         const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-        std::vector<uint32_t>& list = lists[size_t(tile)];
-        for (uint32_t i = 0; i < spheres.size(); ++i) {
-            const LightSphere& s = spheres[i];
-            if (!s.unbounded) {
-                const float centreDepth = -s.centreView.z;
-                if (centreDepth + s.radius < b.minDepthMetres ||
-                    centreDepth - s.radius > b.maxDepthMetres)
-                    continue;
-                if (!sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius) ||
-                    !sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius))
-                    continue;
-                if (distanceSquaredToBox(s.centreView, box.boxMin, box.boxMax) >
-                    s.radius * s.radius)
-                    continue;
-            }
-            list.push_back(i);
-        }
+        tileBackfaceRejected[size_t(tile)] =
+            appendTileLights(candidates, tx, ty, b, box, options, tileLights[size_t(tile)]);
     });
-    return lists;
+    lists.assign(tileLights);
+    TileLightListStats stats;
+    stats.lightsAfterVfc = candidates.size();
+    for (uint64_t rejected : tileBackfaceRejected)
+        stats.backfaceRejected += rejected;
+    return stats;
 }
 
 } // namespace lighting

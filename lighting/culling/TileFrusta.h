@@ -26,6 +26,8 @@
 #include "gbuffer/CameraView.h"
 #include "gbuffer/GBuffer.h"
 #include "lighting/LightBounds.h"
+#include "lighting/culling/CullingTests.h"
+#include "lighting/culling/LightIndexLists.h"
 
 namespace lighting {
 
@@ -130,19 +132,6 @@ struct TileBox {
 TileBox tileBox(const TileEdgePlanes& edges, const TileGrid& grid, int tx, int ty,
                 float minDepthMetres, float maxDepthMetres);
 
-// Squared distance from a point to a box (0 inside).
-inline float distanceSquaredToBox(const glm::vec3& p, const glm::vec3& boxMin,
-                                  const glm::vec3& boxMax) {
-    const glm::vec3 d = glm::max(glm::max(boxMin - p, p - boxMax), glm::vec3(0.0f));
-    return glm::dot(d, d);
-}
-
-// Indices (ascending) of the lights whose sphere may touch the camera's view frustum between
-// the near and far planes (slightly widened); unbounded lights are always kept.
-std::vector<uint32_t> lightsInViewFrustum(const gbuffer::CameraView& view, const TileGrid& grid,
-                                          const TileEdgePlanes& edges,
-                                          const std::vector<LightSphere>& spheres);
-
 // A light that survived view-frustum culling, with the tile columns and rows its sphere may
 // reach (empty when min > max): the cheap integer pre-test before per-tile tests.
 struct CandidateLight {
@@ -155,7 +144,7 @@ struct CandidateLight {
 };
 
 // The candidates in ascending light order: every light, or with `frustumCull` only those
-// lightsInViewFrustum keeps. Parallel over lights.
+// view-frustum culling keeps (ViewFrustum, CullingTests.h). Parallel over lights.
 std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, const TileGrid& grid,
                                             const TileEdgePlanes& edges,
                                             const std::vector<LightSphere>& spheres,
@@ -170,29 +159,58 @@ std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, con
 // the light faces the back of every sample. Returns true when the light can be rejected.
 // Degenerate cases (centre in or on the box, delta >= pi/2, alpha >= pi/2) never reject.
 inline constexpr float kBackfaceSlackRadians = 1e-3f; // >> float error of the angles (~1e-6)
-bool lightBackFacesTile(const TileBox& box, const TileSurfaceBounds& bounds,
+// Cost: what the test needs of the tile alone is computed once per tile (BackfaceTileCone), and a
+// tile whose normal cone is too wide to reject anything (alpha + slack >= pi/2) skips the test.
+// Per (tile, light), the angle between the normal axis and the light's direction to the tile is
+// compared first, as a cosine: when it exceeds pi/2 - alpha - slack, no delta >= 0 can make the
+// test reject, so the light is kept after one square root and one dot product (every light in
+// front of a wall, say) instead of the eight corner directions and two arc cosines; the margin of
+// that comparison (kBackfaceEarlyOutMargin, >> the float error of sin and acos) makes it keep only
+// lights the full test keeps too, so the lists are exactly those of the full test.
+inline constexpr float kBackfaceEarlyOutMargin = 1e-5f;
+struct BackfaceTileCone {
+    bool enabled = false; // alpha + slack < pi/2: the test can reject some light
+    glm::vec3 normalAxisView{0.0f, 0.0f, 1.0f};
+    float normalHalfAngle = 0.0f;
+    float minAxisCos = 1.0f; // sin(alpha + slack) - margin: a lower axis cosine never rejects
+    glm::vec3 padMin{0.0f}, padMax{0.0f}; // the box grown by the "centre next to it" pad
+};
+BackfaceTileCone backfaceTileCone(const TileBox& box, const TileSurfaceBounds& bounds);
+bool lightBackFacesTile(const TileBox& box, const BackfaceTileCone& cone,
                         const glm::vec3& lightCentreView);
 
-// The per-tile light test of `tiled`, `tiled-backface` and `tiled-forward`: appends to `list`,
-// in the candidates' (ascending) order, every candidate that may touch covered tile (tx, ty)
-// with bounds `b` and frustum `box`: unbounded lights always; bounded ones when inside the tile's
-// column/row range, the depth range, and the box (sphere distance); with `depthMask` also
-// Harada's 2.5D test, with `backface` the thesis' normal-cone test (lightBackFacesTile; needs
-// bounds computed with normalCone). Returns how many the back-face test rejected.
-struct TileLightTests {
+// Which tests the tile lists use beyond the basic ones (tile-column/row slabs, depth range,
+// sphere vs tile box): view-frustum culling first (ViewFrustum), Harada's 2.5D depth mask, the
+// thesis' back-face normal-cone test (needs bounds computed with normalCone).
+struct TileCullOptions {
+    bool frustumCull = false;
     bool depthMask = false;
     bool backface = false;
 };
-uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, int ty,
-                          const TileSurfaceBounds& b, const TileBox& box, TileLightTests tests,
-                          std::vector<uint32_t>& list);
 
-// Per-tile light lists (ascending indices) for the covered tiles of `grid` over `gb`, with the
-// conservative tests of `tiled` and none of its optional extras (vfc, masks, cones); `bounds`
-// receives the tiles' surface bounds. Used by the stages that only need plain tile culling.
-std::vector<std::vector<uint32_t>> basicTileLightLists(const gbuffer::GBuffer& gb,
-                                                       const TileGrid& grid,
-                                                       const std::vector<LightSphere>& spheres,
-                                                       std::vector<TileSurfaceBounds>& bounds);
+// The per-tile light test: appends to `list`, in the candidates' (ascending) order, every
+// candidate that may touch covered tile (tx, ty) with bounds `b` and frustum `box`: unbounded
+// lights always; bounded ones when inside the tile's column/row range, the depth range, and the
+// box (sphereTouchesBox); with `depthMask` also Harada's 2.5D test, with `backface` the thesis'
+// normal-cone test (lightBackFacesTile). Returns how many the back-face test rejected.
+uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, int ty,
+                          const TileSurfaceBounds& b, const TileBox& box,
+                          const TileCullOptions& options, std::vector<uint32_t>& list);
+
+struct TileLightListStats {
+    size_t lightsAfterVfc = 0;     // candidates (all lights without frustumCull)
+    uint64_t backfaceRejected = 0; // (tile, light) pairs removed by the back-face test
+};
+
+// The one builder of per-tile light lists, used by `tiled`, `tiled-backface`, `tiled-forward`,
+// `light-prepass`, `inferred` and the overflow path of `light-indexed`: one list per tile of
+// `grid` (row-major), ascending light indices, empty for tiles without a covered sample.
+// `bounds` must come from computeTileSurfaceBounds / computeTileDepthBounds with the depth mask
+// and normal cone that `options` uses. Tiles in parallel, each list written by one task, then
+// concatenated in tile order: the lists never depend on the thread count.
+TileLightListStats buildTileLightLists(const gbuffer::CameraView& view, const TileGrid& grid,
+                                       const std::vector<TileSurfaceBounds>& bounds,
+                                       const std::vector<LightSphere>& spheres,
+                                       const TileCullOptions& options, LightIndexLists& lists);
 
 } // namespace lighting

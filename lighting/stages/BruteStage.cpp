@@ -4,7 +4,6 @@
 // as the list of every packet, on the kernel's ISA (`--isa`); pass "shading".
 #include "lighting/stages/Stages.h"
 
-#include <chrono>
 #include <optional>
 
 #include "lighting/BlendedPass.h"
@@ -22,13 +21,13 @@ public:
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         result.resize(gb.width(), gb.height(), true);
-        const auto start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         if (!mEveryLight || mLightCount != inputs.lights->size()) {
             mLightCount = inputs.lights->size();
             mEveryLight.emplace(mLightCount);
         }
         accumulateLights(inputs, *mEveryLight, {.countOracle = true}, result);
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
         if (mBlended.prepare(inputs))
             mBlended.shadeWithEveryLight(gb.depth(), result);
     }

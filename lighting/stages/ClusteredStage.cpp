@@ -18,7 +18,6 @@
 // decoded position by the same comparisons that define the slices, so it always lies in its
 // cluster (up to rounding, which the widened AABBs and spheres cover).
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <optional>
 
@@ -92,7 +91,7 @@ public:
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
-        const auto assignStart = std::chrono::steady_clock::now();
+        PassTimer assign(result, pass::kAssign);
 
         // Nearest and farthest covered NDC depth (min/max: order-independent, so deterministic).
         const std::span<const float> depth = gb.depth();
@@ -133,12 +132,12 @@ public:
                 mGrid->build(mOptions, gb.view(), nearDepth, farDepth);
             ClusterGrid& grid = *mGrid;
             grid.assign(boundingSpheresView(*inputs.lights));
-            result.timingsMs.emplace_back(pass::kAssign, millisecondsSince(assignStart));
+            assign.stop();
             pairs = std::to_string(grid.pairCount());
 
-            const auto shadingStart = std::chrono::steady_clock::now();
+            PassTimer shading(result, pass::kShading);
             accumulateLights(inputs, ClusterListSource(grid), {}, result);
-            result.timingsMs.emplace_back(pass::kShading, millisecondsSince(shadingStart));
+            shading.stop();
             // Blended surfaces: each fragment with its own cluster's list.
             if (blended)
                 mBlended.shade(
@@ -150,7 +149,7 @@ public:
                     },
                     result);
         } else {
-            result.timingsMs.emplace_back(pass::kAssign, millisecondsSince(assignStart));
+            assign.stop();
             result.timingsMs.emplace_back(pass::kShading, 0.0);
             // No opaque sample, no grid: blended surfaces with every light.
             if (mBlended.prepare(inputs))

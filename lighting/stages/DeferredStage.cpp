@@ -27,8 +27,6 @@
 // no per-pixel list for a packet to walk; its pass structure is what the stage measures.
 #include "lighting/stages/Stages.h"
 
-#include <chrono>
-
 #include "lighting/BlendedPass.h"
 #include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
@@ -53,7 +51,7 @@ public:
         result.resize(width, height, false);
 
         VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
-        const auto start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         float* radiance[3] = {result.radiance[0].data(), result.radiance[1].data(),
                               result.radiance[2].data()};
         uint32_t* evaluated = result.lightsEvaluated.data();
@@ -73,7 +71,7 @@ public:
         cull.volumes.draw(
             cull.spheres, cull.drawn,
             [&](uint32_t light, int x, int y, size_t pixel) { addLight(x, y, pixel, light); });
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
         // Blended surfaces: every light (light volumes are tested against the opaque depth).
         if (mBlended.prepare(inputs))
             mBlended.shadeWithEveryLight(gb.depth(), result);

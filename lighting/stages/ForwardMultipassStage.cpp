@@ -22,12 +22,11 @@
 // by light, not 4x4 packets decoded from a G-buffer.
 #include "lighting/stages/Stages.h"
 
-#include <chrono>
-
 #include <tbb/parallel_for.h>
 
 #include "lighting/BlendedPass.h"
 #include "lighting/ForwardGeometry.h"
+#include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
 
 namespace lighting {
@@ -44,26 +43,22 @@ public:
         const int width = view.width;
         result.resize(width, view.height, false);
 
-        auto start = std::chrono::steady_clock::now();
-        mForward.prepare(inputs);
-        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
+        mForward.prepare(inputs, result);
+        mForward.drawDepthPrepass(result);
 
-        start = std::chrono::steady_clock::now();
-        mForward.drawDepthPrepass();
-        result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
+        PassTimer cull(result, pass::kCull);
+        mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
+        mSets = mObjectLights.transposed(inputs.lights->size());
+        cull.stop();
 
-        start = std::chrono::steady_clock::now();
-        buildIlluminationSets(*inputs.lights);
-        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
-
-        start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const std::vector<ForwardObject>& objects = mForward.objects();
         const std::vector<uint32_t>& allIndices = inputs.geometry->indices;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
         const raster::RasterState state = visibility.redrawState();
         for (uint32_t l = 0; l < lights.size(); ++l) {
-            const std::vector<uint32_t>& set = mSets[l];
+            const std::span<const uint32_t> set = mSets[l];
             if (set.empty())
                 continue;
             // The set's triangles as one list; globalTriangle maps a drawn triangle back to the
@@ -104,47 +99,25 @@ public:
                 raster::TriangleList{visibility.clipPositions(), indices}, state, addLight,
                 [&](uint32_t drawn) { return globalTriangle ? globalTriangle[drawn] : drawn; });
         }
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
-        // Blended surfaces: one fragment at a time with every light whose illumination set holds
-        // the fragment's object (the sets inverted: ascending per object). "Over" does not
+        shading.stop();
+        // Blended surfaces: one fragment at a time with its object's lights (the lists the
+        // illumination sets were transposed from: ascending per object). "Over" does not
         // distribute over one additive pass per light, so the blended layers are shaded whole.
-        if (mBlended.prepare(inputs)) {
-            start = std::chrono::steady_clock::now();
-            mObjectLights.assign(objects.size(), {});
-            for (uint32_t l = 0; l < mSets.size(); ++l)
-                for (uint32_t o : mSets[l])
-                    mObjectLights[o].push_back(l);
+        if (mBlended.prepare(inputs))
             mBlended.shade(
                 mForward.depth(),
                 [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
-                    return std::span<const uint32_t>(
-                        mObjectLights[mForward.objectOfTriangle(triangle)]);
+                    return mObjectLights[mForward.objectOfTriangle(triangle)];
                 },
-                result, start);
-        }
+                result);
     }
 
 private:
-    // Per light, the objects its sphere touches, ascending. Lights in parallel, each into its
-    // own list.
-    void buildIlluminationSets(const LightList& lightList) {
-        const std::vector<LightSphere> spheres = boundingSpheresView(lightList);
-        const std::vector<ForwardObject>& objects = mForward.objects();
-        mSets.resize(spheres.size());
-        tbb::parallel_for(size_t(0), spheres.size(), [&](size_t l) {
-            std::vector<uint32_t>& set = mSets[l];
-            set.clear();
-            for (uint32_t o = 0; o < objects.size(); ++o)
-                if (sphereTouchesObject(spheres[l], objects[o]))
-                    set.push_back(o);
-        });
-    }
-
     ForwardGeometry mForward;
-    std::vector<std::vector<uint32_t>> mSets;
+    LightIndexLists mObjectLights; // per object, the lights touching it, ascending
+    LightIndexLists mSets;         // per light, the objects it touches, ascending (transposed)
     std::vector<uint32_t> mSetIndices;
     std::vector<uint32_t> mSetTriangles;
-    std::vector<std::vector<uint32_t>> mObjectLights; // per object, for the blended pass
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 

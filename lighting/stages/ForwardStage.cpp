@@ -21,12 +21,12 @@
 // are drawn, not 4x4 packets decoded from a G-buffer.
 #include "lighting/stages/Stages.h"
 
-#include <chrono>
-
 #include <tbb/parallel_for.h>
 
 #include "lighting/BlendedPass.h"
 #include "lighting/ForwardGeometry.h"
+#include "lighting/LightBounds.h"
+#include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 
 namespace lighting {
@@ -46,93 +46,51 @@ public:
         result.resize(width, view.height, false);
         result.parameters["prepass"] = mPrepass ? "1" : "0";
 
-        auto start = std::chrono::steady_clock::now();
-        mForward.prepare(inputs);
-        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
-
-        start = std::chrono::steady_clock::now();
-        buildObjectLightLists(*inputs.lights);
-        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
-
-        const gbuffer::VisibilityPass& visibility = mForward.visibility();
-        if (mPrepass) {
-            start = std::chrono::steady_clock::now();
-            mForward.drawDepthPrepass();
-            result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
-        } else {
-            mForward.clearDepth();
+        mForward.prepare(inputs, result);
+        {
+            PassTimer cull(result, pass::kCull);
+            mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
         }
 
-        start = std::chrono::steady_clock::now();
+        const gbuffer::VisibilityPass& visibility = mForward.visibility();
+        if (mPrepass)
+            mForward.drawDepthPrepass(result);
+        else
+            mForward.clearDepth();
+
+        PassTimer shading(result, pass::kShading);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const bool equalOnly = mPrepass;
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             const size_t pixel = size_t(fragment.y) * width + fragment.x;
             if (equalOnly && !visibility.isVisible(fragment, fragment.triangle))
                 return;
-            const uint32_t object = mForward.objectOfTriangle(fragment.triangle);
-            const uint32_t* index = mLightIndices.data() + mLightOffsets[object];
-            const uint32_t* end = mLightIndices.data() + mLightOffsets[object + 1];
-            const gbuffer::Surface point = mForward.surfaceAt(fragment, fragment.triangle);
-            const glm::vec3 toViewer = glm::normalize(-point.positionView);
-            glm::vec3 sum(0.0f);
-            for (; index != end; ++index)
-                sum += evaluateLight(point, toViewer, lights[*index]);
-            result.radiance[0][pixel] = sum.x;
-            result.radiance[1][pixel] = sum.y;
-            result.radiance[2][pixel] = sum.z;
-            result.lightsEvaluated[pixel] += mLightOffsets[object + 1] - mLightOffsets[object];
-            result.traceLightList(pixel, {mLightIndices.data() + mLightOffsets[object],
-                                          mLightIndices.data() + mLightOffsets[object + 1]});
+            // Overdraw: the pixel's radiance is replaced, its evaluations add up.
+            const uint32_t evaluatedBefore = result.lightsEvaluated[pixel];
+            shadeWithLightList(mForward.surfaceAt(fragment, fragment.triangle), pixel, lights,
+                               mObjectLights[mForward.objectOfTriangle(fragment.triangle)], result);
+            result.lightsEvaluated[pixel] += evaluatedBefore;
         };
         // Without a pre-pass, the visibility draw's own state (every fragment that passes the
         // closer test is shaded); with one, the redraw that passes each visible fragment once.
         mForward.draw(visibility.triangles(),
                       mPrepass ? visibility.redrawState() : visibility.drawState(), shadeFragment);
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
         // Blended surfaces: each fragment with its object's list.
         if (mBlended.prepare(inputs))
             mBlended.shade(
                 mForward.depth(),
                 [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
-                    const uint32_t object = mForward.objectOfTriangle(triangle);
-                    return std::span<const uint32_t>(mLightIndices.data() + mLightOffsets[object],
-                                                     mLightIndices.data() +
-                                                         mLightOffsets[object + 1]);
+                    return mObjectLights[mForward.objectOfTriangle(triangle)];
                 },
                 result);
     }
 
 private:
-    // Per object, the lights whose sphere touches its box, ascending; flattened so the fragment
-    // loop reads one contiguous range. Objects in parallel, each into its own list, then
-    // concatenated in object order (deterministic).
-    void buildObjectLightLists(const LightList& lightList) {
-        const std::vector<LightSphere> spheres = boundingSpheresView(lightList);
-        const std::vector<ForwardObject>& objects = mForward.objects();
-        mPerObject.resize(objects.size());
-        tbb::parallel_for(size_t(0), objects.size(), [&](size_t o) {
-            std::vector<uint32_t>& list = mPerObject[o];
-            list.clear();
-            for (uint32_t l = 0; l < spheres.size(); ++l)
-                if (sphereTouchesObject(spheres[l], objects[o]))
-                    list.push_back(l);
-        });
-        mLightOffsets.assign(objects.size() + 1, 0);
-        for (size_t o = 0; o < objects.size(); ++o)
-            mLightOffsets[o + 1] = mLightOffsets[o] + uint32_t(mPerObject[o].size());
-        mLightIndices.resize(mLightOffsets.back());
-        for (size_t o = 0; o < objects.size(); ++o)
-            std::copy(mPerObject[o].begin(), mPerObject[o].end(),
-                      mLightIndices.begin() + mLightOffsets[o]);
-    }
-
     bool mPrepass;
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
     ForwardGeometry mForward;
-    std::vector<std::vector<uint32_t>> mPerObject;
-    std::vector<uint32_t> mLightOffsets;
-    std::vector<uint32_t> mLightIndices;
+    LightIndexLists mObjectLights; // per object, ascending (ForwardGeometry::objectLightLists)
 };
 
 } // namespace

@@ -136,7 +136,6 @@ public:
     StageRequirements requirements() const override { return MaterialPass::gbufferRequirements(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
-        using Clock = std::chrono::steady_clock;
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         const int scale = mOptions.scale;
@@ -154,17 +153,16 @@ public:
 
         // Cull on the full-res grid with tiles of tile*scale pixels: full-res tile (tx, ty) holds
         // exactly the samples of low-res tile (tx, ty), since sample i lies in block i.
-        const auto cullStart = Clock::now();
+        PassTimer cullPass(result, pass::kCull);
         const TileGrid grid = TileGrid::make(width, height, mOptions.tileSizeSamples * scale);
         const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
-        std::vector<TileSurfaceBounds> bounds;
-        const std::vector<std::vector<uint32_t>> tileLights =
-            basicTileLightLists(gb, grid, spheres, bounds);
-        const double cullMs = millisecondsSince(cullStart);
+        const std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {});
+        buildTileLightLists(gb.view(), grid, bounds, spheres, {}, mTileLights);
+        cullPass.stop();
 
         // Blended surfaces: stippled into the L-buffer's samples (InferredStipple.h); all their
         // work is timed as the pass "blend".
-        auto blendStart = Clock::now();
+        auto blendStart = std::chrono::steady_clock::now();
         const bool blended = mBlended.prepare(inputs);
         if (blended)
             mStipple.stipple(inputs, mBlended, gb.depth(),
@@ -172,13 +170,13 @@ public:
         double blendMs = millisecondsSince(blendStart);
 
         // L-buffer at low resolution.
-        const auto lightingStart = Clock::now();
+        PassTimer lightingPass(result, pass::kLighting);
         mSamples.assign(size_t(lowWidth) * lowHeight, LightSample{});
         const int tileSamples = mOptions.tileSizeSamples;
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
             if (!bounds[size_t(tile)].covered)
                 return;
-            const std::vector<uint32_t>& list = tileLights[size_t(tile)];
+            const std::span<const uint32_t> list = mTileLights[size_t(tile)];
             const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
             const int j1 = std::min((ty + 1) * tileSamples, lowHeight);
             const int i1 = std::min((tx + 1) * tileSamples, lowWidth);
@@ -199,9 +197,9 @@ public:
                     result.lightsEvaluated[size_t(y) * width + x] = uint32_t(list.size());
                 }
         });
-        const double lightingMs = millisecondsSince(lightingStart);
+        lightingPass.stop();
         if (blended) {
-            blendStart = Clock::now();
+            blendStart = std::chrono::steady_clock::now();
             mStipple.light(inputs, gb.depth(), mOptions.tileSizeSamples * scale);
             for (int j = 0; j < lowHeight; ++j)
                 for (int i = 0; i < lowWidth; ++i) {
@@ -219,7 +217,7 @@ public:
         }
 
         // Material pass: second geometry pass, DSF upsampling, combine.
-        const auto materialStart = Clock::now();
+        PassTimer materialPass(result, pass::kMaterial);
         mMaterials.draw(inputs);
         // Object IDs: the scene instance of the visible triangle, for every pixel (looked up on
         // the fly) and for every low-res sample (the pixel the sample read in "lighting").
@@ -301,20 +299,16 @@ public:
             result.radiance[1][pixel] = radiance.g;
             result.radiance[2][pixel] = radiance.b;
         });
-        const double materialMs = millisecondsSince(materialStart);
+        materialPass.stop();
 
-        uint64_t pairs = 0, fallbacks = 0, idFallbacks = 0;
-        for (const auto& list : tileLights)
-            pairs += list.size();
+        const uint64_t pairs = mTileLights.pairCount();
+        uint64_t fallbacks = 0, idFallbacks = 0;
         for (uint32_t f : rowFallbacks)
             fallbacks += f;
         for (uint32_t f : rowIdFallbacks)
             idFallbacks += f;
-        result.timingsMs.emplace_back(pass::kCull, cullMs);
-        result.timingsMs.emplace_back(pass::kLighting, lightingMs);
-        result.timingsMs.emplace_back(pass::kMaterial, materialMs);
         if (blended) {
-            blendStart = Clock::now();
+            blendStart = std::chrono::steady_clock::now();
             const InferredStipple::Counts counts = mStipple.composite(
                 mBlended, gb.depth(),
                 {mOptions.depthThreshold, mOptions.normalThreshold, mOptions.objectIds}, result);
@@ -342,6 +336,7 @@ private:
     std::vector<LightSample> mSamples;
     std::vector<uint32_t> mSampleObjects; // object ID per low-res sample; all kNoObject with ids=0
     MaterialPass mMaterials;
+    LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)
 };
 
 } // namespace

@@ -7,8 +7,8 @@
 // grouped by equal lists (neighbouring pixels usually share theirs).
 //
 // Overflow never drops a light: a pixel whose list would exceed `max` is marked and shaded with
-// the light list of its 16x16 screen tile (basicTileLightLists in culling/TileFrusta.h: the
-// conservative tests of `tiled`, ascending), built only when some pixel overflowed. Like
+// the light list of its 16x16 screen tile (buildTileLightLists in culling/TileFrusta.h, `tiled`'s
+// builder without its options: ascending), built only when some pixel overflowed. Like
 // Filament's froxel overflow it is conservative, but it costs a tile's lights, not every light.
 // parameters["overflow_pixels"] counts such pixels.
 //
@@ -24,7 +24,6 @@
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 
 #include <tbb/parallel_for.h>
 
@@ -51,8 +50,7 @@ constexpr int kOverflowTileSize = 16;
 class PerPixelListSource final : public PacketListSource {
 public:
     PerPixelListSource(int width, const uint16_t* counts, const uint32_t* lists, size_t capacity,
-                       const TileGrid& overflowGrid,
-                       const std::vector<std::vector<uint32_t>>& overflowLists)
+                       const TileGrid& overflowGrid, const LightIndexLists& overflowLists)
         : mWidth(width), mCounts(counts), mLists(lists), mCapacity(capacity),
           mOverflowGrid(overflowGrid), mOverflowLists(overflowLists) {}
     void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
@@ -62,7 +60,7 @@ public:
             if (mCounts[pixel] == kOverflowed) {
                 const size_t tile = size_t(y / kOverflowTileSize) * mOverflowGrid.tileCountX +
                                     size_t(x / kOverflowTileSize);
-                return std::span<const uint32_t>(mOverflowLists[tile]);
+                return mOverflowLists[tile];
             }
             return std::span<const uint32_t>(mLists + pixel * mCapacity, mCounts[pixel]);
         });
@@ -74,7 +72,7 @@ private:
     const uint32_t* mLists;
     size_t mCapacity;
     const TileGrid& mOverflowGrid;
-    const std::vector<std::vector<uint32_t>>& mOverflowLists;
+    const LightIndexLists& mOverflowLists;
 };
 
 class LightIndexedStage final : public ShadingStage {
@@ -92,7 +90,7 @@ public:
         result.resize(width, height, false);
 
         VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
-        auto start = std::chrono::steady_clock::now();
+        PassTimer index(result, pass::kIndex);
         mCounts.assign(gb.pixelCount(), 0);
         mLists.resize(gb.pixelCount() * capacity);
         uint16_t* counts = mCounts.data();
@@ -109,24 +107,25 @@ public:
         };
         cull.volumes.draw(cull.spheres, cull.drawn,
                           [&](uint32_t light, int, int, size_t pixel) { append(pixel, light); });
-        result.timingsMs.emplace_back(pass::kIndex, millisecondsSince(start));
+        index.stop();
 
-        start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         const bool anyOverflow =
             std::find(mCounts.begin(), mCounts.end(), kOverflowed) != mCounts.end();
         const TileGrid overflowGrid = TileGrid::make(width, height, kOverflowTileSize);
-        std::vector<std::vector<uint32_t>> overflowLists;
-        if (anyOverflow) {
-            std::vector<TileSurfaceBounds> bounds;
-            overflowLists = basicTileLightLists(gb, overflowGrid, cull.spheres, bounds);
-        }
+        if (anyOverflow)
+            buildTileLightLists(gb.view(), overflowGrid,
+                                computeTileSurfaceBounds(gb, overflowGrid, {}), cull.spheres, {},
+                                mOverflowLists);
+        else
+            mOverflowLists.assign(std::span<const std::vector<uint32_t>>());
         const PerPixelListSource source(width, counts, lists, capacity, overflowGrid,
-                                        overflowLists);
+                                        mOverflowLists);
         accumulateLights(inputs, source, {}, result);
         uint64_t overflowPixels = 0;
         for (uint16_t count : mCounts)
             overflowPixels += count == kOverflowed ? 1 : 0;
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
         // Blended surfaces: every light (the per-pixel lists are the opaque surface's).
         if (mBlended.prepare(inputs))
             mBlended.shadeWithEveryLight(gb.depth(), result);
@@ -140,9 +139,10 @@ private:
     int mMaxLights;
     VolumeStageOptions mVolume;
     // Kept between frames so steady-state frames do not allocate.
-    std::vector<uint16_t> mCounts; // entries used, or kOverflowed
-    std::vector<uint32_t> mLists;  // capacity entries per pixel
-    BlendedPass mBlended;          // blended surfaces after the opaque pass (BlendedPass.h)
+    std::vector<uint16_t> mCounts;  // entries used, or kOverflowed
+    std::vector<uint32_t> mLists;   // capacity entries per pixel
+    LightIndexLists mOverflowLists; // per 16x16 tile, when some pixel overflowed
+    BlendedPass mBlended;           // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 } // namespace

@@ -40,7 +40,6 @@
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 #include <span>
 
 #include <tbb/parallel_for.h>
@@ -69,27 +68,26 @@ public:
     StageRequirements requirements() const override { return MaterialPass::gbufferRequirements(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
-        using Clock = std::chrono::steady_clock;
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
-        const auto cullStart = Clock::now();
+        PassTimer cullPass(result, pass::kCull);
         const TileGrid grid = TileGrid::make(width, height, mTileSizePixels);
-        std::vector<TileSurfaceBounds> bounds;
-        const std::vector<std::vector<uint32_t>> tileLights =
-            basicTileLightLists(gb, grid, boundingSpheresView(*inputs.lights), bounds);
-        const double cullMs = millisecondsSince(cullStart);
+        const std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {});
+        buildTileLightLists(gb.view(), grid, bounds, boundingSpheresView(*inputs.lights), {},
+                            mTileLights);
+        cullPass.stop();
 
         // Light buffer: diffuse RGB + monochromatic specular, per pixel.
-        const auto lightingStart = Clock::now();
+        PassTimer lightingPass(result, pass::kLighting);
         mDiffuse.assign(gb.pixelCount(), glm::vec3(0.0f));
         mSpecular.assign(gb.pixelCount(), 0.0f);
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
             if (!bounds[size_t(tile)].covered)
                 return;
-            const std::vector<uint32_t>& list = tileLights[size_t(tile)];
+            const std::span<const uint32_t> list = mTileLights[size_t(tile)];
             const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
             for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
                 for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
@@ -103,10 +101,10 @@ public:
                     result.lightsEvaluated[pixel] = uint32_t(list.size());
                 }
         });
-        const double lightingMs = millisecondsSince(lightingStart);
+        lightingPass.stop();
 
         // Material pass: second geometry pass into a visibility buffer, then combine.
-        const auto materialStart = Clock::now();
+        PassTimer materialPass(result, pass::kMaterial);
         mMaterials.draw(inputs);
         mMaterials.forEachSurface(gb, [&](int, int, size_t pixel, const gbuffer::Surface& s) {
             const glm::vec3& diffuse = mDiffuse[pixel];
@@ -122,17 +120,12 @@ public:
             result.radiance[1][pixel] = radiance.g;
             result.radiance[2][pixel] = radiance.b;
         });
-        const double materialMs = millisecondsSince(materialStart);
+        materialPass.stop();
 
-        uint64_t pairs = 0;
-        for (const auto& list : tileLights)
-            pairs += list.size();
-        result.timingsMs.emplace_back(pass::kCull, cullMs);
-        result.timingsMs.emplace_back(pass::kLighting, lightingMs);
-        result.timingsMs.emplace_back(pass::kMaterial, materialMs);
         // Blended surfaces: a forward pass with the whole BRDF over near-to-opaque tile lists.
         if (mBlended.prepare(inputs))
             mBlended.shadeWithTileLists(gb.depth(), mTileSizePixels, true, result);
+        const uint64_t pairs = mTileLights.pairCount();
         result.parameters["spec"] = mChroma ? "chroma" : "grey";
         result.parameters["tile"] = std::to_string(mTileSizePixels);
         result.parameters["tile_light_pairs"] = std::to_string(pairs);
@@ -145,7 +138,8 @@ private:
     std::vector<glm::vec3> mDiffuse;
     std::vector<float> mSpecular;
     MaterialPass mMaterials;
-    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
+    LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)
+    BlendedPass mBlended;        // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 } // namespace

@@ -5,16 +5,15 @@
 //   2. "cull": the screen is split into square tiles; the pre-pass depths bound each tile's
 //      frustum (computeTileDepthBounds in culling/TileFrusta.h: min/max view depth of the
 //      covered pixels' reconstructed positions) and every light whose conservative sphere
-//      (LightBounds.h) may touch it goes into the tile's list, in ascending light index. The tests
-//      are exactly `tiled`'s (tile-column/row slabs, depth range, box distance), so the same
-//      depths give the same lists;
+//      (LightBounds.h) may touch it goes into the tile's list, in ascending light index. The lists
+//      come from `tiled`'s builder (buildTileLightLists), so the same depths give the same lists;
 //   3. "shading": the scene is rasterized again with a closer-or-equal test and no depth writes;
 //      only the pre-pass's visible fragment of each pixel is shaded (exact "depth equal"), with
 //      its tile's list. "transform" (vertices to clip/view space) precedes them.
 //
 // Options:
 //   tile=16   tile size in pixels, 4..128
-//   vfc=1     first cull lights against the camera frustum (lightsInViewFrustum); only speed
+//   vfc=1     first cull lights against the camera frustum (ViewFrustum); only speed
 //   mask=0    Harada's 2.5D culling (his proposal was for Forward+): a 32-bin depth mask per
 //             tile from the pre-pass depths against each light's depth range, as in `tiled`
 // Parameters record the options and lights_after_vfc, vfc_culled and tile_light_pairs.
@@ -33,7 +32,6 @@
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 #include <memory>
 #include <span>
 
@@ -69,81 +67,52 @@ public:
         const int width = view.width;
         result.resize(width, view.height, false);
 
-        auto start = std::chrono::steady_clock::now();
-        mForward.prepare(inputs);
-        result.timingsMs.emplace_back(pass::kTransform, millisecondsSince(start));
+        mForward.prepare(inputs, result);
+        mForward.drawDepthPrepass(result);
 
-        start = std::chrono::steady_clock::now();
-        mForward.drawDepthPrepass();
-        result.timingsMs.emplace_back(pass::kPrepass, millisecondsSince(start));
-
-        start = std::chrono::steady_clock::now();
+        PassTimer cull(result, pass::kCull);
         const TileGrid grid = TileGrid::make(width, view.height, mOptions.tileSizePixels);
-        const size_t lightsAfterVfc = buildTileLightLists(view, grid, *inputs.lights);
-        result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
+        const std::vector<TileSurfaceBounds> bounds = computeTileDepthBounds(
+            mForward.depthDecoder(), mForward.depth(), grid, mOptions.depthMask);
+        const size_t lightsAfterVfc =
+            buildTileLightLists(view, grid, bounds, boundingSpheresView(*inputs.lights),
+                                {mOptions.viewFrustumCulling, mOptions.depthMask, false},
+                                mTileLights)
+                .lightsAfterVfc;
+        cull.stop();
 
-        start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             if (!visibility.isVisible(fragment, fragment.triangle))
                 return;
-            const std::vector<uint32_t>& list =
+            const std::span<const uint32_t> list =
                 mTileLights[size_t(fragment.y / tileSize) * tileCountX + fragment.x / tileSize];
             shadeWithLightList(mForward.surfaceAt(fragment, fragment.triangle),
                                size_t(fragment.y) * width + fragment.x, lights, list, result);
         };
         mForward.draw(visibility.triangles(), visibility.redrawState(), shadeFragment);
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
         if (mBlended.prepare(inputs))
             mBlended.shadeWithTileLists(mForward.depth(), mOptions.tileSizePixels,
                                         mOptions.viewFrustumCulling, result);
 
-        uint64_t pairs = 0;
-        for (const std::vector<uint32_t>& list : mTileLights)
-            pairs += list.size();
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
         result.parameters["lights_after_vfc"] = std::to_string(lightsAfterVfc);
         result.parameters["vfc_culled"] =
             std::to_string(inputs.lights->lights.size() - lightsAfterVfc);
-        result.parameters["tile_light_pairs"] = std::to_string(pairs);
+        result.parameters["tile_light_pairs"] = std::to_string(mTileLights.pairCount());
     }
 
 private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
-    // Fills mTileLights from the pre-pass depth (mForward.depth()); returns the number of lights
-    // kept by view-frustum culling. The same tests (appendTileLights) as `tiled` with the same
-    // options.
-    size_t buildTileLightLists(const gbuffer::CameraView& view, const TileGrid& grid,
-                               const LightList& lightList) {
-        const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
-        const std::vector<LightSphere> spheres = boundingSpheresView(lightList);
-        const std::vector<CandidateLight> candidates =
-            candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
-
-        const std::vector<TileSurfaceBounds> bounds = computeTileDepthBounds(
-            mForward.depthDecoder(), mForward.depth(), grid, mOptions.depthMask);
-
-        mTileLights.resize(size_t(grid.tileCount()));
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            std::vector<uint32_t>& list = mTileLights[size_t(tile)];
-            list.clear(); // keeps the capacity from the previous frame
-            const TileSurfaceBounds& b = bounds[size_t(tile)];
-            if (!b.covered)
-                return; // no visible fragment will ask for this list
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-            appendTileLights(candidates, tx, ty, b, box, {mOptions.depthMask, false}, list);
-        });
-        return candidates.size();
-    }
-
     TiledForwardOptions mOptions;
     ForwardGeometry mForward;
-    std::vector<std::vector<uint32_t>> mTileLights; // per tile, ascending light indices
+    LightIndexLists mTileLights; // per tile, ascending light indices (buildTileLightLists)
 };
 
 } // namespace

@@ -21,13 +21,15 @@
 // "shading". Parameters record the options and counts: lights_after_vfc, vfc_culled,
 // tile_light_pairs and (tiled-backface) backface_rejected.
 // Threads: tiles in parallel; each tile's list and pixels are written by one task only.
-// Cost note (CPU): a light that faces away from a sample is rejected by evaluateLight's n.l test
-// before the specular term, so the samples tiled-backface removes are the cheap ones; the
-// thesis' GPU gains (uniform cost per evaluated light) are larger than what we measure here.
+// Cost note (CPU): a light that faces away from a whole packet is rejected by the kernel's n.l
+// early-out at almost no cost, so the samples tiled-backface removes are the cheap ones; the
+// thesis' GPU gains (uniform cost per evaluated light) are larger than what we measure here. The
+// test itself is made cheap instead (BackfaceTileCone in culling/TileFrusta.h: per-tile data once,
+// a one-dot early-out for lights that cannot be rejected, no test at all in tiles whose normal
+// cone is too wide).
 #include "lighting/stages/Stages.h"
 
 #include <algorithm>
-#include <chrono>
 #include <span>
 
 #include <tbb/parallel_for.h>
@@ -46,7 +48,7 @@ namespace {
 // multiple of 4), each with its tile's ascending list.
 class TileListSource final : public PacketListSource {
 public:
-    TileListSource(const TileGrid& grid, const std::vector<std::vector<uint32_t>>& tileLights)
+    TileListSource(const TileGrid& grid, const LightIndexLists& tileLights)
         : mGrid(grid), mTileLights(tileLights) {}
     void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
         const int size = mGrid.tileSizePixels;
@@ -56,12 +58,12 @@ public:
                 return ((packet.y0 + kernel::laneY(lane)) / size) * mGrid.tileCountX +
                        (packet.x0 + kernel::laneX(lane)) / size;
             },
-            [&](int tile) { return std::span<const uint32_t>(mTileLights[size_t(tile)]); });
+            [&](int tile) { return mTileLights[size_t(tile)]; });
     }
 
 private:
     const TileGrid& mGrid;
-    const std::vector<std::vector<uint32_t>>& mTileLights;
+    const LightIndexLists& mTileLights;
 };
 
 struct TiledOptions {
@@ -79,64 +81,41 @@ public:
     StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
-        using Clock = std::chrono::steady_clock;
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const gbuffer::CameraView& view = gb.view();
         result.resize(gb.width(), gb.height(), false);
-        const auto cullStart = Clock::now();
+        PassTimer cull(result, pass::kCull);
 
         const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
-        const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
         const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
-        const std::vector<CandidateLight> candidates =
-            candidateLights(view, grid, edges, spheres, mOptions.viewFrustumCulling);
-
         const std::vector<TileSurfaceBounds> bounds =
             computeTileSurfaceBounds(gb, grid, {mOptions.depthMask, mOptions.backface});
+        const TileLightListStats lists = buildTileLightLists(
+            view, grid, bounds, spheres,
+            {mOptions.viewFrustumCulling, mOptions.depthMask, mOptions.backface}, mTileLights);
+        cull.stop();
 
-        std::vector<std::vector<uint32_t>> tileLights(size_t(grid.tileCount()));
-        std::vector<uint64_t> tileBackfaceRejected(size_t(grid.tileCount()), 0);
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            const TileSurfaceBounds& b = bounds[size_t(tile)];
-            if (!b.covered)
-                return;
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-            tileBackfaceRejected[size_t(tile)] =
-                appendTileLights(candidates, tx, ty, b, box,
-                                 {mOptions.depthMask, mOptions.backface}, tileLights[size_t(tile)]);
-        });
-        const double cullMs =
-            std::chrono::duration<double, std::milli>(Clock::now() - cullStart).count();
+        PassTimer shading(result, pass::kShading);
+        accumulateLights(inputs, TileListSource(grid, mTileLights), {}, result);
+        shading.stop();
 
-        const auto shadeStart = Clock::now();
-        accumulateLights(inputs, TileListSource(grid, tileLights), {}, result);
-        const double shadeMs =
-            std::chrono::duration<double, std::milli>(Clock::now() - shadeStart).count();
-
-        uint64_t pairs = 0, backfaceRejected = 0;
-        for (size_t tile = 0; tile < tileLights.size(); ++tile) {
-            pairs += tileLights[tile].size();
-            backfaceRejected += tileBackfaceRejected[tile];
-        }
-        result.timingsMs.emplace_back(pass::kCull, cullMs);
-        result.timingsMs.emplace_back(pass::kShading, shadeMs);
         if (mBlended.prepare(inputs))
             mBlended.shadeWithTileLists(gb.depth(), mOptions.tileSizePixels,
                                         mOptions.viewFrustumCulling, result);
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
-        result.parameters["lights_after_vfc"] = std::to_string(candidates.size());
-        result.parameters["vfc_culled"] = std::to_string(spheres.size() - candidates.size());
-        result.parameters["tile_light_pairs"] = std::to_string(pairs);
+        result.parameters["lights_after_vfc"] = std::to_string(lists.lightsAfterVfc);
+        result.parameters["vfc_culled"] = std::to_string(spheres.size() - lists.lightsAfterVfc);
+        result.parameters["tile_light_pairs"] = std::to_string(mTileLights.pairCount());
         if (mOptions.backface)
-            result.parameters["backface_rejected"] = std::to_string(backfaceRejected);
+            result.parameters["backface_rejected"] = std::to_string(lists.backfaceRejected);
     }
 
 private:
     TiledOptions mOptions;
-    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
+    LightIndexLists mTileLights; // per tile, ascending; storage reused across frames
+    BlendedPass mBlended;        // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 TiledOptions parseTiledOptions(const StageSpec& spec, bool backface) {

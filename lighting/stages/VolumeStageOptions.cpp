@@ -1,7 +1,5 @@
 #include "lighting/stages/VolumeStageOptions.h"
 
-#include <chrono>
-
 #include "lighting/PassNames.h"
 #include "lighting/stages/Stages.h"
 
@@ -24,12 +22,12 @@ VolumeStageOptions parseVolumeStageOptions(const StageSpec& spec) {
 
 VolumeCull cullLightVolumes(const gbuffer::GBuffer& gb, const LightList& lights,
                             const VolumeStageOptions& options, StageResult& result) {
-    const auto start = std::chrono::steady_clock::now();
+    PassTimer timer(result, pass::kCull);
     VolumeCull cull{boundingSpheresView(lights),
                     LightVolumeRasterizer(gb, options.shape, options.stencil, options.spotProxy),
                     {}};
     cull.drawn = cull.volumes.lightsToDraw(cull.spheres, options.frustumCull);
-    result.timingsMs.emplace_back(pass::kCull, millisecondsSince(start));
+    timer.stop();
     return cull;
 }
 
