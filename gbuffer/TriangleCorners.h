@@ -40,7 +40,8 @@ struct MaterialSampling {
     const scenes::Texture* metallicRoughnessTexture = nullptr; // null when absent or Blinn-Phong
     const scenes::Texture* normalTexture = nullptr;            // null when absent or no tangents
     const scenes::Texture* occlusionTexture = nullptr;         // null when absent or Blinn-Phong
-    bool textured = false;                                     // one of the four is present
+    const scenes::Texture* emissiveTexture = nullptr;          // null when absent or no emission
+    bool textured = false;                                     // one of the five is present
     bool secondUvSet = false; // textured and the geometry has TEXCOORD_1
 
     // One entry per scene material. Cost O(materials).
@@ -59,8 +60,9 @@ struct MaterialSampling {
             entry.metallicRoughnessTexture = texture(metallicRoughness, m.metallicRoughnessTexture);
             entry.normalTexture = texture(!geometry.tangentWorld.empty(), m.normalTexture);
             entry.occlusionTexture = texture(metallicRoughness, m.occlusionTexture);
+            entry.emissiveTexture = texture(m.emits(), m.emissiveTexture);
             entry.textured = entry.baseColorTexture || entry.metallicRoughnessTexture ||
-                             entry.normalTexture || entry.occlusionTexture;
+                             entry.normalTexture || entry.occlusionTexture || entry.emissiveTexture;
             entry.secondUvSet = entry.textured && !geometry.uv1.empty();
             Surface& s = entry.constant;
             s.material = uint32_t(i);
@@ -70,6 +72,7 @@ struct MaterialSampling {
             s.model = m.model;
             s.roughness = m.roughness;
             s.metallic = m.metallic;
+            s.emissive = m.emission();
         }
         return table;
     }
@@ -145,9 +148,10 @@ struct RowWeights {
 };
 
 // The parts of a triangle's surface that do not vary over it: material index and model, albedo
-// factor (the whole albedo when untextured), specular, roughness and metallic factors (made once
-// per material by MaterialSampling::of). Normal, textured albedo and the other textures come per
-// pixel from updateSurfaceAt. positionView stays zero: it comes from depth (DepthDecoder).
+// factor (the whole albedo when untextured), specular, roughness and metallic factors, emission
+// factor (made once per material by MaterialSampling::of). Normal, textured albedo and the other
+// textures come per pixel from updateSurfaceAt. positionView stays zero: it comes from depth
+// (DepthDecoder).
 inline const Surface& triangleSurface(const TriangleCorners& corners) {
     return corners.sampling->constant;
 }
@@ -177,6 +181,10 @@ inline void updateTexturedSurfaceAt(Surface& surface, const TriangleCorners& cor
         const float r = sampling.occlusionTexture->sample(uvOf(material.occlusionMapping)).r;
         surface.occlusion = 1.0f + material.occlusionStrength * (r - 1.0f);
     }
+    if (sampling.emissiveTexture)
+        surface.emissive =
+            sampling.constant.emissive *
+            glm::vec3(sampling.emissiveTexture->sample(uvOf(material.emissiveMapping)));
     if (sampling.normalTexture) {
         const glm::vec4 tangent = raster::interpolate(
             corners.tangentView[0], corners.tangentView[1], corners.tangentView[2], weights);

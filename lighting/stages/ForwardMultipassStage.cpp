@@ -102,6 +102,7 @@ public:
             mForward.draw(raster::TriangleList{visibility.clipPositions(), indices}, state,
                           addLight);
         }
+        mForward.addEmission(result);
         result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
     }
 

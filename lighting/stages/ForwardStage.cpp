@@ -77,6 +77,7 @@ public:
             glm::vec3 sum(0.0f);
             for (; index != end; ++index)
                 sum += evaluateLight(point, toViewer, lights[*index]);
+            sum += point.emissive; // once per shaded fragment; the pixel keeps the visible one
             result.radiance[0][pixel] = sum.x;
             result.radiance[1][pixel] = sum.y;
             result.radiance[2][pixel] = sum.z;
