@@ -245,18 +245,22 @@ nlohmann::json layoutJson(const gbuffer::GBufferLayout& layout, const RunMetrics
     nlohmann::json reasons = nlohmann::json::object();
     for (const auto& [channel, reason] : layout.reasons)
         reasons[gbuffer::channelName(channel)] = reason;
-    return {{"name", layout.name},
-            {"depth", layout.depth.text()},
-            {"position", gbuffer::positionMethodName(layout.position)},
-            {"normals", layout.hasNormals ? layout.normals.text() : "none"},
-            {"normal_space", gbuffer::normalSpaceName(layout.normalSpace)},
-            {"albedo", gbuffer::albedoEncodingName(layout.albedo)},
-            {"specular", gbuffer::specularEncodingName(layout.specular)},
-            {"planes", planes},
-            {"reasons", reasons},
-            {"notes", layout.notes},
-            {metric::kBytesPerPixel, metrics.bytesPerPixel},
-            {metric::kAllocatedBytesPerPixel, metrics.allocatedBytesPerPixel}};
+    return {
+        {"name", layout.name},
+        {"depth", layout.depth.text()},
+        {"position", gbuffer::positionMethodName(layout.position)},
+        {"normals", layout.hasNormals ? layout.normals.text() : "none"},
+        {"normal_space", gbuffer::normalSpaceName(layout.normalSpace)},
+        {"albedo", gbuffer::albedoEncodingName(layout.albedo)},
+        {"specular", gbuffer::specularEncodingName(layout.specular)},
+        {"roughness_metallic", gbuffer::roughnessMetallicEncodingName(layout.roughnessMetallic)},
+        {"occlusion", gbuffer::roughnessMetallicEncodingName(layout.occlusion)},
+        {"emission", gbuffer::emissionEncodingName(layout.emission)},
+        {"planes", planes},
+        {"reasons", reasons},
+        {"notes", layout.notes},
+        {metric::kBytesPerPixel, metrics.bytesPerPixel},
+        {metric::kAllocatedBytesPerPixel, metrics.allocatedBytesPerPixel}};
 }
 
 // timings_ms (the medians) and timings (warm-up, repetitions, every pass's spread and samples).

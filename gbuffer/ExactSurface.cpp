@@ -17,6 +17,7 @@ void ExactSurface::resize(int w, int h) {
     roughnessMetallic.assign(n, glm::vec2(1.0f, 0.0f));
     model.assign(n, scenes::MaterialModel::BlinnPhong);
     occlusion.assign(n, 1.0f);
+    emissive.assign(n, glm::vec3(0.0f));
     positionView.assign(n, glm::dvec3(0.0));
     normalView.assign(n, glm::dvec3(0.0));
 }

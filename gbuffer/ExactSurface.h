@@ -2,7 +2,8 @@
 // The rasterizer records which triangle covers each pixel; position and normal are then
 // recomputed in double by intersecting the pixel centre's view ray with that triangle's
 // unrounded world-space vertices, so no float rounding of depth, interpolation or G-buffer
-// encoding reaches the reference. Material values (albedo, specular, model, roughness, metallic)
+// encoding reaches the reference. Material values (albedo, specular, model, roughness, metallic,
+// emission)
 // come straight from the material and texture lookup, never through a G-buffer encoding. Normal
 // maps are applied here again, in double (NormalMapping.h, the resolve's formula), at the uv of
 // the double-precision intersection.
@@ -32,6 +33,7 @@ struct ExactSurface {
     std::vector<glm::vec2> roughnessMetallic;
     std::vector<scenes::MaterialModel> model;
     std::vector<float> occlusion;
+    std::vector<glm::vec3> emissive; // the resolve's emitted radiance (factor x texture)
     std::vector<glm::dvec3> positionView;
     std::vector<glm::dvec3> normalView;
 
@@ -52,6 +54,7 @@ struct ExactSurface {
         s.metallic = double(roughnessMetallic[pixel].y);
         s.model = model[pixel];
         s.occlusion = double(occlusion[pixel]);
+        s.emissive = glm::dvec3(emissive[pixel]);
         return true;
     }
     // Fills positionView and normalView from `triangle` (parallel over rows, deterministic),

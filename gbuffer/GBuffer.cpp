@@ -81,6 +81,9 @@ GBuffer::GBuffer(const GBufferLayout& layout, const CameraView& view)
         mOcclusion.assign(n, 0.0f);
     if (layout.occlusion == RoughnessMetallicEncoding::Unorm8)
         mOcclusionPacked.assign(n, 0);
+    if (layout.emission == EmissionEncoding::Float32)
+        for (auto& plane : mEmission)
+            plane.assign(n, 0.0f);
     if (layout.hasMaterialIndex())
         mMaterial.assign(n, 0);
 }
@@ -108,6 +111,7 @@ GBuffer::Writer::Writer(GBuffer& target) {
     for (int c = 0; c < 3; ++c) {
         mNormal[c] = pointer(target.mNormal[c]);
         mAlbedo[c] = pointer(target.mAlbedo[c]);
+        mEmission[c] = pointer(target.mEmission[c]);
     }
     for (int c = 0; c < 2; ++c) {
         mSpecular[c] = pointer(target.mSpecular[c]);
@@ -258,6 +262,7 @@ Surface GBuffer::decode(int x, int y) const {
         s.occlusion = mOcclusion[pixel];
     else if (!mOcclusionPacked.empty())
         s.occlusion = float(mOcclusionPacked[pixel]) / 255.0f;
+    s.emissive = emission(pixel);
     return s;
 }
 

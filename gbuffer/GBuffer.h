@@ -13,7 +13,8 @@
 // - Albedo: three float planes (f32), one packed RGB8 sRGB word, or nothing (material index,
 //   constant, none). Specular: two float planes, one packed word, or nothing. Roughness and
 //   metallic: two float planes, one packed 16-bit word (8 bits each), or nothing. Material index:
-//   one 16-bit array when something decodes from the material table. The material model is not
+//   one 16-bit array when something decodes from the material table. Emission: three float planes
+//   or nothing (material index, none). The material model is not
 //   stored per pixel: it is the layout's constant or the material's (GBufferLayout.h).
 // View-space position is reconstructed from depth by the layout's DepthDecoder (DepthFormat.h:
 // inverse projection or view ray). Decoding is const and thread-safe; writing a pixel is safe
@@ -78,6 +79,11 @@ public:
             }
             if (mOcclusion)
                 mOcclusion[pixel] = s.occlusion;
+            if (mEmission[0]) {
+                mEmission[0][pixel] = s.emissive.r;
+                mEmission[1][pixel] = s.emissive.g;
+                mEmission[2][pixel] = s.emissive.b;
+            }
             if (mMaterial)
                 mMaterial[pixel] = uint16_t(s.material);
             if (mEncoded)
@@ -92,6 +98,7 @@ public:
         float* mSpecular[2] = {};
         float* mRoughnessMetallic[2] = {};
         float* mOcclusion = nullptr;
+        float* mEmission[3] = {};
         uint16_t* mMaterial = nullptr;
         GBuffer* mEncoded = nullptr; // the target when it has encoded planes
     };
@@ -101,6 +108,24 @@ public:
     // Reconstructs view-space position from depth (depthDecoder()) and decodes the other channels;
     // channels the layout does not provide are left at Surface's defaults.
     Surface decode(int x, int y) const;
+    // Whether the layout stores emitted radiance (some used material emits): when false,
+    // emission() is zero at every pixel and the stages skip adding it.
+    bool hasEmission() const { return mLayout.emission != EmissionEncoding::None; }
+    // The emitted radiance of a covered pixel, decoded alone (decode() sets Surface::emissive
+    // too): what the stages add once per pixel after their light sum.
+    glm::vec3 emission(size_t pixel) const {
+        switch (mLayout.emission) {
+        case EmissionEncoding::Float32:
+            return {mEmission[0][pixel], mEmission[1][pixel], mEmission[2][pixel]};
+        case EmissionEncoding::Material:
+            return mMaterial[pixel] < mLayout.materials.size()
+                       ? mLayout.materials[mMaterial[pixel]].emission
+                       : glm::vec3(0.0f);
+        case EmissionEncoding::None:
+            break;
+        }
+        return glm::vec3(0.0f);
+    }
     // decode(x, y) into `s` when the pixel is covered; false (and `s` untouched) for background.
     bool surfaceAt(int x, int y, Surface& s) const {
         if (!covered(size_t(y) * size_t(width()) + size_t(x)))
@@ -145,6 +170,7 @@ private:
     Plane<uint16_t> mRoughnessMetallicPacked; // unorm8 roughness | unorm8 metallic << 8
     Plane<float> mOcclusion;                  // f32 ambient occlusion
     Plane<uint8_t> mOcclusionPacked;          // unorm8 ambient occlusion
+    Plane<float> mEmission[3];                // f32 emitted radiance
     Plane<uint16_t> mMaterial;                // material index
 };
 

@@ -59,6 +59,8 @@ const char* channelName(Channel channel) {
         return "albedo";
     case Channel::Specular:
         return "specular";
+    case Channel::Emission:
+        return "emission";
     }
     return "?";
 }
@@ -100,6 +102,18 @@ const char* roughnessMetallicEncodingName(RoughnessMetallicEncoding encoding) {
     return "?";
 }
 
+const char* emissionEncodingName(EmissionEncoding encoding) {
+    switch (encoding) {
+    case EmissionEncoding::None:
+        return "none";
+    case EmissionEncoding::Material:
+        return "material";
+    case EmissionEncoding::Float32:
+        return "f32";
+    }
+    return "?";
+}
+
 bool GBufferLayout::provides(Channel channel) const {
     switch (channel) {
     case Channel::Depth:
@@ -111,6 +125,8 @@ bool GBufferLayout::provides(Channel channel) const {
     case Channel::Specular:
         return specular != SpecularEncoding::None ||
                roughnessMetallic != RoughnessMetallicEncoding::None;
+    case Channel::Emission:
+        return true; // `none` is chosen only where nothing emits: zero is the exact value
     }
     return false;
 }
@@ -173,6 +189,9 @@ std::vector<PlaneDesc> GBufferLayout::planes() const {
         result.push_back({"occlusion", "f32", 32, "specular"});
     if (occlusion == RoughnessMetallicEncoding::Unorm8)
         result.push_back({"occlusion", "unorm8", 8, "specular"});
+    if (emission == EmissionEncoding::Float32)
+        for (const char* name : {"emission.R", "emission.G", "emission.B"})
+            result.push_back({name, "f32", 32, "emission"});
     if (hasMaterialIndex())
         result.push_back({"material", "uint" + std::to_string(materialIndexBits()),
                           materialIndexBits(), "material"});
@@ -227,17 +246,23 @@ std::string GBufferLayout::explain() const {
                 << (specular == SpecularEncoding::Material ? "specular" : "")
                 << (roughnessMetallic == RoughnessMetallicEncoding::Material ? " roughness-metallic"
                                                                              : "")
-                << (modelPerMaterial ? " material-model" : "") << " from the material table ("
-                << materials.size() << " materials)";
+                << (modelPerMaterial ? " material-model" : "")
+                << (emission == EmissionEncoding::Material ? " emission" : "")
+                << " from the material table (" << materials.size() << " materials)";
+        else if (const auto found = planeReasons.find(plane.name); found != planeReasons.end())
+            out << found->second;
         else
             out << reasonOf(plane.channel);
         out << "\n";
     }
-    for (Channel channel : {Channel::Normal, Channel::Albedo, Channel::Specular}) {
+    for (Channel channel :
+         {Channel::Normal, Channel::Albedo, Channel::Specular, Channel::Emission}) {
         const bool stored = [&] {
             for (const PlaneDesc& plane : planes())
                 if (plane.channel == channelName(channel))
                     return true;
+            if (channel == Channel::Emission)
+                return emission == EmissionEncoding::Material;
             return channel != Channel::Normal && hasMaterialIndex() &&
                    (channel == Channel::Albedo
                         ? albedo == AlbedoEncoding::Material
@@ -248,6 +273,8 @@ std::string GBufferLayout::explain() const {
             out << "  (no " << channelName(channel) << " plane)  " << reasonOf(channelName(channel))
                 << "\n";
     }
+    for (const auto& [plane, reason] : absentPlanes)
+        out << "  (no " << plane << " plane)  " << reason << "\n";
     out << "  position: " << positionMethodName(position) << " from " << depth.text() << "\n";
     for (const std::string& note : notes)
         out << "  note: " << note << "\n";

@@ -2,7 +2,7 @@
 // for each channel a lighting stage can read, how it is encoded; the stored planes (structure of
 // arrays), their formats and bits, and the reason each is there follow from that.
 //
-// Channels are what stages read (Depth, Normal, Albedo, Specular). How each is stored:
+// Channels are what stages read (Depth, Normal, Albedo, Specular, Emission). How each is stored:
 //   depth     a DepthFormatSpec (always present: coverage and position come from it) and the
 //             position reconstruction method (inverse projection or view ray)
 //   normal    a NormalCodecSpec (absent when no reader needs normals)
@@ -16,6 +16,8 @@
 //             metallic-roughness (roughnessMetallic)  f32 (roughness, metallic as floats), unorm8
 //                          (8 bits each), material, constant, none
 //             A scene that uses only one model stores only that model's parameters.
+//   emission  f32 (3 x float, where an emissive texture varies it), material, none (no used
+//             material emits: decodes to zero, so every layout provides the channel)
 //   The material model of a pixel (MaterialConstants::model) is the constant's when every used
 //   material has the same model, else it is decoded from the material index (modelPerMaterial).
 // A material index plane (8 or 16 bits) exists when albedo, specular or roughness-metallic is
@@ -39,7 +41,7 @@
 
 namespace gbuffer {
 
-enum class Channel { Depth, Normal, Albedo, Specular };
+enum class Channel { Depth, Normal, Albedo, Specular, Emission };
 const char* channelName(Channel channel);
 
 // Where normals are encoded. View space suits the hemisphere codecs (xy-z, pixel-view,
@@ -55,9 +57,14 @@ bool codecWorksInWorldSpace(NormalCodecKind kind);
 enum class AlbedoEncoding { None, Constant, Material, Rgb8Srgb, Float32 };
 enum class SpecularEncoding { None, Constant, Material, Unorm8Log8, Unorm8Half, Float32 };
 enum class RoughnessMetallicEncoding { None, Constant, Material, Unorm8, Float32 };
+// Emitted radiance: three float planes where an emissive texture makes it vary per pixel,
+// `material` (decoded from the material index) where it is constant per material, none where no
+// used material emits (decodes to zero).
+enum class EmissionEncoding { None, Material, Float32 };
 const char* albedoEncodingName(AlbedoEncoding encoding); // "none", "constant", ...
 const char* specularEncodingName(SpecularEncoding encoding);
 const char* roughnessMetallicEncodingName(RoughnessMetallicEncoding encoding);
+const char* emissionEncodingName(EmissionEncoding encoding);
 
 // Per-material values the `material` and `constant` encodings decode from.
 struct MaterialConstants {
@@ -67,6 +74,7 @@ struct MaterialConstants {
     scenes::MaterialModel model = scenes::MaterialModel::BlinnPhong;
     float roughness = 1.0f; // the factors (metallic-roughness; the texture multiplies them)
     float metallic = 0.0f;
+    glm::vec3 emission{0.0f}; // emissive factor x strength (the texture multiplies it)
     friend bool operator==(const MaterialConstants&, const MaterialConstants&) = default;
 };
 
@@ -94,17 +102,28 @@ struct GBufferLayout {
     // stored only when a used material has an occlusion texture and the scene an ambient light;
     // else it decodes to 1. f32 (derived, lossless) or unorm8 (presets).
     RoughnessMetallicEncoding occlusion = RoughnessMetallicEncoding::None;
+    // Emitted radiance (Channel::Emission): planes only where a used material emits
+    // (LayoutDerivation.h addEmission).
+    EmissionEncoding emission = EmissionEncoding::None;
     std::vector<MaterialConstants> materials; // index = scene material, for `material`
     MaterialConstants constant;               // for `constant`
     std::vector<PlaneDesc> unmodelled;        // historical presets only
     std::map<Channel, std::string> reasons;   // why each channel is stored as it is
-    std::vector<std::string> notes;           // e.g. where a preset departs from its source
+    // Why a plane that is one part of a channel is there (roughness, metallic, occlusion: the
+    // specular channel of metallic-roughness materials), by plane name; explain() prefers it to
+    // the channel's reason.
+    std::map<std::string, std::string> planeReasons;
+    // Parts of a channel the scene could have needed but that are not stored, with why
+    // (e.g. occlusion textures without an ambient light): explain()'s "(no ... plane)" lines.
+    std::vector<std::pair<std::string, std::string>> absentPlanes;
+    std::vector<std::string> notes; // e.g. where a preset departs from its source
 
     // Whether a reader can decode this channel (a `constant` channel can, with no plane).
     bool provides(Channel channel) const;
     bool hasMaterialIndex() const {
         return albedo == AlbedoEncoding::Material || specular == SpecularEncoding::Material ||
-               roughnessMetallic == RoughnessMetallicEncoding::Material || modelPerMaterial;
+               roughnessMetallic == RoughnessMetallicEncoding::Material || modelPerMaterial ||
+               emission == EmissionEncoding::Material;
     }
     int materialIndexBits() const { return materials.size() <= 256 ? 8 : 16; }
     // Every plane of the layout, including unmodelled ones.

@@ -44,6 +44,7 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
                 exact->roughnessMetallic[pixel] = {surface.roughness, surface.metallic};
                 exact->model[pixel] = surface.model;
                 exact->occlusion[pixel] = surface.occlusion;
+                exact->emissive[pixel] = surface.emissive;
             }
         }
     });

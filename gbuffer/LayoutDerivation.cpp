@@ -46,14 +46,14 @@ bool oneModel(const scenes::Scene& scene, const std::set<uint32_t>& used) {
 } // namespace
 
 std::vector<std::string> layoutPresetNames() {
-    return {"reference", "compact", "stalker", "clear-sky", "killzone2", "bf3", "thesis"};
+    return {"reference", "compact", "stalker", "clear-sky", "killzone2", "bf3", "thesis", "ue4"};
 }
 
 std::vector<MaterialConstants> materialTable(const scenes::Scene& scene) {
     std::vector<MaterialConstants> table;
     for (const scenes::Material& m : scene.materials)
         table.push_back({glm::vec3(m.baseColorFactor), m.specularIntensity, m.specularPower,
-                         m.model, m.roughness, m.metallic});
+                         m.model, m.roughness, m.metallic, m.emission()});
     return table;
 }
 
@@ -92,9 +92,19 @@ void addMaterialModels(GBufferLayout& layout, const scenes::Scene& scene, bool r
     layout.constant.metallic = first->metallic;
     std::string& reason = layout.reasons[Channel::Specular];
     reason += reason.empty() ? "" : "; ";
+    const std::string readBy = "; read by the metallic-roughness BRDF (MetallicRoughness.h)";
     if (textured) {
         layout.roughnessMetallic =
             eightBitPlanes ? RoughnessMetallicEncoding::Unorm8 : RoughnessMetallicEncoding::Float32;
+        const std::string precision = eightBitPlanes ? " (8 bits)" : " (float32, lossless)";
+        layout.planeReasons["roughness"] =
+            "perceptual roughness, the GGX lobe's width: factor x the metallic-roughness "
+            "texture's G, varies per pixel" +
+            precision + readBy;
+        layout.planeReasons["metallic"] =
+            "metallic, which mixes base colour into F0 and removes diffuse: factor x the "
+            "metallic-roughness texture's B, varies per pixel" +
+            precision + readBy;
         reason += eightBitPlanes ? "metallic-roughness textures: roughness and metallic vary per "
                                    "pixel (8 bits each)"
                                  : "metallic-roughness textures: roughness and metallic vary per "
@@ -117,6 +127,44 @@ void addMaterialModels(GBufferLayout& layout, const scenes::Scene& scene, bool r
         layout.occlusion =
             eightBitPlanes ? RoughnessMetallicEncoding::Unorm8 : RoughnessMetallicEncoding::Float32;
         reason += "; occlusion textures and an ambient light: ambient occlusion per pixel";
+        layout.planeReasons["occlusion"] =
+            "ambient occlusion (1 + strength x (texture R - 1)): occlusion textures, and the scene "
+            "has an ambient light, the only light it darkens" +
+            std::string(eightBitPlanes ? " (8 bits)" : " (float32, lossless)") + readBy;
+    } else if (occlusionTextured) {
+        layout.absentPlanes.push_back(
+            {"occlusion", "occlusion textures, but no ambient light: occlusion darkens ambient "
+                          "light only, so it would change nothing"});
+    }
+}
+
+void addEmission(GBufferLayout& layout, const scenes::Scene& scene, bool readsEmission) {
+    std::string& reason = layout.reasons[Channel::Emission];
+    layout.emission = EmissionEncoding::None;
+    if (!readsEmission) {
+        reason = "the stage does not read emission (it adds its own surfaces' emission, if any)";
+        return;
+    }
+    int emitting = 0;
+    bool textured = false;
+    for (uint32_t index : usedMaterials(scene)) {
+        if (index >= scene.materials.size() || !scene.materials[index].emits())
+            continue;
+        ++emitting;
+        textured = textured || scene.materials[index].emissiveTexture >= 0;
+    }
+    if (emitting == 0) {
+        reason = "no used material emits: emission is zero, no plane";
+    } else if (textured) {
+        layout.emission = EmissionEncoding::Float32;
+        reason = std::to_string(emitting) +
+                 " emitting material(s) with an emissive texture: emitted radiance varies per "
+                 "pixel (float32 RGB, lossless), added once per pixel after the lights";
+    } else {
+        layout.emission = EmissionEncoding::Material;
+        reason = std::to_string(emitting) +
+                 " emitting material(s), untextured: emission is constant per material, decoded "
+                 "from the material index";
     }
 }
 
@@ -135,6 +183,12 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
     layout.reasons[Channel::Normal] = layout.hasNormals
                                           ? "the stage reads normals (float32, lossless)"
                                           : "the stage does not read normals";
+    const size_t normalMapped = std::count_if(used.begin(), used.end(), [&](uint32_t index) {
+        return index < scene.materials.size() && scene.materials[index].normalTexture >= 0;
+    });
+    if (layout.hasNormals && normalMapped > 0)
+        layout.reasons[Channel::Normal] += "; the shading normal after the normal maps of " +
+                                           std::to_string(normalMapped) + " material(s)";
 
     bool textured = false, oneAlbedo = true, oneSpecular = true, anyBlinnPhong = false;
     const MaterialConstants* first = nullptr;
@@ -199,6 +253,7 @@ GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel
             "specular differs between the " + materialCount + " but not inside one: material index";
     }
     addMaterialModels(layout, scene, reads(stageReads, Channel::Specular), false);
+    addEmission(layout, scene, reads(stageReads, Channel::Emission));
     return layout;
 }
 
@@ -206,11 +261,12 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
     GBufferLayout layout;
     layout.materials = materialTable(scene);
     const std::vector<Channel> everything = {Channel::Depth, Channel::Normal, Channel::Albedo,
-                                             Channel::Specular};
+                                             Channel::Specular, Channel::Emission};
     if (name == "reference") {
         layout = GBufferLayout::reference();
         layout.materials = materialTable(scene);
         addMaterialModels(layout, scene, true, false);
+        addEmission(layout, scene, true);
         return layout;
     }
     if (name == "compact") {
@@ -295,6 +351,28 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
             {Channel::Normal, "RT1 normal xyz (RGB16F; 16-bit SNORM here)"},
             {Channel::Specular, "RT0 alpha intensity (8 bits), RT1 alpha exponent (f16)"}};
         layout.notes = {"published: RGBA8 + RGBA16F + D24S8 = 128 bits"};
+    } else if (name == "ue4") {
+        // Unreal Engine 4's deferred base pass (4.18-era, DeferredShadingCommon.ush): D32 reversed
+        // depth + S8, GBufferA R10G10B10A2 world-space normal + per-object data, GBufferB RGBA8
+        // metallic, specular, roughness, shading model ID, GBufferC RGBA8 sRGB base colour + AO.
+        // Emission is not in the G-buffer there: the base pass adds it into scene colour.
+        layout.depth = {DepthFormatKind::F32Reversed, false};
+        layout.normals = {NormalCodecKind::Xyz, 30};
+        layout.normalSpace = NormalSpace::World;
+        layout.specular = SpecularEncoding::Unorm8Log8;
+        layout.unmodelled = {
+            {"GBufferA.a", "unorm2 per-object data", 2, "unmodelled"},
+            {"GBufferB.a", "uint8 shading model ID + output mask", 8, "unmodelled"},
+            {"stencil", "uint8", 8, "unmodelled"}};
+        layout.reasons = {
+            {Channel::Depth, "D32 reversed-Z hardware depth (UE4 also keeps 8 stencil bits)"},
+            {Channel::Normal, "GBufferA RGB10: world-space normal, 10 bits per component"},
+            {Channel::Specular,
+             "GBufferB: 8-bit specular and roughness (Blinn-Phong here: intensity and log power)"}};
+        layout.notes = {"published: D32S8 + 3 x 32-bit targets (GBufferA-C) = 136 bits; GBufferD "
+                        "(custom data), E (precomputed shadows) and velocity are optional and "
+                        "left out",
+                        "UE4 writes n * 0.5 + 0.5 as UNORM10; SNORM10 (xyz:30) here"};
     } else {
         std::string valid;
         for (const std::string& preset : layoutPresetNames())
@@ -302,9 +380,43 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
         throw std::invalid_argument("unknown G-buffer layout '" + name + "'; valid: " + valid +
                                     " (or none, to derive it from the scene and the stage)");
     }
-    layout.reasons[Channel::Albedo] = "RGB8 diffuse colour, as in the original";
+    layout.reasons[Channel::Albedo] = name == "ue4" ? "GBufferC RGB8 sRGB base colour"
+                                                    : "RGB8 diffuse colour, as in the original";
     addMaterialModels(layout, scene, true, true);
-    if (layout.roughnessMetallic == RoughnessMetallicEncoding::Unorm8)
+    addEmission(layout, scene, true);
+    if (name == "ue4") {
+        // GBufferB and GBufferC's channels are in the budget whether or not this scene uses them:
+        // what a channel does not carry here is counted as unmodelled, so the size stays 136 bits.
+        const bool onlyMetallicRoughness =
+            !layout.modelPerMaterial &&
+            layout.constant.model == scenes::MaterialModel::MetallicRoughness;
+        // GBufferB stores roughness and metallic per pixel whatever the materials do.
+        if (layout.roughnessMetallic == RoughnessMetallicEncoding::Constant ||
+            layout.roughnessMetallic == RoughnessMetallicEncoding::Material)
+            layout.roughnessMetallic = RoughnessMetallicEncoding::Unorm8;
+        if (onlyMetallicRoughness) {
+            layout.specular = SpecularEncoding::None;
+            layout.unmodelled.push_back(
+                {"GBufferB.g", "unorm8 specular (glTF fixes F0 at 0.04)", 8, "unmodelled"});
+        }
+        if (layout.roughnessMetallic == RoughnessMetallicEncoding::None)
+            layout.unmodelled.push_back({"GBufferB.r",
+                                         "unorm8 metallic (no metallic-roughness material)", 8,
+                                         "unmodelled"});
+        if (layout.modelPerMaterial)
+            layout.notes.push_back("+8 bits: both material models are used, so GBufferB holds "
+                                   "Blinn-Phong intensity and power beside roughness and metallic");
+        if (layout.occlusion == RoughnessMetallicEncoding::None)
+            layout.unmodelled.push_back(
+                {"GBufferC.a", "unorm8 ambient occlusion", 8, "unmodelled"});
+        else
+            layout.reasons[Channel::Specular] += "; GBufferC.a ambient occlusion (8 bits)";
+    }
+    if (layout.emission == EmissionEncoding::Float32)
+        layout.notes.push_back("+96 bits: emitted radiance (float32 RGB) for the scene's emissive "
+                               "textures; the original added emission into its light buffer "
+                               "(scene colour) during the geometry pass");
+    if (layout.roughnessMetallic == RoughnessMetallicEncoding::Unorm8 && name != "ue4")
         layout.notes.push_back("+16 bits: roughness and metallic (8 bits each) for the scene's "
                                "metallic-roughness materials, which the original did not model");
     return layout;

@@ -15,6 +15,9 @@
 //             when a metallic-roughness texture makes them vary per pixel, `constant` when every
 //             used material has the same factors, else `material`
 //   model     a constant when every used material has one model, else from the material index
+//   emission  absent when the stage does not read it (forward stages and the material passes add
+//             the emission of their own surfaces) or no used material emits; f32 RGB when an
+//             emissive texture varies it per pixel, else the material index
 // The derived layout is lossless with respect to what the rasterizer computes: brute on it gives
 // bitwise the image of brute on `reference`. Lossy choices are opt-in (overrides, presets).
 //
@@ -53,6 +56,12 @@ std::vector<MaterialConstants> materialTable(const scenes::Scene& scene);
 // presetLayout, and by whoever builds a lossless layout for a scene.
 void addMaterialModels(GBufferLayout& layout, const scenes::Scene& scene, bool readsSpecular,
                        bool eightBitPlanes);
+
+// Sets the emission channel of `layout` (whose `materials` must be the scene's materialTable):
+// none when the stage does not read it or no used material emits, f32 planes when an emitting
+// material has an emissive texture (emission varies per pixel), else `material`. Called by
+// deriveLayout and presetLayout, and by whoever builds a lossless layout for a scene.
+void addEmission(GBufferLayout& layout, const scenes::Scene& scene, bool readsEmission);
 
 GBufferLayout deriveLayout(const scenes::Scene& scene, const std::vector<Channel>& stageReads);
 // Throws std::invalid_argument for an unknown name, listing the valid ones.

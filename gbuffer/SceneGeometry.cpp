@@ -4,6 +4,17 @@
 
 namespace gbuffer {
 
+namespace {
+
+// Tangents serve normal maps only: a mesh whose material has none (every procedural mesh carries
+// tangents) keeps none, so a scene without normal maps transforms no tangents per frame.
+bool keepsTangents(const scenes::Scene& scene, const scenes::Mesh& mesh) {
+    return !mesh.tangents.empty() && mesh.material < scene.materials.size() &&
+           scene.materials[mesh.material].normalTexture >= 0;
+}
+
+} // namespace
+
 SceneGeometry SceneGeometry::build(const scenes::Scene& scene) {
     SceneGeometry g;
     size_t vertexCount = 0, indexCount = 0;
@@ -13,7 +24,7 @@ SceneGeometry SceneGeometry::build(const scenes::Scene& scene) {
         vertexCount += mesh.positions.size();
         indexCount += mesh.indices.size();
         anyUv1 = anyUv1 || !mesh.uvs1.empty();
-        anyTangents = anyTangents || !mesh.tangents.empty();
+        anyTangents = anyTangents || keepsTangents(scene, mesh);
     }
     if (vertexCount > UINT32_MAX || indexCount / 3 > UINT32_MAX)
         throw std::length_error(scene.name + ": too many vertices for 32-bit indices");
@@ -47,7 +58,7 @@ SceneGeometry SceneGeometry::build(const scenes::Scene& scene) {
                 g.uv1.push_back(mesh.uvs1.empty() ? glm::vec2(0.0f) : mesh.uvs1[v]);
             if (anyTangents) {
                 glm::vec4 tangent(0.0f);
-                if (!mesh.tangents.empty()) {
+                if (keepsTangents(scene, mesh)) {
                     // Tangents are surface directions: they transform with the matrix itself.
                     const glm::dvec3 t =
                         glm::dmat3(worldFromObject) * glm::dvec3(glm::vec3(mesh.tangents[v]));

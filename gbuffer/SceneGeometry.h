@@ -2,8 +2,9 @@
 // scene and shared by every pass of every frame (G-buffer, forward shading, the reference).
 // Vertex i of triangle t is vertices[indices[3t + i]]; triangle t has material triangleMaterial[t].
 // Instance transforms are applied here, in double, and rounded once.
-// Tangents (for normal maps) and the second uv set exist only when some mesh has them; then every
-// vertex has one (zero where its mesh has none: a zero tangent means "no normal mapping").
+// Tangents (for normal maps) exist only when some mesh has them and its material a normal map, the
+// second uv set only when some mesh has it; then every vertex has one (zero where its mesh has
+// none or its material no normal map: a zero tangent means "no normal mapping").
 #pragma once
 
 #include <cstdint>
@@ -22,7 +23,7 @@ struct SceneGeometry {
     std::vector<glm::vec2> uv;                  // (0,0) where the mesh has none
     std::vector<glm::vec2> uv1;                 // TEXCOORD_1; empty when no mesh has it
     // World-space unit tangent, w = +-1 the bitangent sign (Mesh::tangents, with the sign
-    // flipped by mirroring instance transforms); empty when no mesh has tangents.
+    // flipped by mirroring instance transforms); empty when no normal-mapped mesh has tangents.
     std::vector<glm::vec4> tangentWorld;
     std::vector<uint32_t> indices;
     std::vector<uint32_t> triangleMaterial;

@@ -9,6 +9,7 @@
 // zero position and albedo, normal +Z, no specular, Blinn-Phong.
 // Which fields a model reads: Blinn-Phong reads albedo (diffuse colour), specularIntensity and
 // specularPower; metallic-roughness reads albedo (base colour), metallic, roughness and occlusion.
+// emissive is not read by the lighting function: the stages add it once per pixel.
 // normalView is the shading normal: after normal mapping where the material has a normal map.
 // A channel a G-buffer layout does not provide decodes to its default (GBuffer::decode). New
 // material parameters (e.g. roughness, metallic, emissive) are new fields with a default here,
@@ -32,6 +33,9 @@ template <class T> struct BasicSurface {
     T roughness = T(1);     // metallic-roughness: perceptual, after the texture's G channel
     T metallic = T(0);      // metallic-roughness: after the texture's B channel
     T occlusion = T(1);     // metallic-roughness: ambient occlusion, 1 = none
+    // Emitted radiance (linear RGB, either model): emissive factor x strength x texture, added
+    // once per pixel after the light sum, never per light.
+    glm::vec<3, T> emissive{T(0)};
     scenes::MaterialModel model = scenes::MaterialModel::BlinnPhong;
     uint32_t material = 0; // index into the scene's materials (written, not always stored)
 };

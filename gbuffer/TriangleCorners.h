@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -26,6 +27,57 @@
 
 namespace gbuffer {
 
+// What the resolve reads of one material, decided once per frame (VisibilityPass::transform) so
+// that a scene that does not use a feature does not pay for it: per triangle, load() copies only
+// the vertex data the material's textures read, and per pixel one flag (textured) skips every
+// texture branch of a material that has none. A texture the material model ignores (the
+// metallic-roughness and occlusion textures of a Blinn-Phong material, a normal map without
+// tangents) is null here, so nothing downstream tests the model again.
+struct MaterialSampling {
+    Surface constant; // the parts of the surface that do not vary over a triangle
+    const scenes::Material* material = nullptr;
+    const scenes::Texture* baseColorTexture = nullptr;         // null when untextured
+    const scenes::Texture* metallicRoughnessTexture = nullptr; // null when absent or Blinn-Phong
+    const scenes::Texture* normalTexture = nullptr;            // null when absent or no tangents
+    const scenes::Texture* occlusionTexture = nullptr;         // null when absent or Blinn-Phong
+    const scenes::Texture* emissiveTexture = nullptr;          // null when absent or no emission
+    bool textured = false;                                     // one of the five is present
+    bool secondUvSet = false; // textured and the geometry has TEXCOORD_1
+
+    // One entry per scene material. Cost O(materials).
+    static std::vector<MaterialSampling> of(const scenes::Scene& scene,
+                                            const SceneGeometry& geometry) {
+        std::vector<MaterialSampling> table(scene.materials.size());
+        auto texture = [&](bool read, int index) {
+            return read && index >= 0 ? &scene.textures[size_t(index)] : nullptr;
+        };
+        for (size_t i = 0; i < table.size(); ++i) {
+            const scenes::Material& m = scene.materials[i];
+            const bool metallicRoughness = m.model == scenes::MaterialModel::MetallicRoughness;
+            MaterialSampling& entry = table[i];
+            entry.material = &m;
+            entry.baseColorTexture = texture(true, m.baseColorTexture);
+            entry.metallicRoughnessTexture = texture(metallicRoughness, m.metallicRoughnessTexture);
+            entry.normalTexture = texture(!geometry.tangentWorld.empty(), m.normalTexture);
+            entry.occlusionTexture = texture(metallicRoughness, m.occlusionTexture);
+            entry.emissiveTexture = texture(m.emits(), m.emissiveTexture);
+            entry.textured = entry.baseColorTexture || entry.metallicRoughnessTexture ||
+                             entry.normalTexture || entry.occlusionTexture || entry.emissiveTexture;
+            entry.secondUvSet = entry.textured && !geometry.uv1.empty();
+            Surface& s = entry.constant;
+            s.material = uint32_t(i);
+            s.albedo = glm::vec3(m.baseColorFactor);
+            s.specularIntensity = m.specularIntensity;
+            s.specularPower = m.specularPower;
+            s.model = m.model;
+            s.roughness = m.roughness;
+            s.metallic = m.metallic;
+            s.emissive = m.emission();
+        }
+        return table;
+    }
+};
+
 struct TriangleCorners {
     // Clip-space x, y and w of the three vertices (z is not needed: depth comes from the
     // rasterizer).
@@ -35,55 +87,39 @@ struct TriangleCorners {
     // it is normalised here once, and per pixel only the sign of the weight sum is needed.
     bool flat;
     bool flatNormalIsZero;    // flat with zero-length normals: the (0, 0, +-1) fallback
+    bool textured;            // sampling->textured, kept here for the per-pixel test
     glm::vec3 flatNormalView; // unit, valid when flat and not zero
     glm::vec2 uv[3];          // loaded only for textured materials
     glm::vec2 uv1[3];         // loaded only when a texture reads TEXCOORD_1
     glm::vec4 tangentView[3]; // loaded only with a normal texture (w = bitangent sign)
-    uint32_t materialIndex;
-    const scenes::Material* material;
-    const scenes::Texture* baseColorTexture;         // null when untextured
-    const scenes::Texture* metallicRoughnessTexture; // null when absent or Blinn-Phong
-    const scenes::Texture* normalTexture;            // null when absent or no tangents
-    const scenes::Texture* occlusionTexture;         // null when absent or Blinn-Phong
-    bool textured;                                   // one of the four is present
+    const MaterialSampling* sampling;
 
-    static TriangleCorners load(const SceneGeometry& geometry, const scenes::Scene& scene,
+    // `materials` is MaterialSampling::of(scene, geometry).
+    static TriangleCorners load(const SceneGeometry& geometry,
+                                std::span<const MaterialSampling> materials,
                                 std::span<const glm::vec4> clipPositions,
                                 std::span<const glm::vec3> normalsView,
                                 std::span<const glm::vec4> tangentsView, uint32_t triangle) {
         const uint32_t* index = geometry.indices.data() + 3 * size_t(triangle);
         TriangleCorners corners;
-        corners.materialIndex = geometry.triangleMaterial[triangle];
-        corners.material = &scene.materials[corners.materialIndex];
-        corners.baseColorTexture = corners.material->baseColorTexture >= 0
-                                       ? &scene.textures[size_t(corners.material->baseColorTexture)]
-                                       : nullptr;
-        const scenes::Material& m = *corners.material;
-        corners.metallicRoughnessTexture =
-            m.model == scenes::MaterialModel::MetallicRoughness && m.metallicRoughnessTexture >= 0
-                ? &scene.textures[size_t(m.metallicRoughnessTexture)]
-                : nullptr;
-        corners.normalTexture = m.normalTexture >= 0 && !tangentsView.empty()
-                                    ? &scene.textures[size_t(m.normalTexture)]
-                                    : nullptr;
-        corners.occlusionTexture =
-            m.model == scenes::MaterialModel::MetallicRoughness && m.occlusionTexture >= 0
-                ? &scene.textures[size_t(m.occlusionTexture)]
-                : nullptr;
-        corners.textured = corners.baseColorTexture || corners.metallicRoughnessTexture ||
-                           corners.normalTexture || corners.occlusionTexture;
-        const bool secondUvSet = corners.textured && !geometry.uv1.empty();
+        corners.sampling = &materials[geometry.triangleMaterial[triangle]];
+        const MaterialSampling& sampling = *corners.sampling;
+        corners.textured = sampling.textured;
         for (int i = 0; i < 3; ++i) {
             const glm::vec4& clip = clipPositions[index[i]];
             corners.clipX[i] = clip.x;
             corners.clipY[i] = clip.y;
             corners.clipW[i] = clip.w;
             corners.normalView[i] = normalsView[index[i]];
-            corners.uv[i] = corners.textured ? geometry.uv[index[i]] : glm::vec2(0.0f);
-            corners.uv1[i] = secondUvSet ? geometry.uv1[index[i]] : corners.uv[i];
-            corners.tangentView[i] =
-                corners.normalTexture ? tangentsView[index[i]] : glm::vec4(0.0f);
         }
+        if (sampling.textured)
+            for (int i = 0; i < 3; ++i) {
+                corners.uv[i] = geometry.uv[index[i]];
+                corners.uv1[i] = sampling.secondUvSet ? geometry.uv1[index[i]] : corners.uv[i];
+            }
+        if (sampling.normalTexture)
+            for (int i = 0; i < 3; ++i)
+                corners.tangentView[i] = tangentsView[index[i]];
         corners.flat = corners.normalView[0] == corners.normalView[1] &&
                        corners.normalView[0] == corners.normalView[2];
         const float length2 = glm::dot(corners.normalView[0], corners.normalView[0]);
@@ -112,50 +148,47 @@ struct RowWeights {
 };
 
 // The parts of a triangle's surface that do not vary over it: material index and model, albedo
-// factor (the whole albedo when untextured), specular, roughness and metallic factors. Normal and
-// textured albedo come per pixel from updateSurfaceAt. positionView stays zero: it comes from depth
+// factor (the whole albedo when untextured), specular, roughness and metallic factors, emission
+// factor (made once per material by MaterialSampling::of). Normal, textured albedo and the other
+// textures come per pixel from updateSurfaceAt. positionView stays zero: it comes from depth
 // (DepthDecoder).
-inline Surface triangleSurface(const TriangleCorners& corners) {
-    const scenes::Material& material = *corners.material;
-    Surface surface;
-    surface.material = corners.materialIndex;
-    surface.albedo = glm::vec3(material.baseColorFactor);
-    surface.specularIntensity = material.specularIntensity;
-    surface.specularPower = material.specularPower;
-    surface.model = material.model;
-    surface.roughness = material.roughness;
-    surface.metallic = material.metallic;
-    return surface;
+inline const Surface& triangleSurface(const TriangleCorners& corners) {
+    return corners.sampling->constant;
 }
 
 // The texture lookups of updateSurfaceAt at barycentric weights `weights` (summing to 1).
 inline void updateTexturedSurfaceAt(Surface& surface, const TriangleCorners& corners,
                                     const glm::vec3& weights, bool backFace) {
-    const scenes::Material& material = *corners.material;
+    const MaterialSampling& sampling = *corners.sampling;
+    const scenes::Material& material = *sampling.material;
     const glm::vec2 uv0 = raster::interpolate(corners.uv[0], corners.uv[1], corners.uv[2], weights);
     const glm::vec2 uv1 =
         raster::interpolate(corners.uv1[0], corners.uv1[1], corners.uv1[2], weights);
     auto uvOf = [&](const scenes::TextureMapping& mapping) {
         return mapping.apply(mapping.texCoord == 1 ? uv1 : uv0);
     };
-    if (corners.baseColorTexture)
+    if (sampling.baseColorTexture)
         surface.albedo =
             glm::vec3(material.baseColorFactor) *
-            glm::vec3(corners.baseColorTexture->sample(uvOf(material.baseColorMapping)));
-    if (corners.metallicRoughnessTexture) {
+            glm::vec3(sampling.baseColorTexture->sample(uvOf(material.baseColorMapping)));
+    if (sampling.metallicRoughnessTexture) {
         const glm::vec4 texel =
-            corners.metallicRoughnessTexture->sample(uvOf(material.metallicRoughnessMapping));
+            sampling.metallicRoughnessTexture->sample(uvOf(material.metallicRoughnessMapping));
         surface.roughness = material.roughness * texel.g;
         surface.metallic = material.metallic * texel.b;
     }
-    if (corners.occlusionTexture) {
-        const float r = corners.occlusionTexture->sample(uvOf(material.occlusionMapping)).r;
+    if (sampling.occlusionTexture) {
+        const float r = sampling.occlusionTexture->sample(uvOf(material.occlusionMapping)).r;
         surface.occlusion = 1.0f + material.occlusionStrength * (r - 1.0f);
     }
-    if (corners.normalTexture) {
+    if (sampling.emissiveTexture)
+        surface.emissive =
+            sampling.constant.emissive *
+            glm::vec3(sampling.emissiveTexture->sample(uvOf(material.emissiveMapping)));
+    if (sampling.normalTexture) {
         const glm::vec4 tangent = raster::interpolate(
             corners.tangentView[0], corners.tangentView[1], corners.tangentView[2], weights);
-        const glm::vec4 texel = corners.normalTexture->sample(uvOf(material.normalMapping));
+        const glm::vec4 texel = sampling.normalTexture->sample(uvOf(material.normalMapping));
         surface.normalView =
             normalMapped(surface.normalView, backFace, glm::vec3(tangent),
                          tangent.w < 0.0f ? -1.0f : 1.0f, glm::vec3(texel), material.normalScale);

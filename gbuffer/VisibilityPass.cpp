@@ -38,6 +38,7 @@ void VisibilityPass::transform(const scenes::Scene& scene, const SceneGeometry& 
         }
     });
     mAlpha.build(scene);
+    mMaterials = MaterialSampling::of(scene, geometry);
     mNdcXOfColumn.resize(size_t(view.width));
     for (int x = 0; x < view.width; ++x)
         mNdcXOfColumn[size_t(x)] = view.ndcOfPixel(x, 0).x;

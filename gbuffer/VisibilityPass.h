@@ -110,7 +110,8 @@ private:
     CameraView mView;
     std::vector<glm::vec4> mClipPositions;
     std::vector<glm::vec3> mNormalsView;
-    std::vector<glm::vec4> mTangentsView; // empty when the geometry has no tangents
+    std::vector<glm::vec4> mTangentsView;     // empty when the geometry has no tangents
+    std::vector<MaterialSampling> mMaterials; // what the resolve reads of each material
     std::vector<float> mNdcXOfColumn; // view.ndcOfPixel(x, y).x per column: no division per pixel
     Plane<uint32_t> mCodes;
     AlphaCoverage mAlpha;
@@ -132,8 +133,9 @@ public:
     [[gnu::always_inline]] const Surface& at(uint32_t code, int x) {
         const uint32_t triangle = triangleOf(code);
         if (triangle != mCornersOf) {
-            mCorners = TriangleCorners::load(*mPass.mGeometry, *mPass.mScene, mPass.mClipPositions,
-                                             mPass.mNormalsView, mPass.mTangentsView, triangle);
+            mCorners =
+                TriangleCorners::load(*mPass.mGeometry, mPass.mMaterials, mPass.mClipPositions,
+                                      mPass.mNormalsView, mPass.mTangentsView, triangle);
             mRow = RowWeights::of(mCorners, mNdcY);
             mSurface = triangleSurface(mCorners);
             mCornersOf = triangle;

@@ -19,7 +19,8 @@
 namespace lighting {
 
 // Resizes `result` to width x height with the oracle plane, shades, and records the loop as the
-// pass "shading". Per covered pixel: radiance summed over `lights` in order, lightsEvaluated =
+// pass "shading". Per covered pixel: radiance summed over `lights` in order plus the surface's
+// emission (in T: the reference adds it in double), lightsEvaluated =
 // every light, lightsOracle = the lights that contribute.
 template <class T, class SurfaceAt>
 void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>>& lights,
@@ -40,6 +41,7 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
                 sum += radiance;
                 contributing += contributes(radiance) ? 1u : 0u;
             }
+            sum += point.emissive; // once per pixel, after the lights; counts unaffected
             result.radiance[0][pixel] = float(sum.x);
             result.radiance[1][pixel] = float(sum.y);
             result.radiance[2][pixel] = float(sum.z);

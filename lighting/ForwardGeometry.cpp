@@ -11,12 +11,32 @@
 
 namespace lighting {
 
+void ForwardGeometry::addEmission(StageResult& result) const {
+    if (!mEmits)
+        return;
+    const uint32_t* codes = mVisibility.codes().data();
+    const int width = mVisibility.view().width;
+    tbb::parallel_for(0, mVisibility.view().height, [&](int y) {
+        gbuffer::VisibilityPass::RowSurfaces row(mVisibility, y);
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = size_t(y) * width + x;
+            if (codes[pixel] == gbuffer::VisibilityPass::kNoTriangle)
+                continue;
+            const glm::vec3 emitted = row.at(codes[pixel], x).emissive;
+            for (int c = 0; c < 3; ++c)
+                result.radiance[c][pixel] += emitted[c];
+        }
+    });
+}
+
 void ForwardGeometry::prepare(const StageInputs& inputs) {
     if (!inputs.scene || !inputs.geometry || !inputs.view)
         throw std::invalid_argument("forward shading needs the frame's scene, geometry and view");
     const gbuffer::SceneGeometry& geometry = *inputs.geometry;
     const gbuffer::CameraView& view = *inputs.view;
     mVisibility.transform(*inputs.scene, geometry, view);
+    mEmits = std::any_of(inputs.scene->materials.begin(), inputs.scene->materials.end(),
+                         [](const scenes::Material& material) { return material.emits(); });
     mDepthDecoder =
         gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar).depthDecoder(view);
     fitRasterizer(mRasterizer, view);

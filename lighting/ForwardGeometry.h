@@ -114,6 +114,10 @@ public:
         s.positionView = mDepthDecoder->positionView(fragment.x, fragment.y, fragment.depth);
         return s;
     }
+    // Adds the emission of every pixel's visible triangle (the pre-pass's visibility buffer,
+    // drawDepthPrepass) to result.radiance, once: for a stage that accumulates light by light.
+    // Nothing to do (no pass over the pixels) when no material of the scene emits.
+    void addEmission(StageResult& result) const;
     // How the forward stages read their own depth planes: the lossless layout's decoder.
     const gbuffer::DepthDecoder& depthDecoder() const { return *mDepthDecoder; }
 
@@ -126,6 +130,7 @@ private:
     std::vector<ForwardObject> mObjects;
     std::vector<uint32_t> mObjectOfTriangle;
     std::vector<std::vector<uint32_t>> mPerObject; // objectLightLists scratch
+    bool mEmits = false;                           // some material of the scene emits
 };
 
 // True when the (widened) light sphere may touch the object's box; unbounded lights always do.

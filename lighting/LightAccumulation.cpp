@@ -173,6 +173,7 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
     const bool packets = packetPathFits(inputs);
+    const bool emission = gb.hasEmission();
     const kernel::KernelIsa isa = packets ? inputs.isa : kernel::KernelIsa::scalar();
     std::optional<kernel::PacketDecoder> decoder;
     std::optional<kernel::KernelLights> kernelLights;
@@ -258,6 +259,11 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                                              size_t(x0 + kernel::laneX(lane));
                         for (int c = 0; c < 3; ++c)
                             result.radiance[c][pixel] = accumulator.radiance[c][lane];
+                        if (emission) {
+                            const glm::vec3 emitted = gb.emission(pixel);
+                            for (int c = 0; c < 3; ++c)
+                                result.radiance[c][pixel] += emitted[c];
+                        }
                         result.lightsEvaluated[pixel] = accumulator.lightsEvaluated[lane];
                         if (options.countOracle)
                             result.lightsOracle[pixel] = accumulator.lightsContributing[lane];

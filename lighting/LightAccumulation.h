@@ -212,7 +212,8 @@ struct AccumulationOptions {
     bool countOracle = false;
 };
 
-// Shades every covered pixel of inputs.gbuffer with its lists and writes result.radiance,
+// Shades every covered pixel of inputs.gbuffer with its lists and writes result.radiance (the light
+// sum, plus the pixel's emission, GBuffer::emission, once, when the layout stores any),
 // result.lightsEvaluated (and lightsOracle when asked); result must be resized already. Records
 // the parameters "isa" (what ran), "simt_warp" and "simt_lane_slots", and on the packet path the
 // packet-level work: "packet_groups" (kernel calls), "packet_lights_skipped_at_range",

@@ -152,4 +152,57 @@ evaluateLightMetallicRoughness(const Vec3<T>& positionView, const Vec3<T>& norma
            metallicRoughnessBrdf(lobes, normalView, incidence.toLight, toViewer);
 }
 
+// The radiance of evaluateLightMetallicRoughness split the way light buffers store lighting
+// (light pre-pass, inferred lighting), into sums that do not depend on the base colour or on
+// metallic, so that a light buffer computed before the material is known can be completed by the
+// material pass exactly:
+//     radiance = c_diff * diffuse + f0 * specularF0 + specularEdge
+// with c_diff = baseColor (1 - metallic) and f0 = mix(0.04, baseColor, metallic)
+// (metallicRoughnessLobes). Schlick's F = f0 + (1 - f0) w = f0 (1 - w) + w splits the specular
+// lobe D Vis into a part proportional to f0 and the Fresnel edge w D Vis, which is not; the
+// diffuse weight (1 - F(0.04)) / pi does not involve f0. The sums depend on the normal, roughness,
+// occlusion (ambient lights: (0.96 c_diff + f0) occlusion) and the lights only. Equal to
+// evaluateLightMetallicRoughness up to rounding (the same factors, grouped differently).
+template <class T> struct MetallicRoughnessSplit {
+    Vec3<T> diffuse{T(0)};      // times c_diff
+    Vec3<T> specularF0{T(0)};   // times f0
+    Vec3<T> specularEdge{T(0)}; // added as is
+};
+
+template <class T>
+inline MetallicRoughnessSplit<T>
+splitLightMetallicRoughness(const Vec3<T>& positionView, const Vec3<T>& normalView, T roughness,
+                            T occlusion, const Vec3<T>& toViewer, const LightInView<T>& light) {
+    MetallicRoughnessSplit<T> split;
+    if (light.type == scenes::LightType::Ambient) {
+        split.diffuse = light.radiance * (occlusion * T(1.0 - kDielectricF0));
+        split.specularF0 = light.radiance * occlusion;
+        return split;
+    }
+    const Incidence<T> incidence = lightIncidence(positionView, normalView, light);
+    if (!(incidence.attenuation > T(0)))
+        return split;
+    const T nDotL = glm::dot(normalView, incidence.toLight);
+    if (!(nDotL > T(0)))
+        return split;
+    const T clamped = glm::clamp(roughness, T(kMinRoughness), T(1));
+    const T alpha = clamped * clamped;
+    const T alpha2 = alpha * alpha;
+    const Vec3<T> sum = incidence.toLight + toViewer;
+    const T sumLength2 = glm::dot(sum, sum);
+    const Vec3<T> h = sumLength2 > T(0) ? sum / std::sqrt(sumLength2) : Vec3<T>(T(0));
+    const T vDotH = glm::dot(toViewer, h);
+    const T w = schlickWeight(vDotH);
+    const T dielectricFresnel = T(kDielectricF0) + T(1.0 - kDielectricF0) * w;
+    const T specular = vDotH > T(0)
+                           ? ggxDistribution(alpha2, normalView, h) *
+                                 smithVisibility(alpha2, nDotL, glm::dot(normalView, toViewer))
+                           : T(0);
+    const Vec3<T> incident = light.radiance * (incidence.attenuation * nDotL);
+    split.diffuse = incident * ((T(1) - dielectricFresnel) * T(1.0 / kPi));
+    split.specularF0 = incident * ((T(1) - w) * specular);
+    split.specularEdge = incident * (w * specular);
+    return split;
+}
+
 } // namespace lighting

@@ -7,13 +7,15 @@ namespace lighting {
 namespace {
 
 // GBufferLayout::reference() and lossless() know no scene: they get the scene's material table
-// and what its metallic-roughness materials need (model, roughness and metallic in float32).
+// and what its metallic-roughness materials need (model, roughness and metallic in float32), and
+// its emission.
 gbuffer::GBufferLayout withSceneMaterials(gbuffer::GBufferLayout layout,
                                           const scenes::Scene& scene) {
     if (!layout.materials.empty())
         return layout;
     layout.materials = gbuffer::materialTable(scene);
     gbuffer::addMaterialModels(layout, scene, layout.provides(gbuffer::Channel::Specular), false);
+    gbuffer::addEmission(layout, scene, true);
     return layout;
 }
 

@@ -77,11 +77,11 @@ struct StageRequirements {
     std::vector<gbuffer::Channel> channels; // G-buffer channels the stage reads
     bool exactSurface = false;              // reads gbuffer::ExactSurface (the reference)
 
-    // Every channel the BRDF reads (depth, normal, albedo, specular): what a stage that shades
-    // from the G-buffer declares.
+    // Every channel the BRDF reads (depth, normal, albedo, specular) and the emission added once
+    // per pixel: what a stage that shades from the G-buffer declares.
     static StageRequirements wholeSurface() {
         return {{gbuffer::Channel::Depth, gbuffer::Channel::Normal, gbuffer::Channel::Albedo,
-                 gbuffer::Channel::Specular},
+                 gbuffer::Channel::Specular, gbuffer::Channel::Emission},
                 false};
     }
 };

@@ -107,6 +107,10 @@ struct Material {
     }
     // True when some texture reads TEXCOORD_1.
     bool usesSecondUvSet() const;
+    // Emitted radiance before the emissive texture: emissiveFactor * emissiveStrength.
+    glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
+    // Whether the material emits at all (a texture alone, with a zero factor, emits nothing).
+    bool emits() const { return emission() != glm::vec3(0.0f); }
 };
 
 // The Blinn-Phong pair that stands in for a metallic-roughness material when Blinn-Phong is the

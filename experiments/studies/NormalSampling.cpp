@@ -77,16 +77,15 @@ Dataset hardDataset() {
     return data;
 }
 
-Dataset sceneDataset(const std::string& source, const std::string& label, int width, int height,
-                     NormalStudyScene& info, std::vector<std::string>& warnings) {
-    scenes::SceneRequest request; // no generated lights: only the geometry matters here
-    scenes::Scene scene = scenes::loadScene(source, request);
-    for (const std::string& warning : scene.warnings)
-        warnings.push_back(label + ": " + warning);
+namespace {
+
+// The covered pixels' normals and view rays of one render, and its figures.
+Dataset renderedNormals(scenes::Scene scene, const std::string& name, const std::string& source,
+                        int width, int height, NormalStudyScene& info) {
     lighting::PreparedScene prepared(std::move(scene), width, height);
     const gbuffer::GBuffer& gb = *prepared.gbuffer;
     const gbuffer::CameraView& view = prepared.view;
-    Dataset data{"scene:" + label, {}, {}};
+    Dataset data{name, {}, {}};
     std::uint64_t negative = 0, backFacing = 0;
     for (int y = 0; y < gb.height(); ++y)
         for (int x = 0; x < gb.width(); ++x) {
@@ -107,6 +106,39 @@ Dataset sceneDataset(const std::string& source, const std::string& label, int wi
     const double covered = std::max<double>(1.0, double(data.normals.size()));
     info.negativeZFraction = double(negative) / covered;
     info.backFacingFraction = double(backFacing) / covered;
+    return data;
+}
+
+} // namespace
+
+Dataset sceneDataset(const std::string& source, const std::string& label, int width, int height,
+                     NormalStudyScene& info, std::vector<std::string>& warnings, Dataset& geometric,
+                     NormalStudyScene& geometricInfo) {
+    scenes::SceneRequest request; // no generated lights: only the geometry matters here
+    scenes::Scene scene = scenes::loadScene(source, request);
+    for (const std::string& warning : scene.warnings)
+        warnings.push_back(label + ": " + warning);
+    const bool normalMapped =
+        std::any_of(scene.meshes.begin(), scene.meshes.end(), [&](const scenes::Mesh& mesh) {
+            return mesh.material < scene.materials.size() &&
+                   scene.materials[mesh.material].normalTexture >= 0;
+        });
+    scenes::Scene withoutMaps = scene;
+    Dataset data = renderedNormals(std::move(scene), "scene:" + label, source, width, height, info);
+    geometric = {};
+    if (!normalMapped)
+        return data;
+    for (scenes::Material& material : withoutMaps.materials)
+        material.normalTexture = -1;
+    geometric = renderedNormals(std::move(withoutMaps), "scene:" + label + ":geometric", source,
+                                width, height, geometricInfo);
+    geometricInfo.geometric = true;
+    // The same triangles through the same rasterizer cover the same pixels in the same order.
+    std::uint64_t changed = 0;
+    for (std::size_t i = 0; i < data.normals.size() && i < geometric.normals.size(); ++i)
+        changed += data.normals[i] != geometric.normals[i];
+    info.normalMappedFraction =
+        double(changed) / std::max<double>(1.0, double(data.normals.size()));
     return data;
 }
 

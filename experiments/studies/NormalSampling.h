@@ -80,8 +80,13 @@ Dataset visibleDataset(std::uint64_t count, std::uint64_t seed);
 Dataset hardDataset(); // hardNormalCases()
 // The covered pixels of `source` rendered from its first camera at width x height (float32
 // G-buffer), with their view rays; `info` gets the scene's figures, `warnings` the loader's.
+// The normals are the shading normals the G-buffer stores, after normal mapping. When a used
+// material has a normal map, `geometric` receives the same render with the normal maps removed
+// ("scene:LABEL:geometric", its figures in geometricInfo), and info.normalMappedFraction the
+// share of covered pixels whose normal the maps changed; otherwise geometric stays empty.
 Dataset sceneDataset(const std::string& source, const std::string& label, int width, int height,
-                     NormalStudyScene& info, std::vector<std::string>& warnings);
+                     NormalStudyScene& info, std::vector<std::string>& warnings, Dataset& geometric,
+                     NormalStudyScene& geometricInfo);
 // The .gltf and .glb files below dir, sorted.
 std::vector<std::filesystem::path> findModels(const std::filesystem::path& dir);
 

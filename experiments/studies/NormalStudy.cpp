@@ -169,11 +169,17 @@ private:
         for (const auto& [source, label] : sceneSources(mOptions, mModels)) {
             step("scene " + label + " at " + std::to_string(mSetup.sceneWidth) + "x" +
                  std::to_string(mSetup.sceneHeight));
-            NormalStudyScene info;
+            NormalStudyScene info, geometricInfo;
+            Dataset geometric;
             const Dataset data = sceneDataset(source, label, mSetup.sceneWidth, mSetup.sceneHeight,
-                                              info, mResult.warnings);
+                                              info, mResult.warnings, geometric, geometricInfo);
             mResult.scenes.push_back(info);
             addDataset(data);
+            if (!geometric.normals.empty()) {
+                step("scene " + label + " without its normal maps (" + geometric.name + ")");
+                mResult.scenes.push_back(geometricInfo);
+                addDataset(geometric);
+            }
         }
     }
     void hard() {

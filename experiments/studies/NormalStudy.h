@@ -102,6 +102,12 @@ struct NormalStudyScene {
     std::uint64_t coveredPixels = 0;
     double negativeZFraction = 0.0;  // view-space z < 0 (xy-z's failure case)
     double backFacingFraction = 0.0; // dot(normal, view ray) > 0 (interpolated normals at edges)
+    // Normal maps: the dataset holds the shading normals the G-buffer stores, after the normal
+    // maps of the scene's materials. normalMappedFraction is the share of covered pixels whose
+    // normal the maps changed (against the same render without them); "scene:NAME:geometric" is
+    // that render without normal maps, a dataset of its own for comparison (geometric = true).
+    double normalMappedFraction = 0.0;
+    bool geometric = false;
 };
 
 // Fraction of visible surface orientations with view-space z < 0 at one field of view.

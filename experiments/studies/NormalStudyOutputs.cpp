@@ -62,7 +62,9 @@ nlohmann::json scenesJson(const std::vector<NormalStudyScene>& scenes) {
                         {"height", scene.height},
                         {"covered_pixels", scene.coveredPixels},
                         {"negative_z_fraction", scene.negativeZFraction},
-                        {"back_facing_fraction", scene.backFacingFraction}});
+                        {"back_facing_fraction", scene.backFacingFraction},
+                        {"normal_mapped_fraction", scene.normalMappedFraction},
+                        {"geometric", scene.geometric}});
     return list;
 }
 
@@ -148,6 +150,11 @@ void printScenes(const NormalStudyResult& result, std::ostream& out) {
                       scene.dataset.c_str(), static_cast<unsigned long long>(scene.coveredPixels),
                       100.0 * scene.negativeZFraction, 100.0 * scene.backFacingFraction);
         out << line;
+        if (scene.normalMappedFraction > 0.0) {
+            std::snprintf(line, sizeof line, "  normal-mapped: %6.3f%%",
+                          100.0 * scene.normalMappedFraction);
+            out << line;
+        }
         for (const char* codec : {"xy-z:32", "pixel-view:32"})
             if (const NormalStudyRow* row = findRow(result, codec, scene.dataset)) {
                 std::snprintf(line, sizeof line, "  %s on z<0: mean %.3f max %.3f deg", codec,

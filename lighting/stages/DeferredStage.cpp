@@ -3,7 +3,8 @@
 // light's volume is rasterized over the G-buffer (LightVolumes.h) and, in the fragment function,
 // decodes the G-buffer surface, evaluates the light and ADDS it to the pixel. Decoding the
 // G-buffer once per light per pixel is the honest bandwidth cost of this technique. Directional
-// and ambient lights are full-screen quads at their place in the light order.
+// and ambient lights are full-screen quads at their place in the light order. Emission is added
+// once per pixel after the last light (addEmission, LightListShading.h), inside "shading".
 //
 // Exactness: every pixel receives its lights in ascending index order and skipped lights
 // contribute exactly zero, so the image is bitwise equal to `brute`'s. All volumes go through
@@ -29,6 +30,7 @@
 
 #include "lighting/BlendedPass.h"
 #include "lighting/LightBounds.h"
+#include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/stages/VolumeStageOptions.h"
@@ -71,6 +73,7 @@ public:
         cull.volumes.draw(
             cull.spheres, cull.drawn,
             [&](uint32_t light, int x, int y, size_t pixel) { addLight(x, y, pixel, light); });
+        addEmission(gb, result);
         shading.stop();
         // Blended surfaces: every light (light volumes are tested against the opaque depth).
         if (mBlended.prepare(inputs))

@@ -99,6 +99,7 @@ public:
                 raster::TriangleList{visibility.clipPositions(), indices}, state, addLight,
                 [&](uint32_t drawn) { return globalTriangle ? globalTriangle[drawn] : drawn; });
         }
+        mForward.addEmission(result);
         shading.stop();
         // Blended surfaces: one fragment at a time with its object's lights (the lists the
         // illumination sets were transposed from: ascending per object). "Over" does not

@@ -105,6 +105,7 @@ struct LightSample {
     glm::vec3 normalView{0.0f, 0.0f, 1.0f};
     glm::vec3 diffuse{0.0f};
     glm::vec3 specular{0.0f};
+    glm::vec3 specularEdge{0.0f}; // metallic-roughness (SplitLighting)
 };
 
 float floatOption(const StageSpec& spec, const char* key, float defaultValue, float minValue,
@@ -194,6 +195,7 @@ public:
                     const SplitLighting lighting = splitLighting(point, lights, list);
                     sample.diffuse = lighting.diffuse;
                     sample.specular = lighting.specular;
+                    sample.specularEdge = lighting.specularEdge;
                     result.lightsEvaluated[size_t(y) * width + x] = uint32_t(list.size());
                 }
         });
@@ -254,8 +256,8 @@ public:
             const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
             // Two filters at once: `same` applies the ID, depth and normal tests, `surface` the
             // depth and normal tests only (with ids=0 they coincide).
-            glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f);
-            glm::vec3 surfaceDiffuse(0.0f), surfaceSpecular(0.0f);
+            glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f), sameEdge(0.0f);
+            glm::vec3 surfaceDiffuse(0.0f), surfaceSpecular(0.0f), surfaceEdge(0.0f);
             float sameWeight = 0.0f, surfaceWeight = 0.0f;
             int nearest = -1;
             float nearestWeight = -1.0f;
@@ -272,29 +274,35 @@ public:
                     continue;
                 surfaceDiffuse += bilinear[k] * t.diffuse;
                 surfaceSpecular += bilinear[k] * t.specular;
+                surfaceEdge += bilinear[k] * t.specularEdge;
                 surfaceWeight += bilinear[k];
                 if (mSampleObjects[tapIndex[k]] != object)
                     continue;
                 sameDiffuse += bilinear[k] * t.diffuse;
                 sameSpecular += bilinear[k] * t.specular;
+                sameEdge += bilinear[k] * t.specularEdge;
                 sameWeight += bilinear[k];
             }
-            glm::vec3 diffuse(0.0f), specular(0.0f);
+            glm::vec3 diffuse(0.0f), specular(0.0f), edge(0.0f);
             if (sameWeight > 0.0f) {
                 diffuse = sameDiffuse / sameWeight;
                 specular = sameSpecular / sameWeight;
+                edge = sameEdge / sameWeight;
             } else if (surfaceWeight > 0.0f) {
                 diffuse = surfaceDiffuse / surfaceWeight;
                 specular = surfaceSpecular / surfaceWeight;
+                edge = surfaceEdge / surfaceWeight;
                 ++idFallbacks;
             } else if (nearest >= 0) {
                 diffuse = mSamples[tapIndex[nearest]].diffuse;
                 specular = mSamples[tapIndex[nearest]].specular;
+                edge = mSamples[tapIndex[nearest]].specularEdge;
                 ++fallbacks;
             } else {
                 ++fallbacks;
             }
-            const glm::vec3 radiance = s.albedo * diffuse + s.specularIntensity * specular;
+            const glm::vec3 radiance =
+                combineSplitLighting(s, diffuse, specular, edge) + s.emissive;
             result.radiance[0][pixel] = radiance.r;
             result.radiance[1][pixel] = radiance.g;
             result.radiance[2][pixel] = radiance.b;

@@ -84,6 +84,7 @@ public:
         PassTimer lightingPass(result, pass::kLighting);
         mDiffuse.assign(gb.pixelCount(), glm::vec3(0.0f));
         mSpecular.assign(gb.pixelCount(), 0.0f);
+        mSpecularEdge.assign(gb.pixelCount(), 0.0f);
         tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
             if (!bounds[size_t(tile)].covered)
                 return;
@@ -98,6 +99,7 @@ public:
                     const SplitLighting lighting = splitLighting(point, lights, list);
                     mDiffuse[pixel] = lighting.diffuse;
                     mSpecular[pixel] = luminance(lighting.specular); // one monochrome scalar
+                    mSpecularEdge[pixel] = luminance(lighting.specularEdge);
                     result.lightsEvaluated[pixel] = uint32_t(list.size());
                 }
         });
@@ -114,8 +116,14 @@ public:
                 if (lum > 0.0f)
                     specularColour = diffuse / lum;
             }
-            const glm::vec3 radiance =
-                s.albedo * diffuse + (s.specularIntensity * mSpecular[pixel]) * specularColour;
+            glm::vec3 radiance;
+            if (s.model == scenes::MaterialModel::MetallicRoughness)
+                radiance = combineSplitLighting(s, diffuse, mSpecular[pixel] * specularColour,
+                                                mSpecularEdge[pixel] * specularColour);
+            else // Blinn-Phong, in the order the stage has always summed it
+                radiance =
+                    s.albedo * diffuse + (s.specularIntensity * mSpecular[pixel]) * specularColour;
+            radiance += s.emissive;
             result.radiance[0][pixel] = radiance.r;
             result.radiance[1][pixel] = radiance.g;
             result.radiance[2][pixel] = radiance.b;
@@ -137,6 +145,7 @@ private:
     // Per-frame scratch, kept to avoid reallocation between repetitions.
     std::vector<glm::vec3> mDiffuse;
     std::vector<float> mSpecular;
+    std::vector<float> mSpecularEdge; // metallic-roughness: the Fresnel edge's monochrome sum
     MaterialPass mMaterials;
     LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)
     BlendedPass mBlended;        // blended surfaces after the opaque pass (BlendedPass.h)

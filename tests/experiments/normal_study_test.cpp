@@ -213,3 +213,31 @@ TEST(NormalStudy, BadOptionsFailBeforeAnyWork) {
 }
 
 } // namespace
+
+namespace {
+
+// The normal-mapped normals of a shared model are a data set of their own (the G-buffer's
+// shading normals), beside the same render without normal maps (":geometric"). The shared
+// models are not part of the repository: without them the test says so and skips.
+TEST(NormalStudy, NormalMappedModelsAddAGeometricDatasetBesideTheMappedOne) {
+    const fs::path helmet = fs::path(TESTBED_GLTF_DIR) / "DamagedHelmet" / "DamagedHelmet.gltf";
+    if (!fs::is_regular_file(helmet))
+        GTEST_SKIP() << helmet << " not found (../shared absent): no normal-mapped data set";
+    NormalStudyOptions options = quickOptions(outputDir("normal_mapped"), 2);
+    options.scenes = {helmet.string()};
+    const NormalStudyResult result = experiments::runNormalStudy(options);
+    ASSERT_EQ(result.scenes.size(), 2u);
+    EXPECT_EQ(result.scenes[0].dataset, "scene:DamagedHelmet");
+    EXPECT_FALSE(result.scenes[0].geometric);
+    EXPECT_GT(result.scenes[0].normalMappedFraction, 0.5); // the helmet is normal-mapped all over
+    EXPECT_EQ(result.scenes[1].dataset, "scene:DamagedHelmet:geometric");
+    EXPECT_TRUE(result.scenes[1].geometric);
+    EXPECT_EQ(result.scenes[1].coveredPixels, result.scenes[0].coveredPixels);
+    for (const char* dataset : {"scene:DamagedHelmet", "scene:DamagedHelmet:geometric"})
+        EXPECT_TRUE(std::any_of(
+            result.rows.begin(), result.rows.end(),
+            [&](const NormalStudyRow& row) { return row.dataset == dataset && row.samples > 0; }))
+            << dataset;
+}
+
+} // namespace

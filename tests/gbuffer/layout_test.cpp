@@ -128,6 +128,29 @@ TEST(LayoutPresets, HistoricalSizesMatchTheThesis) {
     EXPECT_THROW(gbuffer::presetLayout("gbuffer-of-doom", scene), std::invalid_argument);
 }
 
+// UE4's deferred base pass (4.18): D32S8 + GBufferA (RGB10A2) + GBufferB (RGBA8) + GBufferC
+// (RGBA8) = 136 bits, whichever material model the scene uses: what a channel does not carry for
+// this scene is counted as unmodelled, never dropped from the budget.
+TEST(LayoutPresets, Ue4IsD32S8PlusThreeTargets) {
+    const scenes::Scene blinnPhong = scenes::buildProceduralScene("spheres", {});
+    const gbuffer::GBufferLayout layout = gbuffer::presetLayout("ue4", blinnPhong);
+    EXPECT_DOUBLE_EQ(layout.bytesPerPixel(), 17.0);
+    EXPECT_EQ(layout.normals.text(), "xyz:30");
+    EXPECT_EQ(layout.normalSpace, gbuffer::NormalSpace::World);
+    EXPECT_EQ(layout.albedo, gbuffer::AlbedoEncoding::Rgb8Srgb);
+    EXPECT_NE(layout.explain().find("GBufferA"), std::string::npos) << layout.explain();
+
+    scenes::Scene metallic = blinnPhong;
+    for (scenes::Material& m : metallic.materials) {
+        m.model = scenes::MaterialModel::MetallicRoughness;
+        m.metallicRoughnessTexture = -1;
+    }
+    metallic.materials[0].roughness = 0.25f; // two values: stored, not a constant
+    const gbuffer::GBufferLayout pbr = gbuffer::presetLayout("ue4", metallic);
+    EXPECT_DOUBLE_EQ(pbr.bytesPerPixel(), 17.0);
+    EXPECT_EQ(pbr.specular, gbuffer::SpecularEncoding::None);
+}
+
 // Brute on the derived layout must be bitwise brute on the reference layout: derivation only
 // removes what is constant or redundant, never precision.
 TEST(LayoutDerivation, DerivedLayoutIsLossless) {
@@ -160,7 +183,8 @@ TEST(GBufferStorage, LossyEncodingsDecodeCloseToTheLosslessSurface) {
     const scenes::Scene scene = scenes::buildProceduralScene("atrium", sceneRequest);
     lighting::PreparedScene lossless(scenes::Scene(scene), 160, 90, false,
                                      gbuffer::deriveLayout(scene, kEverything));
-    for (const char* preset : {"thesis", "killzone2", "bf3", "stalker", "clear-sky", "compact"}) {
+    for (const char* preset :
+         {"thesis", "killzone2", "bf3", "stalker", "clear-sky", "compact", "ue4"}) {
         const gbuffer::GBufferLayout layout = gbuffer::presetLayout(preset, scene);
         lighting::PreparedScene lossy(scenes::Scene(scene), 160, 90, false, layout);
         const gbuffer::GBuffer& a = *lossless.gbuffer;

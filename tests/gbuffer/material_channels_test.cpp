@@ -25,7 +25,7 @@ using gbuffer::RoughnessMetallicEncoding;
 using scenes::MaterialModel;
 
 const std::vector<Channel> kEverything = {Channel::Depth, Channel::Normal, Channel::Albedo,
-                                          Channel::Specular};
+                                          Channel::Specular, Channel::Emission};
 
 // The first covered pixel of row y scanning from the left (or from the right).
 int coveredPixel(const gbuffer::GBuffer& gb, int y, bool fromLeft) {
