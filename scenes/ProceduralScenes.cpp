@@ -676,7 +676,7 @@ Scene buildGlass(const SceneRequest& request) {
     scatter.maxRangeMetres = 4.0f;
     scatter.minIntensity = 0.3f;
     scatter.maxIntensity = 1.5f;
-    scatterPointLights(scene, scatter, request.lightCount, request.seed);
+    scatterPointLights(scene, scatter, request.lightCount.value_or(0), request.seed);
     addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
     scene.cameras.push_back(makeCamera("side", {4.5f, 1.5f, 4.5f}, {0.0f, 1.1f, 0.0f}, 40.0f));
     return scene;
