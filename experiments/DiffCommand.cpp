@@ -7,6 +7,8 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -291,12 +293,91 @@ std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
 
 } // namespace
 
-// An OpenEXR header is a list of attributes (name, type name, int32 byte count, bytes) ending
-// in an empty name, one such list per part of a multi-part file. OpenEXR allocates each
-// attribute's declared count before reading it, so a 4 KB file declaring a 1.7 GB attribute made
-// a 1.7 GB allocation (and 37 s under AddressSanitizer; found by exr_fuzzer). Every count is
-// checked here against the bytes the file has left, before OpenImageIO opens it. Files that are
-// not EXR, and headers this walk cannot follow (a name over 255 bytes), are left to the reader.
+namespace {
+
+// The byte counts of the attribute types OpenEXR reads by their content, whatever count the
+// header declares (OpenEXR 3.1, ImfStandardAttributes and ImfAttribute.cpp).
+std::optional<uint32_t> fixedExrAttributeSize(const std::string& type) {
+    static const std::map<std::string, uint32_t> sizes = {{"box2f", 16},
+                                                          {"box2i", 16},
+                                                          {"chromaticities", 32},
+                                                          {"compression", 1},
+                                                          {"deepImageState", 1},
+                                                          {"double", 8},
+                                                          {"envmap", 1},
+                                                          {"float", 4},
+                                                          {"int", 4},
+                                                          {"keycode", 28},
+                                                          {"lineOrder", 1},
+                                                          {"m33d", 72},
+                                                          {"m33f", 36},
+                                                          {"m44d", 128},
+                                                          {"m44f", 64},
+                                                          {"rational", 8},
+                                                          {"tiledesc", 9},
+                                                          {"timecode", 8},
+                                                          {"v2d", 16},
+                                                          {"v2f", 8},
+                                                          {"v2i", 8},
+                                                          {"v3d", 24},
+                                                          {"v3f", 12},
+                                                          {"v3i", 12}};
+    const auto found = sizes.find(type);
+    return found == sizes.end() ? std::nullopt : std::optional<uint32_t>(found->second);
+}
+
+uint32_t littleEndian32(const char* bytes) {
+    const auto* b = reinterpret_cast<const unsigned char*>(bytes);
+    return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+}
+
+// How many bytes OpenEXR consumes reading a value of `type` from `value` (the declared count's
+// bytes), or nullopt when it would read past them or allocate more than they hold.
+std::optional<uint64_t> exrValueBytesRead(const std::string& type, const std::string& value) {
+    if (const auto fixed = fixedExrAttributeSize(type))
+        return *fixed;
+    if (type == "chlist") { // {name\0, int32 type, uint8 linear, 3 reserved, 2 int32}*, \0
+        size_t at = 0;
+        for (;;) {
+            const size_t end = value.find('\0', at);
+            if (end == std::string::npos)
+                return std::nullopt;
+            if (end == at)
+                return end + 1;
+            at = end + 1 + 16;
+            if (at > value.size())
+                return std::nullopt;
+        }
+    }
+    if (type == "preview") { // uint32 width, uint32 height, width x height RGBA8 pixels
+        if (value.size() < 8)
+            return std::nullopt;
+        return 8 + uint64_t(littleEndian32(value.data())) * littleEndian32(value.data() + 4) * 4;
+    }
+    if (type == "stringvector") { // {int32 length, bytes}* up to the declared count
+        for (size_t at = 0; at < value.size();) {
+            if (value.size() - at < 4)
+                return std::nullopt;
+            const uint32_t length = littleEndian32(value.data() + at);
+            if (length > value.size() - at - 4)
+                return std::nullopt;
+            at += 4 + length;
+        }
+    }
+    return value.size(); // string, floatvector and opaque types: read by the declared count
+}
+
+} // namespace
+
+// An OpenEXR header is a list of attributes (name, type name, int32 byte count, value) ending in
+// an empty name, one such list per part of a multi-part file. OpenEXR allocates an attribute's
+// declared count before reading it, so a 4 KB file declaring a 1.7 GB attribute made a 1.7 GB
+// allocation (37 s under AddressSanitizer; found by exr_fuzzer). And it reads most types by their
+// content, not by the count: a chlist declaring 373 bytes for 67 bytes of channels made it parse
+// the rest as the next attribute, which declared 1.5 GB (exr_fuzzer again). So this walk checks
+// every count against the bytes the file has left AND against what OpenEXR will read of it, and
+// refuses a header where the two disagree: no valid file has one. Files that are not EXR, and
+// headers this walk cannot follow (a name over 255 bytes), are left to the reader.
 void checkExrAttributeSizes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     unsigned char magic[8] = {};
@@ -319,7 +400,10 @@ void checkExrAttributeSizes(const fs::path& path) {
         }
         return false;
     };
-    std::string name, type;
+    auto corrupt = [&](const std::string& what) {
+        return std::runtime_error("cannot read " + path.string() + ": corrupt EXR header: " + what);
+    };
+    std::string name, type, value;
     for (;;) { // one header (part)
         if (!readName(name))
             return;
@@ -328,20 +412,22 @@ void checkExrAttributeSizes(const fs::path& path) {
         while (!name.empty()) {
             if (!readName(type))
                 return;
-            unsigned char count[4];
-            if (!in.read(reinterpret_cast<char*>(count), 4))
+            char count[4];
+            if (!in.read(count, 4))
                 return;
-            const int32_t size = int32_t(uint32_t(count[0]) | uint32_t(count[1]) << 8 |
-                                         uint32_t(count[2]) << 16 | uint32_t(count[3]) << 24);
+            const int32_t size = int32_t(littleEndian32(count));
             const uint64_t left = fileSize - std::min<uint64_t>(fileSize, uint64_t(in.tellg()));
             if (size < 0 || uint64_t(size) > left)
-                throw std::runtime_error("cannot read " + path.string() +
-                                         ": corrupt EXR header: attribute '" + name +
-                                         "' declares " + std::to_string(size) +
-                                         " bytes, the file has " + std::to_string(left) + " left");
-            in.seekg(size, std::ios::cur);
-            if (!in)
+                throw corrupt("attribute '" + name + "' declares " + std::to_string(size) +
+                              " bytes, the file has " + std::to_string(left) + " left");
+            value.resize(size_t(size));
+            if (!in.read(value.data(), size))
                 return;
+            const std::optional<uint64_t> read = exrValueBytesRead(type, value);
+            if (!read || *read != uint64_t(size))
+                throw corrupt("attribute '" + name + "' of type " + type + " declares " +
+                              std::to_string(size) + " bytes, its value " +
+                              (read ? "holds " + std::to_string(*read) : "does not fit them"));
             if (!readName(name))
                 return;
         }

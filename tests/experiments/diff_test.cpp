@@ -212,6 +212,48 @@ TEST(DiffCommand, RefusesAnExrAttributeLongerThanTheFile) {
     }
 }
 
+// OpenEXR reads a chlist (and the fixed-size types) by its content, not by the count the header
+// declares; a count larger than the content made it parse the rest as another attribute that
+// declared 1.5 GB (exr_fuzzer). A count that disagrees with the value is refused before OpenEXR
+// opens the file, for a chlist and for a fixed-size attribute.
+TEST(DiffCommand, RefusesAnExrAttributeWhoseCountDisagreesWithItsValue) {
+    const fs::path dir = freshTestFolder();
+    const fs::path path = writeImage(dir / "a.exr", 0.0f, nowhere, 1.0f);
+    const std::string original = readText(path);
+    auto withCount = [&](const std::string& name, const std::string& type, int32_t change) {
+        std::string bytes = original;
+        const std::string attribute = name + '\0' + type + '\0';
+        const size_t at = bytes.find(attribute);
+        EXPECT_NE(at, std::string::npos) << name;
+        if (at == std::string::npos)
+            return std::pair<std::string, uint32_t>{};
+        const size_t countAt = at + attribute.size();
+        uint32_t count = 0;
+        for (int i = 0; i < 4; ++i)
+            count |= uint32_t(uint8_t(bytes[countAt + size_t(i)])) << (8 * i);
+        const uint32_t changed = count + uint32_t(change);
+        for (int i = 0; i < 4; ++i)
+            bytes[countAt + size_t(i)] = char((changed >> (8 * i)) & 0xff);
+        return std::pair{bytes, count};
+    };
+    for (const auto& [name, type] : {std::pair<std::string, std::string>{"channels", "chlist"},
+                                     {"compression", "compression"}}) {
+        const auto [bytes, count] = withCount(name, type, 4);
+        const fs::path changed = dir / (name + ".exr");
+        std::ofstream(changed, std::ios::binary | std::ios::trunc) << bytes;
+        try {
+            (void)diffImageFiles(changed, path);
+            ADD_FAILURE() << name << ": no error";
+        } catch (const std::runtime_error& e) {
+            const std::string expected = "corrupt EXR header: attribute '" + name + "' of type " +
+                                         type + " declares " + std::to_string(count + 4) +
+                                         " bytes, its value holds " + std::to_string(count);
+            EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_NO_THROW((void)diffImageFiles(path, path)); // the unchanged file still compares
+}
+
 // The message diffImageFiles refuses `path` with, or "" when it compares it.
 std::string refusalOf(const fs::path& path, const fs::path& other) {
     try {
