@@ -8,8 +8,20 @@
 #include <tbb/parallel_for.h>
 
 #include "gbuffer/GBufferLayout.h"
+#include "lighting/BlendedPass.h"
 
 namespace lighting {
+
+void ForwardGeometry::shadeBlended(const StageInputs& inputs, BlendedPass& blended,
+                                   const LightIndexLists& objectLights, StageResult& result) const {
+    if (blended.prepare(inputs))
+        blended.shade(
+            depth(),
+            [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
+                return objectLights[objectOfTriangle(triangle)];
+            },
+            result);
+}
 
 void ForwardGeometry::addEmission(StageResult& result) const {
     if (!mEmits)

@@ -43,6 +43,8 @@
 
 namespace lighting {
 
+class BlendedPass;
+
 // A run of consecutive triangles of one instance, drawn as one unit, and its view-space bounds.
 struct ForwardObject {
     uint32_t firstTriangle = 0;
@@ -118,6 +120,11 @@ public:
     // drawDepthPrepass) to result.radiance, once: for a stage that accumulates light by light.
     // Nothing to do (no pass over the pixels) when no material of the scene emits.
     void addEmission(StageResult& result) const;
+    // The blended pass of the forward stages (BlendedPass.h), after their opaque draws: each
+    // blended fragment lit with its object's lights (`objectLights`, objectLightLists). Nothing
+    // to do when the scene has no blended surface.
+    void shadeBlended(const StageInputs& inputs, BlendedPass& blended,
+                      const LightIndexLists& objectLights, StageResult& result) const;
     // How the forward stages read their own depth planes: the lossless layout's decoder.
     const gbuffer::DepthDecoder& depthDecoder() const { return *mDepthDecoder; }
 

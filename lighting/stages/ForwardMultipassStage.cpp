@@ -104,13 +104,7 @@ public:
         // Blended surfaces: one fragment at a time with its object's lights (the lists the
         // illumination sets were transposed from: ascending per object). "Over" does not
         // distribute over one additive pass per light, so the blended layers are shaded whole.
-        if (mBlended.prepare(inputs))
-            mBlended.shade(
-                mForward.depth(),
-                [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
-                    return mObjectLights[mForward.objectOfTriangle(triangle)];
-                },
-                result);
+        mForward.shadeBlended(inputs, mBlended, mObjectLights, result);
     }
 
 private:

@@ -77,13 +77,7 @@ public:
                       mPrepass ? visibility.redrawState() : visibility.drawState(), shadeFragment);
         shading.stop();
         // Blended surfaces: each fragment with its object's list.
-        if (mBlended.prepare(inputs))
-            mBlended.shade(
-                mForward.depth(),
-                [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
-                    return mObjectLights[mForward.objectOfTriangle(triangle)];
-                },
-                result);
+        mForward.shadeBlended(inputs, mBlended, mObjectLights, result);
     }
 
 private:
