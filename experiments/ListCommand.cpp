@@ -48,9 +48,13 @@ void printScenes(std::ostream& out) {
 
 void printStages(std::ostream& out) {
     out << "stages (--stage NAME or NAME:key=value,...; default " << RenderOptions{}.stage
-        << "; options: lighting/README.md):\n";
-    for (const lighting::StageInfo& info : lighting::stageInfos())
+        << "), with their options (key=accepted values, type, default: what it does):\n";
+    for (const lighting::StageInfo& info : lighting::stageInfos()) {
         out << "  " << info.name << "  - " << info.description << "\n";
+        for (const lighting::StageOption& option : info.options)
+            out << "    " << option.key << "=" << option.range() << "  " << option.typeName()
+                << ", default " << option.defaultText << ": " << option.doc << "\n";
+    }
 }
 
 void printNormalCodecs(std::ostream& out) {

@@ -20,6 +20,7 @@
 #include "experiments/LightOrigins.h"
 #include "experiments/Progress.h"
 #include "lighting/PassNames.h"
+#include "lighting/StageRegistry.h"
 #include "scenes/Scene.h"
 #include "scenes/Viewpoints.h"
 
@@ -326,6 +327,9 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["scene_options"] = run.options.sceneOptions;
     stats["view"] = run.scene().cameras.front().name;
     stats["stage"] = run.options.stage;
+    // Every option of the stage's table, defaults filled in (StageOptions.h); the spec was
+    // checked when the stage was made, so this cannot throw.
+    stats["stage_options"] = lighting::resolvedStageOptions(run.options.stage);
     stats["stage_parameters"] = run.result.parameters;
     stats["width"] = run.options.width;
     stats["height"] = run.options.height;

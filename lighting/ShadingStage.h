@@ -1,5 +1,6 @@
 // ShadingStage: the interface every lighting pipeline implements (one stage per file under
-// lighting/stages/, registered by name in StageRegistry.cpp), and what it reads and writes.
+// lighting/stages/, each registering itself by name: StageRegistry.h), and what it reads and
+// writes.
 //
 // Declare, then run. The runner (experiments/RenderJob, the tests and the benchmarks through
 // PreparedScene) first asks requirements(), derives the G-buffer layout from it and the scene

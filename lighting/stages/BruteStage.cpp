@@ -2,7 +2,7 @@
 // stage must match (bitwise, for the same ISA, when its lists are ascending) and the source of
 // the per-pixel oracle count. The loop is accumulateLights (LightAccumulation.h) with every light
 // as the list of every packet, on the kernel's ISA (`--isa`); pass "shading".
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include <optional>
 
@@ -38,11 +38,14 @@ private:
     std::optional<EveryLightSource> mEveryLight; // the list 0..n-1, kept across frames
 };
 
-} // namespace
+const StageRegistrar
+    kRegistrar({.name = "brute",
+                .description = "every light at every pixel, float, from the G-buffer",
+                .kind = StageKind::Exact,
+                .options = {}, // none
+                .listOrder = 10},
+               [](const StageOptions&) { return std::make_unique<BruteStage>(); });
 
-std::unique_ptr<ShadingStage> makeBruteStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {});
-    return std::make_unique<BruteStage>();
-}
+} // namespace
 
 } // namespace lighting

@@ -28,8 +28,8 @@
 #include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
+#include "lighting/StageRegistry.h"
 #include "lighting/culling/ClusterGrid.h"
-#include "lighting/stages/Stages.h"
 
 #include "lighting/BlendedPass.h"
 
@@ -175,27 +175,48 @@ private:
     BlendedPass mBlended;             // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-} // namespace
-
-std::unique_ptr<ShadingStage> makeClusteredStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"grid", "slices", "assign", "test"});
-    ClusterGridOptions options;
-    const auto grid = spec.options.find("grid");
-    if (grid != spec.options.end() &&
-        !parseClusterGrid(grid->second, options.tilesX, options.tilesY, options.slices))
-        throw StageError("stage '" + spec.name + "': option grid=" + grid->second +
-                         " is not XxYxZ with each of X, Y, Z in 1.." +
-                         std::to_string(kMaxClusterDimension) + " and at most " +
-                         std::to_string(kMaxClusterCount) + " clusters");
-    options.spacing = choiceOption(spec, "slices", {"exp", "uniform"}) == "exp"
-                          ? SliceSpacing::Exponential
-                          : SliceSpacing::Uniform;
-    options.assign = choiceOption(spec, "assign", {"walk", "binary"}) == "walk"
-                         ? AssignMethod::Walk
-                         : AssignMethod::Binary;
-    options.test = choiceOption(spec, "test", {"aabb", "frustum"}) == "aabb" ? ClusterTest::Aabb
-                                                                             : ClusterTest::Frustum;
-    return std::make_unique<ClusteredStage>(options);
+std::vector<StageOption> clusteredOptionTable() {
+    const ClusterGridOptions defaults;
+    return {
+        StageOption::text(
+            "grid",
+            std::to_string(defaults.tilesX) + "x" + std::to_string(defaults.tilesY) + "x" +
+                std::to_string(defaults.slices),
+            "XxYxZ with each of X, Y, Z in 1.." + std::to_string(kMaxClusterDimension) +
+                " and at most " + std::to_string(kMaxClusterCount) + " clusters",
+            [](const std::string& value) -> std::optional<std::string> {
+                int x = 0, y = 0, z = 0;
+                if (!parseClusterGrid(value, x, y, z))
+                    return std::nullopt;
+                return std::to_string(x) + "x" + std::to_string(y) + "x" + std::to_string(z);
+            },
+            "tile columns x tile rows x depth slices"),
+        StageOption::choice("slices", {"exp", "uniform"},
+                            "slice boundaries between the G-buffer's nearest and farthest depth: "
+                            "geometric or linear"),
+        StageOption::choice("assign", {"walk", "binary"},
+                            "a light's cluster ranges by walking the planes or by binary search"),
+        StageOption::choice("test", {"aabb", "frustum"},
+                            "cluster test: sphere vs AABB, or AABB and the four side planes")};
 }
+
+const StageRegistrar kRegistrar(
+    {.name = "clustered",
+     .description = "implicit clusters: grid of screen tiles x depth slices, lights assigned per "
+                    "cluster AABB",
+     .kind = StageKind::Exact,
+     .options = clusteredOptionTable(),
+     .listOrder = 50},
+    [](const StageOptions& table) {
+        ClusterGridOptions options;
+        parseClusterGrid(table.text("grid"), options.tilesX, options.tilesY, options.slices);
+        options.spacing =
+            table.text("slices") == "exp" ? SliceSpacing::Exponential : SliceSpacing::Uniform;
+        options.assign = table.text("assign") == "walk" ? AssignMethod::Walk : AssignMethod::Binary;
+        options.test = table.text("test") == "aabb" ? ClusterTest::Aabb : ClusterTest::Frustum;
+        return std::make_unique<ClusteredStage>(options);
+    });
+
+} // namespace
 
 } // namespace lighting

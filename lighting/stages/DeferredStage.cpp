@@ -26,7 +26,7 @@
 // Shading stays scalar (evaluateLight per pixel, not lighting/LightAccumulation.h): the stage sums
 // light by light over each light volume's pixels, decoding the G-buffer once per light, so there is
 // no per-pixel list for a packet to walk; its pass structure is what the stage measures.
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include "lighting/BlendedPass.h"
 #include "lighting/LightBounds.h"
@@ -87,11 +87,17 @@ private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-} // namespace
+const StageRegistrar kRegistrar(
+    {.name = "deferred",
+     .description = "traditional deferred: one light volume per light, shaded and added per "
+                    "fragment",
+     .kind = StageKind::Exact,
+     .options = volumeStageOptionTable(),
+     .listOrder = 30},
+    [](const StageOptions& options) {
+        return std::make_unique<DeferredStage>(volumeStageOptions(options));
+    });
 
-std::unique_ptr<ShadingStage> makeDeferredStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"volume", "spot", "stencil", "vfc"});
-    return std::make_unique<DeferredStage>(parseVolumeStageOptions(spec));
-}
+} // namespace
 
 } // namespace lighting

@@ -20,7 +20,7 @@
 //
 // Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments light
 // by light, not 4x4 packets decoded from a G-buffer.
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include <tbb/parallel_for.h>
 
@@ -116,11 +116,14 @@ private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-} // namespace
+const StageRegistrar
+    kRegistrar({.name = "forward-multipass",
+                .description = "one additive pass per light over its illumination set",
+                .kind = StageKind::Exact,
+                .options = {}, // none
+                .listOrder = 90},
+               [](const StageOptions&) { return std::make_unique<ForwardMultipassStage>(); });
 
-std::unique_ptr<ShadingStage> makeForwardMultipassStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {});
-    return std::make_unique<ForwardMultipassStage>();
-}
+} // namespace
 
 } // namespace lighting

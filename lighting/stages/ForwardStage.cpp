@@ -19,7 +19,7 @@
 //
 // Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments as they
 // are drawn, not 4x4 packets decoded from a G-buffer.
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include <tbb/parallel_for.h>
 
@@ -87,11 +87,17 @@ private:
     LightIndexLists mObjectLights; // per object, ascending (ForwardGeometry::objectLightLists)
 };
 
-} // namespace
+const StageRegistrar kRegistrar(
+    {.name = "forward",
+     .description = "single-pass forward, per-object light lists",
+     .kind = StageKind::Exact,
+     .options = {StageOption::boolean(
+         "prepass", false, "depth-only pre-pass first, then shade each pixel once (no overdraw)")},
+     .listOrder = 80},
+    [](const StageOptions& options) {
+        return std::make_unique<ForwardStage>(options.boolean("prepass"));
+    });
 
-std::unique_ptr<ShadingStage> makeForwardStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"prepass"});
-    return std::make_unique<ForwardStage>(intOption(spec, "prepass", 0, 0, 1) != 0);
-}
+} // namespace
 
 } // namespace lighting

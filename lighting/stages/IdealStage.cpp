@@ -73,11 +73,15 @@ private:
     PacketContributingLights mPacketLists; // reused across calls
 };
 
-} // namespace
+const StageRegistrar kRegistrar(
+    {.name = "ideal",
+     .description = "perfect culling, the ceiling of exact culling: each pixel shades exactly its "
+                    "contributing lights (lists made outside the timer)",
+     .kind = StageKind::Exact,
+     .options = {}, // none
+     .listOrder = 20},
+    [](const StageOptions&) { return std::make_unique<IdealStage>(); });
 
-std::unique_ptr<ShadingStage> makeIdealStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {});
-    return std::make_unique<IdealStage>();
-}
+} // namespace
 
 } // namespace lighting

@@ -66,7 +66,7 @@
 //
 // Shading stays scalar (not lighting/LightAccumulation.h): lighting is accumulated into split
 // diffuse/specular buffers at a lower resolution (splitLighting), not the kernel's radiance sum.
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include <algorithm>
 #include <chrono>
@@ -107,27 +107,6 @@ struct LightSample {
     glm::vec3 specular{0.0f};
     glm::vec3 specularEdge{0.0f}; // metallic-roughness (SplitLighting)
 };
-
-float floatOption(const StageSpec& spec, const char* key, float defaultValue, float minValue,
-                  float maxValue, bool minExclusive) {
-    const auto found = spec.options.find(key);
-    if (found == spec.options.end())
-        return defaultValue;
-    size_t used = 0;
-    float value = 0.0f;
-    try {
-        value = std::stof(found->second, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    const bool aboveMin = minExclusive ? value > minValue : value >= minValue;
-    if (used != found->second.size() || found->second.empty() || !std::isfinite(value) ||
-        !aboveMin || value > maxValue)
-        throw StageError("stage '" + spec.name + "': option " + key + "=" + found->second +
-                         " is not a number in " + (minExclusive ? "(" : "[") +
-                         std::to_string(minValue) + ", " + std::to_string(maxValue) + "]");
-    return value;
-}
 
 class InferredStage final : public ShadingStage {
 public:
@@ -347,17 +326,29 @@ private:
     LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)
 };
 
-} // namespace
+const StageRegistrar kRegistrar(
+    {.name = "inferred",
+     .description = "inferred lighting: L-buffer at 1/scale resolution, DSF upsampling in the "
+                    "material pass",
+     .kind = StageKind::Approximate,
+     .options = {StageOption::integer("scale", 2, 1, 8, "lighting resolution divisor per axis"),
+                 StageOption::number("depth", 0.1f, 0.0f, 1e30f, true,
+                                     "DSF: relative view-depth difference a sample may have"),
+                 StageOption::number("normal", 0.9f, -1.0f, 1.0f, false,
+                                     "DSF: minimum cosine between sample and pixel normals"),
+                 StageOption::integer("tile", 16, 4, 128, "culling tile size in low-res samples"),
+                 StageOption::boolean("ids", true, "DSF object-ID test")},
+     .listOrder = 110},
+    [](const StageOptions& table) {
+        InferredOptions options;
+        options.scale = table.integer("scale");
+        options.depthThreshold = table.number("depth");
+        options.normalThreshold = table.number("normal");
+        options.tileSizeSamples = table.integer("tile");
+        options.objectIds = table.boolean("ids");
+        return std::make_unique<InferredStage>(options);
+    });
 
-std::unique_ptr<ShadingStage> makeInferredStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"scale", "depth", "normal", "tile", "ids"});
-    InferredOptions options;
-    options.scale = intOption(spec, "scale", 2, 1, 8);
-    options.depthThreshold = floatOption(spec, "depth", 0.1f, 0.0f, 1e30f, true);
-    options.normalThreshold = floatOption(spec, "normal", 0.9f, -1.0f, 1.0f, false);
-    options.tileSizeSamples = intOption(spec, "tile", 16, 4, 128);
-    options.objectIds = boolOption(spec, "ids", true);
-    return std::make_unique<InferredStage>(options);
-}
+} // namespace
 
 } // namespace lighting

@@ -21,7 +21,7 @@
 //   max=16           list capacity per pixel, 1..255
 //   volume=sphere|rect, spot=cone|sphere, stencil=0|1, vfc=1|0   as for `deferred`
 // Passes: "cull", "index", "shading".
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include <algorithm>
 
@@ -145,12 +145,27 @@ private:
     BlendedPass mBlended;           // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-} // namespace
-
-std::unique_ptr<ShadingStage> makeLightIndexedStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"max", "volume", "spot", "stencil", "vfc"});
-    const VolumeStageOptions volume = parseVolumeStageOptions(spec);
-    return std::make_unique<LightIndexedStage>(intOption(spec, "max", 16, 1, 255), volume);
+std::vector<StageOption> lightIndexedOptionTable() {
+    std::vector<StageOption> table = {StageOption::integer(
+        "max", 16, 1, 255,
+        "per-pixel light list capacity; a pixel beyond it uses its tile's list")};
+    for (StageOption& option : volumeStageOptionTable())
+        table.push_back(std::move(option));
+    return table;
 }
+
+const StageRegistrar kRegistrar(
+    {.name = "light-indexed",
+     .description = "light-indexed deferred: volumes write per-pixel light lists, overflow "
+                    "shades its tile's lights",
+     .kind = StageKind::Exact,
+     .options = lightIndexedOptionTable(),
+     .listOrder = 40},
+    [](const StageOptions& options) {
+        const VolumeStageOptions volume = volumeStageOptions(options);
+        return std::make_unique<LightIndexedStage>(options.integer("max"), volume);
+    });
+
+} // namespace
 
 } // namespace lighting

@@ -37,7 +37,7 @@
 //
 // Shading stays scalar (not lighting/LightAccumulation.h): the light buffer holds diffuse and
 // specular sums apart (splitLighting), which the kernel's one radiance sum does not produce.
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include <algorithm>
 #include <span>
@@ -151,12 +151,21 @@ private:
     BlendedPass mBlended;        // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-} // namespace
+const StageRegistrar kRegistrar(
+    {.name = "light-prepass",
+     .description = "Light Pre-Pass: thin G-buffer, diffuse RGB + monochrome specular light "
+                    "buffer, material pass",
+     .kind = StageKind::Approximate,
+     .options = {StageOption::choice("spec", {"grey", "chroma"},
+                                     "colour of the monochrome specular: white, or the "
+                                     "chromaticity of the diffuse light (Engel)"),
+                 StageOption::integer("tile", 16, 4, 128, "culling tile size in pixels")},
+     .listOrder = 100},
+    [](const StageOptions& options) {
+        return std::make_unique<LightPrepassStage>(options.text("spec") == "chroma",
+                                                   options.integer("tile"));
+    });
 
-std::unique_ptr<ShadingStage> makeLightPrepassStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"spec", "tile"});
-    const bool chroma = choiceOption(spec, "spec", {"grey", "chroma"}) == "chroma";
-    return std::make_unique<LightPrepassStage>(chroma, intOption(spec, "tile", 16, 4, 128));
-}
+} // namespace
 
 } // namespace lighting

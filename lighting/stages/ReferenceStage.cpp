@@ -1,7 +1,7 @@
 // `reference`: every light at every pixel in double precision, from the exact surface (position
 // and normal recomputed in double from the unrounded geometry, materials unencoded). Every other
 // image is compared with it. The loop is shadeWithEveryLight (EveryLight.h), shared with `brute`.
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include "lighting/BlendedPass.h"
 #include "lighting/EveryLight.h"
@@ -30,11 +30,14 @@ private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-} // namespace
+const StageRegistrar
+    kRegistrar({.name = "reference",
+                .description = "every light at every pixel, double precision, exact surface",
+                .kind = StageKind::Reference,
+                .options = {}, // none
+                .listOrder = 0},
+               [](const StageOptions&) { return std::make_unique<ReferenceStage>(); });
 
-std::unique_ptr<ShadingStage> makeReferenceStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {});
-    return std::make_unique<ReferenceStage>();
-}
+} // namespace
 
 } // namespace lighting

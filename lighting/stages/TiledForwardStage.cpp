@@ -29,7 +29,7 @@
 //
 // Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments with
 // their tile's list as they are drawn, not 4x4 packets decoded from a G-buffer.
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include <algorithm>
 #include <memory>
@@ -115,15 +115,24 @@ private:
     LightIndexLists mTileLights; // per tile, ascending light indices (buildTileLightLists)
 };
 
-} // namespace
+const StageRegistrar kRegistrar(
+    {.name = "tiled-forward",
+     .description = "Forward+: depth pre-pass, per-tile light lists, forward shading",
+     .kind = StageKind::Exact,
+     .options = {StageOption::integer("tile", 16, 4, 128, "tile size in pixels"),
+                 StageOption::boolean("vfc", true,
+                                      "cull lights against the camera frustum first (speed only)"),
+                 StageOption::boolean("mask", false,
+                                      "Harada's 2.5D culling: a 32-bin depth mask per tile")},
+     .listOrder = 120},
+    [](const StageOptions& table) {
+        TiledForwardOptions options;
+        options.tileSizePixels = table.integer("tile");
+        options.viewFrustumCulling = table.boolean("vfc");
+        options.depthMask = table.boolean("mask");
+        return std::make_unique<TiledForwardStage>(options);
+    });
 
-std::unique_ptr<ShadingStage> makeTiledForwardStage(const StageSpec& spec) {
-    rejectUnknownOptions(spec, {"tile", "vfc", "mask"});
-    TiledForwardOptions options;
-    options.tileSizePixels = intOption(spec, "tile", 16, 4, 128);
-    options.viewFrustumCulling = boolOption(spec, "vfc", true);
-    options.depthMask = boolOption(spec, "mask", false);
-    return std::make_unique<TiledForwardStage>(options);
-}
+} // namespace
 
 } // namespace lighting

@@ -27,7 +27,7 @@
 // test itself is made cheap instead (BackfaceTileCone in culling/TileFrusta.h: per-tile data once,
 // a one-dot early-out for lights that cannot be rejected, no test at all in tiles whose normal
 // cone is too wide).
-#include "lighting/stages/Stages.h"
+#include "lighting/StageRegistry.h"
 
 #include <algorithm>
 #include <span>
@@ -118,24 +118,42 @@ private:
     BlendedPass mBlended;        // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-TiledOptions parseTiledOptions(const StageSpec& spec, bool backface) {
-    rejectUnknownOptions(spec, {"tile", "vfc", "mask"});
-    TiledOptions options;
-    options.tileSizePixels = intOption(spec, "tile", 16, 4, 128);
-    options.viewFrustumCulling = boolOption(spec, "vfc", true);
-    options.depthMask = boolOption(spec, "mask", false);
-    options.backface = backface;
-    return options;
+// The options of both stages.
+std::vector<StageOption> tiledOptionTable() {
+    return {
+        StageOption::integer("tile", 16, 4, 128, "tile size in pixels"),
+        StageOption::boolean("vfc", true,
+                             "cull lights against the camera frustum first (speed only)"),
+        StageOption::boolean("mask", false, "Harada's 2.5D culling: a 32-bin depth mask per tile")};
 }
+
+StageFactory tiledFactory(bool backface) {
+    return [backface](const StageOptions& table) {
+        TiledOptions options;
+        options.tileSizePixels = table.integer("tile");
+        options.viewFrustumCulling = table.boolean("vfc");
+        options.depthMask = table.boolean("mask");
+        options.backface = backface;
+        return std::make_unique<TiledStage>(options);
+    };
+}
+
+const StageRegistrar
+    kTiledRegistrar({.name = "tiled",
+                     .description = "tiled deferred: per-tile depth-bounded frusta",
+                     .kind = StageKind::Exact,
+                     .options = tiledOptionTable(),
+                     .listOrder = 60},
+                    tiledFactory(false));
+
+const StageRegistrar kTiledBackfaceRegistrar(
+    {.name = "tiled-backface",
+     .description = "tiled deferred plus per-tile normal-cone back-face culling of lights",
+     .kind = StageKind::Exact,
+     .options = tiledOptionTable(),
+     .listOrder = 70},
+    tiledFactory(true));
 
 } // namespace
-
-std::unique_ptr<ShadingStage> makeTiledStage(const StageSpec& spec) {
-    return std::make_unique<TiledStage>(parseTiledOptions(spec, false));
-}
-
-std::unique_ptr<ShadingStage> makeTiledBackfaceStage(const StageSpec& spec) {
-    return std::make_unique<TiledStage>(parseTiledOptions(spec, true));
-}
 
 } // namespace lighting

@@ -1,22 +1,32 @@
 #include "lighting/stages/VolumeStageOptions.h"
 
 #include "lighting/PassNames.h"
-#include "lighting/stages/Stages.h"
 
 namespace lighting {
 
-VolumeStageOptions parseVolumeStageOptions(const StageSpec& spec) {
+std::vector<StageOption> volumeStageOptionTable() {
+    return {
+        StageOption::choice("volume", {"sphere", "rect"},
+                            "light volume: back faces of a bounding icosphere, or the "
+                            "sphere's screen rectangle"),
+        StageOption::choice("spot", {"cone", "sphere"},
+                            "volume=sphere only: a spot light's pyramid proxy when smaller "
+                            "than its sphere, or always the sphere"),
+        StageOption::boolean("stencil", false,
+                             "also require the surface not in front of the volume's front "
+                             "face (two draws per light)"),
+        StageOption::boolean("vfc", true, "cull light spheres against the camera frustum first")};
+}
+
+VolumeStageOptions volumeStageOptions(const StageOptions& table) {
     VolumeStageOptions options;
-    options.shape = choiceOption(spec, "volume", {"sphere", "rect"}) == "sphere"
-                        ? VolumeShape::Sphere
-                        : VolumeShape::Rect;
-    if (options.shape == VolumeShape::Rect && spec.options.count("spot"))
-        throw StageError("stage '" + spec.name + "': option spot applies to volume=sphere only");
-    options.spotProxy = choiceOption(spec, "spot", {"cone", "sphere"}) == "cone"
-                            ? SpotProxy::Cone
-                            : SpotProxy::Sphere;
-    options.stencil = boolOption(spec, "stencil", false);
-    options.frustumCull = boolOption(spec, "vfc", true);
+    options.shape = table.text("volume") == "sphere" ? VolumeShape::Sphere : VolumeShape::Rect;
+    if (options.shape == VolumeShape::Rect && table.given("spot"))
+        throw StageError("stage '" + table.stageName() +
+                         "': option spot applies to volume=sphere only");
+    options.spotProxy = table.text("spot") == "cone" ? SpotProxy::Cone : SpotProxy::Sphere;
+    options.stencil = table.boolean("stencil");
+    options.frustumCull = table.boolean("vfc");
     return options;
 }
 

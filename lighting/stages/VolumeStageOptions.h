@@ -1,4 +1,5 @@
-// The light-volume options `deferred` and `light-indexed` share, parsed and recorded in one place:
+// The light-volume options `deferred` and `light-indexed` share, declared (one option table,
+// StageOptions.h) and recorded in one place:
 //   volume=sphere|rect  spot=cone|sphere (volume=sphere only)  stencil=0|1  vfc=1|0
 // (their meaning: DeferredStage.cpp's header and culling/LightVolumes.h).
 #pragma once
@@ -24,9 +25,11 @@ struct VolumeStageOptions {
     bool frustumCull = true;
 };
 
-// Reads the four options (the caller rejects unknown keys); a StageError when malformed or when
-// `spot` is given with volume=rect.
-VolumeStageOptions parseVolumeStageOptions(const StageSpec& spec);
+// The four options' rows, for the stages' option tables.
+std::vector<StageOption> volumeStageOptionTable();
+// Reads the four options from the checked table values; a StageError when `spot` is given with
+// volume=rect (a rule between options the table cannot state).
+VolumeStageOptions volumeStageOptions(const StageOptions& options);
 
 // The "cull" pass both volume stages start with: the lights' conservative spheres, the volume
 // rasterizer over the G-buffer, and the lights to draw (ascending; only those whose sphere may

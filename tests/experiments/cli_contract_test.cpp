@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 
 #include "experiments/PlotScript.h"
+#include "lighting/StageRegistry.h"
 
 namespace {
 
@@ -106,6 +107,34 @@ TEST(CliContract, ListShowsEveryChoiceOfTheRenderOptions) {
           "depth formats (--depth NAME or NAME:infinite; default f32-reversed)", "unorm24",
           "f16-linear", "position methods (--position; default inverse-projection)", "view-ray",
           "normal spaces (--normal-space; default view)", "world"})
+        EXPECT_NE(list.output.find(expected), std::string::npos) << expected << "\n" << list.output;
+}
+
+TEST(CliContract, ListShowsEveryOptionOfEveryStageFromItsTable) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const CliRun list = run("list");
+    EXPECT_EQ(list.exitCode, 0) << list.output;
+    size_t previous = 0;
+    for (const lighting::StageInfo& info : lighting::stageInfos()) {
+        // Stages in registry order, each with its options beneath it.
+        const size_t at = list.output.find("\n  " + info.name + "  - " + info.description + "\n");
+        ASSERT_NE(at, std::string::npos) << info.name << "\n" << list.output;
+        EXPECT_GT(at, previous) << info.name;
+        previous = at;
+        for (const lighting::StageOption& option : info.options) {
+            const std::string line = "\n    " + option.key + "=" + option.range() + "  " +
+                                     option.typeName() + ", default " + option.defaultText + ": " +
+                                     option.doc + "\n";
+            EXPECT_NE(list.output.find(line, at), std::string::npos)
+                << info.name << ": " << line << "\n"
+                << list.output;
+        }
+    }
+    // Spot checks of what the table generates.
+    for (const char* expected :
+         {"    tile=4..128  int, default 16: tile size in pixels",
+          "    depth=(0, 1e+30]  float, default 0.1:",
+          "    slices=exp|uniform  choice, default exp:", "    vfc=1|0  bool, default 1:"})
         EXPECT_NE(list.output.find(expected), std::string::npos) << expected << "\n" << list.output;
 }
 

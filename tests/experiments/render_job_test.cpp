@@ -291,6 +291,28 @@ TEST(RenderCommand, UnwritableOutputFolderIsRefused) {
     EXPECT_NE(message.find("a_regular_file"), std::string::npos) << message;
 }
 
+TEST(RenderCommand, StatsRecordTheStagesResolvedOptions) {
+    const std::filesystem::path out =
+        std::filesystem::path(::testing::TempDir()) / "render_stage_options";
+    std::filesystem::remove_all(out);
+    experiments::RenderCommandOptions options;
+    options.render = smallAtrium(1);
+    options.render.stage = "tiled:vfc=off,tile=032";
+    options.out = out;
+    testing::internal::CaptureStdout();
+    ASSERT_EQ(experiments::runRenderCommand(options), 0);
+    testing::internal::GetCapturedStdout();
+    std::ifstream statsFile(out / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(statsFile);
+    // The spec as given, and every option of the table with defaults filled in, canonical.
+    EXPECT_EQ(stats["stage"], "tiled:vfc=off,tile=032");
+    EXPECT_EQ(stats["stage_options"],
+              nlohmann::json({{"tile", "32"}, {"vfc", "0"}, {"mask", "0"}}));
+    // What the stage ran with agrees with what is recorded.
+    for (const auto& [key, value] : stats["stage_options"].items())
+        EXPECT_EQ(stats["stage_parameters"][key], value) << key;
+}
+
 TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
     const std::filesystem::path out = std::filesystem::path(::testing::TempDir()) / "render_ok";
     std::filesystem::remove_all(out);
