@@ -80,7 +80,7 @@ std::span<const uint32_t> BlendedPass::contributingLights(const gbuffer::Surface
 
 void BlendedPass::shadeWithTileLists(std::span<const float> opaqueDepth, int tileSizePixels,
                                      bool viewFrustumCulling, StageResult& result) {
-    const auto start = std::chrono::steady_clock::now();
+    PassTimer blendPass(result, pass::kBlend);
     const TileGrid grid = TileGrid::make(result.width, result.height, tileSizePixels);
     const std::vector<std::vector<uint32_t>> lists =
         blendedTileLightLists(*mInputs, opaqueDepth, grid, viewFrustumCulling);
@@ -90,11 +90,11 @@ void BlendedPass::shadeWithTileLists(std::span<const float> opaqueDepth, int til
             return std::span<const uint32_t>(
                 lists[size_t((y / tileSizePixels) * grid.tileCountX + x / tileSizePixels)]);
         },
-        result, start);
+        result, blendPass);
 }
 
 void BlendedPass::compositeExact(std::span<const float> opaqueDepth, StageResult& result) {
-    const auto start = std::chrono::steady_clock::now();
+    PassTimer blendPass(result, pass::kBlend);
     const size_t width = size_t(result.width);
     // Every blended fragment of each pixel (scene triangle, back face), in any order: sorted per
     // pixel below. Each list is written by the thread owning the pixel's raster tile.
@@ -174,7 +174,7 @@ void BlendedPass::compositeExact(std::span<const float> opaqueDepth, StageResult
                 result.radiance[c][pixel] = float(colour[c]);
         }
     });
-    result.timingsMs.emplace_back(pass::kBlend, millisecondsSince(start));
+    blendPass.stop();
 }
 
 void BlendedPass::addOracle(std::span<const float> opaqueDepth, std::vector<uint32_t>& oracle) {

@@ -32,7 +32,6 @@
 // result does not depend on the thread count.
 #pragma once
 
-#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -64,10 +63,16 @@ public:
     // Composites the blended fragments in front of opaqueDepth (the frame's opaque depth plane,
     // the view's convention) over result.radiance, in the pass's order, with the lists of
     // lightsAt (see the file comment). Appends pass::kBlend to result.timingsMs.
-    // `start` is when the pass began (list building that precedes shade() belongs to it).
+    template <class LightsAt>
+    void shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt, StageResult& result) {
+        PassTimer blendPass(result, pass::kBlend);
+        shade(opaqueDepth, lightsAt, result, blendPass);
+    }
+    // The same, timed by the caller's `blendPass` (started before list building that belongs to
+    // the pass), which this stops.
     template <class LightsAt>
     void shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt, StageResult& result,
-               std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now());
+               PassTimer& blendPass);
 
     // shade() with every light for every fragment: brute, and the stages that state they use
     // brute force for blended surfaces (lighting/README.md).
@@ -139,7 +144,7 @@ void BlendedPass::draw(std::span<const float> opaqueDepth, FragmentFn&& fragment
 
 template <class LightsAt>
 void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
-                        StageResult& result, std::chrono::steady_clock::time_point start) {
+                        StageResult& result, PassTimer& blendPass) {
     const std::vector<LightInView<float>>& lights = mInputs->lights->lights;
     const size_t width = size_t(result.width);
     const bool countOracle = !result.lightsOracle.empty();
@@ -163,7 +168,7 @@ void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
         if (countOracle)
             result.lightsOracle[pixel] += contributing;
     });
-    result.timingsMs.emplace_back(pass::kBlend, millisecondsSince(start));
+    blendPass.stop();
 }
 
 } // namespace lighting

@@ -157,37 +157,68 @@ struct StageResult {
     }
 };
 
-// Milliseconds since `start` on the steady clock.
-inline double millisecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
-}
+// The one clock of the stages: a steady-clock stopwatch that runs in spans, from construction (or
+// resume()) to pause(); milliseconds() is the sum of the spans so far, the running one included.
+// What PassTimer measures with, and what a stage uses alone for a figure that is no pass (ideal's
+// untimed list build).
+class Stopwatch {
+public:
+    Stopwatch() : mStart(std::chrono::steady_clock::now()) {}
+    void pause() {
+        if (mRunning) {
+            mMilliseconds += span();
+            mRunning = false;
+        }
+    }
+    void resume() {
+        if (!mRunning) {
+            mStart = std::chrono::steady_clock::now();
+            mRunning = true;
+        }
+    }
+    double milliseconds() const { return mMilliseconds + (mRunning ? span() : 0.0); }
+
+private:
+    double span() const {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - mStart)
+            .count();
+    }
+
+    std::chrono::steady_clock::time_point mStart;
+    double mMilliseconds = 0.0;
+    bool mRunning = true;
+};
 
 // How stages time their passes: a pass runs from the timer's construction to stop() (or the end
 // of its scope), and is then appended to result.timingsMs under `pass` (a PassNames.h constant),
-// so passes are recorded in execution order. stop() returns the milliseconds; calls after the
-// first return the same value and record nothing. Not copyable; one timer per pass.
+// so passes are recorded in execution order. A pass done in several spans (inferred's blend:
+// stipple, light, composite, with other passes between) pause()s and resume()s its timer and is
+// recorded once, at stop(), as the sum. discard() ends the timer without recording (a pass that
+// turned out not to run). stop() returns the milliseconds; calls after the first return the same
+// value and record nothing. Not copyable; one timer per pass.
 class PassTimer {
 public:
-    PassTimer(StageResult& result, const char* pass)
-        : mResult(result), mPass(pass), mStart(std::chrono::steady_clock::now()) {}
+    PassTimer(StageResult& result, const char* pass) : mResult(result), mPass(pass) {}
     ~PassTimer() { stop(); }
     PassTimer(const PassTimer&) = delete;
     PassTimer& operator=(const PassTimer&) = delete;
 
+    void pause() { mClock.pause(); }
+    void resume() { mClock.resume(); }
     double stop() {
         if (!mStopped) {
             mStopped = true;
-            mMilliseconds = millisecondsSince(mStart);
+            mMilliseconds = mClock.milliseconds();
             mResult.timingsMs.emplace_back(mPass, mMilliseconds);
         }
         return mMilliseconds;
     }
+    void discard() { mStopped = true; }
 
 private:
     StageResult& mResult;
     const char* mPass;
-    std::chrono::steady_clock::time_point mStart;
+    Stopwatch mClock;
     bool mStopped = false;
     double mMilliseconds = 0.0;
 };

@@ -22,9 +22,7 @@
 // packet_light_pairs (packet-wide evaluations), and accumulateLights' isa, simt_warp and
 // simt_lane_slots. Threads: lists as ContributingLights (deterministic), shading as
 // accumulateLights (each pixel written by one task).
-#include "lighting/stages/Stages.h"
-
-#include <chrono>
+#include "lighting/StageRegistry.h"
 
 #include "lighting/BlendedPass.h"
 #include "lighting/ContributingLights.h"
@@ -45,14 +43,14 @@ public:
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         result.resize(gb.width(), gb.height(), false);
 
-        auto start = std::chrono::steady_clock::now();
+        const Stopwatch listBuild; // untimed: a figure of its own, in no pass
         mPixelLists.build(gb, lights);
         mPacketLists.build(mPixelLists, lights.size());
-        const double listBuildMs = millisecondsSince(start);
+        const double listBuildMs = listBuild.milliseconds();
 
-        start = std::chrono::steady_clock::now();
+        PassTimer shading(result, pass::kShading);
         accumulateLights(inputs, mPacketLists, {}, result);
-        result.timingsMs.emplace_back(pass::kShading, millisecondsSince(start));
+        shading.stop();
         // Blended surfaces: each fragment's contributing lights, found by testing every light at
         // the fragment (the lists above are the opaque surface's), inside the blend pass's time.
         if (mBlended.prepare(inputs))

@@ -69,7 +69,6 @@
 #include "lighting/StageRegistry.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <span>
 
@@ -142,12 +141,12 @@ public:
 
         // Blended surfaces: stippled into the L-buffer's samples (InferredStipple.h); all their
         // work is timed as the pass "blend".
-        auto blendStart = std::chrono::steady_clock::now();
+        PassTimer blendPass(result, pass::kBlend); // three spans, recorded after "material"
         const bool blended = mBlended.prepare(inputs);
         if (blended)
             mStipple.stipple(inputs, mBlended, gb.depth(),
                              {width, height, scale, lowWidth, lowHeight});
-        double blendMs = millisecondsSince(blendStart);
+        blendPass.pause();
 
         // L-buffer at low resolution.
         PassTimer lightingPass(result, pass::kLighting);
@@ -180,7 +179,7 @@ public:
         });
         lightingPass.stop();
         if (blended) {
-            blendStart = std::chrono::steady_clock::now();
+            blendPass.resume();
             mStipple.light(inputs, gb.depth(), mOptions.tileSizeSamples * scale);
             for (int j = 0; j < lowHeight; ++j)
                 for (int i = 0; i < lowWidth; ++i) {
@@ -194,7 +193,7 @@ public:
                     result.lightsEvaluated[size_t(sampleY(j)) * width + sampleX(i)] =
                         stippled.lightCount;
                 }
-            blendMs += millisecondsSince(blendStart);
+            blendPass.pause();
         }
 
         // Material pass: second geometry pass, DSF upsampling, combine.
@@ -295,14 +294,16 @@ public:
         for (uint32_t f : rowIdFallbacks)
             idFallbacks += f;
         if (blended) {
-            blendStart = std::chrono::steady_clock::now();
+            blendPass.resume();
             const InferredStipple::Counts counts = mStipple.composite(
                 mBlended, gb.depth(),
                 {mOptions.depthThreshold, mOptions.normalThreshold, mOptions.objectIds}, result);
-            result.timingsMs.emplace_back(pass::kBlend, blendMs + millisecondsSince(blendStart));
+            blendPass.stop();
             result.parameters["stipple_fragments"] = std::to_string(counts.fragments);
             result.parameters["stipple_fallbacks"] = std::to_string(counts.fallbacks);
             result.parameters["stipple_unlit"] = std::to_string(counts.unlit);
+        } else {
+            blendPass.discard(); // no blended surface: no "blend" pass
         }
         result.parameters["scale"] = std::to_string(scale);
         result.parameters["depth"] = std::to_string(mOptions.depthThreshold);
