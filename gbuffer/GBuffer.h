@@ -140,12 +140,17 @@ public:
     std::span<const float> depth() const { return mDepth; }
     // The stored planes, for readers that decode many pixels at once (the shading kernel's
     // PacketDecoder, lighting/kernel/); an empty span for a plane the layout does not store.
-    // Encoded planes (normal codes, packed albedo or specular) are not exposed: such layouts are
-    // read through decode().
+    // Encoded planes (normal codes, packed albedo, specular, roughness-metallic or occlusion) are
+    // not exposed: such layouts are read through decode().
     std::span<const float> normalPlane(int axis) const { return mNormal[axis]; }
     std::span<const float> albedoPlane(int channel) const { return mAlbedo[channel]; }
     std::span<const float> specularPlane(int index) const { return mSpecular[index]; }
     std::span<const uint16_t> materialPlane() const { return mMaterial; }
+    // f32 roughness (index 0) and metallic (1); f32 ambient occlusion.
+    std::span<const float> roughnessMetallicPlane(int index) const {
+        return mRoughnessMetallic[index];
+    }
+    std::span<const float> occlusionPlane() const { return mOcclusion; }
 
 private:
     glm::vec3 viewRayOfPixel(size_t pixel) const;

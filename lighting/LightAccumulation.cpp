@@ -38,15 +38,9 @@ struct PacketCounts {
 };
 
 // The one check of which path a frame takes (see the header): the packet decoder must read the
-// layout, and the kernel implements only the Blinn-Phong lighting function.
+// layout. The kernel shades both material models (Blinn-Phong and metallic-roughness).
 bool packetPathFits(const StageInputs& inputs) {
-    if (!kernel::PacketDecoder::supports(inputs.gbuffer->layout()))
-        return false;
-    if (inputs.scene)
-        for (const scenes::Material& material : inputs.scene->materials)
-            if (material.model != scenes::MaterialModel::BlinnPhong)
-                return false;
-    return true;
+    return kernel::PacketDecoder::supports(inputs.gbuffer->layout());
 }
 
 kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb) {
@@ -58,6 +52,10 @@ kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb) {
     }
     for (int k = 0; k < 2; ++k)
         planes.specular[k] = gb.specularPlane(k).empty() ? nullptr : gb.specularPlane(k).data();
+    for (int k = 0; k < 2; ++k)
+        planes.roughnessMetallic[k] =
+            gb.roughnessMetallicPlane(k).empty() ? nullptr : gb.roughnessMetallicPlane(k).data();
+    planes.occlusion = gb.occlusionPlane().empty() ? nullptr : gb.occlusionPlane().data();
     planes.material = gb.materialPlane().empty() ? nullptr : gb.materialPlane().data();
     return planes;
 }

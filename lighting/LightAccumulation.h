@@ -12,13 +12,13 @@
 //
 // Two paths, chosen once per frame by packetPathFits in LightAccumulation.cpp (the one place that
 // check lives):
-// - packets: the G-buffer layout is one PacketDecoder reads and every material of the scene uses
-//   the Blinn-Phong model; the kernel runs on the requested ISA (`scalar` = evaluateLight lane by
-//   lane, bitwise the former per-pixel loops; a vector target differs from it by a few ulps,
-//   lighting/kernel/README.md);
-// - per pixel: otherwise (layouts with normal codes or packed albedo/specular; scenes with
-//   metallic-roughness materials, whose lighting function the kernel does not implement):
-//   GBuffer::surfaceAt and evaluateLight pixel by pixel, over the same lists, in the same order.
+// - packets: the G-buffer layout is one PacketDecoder reads (either material model, or both);
+//   the kernel runs on the requested ISA (`scalar` = evaluateLight lane by lane, bitwise the
+//   per-pixel loop; a vector target differs from it by a few ulps on Blinn-Phong lanes, through
+//   pow, and not at all on metallic-roughness lanes, lighting/kernel/README.md);
+// - per pixel: otherwise (layouts with normal codes, packed albedo, specular, roughness-metallic
+//   or occlusion, world-space normals): GBuffer::surfaceAt and evaluateLight pixel by pixel, over
+//   the same lists, in the same order.
 //   result.parameters["isa"] then says "scalar" whatever was requested.
 //
 // SIMT cost model (issue 14, section 3; lighting/README.md): a warp pays one lane slot per lane

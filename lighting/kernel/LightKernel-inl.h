@@ -1,8 +1,14 @@
 // shadePacketVector: the vector light loop of the shading kernel, once per compiled instruction
-// set (included by VectorTargets.cpp through foreach_target.h). It evaluates the one lighting
-// model of lighting/Brdf.h (evaluateLight: Lambert + normalised Blinn-Phong, windowed
-// inverse-square falloff, spot smoothstep, directional and ambient lights) for the 16 lanes of a
-// ShadingPacket and each light of a list, in list order.
+// set (included by VectorTargets.cpp through foreach_target.h). It evaluates lighting/Brdf.h's
+// evaluateLight (windowed inverse-square falloff, spot smoothstep, directional and ambient lights)
+// with each lane's material model, Lambert + normalised Blinn-Phong (Brdf.h) or glTF
+// metallic-roughness (MetallicRoughness.h: GGX, Smith height-correlated visibility, Schlick), for
+// the 16 lanes of a ShadingPacket and each light of a list, in list order.
+//
+// Models: the packet's metallicRoughnessMask says which lanes use metallic-roughness. A call whose
+// active lanes all use one model runs that model's loop only (a Blinn-Phong scene runs exactly the
+// loop it ran before the second model existed); a call with both computes both shadings for the
+// packet and selects per lane. Phases 1 and 2 are the same for both models (lightIncidence).
 //
 // The packet's 16 lanes are kChunks = 16 / N hardware vectors of N lanes (AVX-512: 1 x 16,
 // AVX2: 2 x 8, SSE4: 4 x 4). A light goes through three phases, each over every chunk, and the
@@ -10,7 +16,8 @@
 //   1. range:  offset, distance^2 < range^2                   (all lanes out: skipped at range)
 //   2. cone and facing: direction, attenuation, spot cone, n.l > 0
 //                                                              (all lanes out: skipped later)
-//   3. shading: halfway vector, n.h, pow, sum                  (at least one lane: shaded)
+//   3. shading: halfway vector, n.h, pow, sum (Blinn-Phong); halfway vector, Schlick's weight,
+//      GGX D, Smith Vis, Fresnel, sum (metallic-roughness)   (at least one lane: shaded)
 // Lanes that rejected the light, and lanes outside the lane mask, add exactly +0 (their radiance
 // is selected to zero, whatever NaN or Inf their arithmetic produced), so a lane's sum depends on
 // its own surface and the light list only, never on its neighbours.
@@ -20,14 +27,18 @@
 // add kept apart: the project compiles with -ffp-contract=off, which also keeps the compiler from
 // fusing Highway's Mul and Add), except pow (VectorPow-inl.h). So every decision (range, cone,
 // n.l) and every factor but the specular lobe are bitwise the scalar path's, and the radiance
-// differs from it only through pow. Quantities that depend only on the pixel (direction to the
-// viewer, albedo / pi, the specular normalisation) are computed once per call with the operations
-// evaluateLight repeats per light, so they too are bitwise the same. (Measured: fusing the dot
+// differs from it only through pow. The metallic-roughness model has no pow ((1 - |V.H|)^5 is
+// multiplications, as MetallicRoughness.h computes it), so its radiance is bitwise the scalar
+// path's. Quantities that depend only on the pixel (direction to the viewer, albedo / pi, the
+// specular normalisation; c_diff, f0, alpha^2, the |N.V| half of Vis's denominator) are computed
+// once per call with the operations evaluateLight repeats per light, so they too are bitwise the
+// same. (Measured: fusing the dot
 // products of the shading part and skipping the halfway vector's normalisation saved ~3% of a
 // shaded light and made sharp lobes (powers of thousands) differ from the scalar path by up to
 // 10^4 ulps; not worth losing the tight comparison.)
 
 // Ordinary headers outside the per-target region, so they are compiled for the baseline only.
+#include "lighting/MetallicRoughness.h"
 #include "lighting/kernel/VectorTargets.h"
 #include "scenes/Scene.h"
 
@@ -62,13 +73,35 @@ HWY_INLINE FloatVec dot3(FloatVec ax, FloatVec ay, FloatVec az, FloatVec bx, Flo
     return hn::Add(hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)), hn::Mul(az, bz));
 }
 
-// One chunk's surface, read once per call.
+// Which material models a call's active lanes use (ShadingPacket::metallicRoughnessMask).
+enum class Models { BlinnPhong, MetallicRoughness, Mixed };
+
+// The float constants of MetallicRoughness.h as its float instantiation rounds them.
+constexpr float kDielectricF0Float = float(kDielectricF0);
+constexpr float kDielectricWeightFloat = float(1.0 - kDielectricF0);
+constexpr float kMinRoughnessFloat = float(kMinRoughness);
+constexpr float kMinVisibilityDenominatorFloat = float(kMinVisibilityDenominator);
+constexpr float kPiFloat = float(kPi);
+constexpr float kInversePiFloat = float(1.0 / kPi);
+
+// One chunk's surface, read once per call. The rows of a model no lane uses are not filled.
 struct ChunkSurface {
     FloatVec normal[3];
     FloatVec toViewer[3];
+    // Blinn-Phong
     FloatVec diffuse[3];    // albedo * (1 / pi)
     FloatVec specularScale; // specularIntensity * (specularPower + 8) * (1 / (8 pi))
     FloatVec specularPower;
+    // Metallic-roughness: metallicRoughnessLobes, and the per-pixel parts of the BRDF.
+    FloatVec diffuseColor[3]; // c_diff = baseColor (1 - metallic)
+    FloatVec f0[3];           // 0.04 (1 - metallic) + baseColor metallic
+    FloatVec ambientColor[3]; // c_diff 0.96 + f0 (the ambient response)
+    FloatVec occlusion;
+    FloatVec alpha2;
+    FloatVec oneMinusAlpha2;
+    FloatVec absNDotV;
+    FloatVec viewTerm; // sqrt(alpha^2 + (1 - alpha^2) |N.V| |N.V|), Vis's second square root
+    LaneMask metallicRoughness;
     LaneMask active;
 };
 
@@ -103,10 +136,10 @@ HWY_INLINE void accumulate(const FloatVec radiance[3], ChunkSums& sums) {
         hn::Sub(sums.contributing, hn::VecFromMask(di, hn::RebindMask(di, contributes)));
 }
 
-// Phase 3 for one chunk: the halfway vector, the specular lobe and the radiance, with
-// evaluateLight's operations except pow.
-HWY_INLINE void shadedRadiance(const KernelLight& light, const ChunkSurface& s, const ChunkLight& l,
-                               FloatVec radiance[3]) {
+// Phase 3 for one chunk, Blinn-Phong: the halfway vector, the specular lobe and the radiance,
+// with evaluateLightBlinnPhong's operations except pow.
+HWY_INLINE void blinnPhongRadiance(const KernelLight& light, const ChunkSurface& s,
+                                   const ChunkLight& l, FloatVec radiance[3]) {
     const FloatTag d;
     const FloatVec one = hn::Set(d, 1.0f);
     FloatVec halfway[3];
@@ -129,11 +162,108 @@ HWY_INLINE void shadedRadiance(const KernelLight& light, const ChunkSurface& s, 
                                                hn::Add(s.diffuse[k], specular)));
 }
 
-template <bool kCountContributing>
+// Phase 3 for one chunk, metallic-roughness: evaluateLightMetallicRoughness's operations after
+// lightIncidence, in its order (metallicRoughnessBrdf, ggxDistribution, smithVisibility,
+// schlickWeight), with its branches as selections. evaluateLightMetallicRoughness returns 0 where
+// the attenuation is not > 0 (it can underflow inside the range); that is selected here too.
+HWY_INLINE void metallicRoughnessRadiance(const KernelLight& light, const ChunkSurface& s,
+                                          const ChunkLight& l, FloatVec radiance[3]) {
+    const FloatTag d;
+    const FloatVec zero = hn::Zero(d);
+    const FloatVec one = hn::Set(d, 1.0f);
+    // h = normalize(l + v), or 0 when l = -v.
+    FloatVec sum[3], h[3];
+    for (int k = 0; k < 3; ++k)
+        sum[k] = hn::Add(l.toLight[k], s.toViewer[k]);
+    const FloatVec sumLength2 = dot3(sum[0], sum[1], sum[2], sum[0], sum[1], sum[2]);
+    const LaneMask hasHalfway = hn::Gt(sumLength2, zero);
+    const FloatVec sumLength = hn::Sqrt(sumLength2);
+    for (int k = 0; k < 3; ++k)
+        h[k] = hn::IfThenElseZero(hasHalfway, hn::Div(sum[k], sumLength));
+    const FloatVec vDotH = dot3(s.toViewer[0], s.toViewer[1], s.toViewer[2], h[0], h[1], h[2]);
+    // schlickWeight: x = clamp(1 - |V.H|, 0, 1), x^5 as (x^2 x^2) x.
+    const FloatVec x = hn::Min(hn::Max(hn::Sub(one, hn::Abs(vDotH)), zero), one);
+    const FloatVec x2 = hn::Mul(x, x);
+    const FloatVec w = hn::Mul(hn::Mul(x2, x2), x);
+    const FloatVec dielectricFresnel =
+        hn::Add(hn::Set(d, kDielectricF0Float), hn::Mul(hn::Set(d, kDielectricWeightFloat), w));
+    // ggxDistribution: k = |N x H|^2 + (N.H)^2 alpha^2 (glm::cross's operand order).
+    const FloatVec nDotH = dot3(s.normal[0], s.normal[1], s.normal[2], h[0], h[1], h[2]);
+    const FloatVec cross[3] = {hn::Sub(hn::Mul(s.normal[1], h[2]), hn::Mul(h[1], s.normal[2])),
+                               hn::Sub(hn::Mul(s.normal[2], h[0]), hn::Mul(h[2], s.normal[0])),
+                               hn::Sub(hn::Mul(s.normal[0], h[1]), hn::Mul(h[0], s.normal[1]))};
+    const FloatVec kTerm = hn::Add(dot3(cross[0], cross[1], cross[2], cross[0], cross[1], cross[2]),
+                                   hn::Mul(hn::Mul(nDotH, nDotH), s.alpha2));
+    const FloatVec distribution =
+        hn::IfThenElseZero(hn::Gt(nDotH, zero),
+                           hn::Div(s.alpha2, hn::Mul(hn::Mul(hn::Set(d, kPiFloat), kTerm), kTerm)));
+    // smithVisibility: |N.V| sqrt(a2 + (1 - a2) |N.L|^2) + |N.L| sqrt(a2 + (1 - a2) |N.V|^2).
+    const FloatVec absNDotL = hn::Abs(l.nDotL);
+    const FloatVec lightTerm =
+        hn::Sqrt(hn::Add(s.alpha2, hn::Mul(hn::Mul(s.oneMinusAlpha2, absNDotL), absNDotL)));
+    const FloatVec denominator =
+        hn::Add(hn::Mul(s.absNDotV, lightTerm), hn::Mul(absNDotL, s.viewTerm));
+    const FloatVec visibility =
+        hn::Div(hn::Set(d, 0.5f), hn::Max(denominator, hn::Set(d, kMinVisibilityDenominatorFloat)));
+    const FloatVec specular =
+        hn::IfThenElseZero(hn::Gt(vDotH, zero), hn::Mul(distribution, visibility));
+    const FloatVec diffuseWeight =
+        hn::Mul(hn::Sub(one, dielectricFresnel), hn::Set(d, kInversePiFloat));
+    const FloatVec scale = hn::Mul(l.attenuation, l.nDotL);
+    const LaneMask pass = hn::And(l.pass, hn::Gt(l.attenuation, zero));
+    for (int k = 0; k < 3; ++k) {
+        const FloatVec fresnel = hn::Add(s.f0[k], hn::Mul(hn::Sub(one, s.f0[k]), w));
+        const FloatVec brdf =
+            hn::Add(hn::Mul(s.diffuseColor[k], diffuseWeight), hn::Mul(fresnel, specular));
+        radiance[k] =
+            hn::IfThenElseZero(pass, hn::Mul(hn::Mul(hn::Set(d, light.radiance[k]), scale), brdf));
+    }
+}
+
+// Phase 3 with the call's models: a lane's radiance is its own model's.
+template <Models kModels>
+HWY_INLINE void shadedRadiance(const KernelLight& light, const ChunkSurface& s, const ChunkLight& l,
+                               FloatVec radiance[3]) {
+    if constexpr (kModels == Models::BlinnPhong) {
+        blinnPhongRadiance(light, s, l, radiance);
+    } else if constexpr (kModels == Models::MetallicRoughness) {
+        metallicRoughnessRadiance(light, s, l, radiance);
+    } else {
+        FloatVec blinnPhong[3];
+        blinnPhongRadiance(light, s, l, blinnPhong);
+        metallicRoughnessRadiance(light, s, l, radiance);
+        for (int k = 0; k < 3; ++k)
+            radiance[k] = hn::IfThenElse(s.metallicRoughness, radiance[k], blinnPhong[k]);
+    }
+}
+
+// An ambient light with the call's models: Blinn-Phong reflects radiance x albedo,
+// metallic-roughness (radiance x occlusion) x (c_diff 0.96 + f0).
+template <Models kModels>
+HWY_INLINE void ambientRadiance(const KernelLight& light, const ShadingPacket& packet, size_t chunk,
+                                const ChunkSurface& s, LaneMask active, FloatVec radiance[3]) {
+    const FloatTag d;
+    for (int k = 0; k < 3; ++k) {
+        const FloatVec lightRadiance = hn::Set(d, light.radiance[k]);
+        FloatVec value;
+        if constexpr (kModels != Models::MetallicRoughness)
+            value = hn::Mul(lightRadiance, hn::Load(d, packet.albedo[k] + chunk * kLanesPerVector));
+        if constexpr (kModels != Models::BlinnPhong) {
+            const FloatVec metallicRoughness =
+                hn::Mul(hn::Mul(lightRadiance, s.occlusion), s.ambientColor[k]);
+            value = kModels == Models::Mixed
+                        ? hn::IfThenElse(s.metallicRoughness, metallicRoughness, value)
+                        : metallicRoughness;
+        }
+        radiance[k] = hn::IfThenElseZero(active, value);
+    }
+}
+
+template <bool kCountContributing, Models kModels>
 HWY_INLINE void shadeAndAdd(const KernelLight& light, const ChunkSurface& s, const ChunkLight& l,
                             ChunkSums& sums) {
     FloatVec radiance[3];
-    shadedRadiance(light, s, l, radiance);
+    shadedRadiance<kModels>(light, s, l, radiance);
     accumulate<kCountContributing>(radiance, sums);
 }
 
@@ -206,6 +336,7 @@ HWY_INLINE LaneMask chunkMask(uint32_t laneMask, size_t chunk) {
     return hn::LoadMaskBits(d, bytes);
 }
 
+template <Models kModels>
 HWY_INLINE void loadSurface(const ShadingPacket& packet, uint32_t laneMask, size_t chunk,
                             ChunkSurface& s) {
     const FloatTag d;
@@ -215,8 +346,9 @@ HWY_INLINE void loadSurface(const ShadingPacket& packet, uint32_t laneMask, size
     for (int k = 0; k < 3; ++k) {
         s.normal[k] = hn::Load(d, packet.normalView[k] + first);
         toViewer[k] = hn::Neg(hn::Load(d, packet.positionView[k] + first));
-        s.diffuse[k] = hn::Mul(hn::Load(d, packet.albedo[k] + first),
-                               hn::Set(d, float(1.0 / 3.14159265358979323846)));
+        if constexpr (kModels != Models::MetallicRoughness)
+            s.diffuse[k] = hn::Mul(hn::Load(d, packet.albedo[k] + first),
+                                   hn::Set(d, float(1.0 / 3.14159265358979323846)));
     }
     // glm::normalize: v * (1 / sqrt(dot(v, v))).
     const FloatVec inverseLength =
@@ -224,16 +356,46 @@ HWY_INLINE void loadSurface(const ShadingPacket& packet, uint32_t laneMask, size
                                    toViewer[2])));
     for (int k = 0; k < 3; ++k)
         s.toViewer[k] = hn::Mul(toViewer[k], inverseLength);
-    s.specularPower = hn::Load(d, packet.specularPower + first);
-    s.specularScale = hn::Mul(hn::Mul(hn::Load(d, packet.specularIntensity + first),
-                                      hn::Add(s.specularPower, hn::Set(d, 8.0f))),
-                              hn::Set(d, float(1.0 / (8.0 * 3.14159265358979323846))));
+    if constexpr (kModels != Models::MetallicRoughness) {
+        s.specularPower = hn::Load(d, packet.specularPower + first);
+        s.specularScale = hn::Mul(hn::Mul(hn::Load(d, packet.specularIntensity + first),
+                                          hn::Add(s.specularPower, hn::Set(d, 8.0f))),
+                                  hn::Set(d, float(1.0 / (8.0 * 3.14159265358979323846))));
+    }
+    if constexpr (kModels != Models::BlinnPhong) {
+        // metallicRoughnessLobes: metallic clamped to [0, 1], roughness to [kMinRoughness, 1]
+        // (glm::clamp: min(max(x, lo), hi)).
+        const FloatVec zero = hn::Zero(d);
+        const FloatVec metallic = hn::Min(hn::Max(hn::Load(d, packet.metallic + first), zero), one);
+        const FloatVec roughness = hn::Min(
+            hn::Max(hn::Load(d, packet.roughness + first), hn::Set(d, kMinRoughnessFloat)), one);
+        const FloatVec alpha = hn::Mul(roughness, roughness);
+        s.alpha2 = hn::Mul(alpha, alpha);
+        s.oneMinusAlpha2 = hn::Sub(one, s.alpha2);
+        const FloatVec oneMinusMetallic = hn::Sub(one, metallic);
+        for (int k = 0; k < 3; ++k) {
+            const FloatVec baseColor = hn::Load(d, packet.albedo[k] + first);
+            s.diffuseColor[k] = hn::Mul(baseColor, oneMinusMetallic);
+            s.f0[k] = hn::Add(hn::Mul(hn::Set(d, kDielectricF0Float), oneMinusMetallic),
+                              hn::Mul(baseColor, metallic));
+            s.ambientColor[k] =
+                hn::Add(hn::Mul(s.diffuseColor[k], hn::Set(d, kDielectricWeightFloat)), s.f0[k]);
+        }
+        s.occlusion = hn::Load(d, packet.occlusion + first);
+        s.absNDotV = hn::Abs(dot3(s.normal[0], s.normal[1], s.normal[2], s.toViewer[0],
+                                  s.toViewer[1], s.toViewer[2]));
+        s.viewTerm =
+            hn::Sqrt(hn::Add(s.alpha2, hn::Mul(hn::Mul(s.oneMinusAlpha2, s.absNDotV), s.absNDotV)));
+        s.metallicRoughness = chunkMask(packet.metallicRoughnessMask, chunk);
+    }
     s.active = chunkMask(laneMask, chunk);
 }
 
 // kPerLightMasks: args.lightLaneMasks[i] further restricts light i to some lanes (the `ideal`
 // stage's per-lane lists as one union list); each lane then counts only its own lights.
-template <bool kCountContributing, bool kPerLightMasks> void shadeLights(const ShadeArgs& args) {
+// kModels: which models the active lanes use (shadePacketVector decides it per call).
+template <bool kCountContributing, bool kPerLightMasks, Models kModels>
+void shadeLights(const ShadeArgs& args) {
     const FloatTag d;
     const IntTag di;
     const ShadingPacket& packet = *args.packet;
@@ -245,7 +407,7 @@ template <bool kCountContributing, bool kPerLightMasks> void shadeLights(const S
     ChunkSurface surface[kChunks];
     ChunkSums sums[kChunks];
     for (size_t c = 0; c < kChunks; ++c) {
-        loadSurface(packet, laneMask, c, surface[c]);
+        loadSurface<kModels>(packet, laneMask, c, surface[c]);
         // Sums continue from the accumulator, so a list split over calls adds in the same order.
         for (int k = 0; k < 3; ++k)
             sums[c].radiance[k] = hn::Load(d, accumulator.radiance[k] + c * kLanesPerVector);
@@ -286,15 +448,13 @@ template <bool kCountContributing, bool kPerLightMasks> void shadeLights(const S
         if (type == scenes::LightType::Ambient) {
             if (pending) {
                 for (size_t c = 0; c < kChunks; ++c)
-                    shadeAndAdd<kCountContributing>(*pending, surface[c], pendingLight[c], sums[c]);
+                    shadeAndAdd<kCountContributing, kModels>(*pending, surface[c], pendingLight[c],
+                                                             sums[c]);
                 pending = nullptr;
             }
             for (size_t c = 0; c < kChunks; ++c) {
                 FloatVec radiance[3];
-                for (int k = 0; k < 3; ++k)
-                    radiance[k] = hn::IfThenElseZero(
-                        active[c], hn::Mul(hn::Set(d, light.radiance[k]),
-                                           hn::Load(d, packet.albedo[k] + c * kLanesPerVector)));
+                ambientRadiance<kModels>(light, packet, c, surface[c], active[c], radiance);
                 accumulate<kCountContributing>(radiance, sums[c]);
             }
             ++accumulator.lightsShaded;
@@ -326,7 +486,7 @@ template <bool kCountContributing, bool kPerLightMasks> void shadeLights(const S
         ++accumulator.lightsShaded;
         if (!kPairLights) {
             for (size_t c = 0; c < kChunks; ++c)
-                shadeAndAdd<kCountContributing>(light, surface[c], chunkLight[c], sums[c]);
+                shadeAndAdd<kCountContributing, kModels>(light, surface[c], chunkLight[c], sums[c]);
         } else if (!pending) {
             pending = &light;
             for (size_t c = 0; c < kChunks; ++c)
@@ -334,8 +494,8 @@ template <bool kCountContributing, bool kPerLightMasks> void shadeLights(const S
         } else {
             for (size_t c = 0; c < kChunks; ++c) {
                 FloatVec first[3], second[3];
-                shadedRadiance(*pending, surface[c], pendingLight[c], first);
-                shadedRadiance(light, surface[c], chunkLight[c], second);
+                shadedRadiance<kModels>(*pending, surface[c], pendingLight[c], first);
+                shadedRadiance<kModels>(light, surface[c], chunkLight[c], second);
                 accumulate<kCountContributing>(first, sums[c]);
                 accumulate<kCountContributing>(second, sums[c]);
             }
@@ -344,7 +504,8 @@ template <bool kCountContributing, bool kPerLightMasks> void shadeLights(const S
     }
     if (pending)
         for (size_t c = 0; c < kChunks; ++c)
-            shadeAndAdd<kCountContributing>(*pending, surface[c], pendingLight[c], sums[c]);
+            shadeAndAdd<kCountContributing, kModels>(*pending, surface[c], pendingLight[c],
+                                                     sums[c]);
 
     for (size_t c = 0; c < kChunks; ++c) {
         const size_t first = c * kLanesPerVector;
@@ -366,17 +527,28 @@ template <bool kCountContributing, bool kPerLightMasks> void shadeLights(const S
     }
 }
 
-void shadePacketVector(const ShadeArgs& args) {
+template <Models kModels> void shadeWithModels(const ShadeArgs& args) {
     if (args.lightLaneMasks) {
         if (args.countContributing)
-            shadeLights<true, true>(args);
+            shadeLights<true, true, kModels>(args);
         else
-            shadeLights<false, true>(args);
+            shadeLights<false, true, kModels>(args);
     } else if (args.countContributing) {
-        shadeLights<true, false>(args);
+        shadeLights<true, false, kModels>(args);
     } else {
-        shadeLights<false, false>(args);
+        shadeLights<false, false, kModels>(args);
     }
+}
+
+void shadePacketVector(const ShadeArgs& args) {
+    const uint32_t lanes = args.laneMask & args.packet->laneMask;
+    const uint32_t metallicRoughness = lanes & args.packet->metallicRoughnessMask;
+    if (metallicRoughness == 0)
+        shadeWithModels<Models::BlinnPhong>(args);
+    else if (metallicRoughness == lanes)
+        shadeWithModels<Models::MetallicRoughness>(args);
+    else
+        shadeWithModels<Models::Mixed>(args);
 }
 
 } // namespace lighting::kernel::HWY_NAMESPACE

@@ -126,6 +126,7 @@ void decodePacketVector(const DecodeArgs& args) {
     packet.x0 = args.x0;
     packet.y0 = args.y0;
     packet.laneMask = 0;
+    packet.metallicRoughnessMask = 0;
     const size_t stride = size_t(t.width);
     const FloatVec one = hn::Set(d, 1.0f);
     const FloatVec two = hn::Set(d, 2.0f);
@@ -138,7 +139,8 @@ void decodePacketVector(const DecodeArgs& args) {
         const size_t pixel0 = (size_t(args.y0) + first / kPacketWidth) * stride + size_t(args.x0);
         const FloatVec depth = loadRows(d, t.depth + pixel0, stride);
         uint8_t coveredBits[8] = {};
-        hn::StoreMaskBits(d, hn::Ne(depth, hn::Set(d, t.clearDepth)), coveredBits);
+        const LaneMask covered = hn::Ne(depth, hn::Set(d, t.clearDepth));
+        hn::StoreMaskBits(d, covered, coveredBits);
         packet.laneMask |= (uint32_t(coveredBits[0]) | uint32_t(coveredBits[1]) << 8) << first;
 
         // CameraView::ndcOfPixel: (x + 0.5) / width * 2 - 1 and 1 - (y + 0.5) / height * 2.
@@ -176,7 +178,9 @@ void decodePacketVector(const DecodeArgs& args) {
         }
 
         MaterialLookup material;
-        if (t.albedoSource == DecodeSource::Material || t.specularSource == DecodeSource::Material)
+        if (t.albedoSource == DecodeSource::Material ||
+            t.specularSource == DecodeSource::Material ||
+            t.roughnessMetallicSource == DecodeSource::Material || t.modelPerMaterial)
             material = MaterialLookup(t, loadMaterialRows(IntTag(), t.material + pixel0, stride));
         for (int k = 0; k < 3; ++k) {
             FloatVec albedo = hn::Zero(d);
@@ -200,6 +204,30 @@ void decodePacketVector(const DecodeArgs& args) {
                 specular = hn::Set(d, t.constantSpecular[k]);
             hn::Store(specular, d, specularTargets[k]);
         }
+        float* roughnessMetallicTargets[2] = {packet.roughness + first, packet.metallic + first};
+        for (int k = 0; k < 2; ++k) {
+            FloatVec value = hn::Set(d, k == 0 ? 1.0f : 0.0f); // Surface's defaults
+            if (t.roughnessMetallicSource == DecodeSource::Plane)
+                value = loadRows(d, t.roughnessMetallicPlane[k] + pixel0, stride);
+            else if (t.roughnessMetallicSource == DecodeSource::Material)
+                value = material.column(t.materialRoughnessMetallic[k], t.materialCount);
+            else if (t.roughnessMetallicSource == DecodeSource::Constant)
+                value = hn::Set(d, t.constantRoughnessMetallic[k]);
+            hn::Store(value, d, roughnessMetallicTargets[k]);
+        }
+        hn::Store(t.occlusionPlane ? loadRows(d, t.occlusionPlane + pixel0, stride) : one, d,
+                  packet.occlusion + first);
+        // The model: the material's (its column is 1 for metallic-roughness) or the layout's.
+        LaneMask metallicRoughness = hn::FirstN(d, 0);
+        if (t.modelPerMaterial)
+            metallicRoughness =
+                hn::Ne(material.column(t.materialMetallicRoughness, t.materialCount), hn::Zero(d));
+        else if (t.constantMetallicRoughness)
+            metallicRoughness = hn::FirstN(d, kLanes);
+        uint8_t modelBits[8] = {};
+        hn::StoreMaskBits(d, hn::And(covered, metallicRoughness), modelBits);
+        packet.metallicRoughnessMask |= (uint32_t(modelBits[0]) | uint32_t(modelBits[1]) << 8)
+                                        << first;
     }
 }
 

@@ -36,6 +36,19 @@ DecodeSource specularSource(gbuffer::SpecularEncoding encoding) {
     }
 }
 
+DecodeSource roughnessMetallicSource(gbuffer::RoughnessMetallicEncoding encoding) {
+    switch (encoding) {
+    case gbuffer::RoughnessMetallicEncoding::Float32:
+        return DecodeSource::Plane;
+    case gbuffer::RoughnessMetallicEncoding::Material:
+        return DecodeSource::Material;
+    case gbuffer::RoughnessMetallicEncoding::Constant:
+        return DecodeSource::Constant;
+    default:
+        return DecodeSource::Absent;
+    }
+}
+
 void requirePlane(const void* plane, const char* name, const gbuffer::GBufferLayout& layout) {
     if (!plane)
         throw std::invalid_argument(std::string("packet decoder: layout '") + layout.name +
@@ -57,6 +70,11 @@ bool PacketDecoder::supports(const gbuffer::GBufferLayout& layout, std::string* 
     else if (layout.specular == gbuffer::SpecularEncoding::Unorm8Half ||
              layout.specular == gbuffer::SpecularEncoding::Unorm8Log8)
         reason = "specular is packed";
+    else if (layout.roughnessMetallic == gbuffer::RoughnessMetallicEncoding::Unorm8)
+        reason = "roughness and metallic are packed (unorm8)";
+    else if (layout.occlusion != gbuffer::RoughnessMetallicEncoding::None &&
+             layout.occlusion != gbuffer::RoughnessMetallicEncoding::Float32)
+        reason = "ambient occlusion is packed (unorm8)";
     if (why)
         *why = reason;
     return reason.empty();
@@ -91,6 +109,20 @@ PacketDecoder::PacketDecoder(const gbuffer::GBufferLayout& layout, const gbuffer
             requirePlane(planes.specular[k], "specular", layout);
             t.specularPlane[k] = planes.specular[k];
         }
+    t.roughnessMetallicSource = roughnessMetallicSource(layout.roughnessMetallic);
+    if (t.roughnessMetallicSource == DecodeSource::Plane)
+        for (int k = 0; k < 2; ++k) {
+            requirePlane(planes.roughnessMetallic[k], "roughness/metallic", layout);
+            t.roughnessMetallicPlane[k] = planes.roughnessMetallic[k];
+        }
+    t.constantRoughnessMetallic[0] = layout.constant.roughness;
+    t.constantRoughnessMetallic[1] = layout.constant.metallic;
+    if (layout.occlusion == gbuffer::RoughnessMetallicEncoding::Float32) {
+        requirePlane(planes.occlusion, "occlusion", layout);
+        t.occlusionPlane = planes.occlusion;
+    }
+    t.modelPerMaterial = layout.modelPerMaterial;
+    t.constantMetallicRoughness = layout.constant.model == scenes::MaterialModel::MetallicRoughness;
     for (int k = 0; k < 3; ++k)
         t.constantAlbedo[k] = layout.constant.albedo[k];
     t.constantSpecular[0] = layout.constant.specularIntensity;
@@ -106,16 +138,23 @@ PacketDecoder::PacketDecoder(const gbuffer::GBufferLayout& layout, const gbuffer
             mMaterialColumns[k].push_back(m.albedo[k]);
         mMaterialColumns[3].push_back(m.specularIntensity);
         mMaterialColumns[4].push_back(m.specularPower);
+        mMaterialColumns[5].push_back(m.roughness);
+        mMaterialColumns[6].push_back(m.metallic);
+        mMaterialColumns[7].push_back(m.model == scenes::MaterialModel::MetallicRoughness ? 1.0f
+                                                                                          : 0.0f);
     }
     // The sentinel, repeated up to 16 entries so a vector decoder can load a whole column as one
     // vector of up to 16 lanes.
-    const float sentinel[5] = {0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
-    for (int k = 0; k < 5; ++k)
+    const float sentinel[8] = {0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f, 0.0f};
+    for (int k = 0; k < 8; ++k)
         mMaterialColumns[k].resize(std::max<size_t>(layout.materials.size() + 1, 16), sentinel[k]);
     for (int k = 0; k < 3; ++k)
         t.materialAlbedo[k] = mMaterialColumns[k].data();
     t.materialSpecular[0] = mMaterialColumns[3].data();
     t.materialSpecular[1] = mMaterialColumns[4].data();
+    t.materialRoughnessMetallic[0] = mMaterialColumns[5].data();
+    t.materialRoughnessMetallic[1] = mMaterialColumns[6].data();
+    t.materialMetallicRoughness = mMaterialColumns[7].data();
 
     t.viewRay = layout.position == gbuffer::PositionMethod::ViewRay;
     for (int column = 0; column < 4; ++column)
@@ -183,6 +222,24 @@ void PacketDecoder::decodeScalar(int x0, int y0, ShadingPacket& packet) const {
                 specular[k] = t.constantSpecular[k];
         }
         packet.setLane(lane, position, normal, albedo, specular[0], specular[1]);
+        // Both models' rows are filled whatever the lane's model, with GBuffer::decode's values.
+        float roughnessMetallic[2] = {1.0f, 0.0f};
+        for (int k = 0; k < 2; ++k) {
+            if (t.roughnessMetallicSource == DecodeSource::Plane)
+                roughnessMetallic[k] = t.roughnessMetallicPlane[k][pixel];
+            else if (t.roughnessMetallicSource == DecodeSource::Material)
+                roughnessMetallic[k] = t.materialRoughnessMetallic[k][material];
+            else if (t.roughnessMetallicSource == DecodeSource::Constant)
+                roughnessMetallic[k] = t.constantRoughnessMetallic[k];
+        }
+        packet.roughness[lane] = roughnessMetallic[0];
+        packet.metallic[lane] = roughnessMetallic[1];
+        packet.occlusion[lane] = t.occlusionPlane ? t.occlusionPlane[pixel] : 1.0f;
+        const bool metallicRoughness = t.modelPerMaterial
+                                           ? t.materialMetallicRoughness[material] != 0.0f
+                                           : t.constantMetallicRoughness;
+        if (metallicRoughness)
+            packet.metallicRoughnessMask |= 1u << lane;
     }
 }
 

@@ -4,11 +4,14 @@
 // Scope (a prototype that lives beside the kernel until the integration moves it into gbuffer/):
 // layouts with float32 view-space normals, any depth format (the G-buffer keeps depth as a float
 // NDC plane whatever the format, quantised on write), either position method, albedo and specular
-// stored as float32 planes, looked up from the per-pixel material index, constant or absent. That
-// covers the reference layout and the layouts `render` derives for untextured scenes (atrium:
-// float depth + float32 normals + material index, 17 bytes per pixel). Other layouts (normal
-// codes, packed albedo or specular, world-space normals) are refused by supports(); their readers
-// keep GBuffer::decode.
+// stored as float32 planes, looked up from the per-pixel material index, constant or absent; the
+// same for metallic-roughness parameters (roughness, metallic: float32 planes, material, constant
+// or absent; ambient occlusion: a float32 plane or absent = 1), and the material model per lane
+// (the layout's constant, or the material's when the layout has modelPerMaterial). That covers the
+// reference layout and the layouts `render` derives with float planes (atrium: float depth +
+// float32 normals + material index, 17 bytes per pixel; DamagedHelmet: + f32 albedo, roughness,
+// metallic, occlusion). Other layouts (normal codes, packed albedo, specular, roughness-metallic or
+// occlusion, world-space normals) are refused by supports(); their readers keep GBuffer::decode.
 //
 // The planes come in as raw pointers (GBufferPlanes) because gbuffer::GBuffer does not expose
 // them yet; tests and benchmarks copy them out of a G-buffer, the integration will hand the
@@ -42,7 +45,9 @@ struct GBufferPlanes {
         nullptr;                 // NDC depth in the view's convention; the clear value = background
     const float* normal[3] = {}; // float32 view-space normal
     const float* albedo[3] = {}; // float32 albedo
-    const float* specular[2] = {}; // float32 intensity, power
+    const float* specular[2] = {};          // float32 intensity, power
+    const float* roughnessMetallic[2] = {}; // float32 roughness, metallic
+    const float* occlusion = nullptr;       // float32 ambient occlusion
     const uint16_t* material = nullptr;
 };
 
@@ -63,11 +68,20 @@ struct PacketDecodeTables {
     const float* specularPlane[2] = {};
     float constantAlbedo[3] = {};
     float constantSpecular[2] = {0.0f, 1.0f};
+    DecodeSource roughnessMetallicSource = DecodeSource::Absent;
+    const float* roughnessMetallicPlane[2] = {};
+    float constantRoughnessMetallic[2] = {1.0f, 0.0f};
+    const float* occlusionPlane = nullptr; // null: occlusion 1
+    // The material model: the layout's constant, or per material (materialMetallicRoughness).
+    bool modelPerMaterial = false;
+    bool constantMetallicRoughness = false;
     // The layout's material table as columns, with one more entry at index materialCount holding
-    // what GBuffer::decode gives for an index out of range (albedo 0, specular (0, 1)), repeated
-    // to at least 16 entries.
+    // what GBuffer::decode gives for an index out of range (albedo 0, specular (0, 1), roughness
+    // 1, metallic 0, Blinn-Phong), repeated to at least 16 entries.
     const float* materialAlbedo[3] = {};
     const float* materialSpecular[2] = {};
+    const float* materialRoughnessMetallic[2] = {};
+    const float* materialMetallicRoughness = nullptr; // 1 where the model is metallic-roughness
     uint32_t materialCount = 0;
     bool viewRay = false;          // position method: false = inverse projection
     float viewFromClip[4][4] = {}; // columns, as glm::mat4
@@ -104,7 +118,8 @@ private:
     gbuffer::CameraView mView;
     gbuffer::PositionMethod mPosition;
     PacketDecodeTables mTables;
-    std::vector<float> mMaterialColumns[5]; // albedo r, g, b, intensity, power
+    // albedo r, g, b, intensity, power, roughness, metallic, model (1 = metallic-roughness)
+    std::vector<float> mMaterialColumns[8];
 };
 
 } // namespace lighting::kernel

@@ -1,5 +1,6 @@
 // shadePacketScalar: the kernel's scalar path and the vector path's oracle. Each lane calls
-// lighting/Brdf.h's evaluateLight<float> for each light, exactly as the per-pixel stages do today;
+// lighting/Brdf.h's evaluateLight<float> for each light with the lane's material model (Blinn-Phong
+// or metallic-roughness), exactly as the per-pixel path does;
 // the packet-level early-out counters come from earlyExit, which repeats evaluateLight's three
 // rejection tests with the same float operations (so they take the same decisions), and apply the
 // vector path's rule: a light is skipped when every active lane rejects it.
@@ -15,7 +16,8 @@ namespace {
 
 enum class EarlyExit { None, Range, ConeOrFacing };
 
-// Where evaluateLight returns zero before shading, for this point and light.
+// Where evaluateLight returns zero before shading, for this point and light (both models share
+// these tests: lightIncidence, then n.l).
 EarlyExit earlyExit(const gbuffer::Surface& s, const LightInView<float>& light) {
     using scenes::LightType;
     if (light.type == LightType::Ambient)
@@ -57,6 +59,12 @@ void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const Ker
         }
         p.specularIntensity = packet.specularIntensity[lane];
         p.specularPower = packet.specularPower[lane];
+        p.roughness = packet.roughness[lane];
+        p.metallic = packet.metallic[lane];
+        p.occlusion = packet.occlusion[lane];
+        p.model = packet.metallicRoughnessMask >> lane & 1u
+                      ? scenes::MaterialModel::MetallicRoughness
+                      : scenes::MaterialModel::BlinnPhong;
         toViewer[lane] = glm::normalize(-p.positionView);
         if (lightLaneMasks.empty())
             accumulator.lightsEvaluated[lane] += uint32_t(lightIndices.size());

@@ -13,7 +13,11 @@ void ShadingPacket::clear(int originX, int originY) {
     }
     std::fill(std::begin(specularIntensity), std::end(specularIntensity), 0.0f);
     std::fill(std::begin(specularPower), std::end(specularPower), 1.0f);
+    std::fill(std::begin(roughness), std::end(roughness), 1.0f);
+    std::fill(std::begin(metallic), std::end(metallic), 0.0f);
+    std::fill(std::begin(occlusion), std::end(occlusion), 1.0f);
     laneMask = 0;
+    metallicRoughnessMask = 0;
     x0 = originX;
     y0 = originY;
 }
@@ -29,6 +33,14 @@ void ShadingPacket::setLane(int lane, const glm::vec3& position, const glm::vec3
     specularIntensity[lane] = specularIntensityValue;
     specularPower[lane] = specularPowerValue;
     laneMask |= 1u << lane;
+}
+
+void ShadingPacket::setMetallicRoughness(int lane, float roughnessValue, float metallicValue,
+                                         float occlusionValue) {
+    roughness[lane] = roughnessValue;
+    metallic[lane] = metallicValue;
+    occlusion[lane] = occlusionValue;
+    metallicRoughnessMask |= 1u << lane;
 }
 
 void PacketAccumulator::clear() {

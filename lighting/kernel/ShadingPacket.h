@@ -12,7 +12,11 @@
 //   is clear may hold anything, NaN included (the vector decoder reconstructs background pixels
 //   like any other); the kernel computes them and selects their results away.
 // - Arrays are 64-byte aligned so a 16-lane float row is one aligned AVX-512 load.
-// Memory: 832 bytes of surface per packet (13 rows of 16 floats), 320 bytes of accumulator.
+// - Material model per lane: bit l of metallicRoughnessMask set = lane l uses the glTF
+//   metallic-roughness model (lighting/MetallicRoughness.h): albedo is its base colour and the
+//   roughness, metallic and occlusion rows are read; clear = Lambert + Blinn-Phong, which reads
+//   albedo and the specular rows. The rows of the other model are ignored (any value).
+// Memory: 1024 bytes of surface per packet (16 rows of 16 floats), 320 bytes of accumulator.
 #pragma once
 
 #include <cstdint>
@@ -39,16 +43,26 @@ struct alignas(64) ShadingPacket {
     float albedo[3][kPacketLanes];
     float specularIntensity[kPacketLanes];
     float specularPower[kPacketLanes];
+    float roughness[kPacketLanes]; // metallic-roughness: perceptual, unclamped (the BRDF clamps)
+    float metallic[kPacketLanes];
+    float occlusion[kPacketLanes]; // ambient occlusion, 1 = none
     uint32_t laneMask = 0;
-    int x0 = 0; // pixel of lane 0
+    uint32_t metallicRoughnessMask = 0; // lanes of the metallic-roughness model
+    int x0 = 0;                         // pixel of lane 0
     int y0 = 0;
 
-    // Every lane to the background values and laneMask to 0.
+    // Every lane to the background values (gbuffer::Surface's defaults), laneMask and
+    // metallicRoughnessMask to 0.
     void clear(int originX = 0, int originY = 0);
-    // Fills lane `lane` and sets its bit in laneMask (used by tests and scalar decoders).
+    // Fills lane `lane` and sets its bit in laneMask (used by tests and scalar decoders); the lane
+    // keeps its model (Blinn-Phong after clear()).
     void setLane(int lane, const glm::vec3& position, const glm::vec3& normal,
                  const glm::vec3& albedoLinear, float specularIntensityValue,
                  float specularPowerValue);
+    // Makes lane `lane` a metallic-roughness lane with these parameters (albedo is then its base
+    // colour).
+    void setMetallicRoughness(int lane, float roughnessValue, float metallicValue,
+                              float occlusionValue);
 };
 
 // What the kernel adds into, per lane and per packet. The kernel only ever adds, so a caller may

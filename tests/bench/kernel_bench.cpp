@@ -6,9 +6,13 @@
 //                                the median ratio (the target: >= 8)
 //   kernelBruteFrame/<isa>/<t>   the same with the decode inside the timer, on t threads: what a
 //                                brute stage on the kernel would cost (compare bruteShading)
+//   kernelBruteSpeedupHelmet/<isa>  the same ratio on the DamagedHelmet glTF model (every
+//                                material metallic-roughness: the GGX path), 256 point lights
 //   kernelContributing/<isa>     synthetic packets where every lane receives every light (the
 //                                kernel's full path only): GFLOP/s and fraction of the FP32 FMA
 //                                peak
+//   kernelContributingGgx/<isa>  the same packets with metallic-roughness surfaces (GGX, Smith,
+//                                Schlick: 110 flops per point light)
 //   kernelIdealAtrium/<isa>      atrium, each packet with exactly the lights that contribute to at
 //                                least one of its lanes: contributing-light GFLOP/s and fraction
 //   packetDecode/<isa>           derived atrium layout decoded a packet at a time, ns per pixel
@@ -17,11 +21,12 @@
 // Single-threaded benchmarks time the thread's CPU time (the machine is shared: time spent
 // descheduled is not the kernel's); kernelBruteFrame times wall clock, as a frame is.
 // Flops of one evaluation as the kernel executes it (lighting/kernel/README.md counts them): 99
-// for a point light, 111 for a spot, 81 for a directional light, 6 for an ambient one; additions,
-// multiplications, divisions and square roots count 1, fused multiply-adds 2, comparisons,
-// selections, conversions and integer operations 0, and pow the 44 flops Highway's Log (20), the
-// product y log x (1) and Exp (23) execute. Peak = lanes x 2 FMA pipes x 2 flops x measured clock,
-// with lanes the ISA's floats per vector (1 for the scalar path).
+// for a point light, 111 for a spot, 81 for a directional light, 6 for an ambient one
+// (Blinn-Phong); 110, 122, 92 and 9 (metallic-roughness, no pow); additions, multiplications,
+// divisions and square roots count 1, fused multiply-adds 2, comparisons, selections, conversions
+// and integer operations 0, and pow the 44 flops Highway's Log (20), the product y log x (1) and
+// Exp (23) execute. Peak = lanes x 2 FMA pipes x 2 flops x measured clock, with lanes the ISA's
+// floats per vector (1 for the scalar path).
 //   build/bin/testbed_bench --benchmark_counters_tabular=true
 //       --benchmark_filter='kernel|packetDecode|gbufferDecode|machinePeak'
 #include <benchmark/benchmark.h>
@@ -37,6 +42,7 @@
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/kernel/LightKernel.h"
 #include "lighting/kernel/PacketDecoder.h"
+#include "scenes/SceneLoader.h"
 #include "tests/bench/BenchScenes.h"
 #include "tests/bench/MachinePeak.h"
 #include "tests/kernel/GBufferPlaneCopy.h"
@@ -49,6 +55,13 @@ using lighting::kernel::PacketAccumulator;
 using lighting::kernel::ShadingPacket;
 
 constexpr int kFmaPipes = 2; // Zen 5 (MachinePeak.h); machinePeak reports the measured figure
+
+// A shaded metallic-roughness point light (lighting/kernel/README.md): range 8, direction and
+// attenuation 10, n.l 5, then the BRDF 84 (halfway vector 12, V.H 5, Schlick 4, dielectric Fresnel
+// 2, N.H 5, |N x H|^2 14, D's denominator and division 6, Vis 8 (its |N.V| half is per pixel),
+// D Vis 1, diffuse weight 2, n.l x attenuation 1, per channel Fresnel 3, BRDF 3, radiance 2) and
+// the sum 3.
+constexpr double kGgxPointLightFlops = 110;
 
 double flopsPerEvaluation(scenes::LightType type) {
     switch (type) {
@@ -102,7 +115,8 @@ void registerPerIsa(const char* name, void (*function)(benchmark::State&, const 
     }
 }
 
-// The atrium frame of the stage benchmarks, its planes, decoder, lights and decoded packets.
+// A frame of the stage benchmarks (atrium, or the helmet), its planes, decoder, lights and decoded
+// packets.
 struct AtriumKernelFrame {
     std::unique_ptr<lighting::PreparedScene> frame;
     std::unique_ptr<kerneltest::GBufferPlaneCopy> planes;
@@ -113,11 +127,11 @@ struct AtriumKernelFrame {
     uint64_t coveredPixels = 0;
 };
 
-const AtriumKernelFrame& atriumKernelFrame() {
-    static const AtriumKernelFrame f = [] {
-        AtriumKernelFrame a;
-        scenes::Scene scene = bench::proceduralScene("atrium", 256);
-        // The layout `render` derives for brute: float depth, float32 normals, material index.
+// The layout `render` derives for brute: float depth, float32 normals, material index (atrium);
+// plus float32 albedo, roughness, metallic (the helmet's textures).
+AtriumKernelFrame makeKernelFrame(scenes::Scene scene) {
+    AtriumKernelFrame a;
+    {
         const gbuffer::GBufferLayout layout =
             gbuffer::deriveLayout(scene, {gbuffer::Channel::Depth, gbuffer::Channel::Normal,
                                           gbuffer::Channel::Albedo, gbuffer::Channel::Specular});
@@ -137,7 +151,22 @@ const AtriumKernelFrame& atriumKernelFrame() {
                 if (packet.laneMask)
                     a.packets.push_back(packet);
             }
-        return a;
+    }
+    return a;
+}
+
+const AtriumKernelFrame& atriumKernelFrame() {
+    static const AtriumKernelFrame f = makeKernelFrame(bench::proceduralScene("atrium", 256));
+    return f;
+}
+
+const AtriumKernelFrame& helmetKernelFrame() {
+    static const AtriumKernelFrame f = [] {
+        scenes::SceneRequest request;
+        request.lightCount = 256;
+        request.seed = 1;
+        return makeKernelFrame(
+            scenes::loadScene(TESTBED_GLTF_DIR "/DamagedHelmet/DamagedHelmet.gltf", request));
     }();
     return f;
 }
@@ -172,8 +201,8 @@ void kernelBruteShading(benchmark::State& state, const KernelIsa& isa) {
 // iteration times the scalar path and then `isa` on the same packets (every 8th packet of the
 // frame, brute force, with the oracle count), and the ratio of the two times is kept; the median
 // ratio over the iterations is reported.
-void kernelBruteSpeedup(benchmark::State& state, const KernelIsa& isa) {
-    const AtriumKernelFrame& f = atriumKernelFrame();
+void kernelBruteSpeedupOn(benchmark::State& state, const KernelIsa& isa,
+                          const AtriumKernelFrame& f) {
     PacketAccumulator accumulator;
     auto shadeEighth = [&](const KernelIsa& which) {
         const double start = bench::threadCpuSeconds();
@@ -205,7 +234,21 @@ void kernelBruteSpeedup(benchmark::State& state, const KernelIsa& isa) {
     state.counters["speedup_min"] = *std::min_element(ratios.begin(), ratios.end());
     state.counters["scalar_ns/pixel-light"] = median(scalarTimes) * 1e9 / pixelLights;
     state.counters["vector_ns/pixel-light"] = median(vectorTimes) * 1e9 / pixelLights;
+    uint32_t metallicRoughnessLanes = 0, lanes = 0;
+    for (const ShadingPacket& packet : f.packets) {
+        metallicRoughnessLanes += uint32_t(__builtin_popcount(packet.metallicRoughnessMask));
+        lanes += uint32_t(__builtin_popcount(packet.laneMask));
+    }
+    state.counters["metallic_roughness_lanes"] = double(metallicRoughnessLanes) / double(lanes);
     state.SetLabel(isa.name() + " vs scalar");
+}
+
+void kernelBruteSpeedup(benchmark::State& state, const KernelIsa& isa) {
+    kernelBruteSpeedupOn(state, isa, atriumKernelFrame());
+}
+
+void kernelBruteSpeedupHelmet(benchmark::State& state, const KernelIsa& isa) {
+    kernelBruteSpeedupOn(state, isa, helmetKernelFrame());
 }
 
 void kernelBruteFrame(benchmark::State& state, const KernelIsa& isa) {
@@ -253,8 +296,10 @@ struct ContributingCase {
     std::vector<uint32_t> indices;
 };
 
-const ContributingCase& contributingCase() {
-    static const ContributingCase c = [] {
+// metallicRoughness: the same packets with metallic-roughness surfaces (roughness 0.2-0.8,
+// metallic 0, 0.5 or 1 by packet).
+ContributingCase makeContributingCase(bool metallicRoughness) {
+    {
         ContributingCase r;
         for (int p = 0; p < 256; ++p) {
             ShadingPacket packet;
@@ -265,6 +310,9 @@ const ContributingCase& contributingCase() {
                                          -4.0f);
                 const float power = float(8 << (p % 6)); // 8..256
                 packet.setLane(lane, position, {0.0f, 0.0f, 1.0f}, {0.6f, 0.5f, 0.4f}, 0.3f, power);
+                if (metallicRoughness)
+                    packet.setMetallicRoughness(lane, 0.2f + 0.1f * float(p % 7),
+                                                0.5f * float(p % 3), 1.0f);
             }
             r.packets.push_back(packet);
         }
@@ -283,8 +331,13 @@ const ContributingCase& contributingCase() {
         r.indices.resize(lights.size());
         std::iota(r.indices.begin(), r.indices.end(), 0u);
         return r;
-    }();
-    return c;
+    }
+}
+
+const ContributingCase& contributingCase(bool metallicRoughness = false) {
+    static const ContributingCase blinnPhong = makeContributingCase(false);
+    static const ContributingCase ggx = makeContributingCase(true);
+    return metallicRoughness ? ggx : blinnPhong;
 }
 
 void reportFlops(benchmark::State& state, const KernelIsa& isa, double flopsPerIteration,
@@ -296,8 +349,8 @@ void reportFlops(benchmark::State& state, const KernelIsa& isa, double flopsPerI
     state.SetLabel(isa.name());
 }
 
-void kernelContributing(benchmark::State& state, const KernelIsa& isa) {
-    const ContributingCase& c = contributingCase();
+void kernelContributingOf(benchmark::State& state, const KernelIsa& isa, bool metallicRoughness) {
+    const ContributingCase& c = contributingCase(metallicRoughness);
     PacketAccumulator accumulator;
     IterationTimes times;
     for (auto _ : state) {
@@ -323,8 +376,20 @@ void kernelContributing(benchmark::State& state, const KernelIsa& isa) {
     const double laneLights = double(c.packets.size()) * 16.0 * double(c.indices.size());
     if (double(contributing) != laneLights)
         state.SkipWithError("not every lane-light contributes");
-    reportFlops(state, isa, laneLights * flopsPerEvaluation(scenes::LightType::Point), times);
+    const double flops =
+        metallicRoughness ? kGgxPointLightFlops : flopsPerEvaluation(scenes::LightType::Point);
+    reportFlops(state, isa, laneLights * flops, times);
+    state.counters["flops/evaluation"] = flops;
     state.counters["cycles/packet-light_best"] = times.fastest() * clockHz() * 16.0 / laneLights;
+    state.counters["cycles/packet-light_median"] = times.median() * clockHz() * 16.0 / laneLights;
+}
+
+void kernelContributing(benchmark::State& state, const KernelIsa& isa) {
+    kernelContributingOf(state, isa, false);
+}
+
+void kernelContributingGgx(benchmark::State& state, const KernelIsa& isa) {
+    kernelContributingOf(state, isa, true);
 }
 
 // Per packet of the atrium: the lights contributing to at least one lane (found with the widest
@@ -452,13 +517,17 @@ const bool kRegistered = [] {
     registerPerIsa("kernelBruteFrame", kernelBruteFrame, {1, 2});
     for (const KernelIsa& isa : KernelIsa::available())
         if (!isa.isScalar())
-            benchmark::RegisterBenchmark(
-                ("kernelBruteSpeedup/" + isa.name()).c_str(),
-                [isa](benchmark::State& state) { kernelBruteSpeedup(state, isa); })
-                ->UseManualTime()
-                ->MinTime(4.0)
-                ->Unit(benchmark::kMillisecond);
+            for (auto [name, function] :
+                 {std::pair{"kernelBruteSpeedup/", &kernelBruteSpeedup},
+                  std::pair{"kernelBruteSpeedupHelmet/", &kernelBruteSpeedupHelmet}})
+                benchmark::RegisterBenchmark(
+                    (name + isa.name()).c_str(),
+                    [isa, function](benchmark::State& state) { function(state, isa); })
+                    ->UseManualTime()
+                    ->MinTime(4.0)
+                    ->Unit(benchmark::kMillisecond);
     registerPerIsa("kernelContributing", kernelContributing);
+    registerPerIsa("kernelContributingGgx", kernelContributingGgx);
     registerPerIsa("kernelIdealAtrium", kernelIdealAtrium);
     registerPerIsa("packetDecode", packetDecode);
     return true;

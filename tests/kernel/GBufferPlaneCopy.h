@@ -1,5 +1,6 @@
 // GBufferPlaneCopy: the planes of a G-buffer copied out through GBuffer::decode (lossless for the
-// layouts PacketDecoder supports: float32 normals, albedo and specular, 16-bit material index),
+// layouts PacketDecoder supports: float32 normals, albedo, specular, roughness, metallic and
+// occlusion, 16-bit material index),
 // because gbuffer::GBuffer does not expose its arrays yet. For the kernel's tests and benchmarks.
 #pragma once
 
@@ -15,13 +16,16 @@ struct GBufferPlaneCopy {
     std::vector<float> normal[3];
     std::vector<float> albedo[3];
     std::vector<float> specular[2];
+    std::vector<float> roughnessMetallic[2];
+    std::vector<float> occlusion;
     std::vector<uint16_t> material;
 
     explicit GBufferPlaneCopy(const gbuffer::GBuffer& gb) {
         const size_t n = gb.pixelCount();
         depth.assign(gb.depth().begin(), gb.depth().end());
-        for (auto* planes : {&normal[0], &normal[1], &normal[2], &albedo[0], &albedo[1], &albedo[2],
-                             &specular[0], &specular[1]})
+        for (auto* planes :
+             {&normal[0], &normal[1], &normal[2], &albedo[0], &albedo[1], &albedo[2], &specular[0],
+              &specular[1], &roughnessMetallic[0], &roughnessMetallic[1], &occlusion})
             planes->resize(n);
         material.resize(n);
         for (int y = 0; y < gb.height(); ++y)
@@ -34,6 +38,9 @@ struct GBufferPlaneCopy {
                 }
                 specular[0][pixel] = s.specularIntensity;
                 specular[1][pixel] = s.specularPower;
+                roughnessMetallic[0][pixel] = s.roughness;
+                roughnessMetallic[1][pixel] = s.metallic;
+                occlusion[pixel] = s.occlusion;
                 material[pixel] = uint16_t(s.material);
             }
     }
@@ -47,6 +54,9 @@ struct GBufferPlaneCopy {
         }
         p.specular[0] = specular[0].data();
         p.specular[1] = specular[1].data();
+        p.roughnessMetallic[0] = roughnessMetallic[0].data();
+        p.roughnessMetallic[1] = roughnessMetallic[1].data();
+        p.occlusion = occlusion.data();
         p.material = material.data();
         return p;
     }

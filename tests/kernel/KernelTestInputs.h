@@ -27,14 +27,36 @@ struct Surface {
     glm::vec3 albedo{0.5f};
     float specularIntensity = 0.2f;
     float specularPower = 16.0f;
+    // The glTF metallic-roughness model instead of Blinn-Phong (albedo is then the base colour).
+    bool metallicRoughness = false;
+    float roughness = 1.0f;
+    float metallic = 0.0f;
+    float occlusion = 1.0f;
 };
 
+template <class T> gbuffer::BasicSurface<T> basicSurfaceOf(const Surface& s) {
+    gbuffer::BasicSurface<T> p;
+    p.positionView = glm::vec<3, T>(s.position);
+    p.normalView = glm::vec<3, T>(s.normal);
+    p.albedo = glm::vec<3, T>(s.albedo);
+    p.specularIntensity = T(s.specularIntensity);
+    p.specularPower = T(s.specularPower);
+    p.roughness = T(s.roughness);
+    p.metallic = T(s.metallic);
+    p.occlusion = T(s.occlusion);
+    p.model = s.metallicRoughness ? scenes::MaterialModel::MetallicRoughness
+                                  : scenes::MaterialModel::BlinnPhong;
+    return p;
+}
+
 inline gbuffer::Surface pointOf(const Surface& s) {
-    return {s.position, s.normal, s.albedo, s.specularIntensity, s.specularPower};
+    return basicSurfaceOf<float>(s);
 }
 
 inline void setLane(ShadingPacket& packet, int lane, const Surface& s) {
     packet.setLane(lane, s.position, s.normal, s.albedo, s.specularIntensity, s.specularPower);
+    if (s.metallicRoughness)
+        packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
 }
 
 // A packet whose inactive lanes hold NaN, so a kernel that lets them leak is caught.
@@ -50,6 +72,9 @@ inline ShadingPacket poisonedPacket() {
         }
         packet.specularIntensity[lane] = nan;
         packet.specularPower[lane] = nan;
+        packet.roughness[lane] = nan;
+        packet.metallic[lane] = nan;
+        packet.occlusion[lane] = nan;
     }
     return packet;
 }
@@ -84,6 +109,17 @@ public:
         s.specularIntensity = chance(0.1f) ? 0.0f : uniform(0, 1);
         s.specularPower = chance(0.05f) ? 0.0f : std::exp2(uniform(0, 13));
         return s;
+    }
+
+    // Makes `s` a metallic-roughness surface of the range glTF materials use: roughness over
+    // [0, 1] (sometimes exactly 0, the mirror the BRDF clamps, or 1), metallic over [0, 1]
+    // (often exactly 0 or 1), occlusion over [0, 1].
+    void makeMetallicRoughness(Surface& s) {
+        s.metallicRoughness = true;
+        s.roughness = chance(0.05f) ? 0.0f : chance(0.05f) ? 1.0f : uniform(0, 1);
+        const float m = uniform(0, 1);
+        s.metallic = m < 0.3f ? 0.0f : m < 0.5f ? 1.0f : uniform(0, 1);
+        s.occlusion = chance(0.5f) ? 1.0f : uniform(0, 1);
     }
 
     // A light near `target`: mostly points, some spots (some with a zero-width cone edge),
@@ -124,9 +160,7 @@ private:
 // The double-precision sum of `lights[indices]` at a lane's surface, from the same float inputs.
 inline glm::dvec3 referenceSum(const Surface& s, const std::vector<LightInView<float>>& lights,
                                const std::vector<uint32_t>& indices) {
-    gbuffer::BasicSurface<double> p{glm::dvec3(s.position), glm::dvec3(s.normal),
-                                    glm::dvec3(s.albedo), double(s.specularIntensity),
-                                    double(s.specularPower)};
+    const gbuffer::BasicSurface<double> p = basicSurfaceOf<double>(s);
     const glm::dvec3 toViewer = glm::normalize(-p.positionView);
     glm::dvec3 sum(0.0);
     for (uint32_t index : indices) {

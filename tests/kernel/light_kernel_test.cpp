@@ -1,5 +1,6 @@
 // The shading kernel's vector paths (every compiled instruction set this CPU runs) against its
-// scalar path (lighting/Brdf.h's evaluateLight lane by lane) and the double-precision formula:
+// scalar path (lighting/Brdf.h's evaluateLight lane by lane) and the double-precision formula,
+// for both material models (Blinn-Phong, metallic-roughness) and packets that mix them:
 // random packets and lights, hand-built edge cases with known outcomes, lane independence, the
 // early-out rule (a contributing light is never skipped, counters equal to the scalar path's),
 // split lists and lane subsets.
@@ -58,6 +59,13 @@ bool bitwiseEqual(const PacketAccumulator& a, const PacketAccumulator& b) {
 
 class LightKernelTest : public ::testing::TestWithParam<KernelIsa> {};
 
+// Which material models the lanes of a random packet use.
+enum class CaseModels { BlinnPhong, MetallicRoughness, Mixed };
+
+CaseModels modelsOfCase(int caseIndex) {
+    return CaseModels(caseIndex % 3);
+}
+
 // One random packet: lanes around a common point (coherent, like a 4x4 block of a surface) or
 // scattered, some lanes background; lights near the packet and far from it; a random ascending
 // subset of them as the list.
@@ -68,7 +76,7 @@ struct RandomCase {
     std::vector<uint32_t> indices;
 };
 
-RandomCase randomCase(RandomScene& random) {
+RandomCase randomCase(RandomScene& random, CaseModels models = CaseModels::BlinnPhong) {
     RandomCase c;
     const bool coherent = random.chance(0.5f);
     const Surface centre = random.surface();
@@ -80,6 +88,9 @@ RandomCase randomCase(RandomScene& random) {
                                                      random.uniform(-0.05f, 0.05f));
             s.normal = glm::normalize(centre.normal + 0.1f * random.unitVector());
         }
+        if (models == CaseModels::MetallicRoughness ||
+            (models == CaseModels::Mixed && random.chance(0.5f)))
+            random.makeMetallicRoughness(s);
         c.surfaces[lane] = s;
         if (!random.chance(0.15f))
             setLane(c.packet, lane, s);
@@ -150,6 +161,62 @@ TEST_P(LightKernelTest, RandomPacketsMatchScalarPath) {
     EXPECT_GT(skippedLater, 0u);
 }
 
+// The metallic-roughness model has no pow: its vector radiance is the scalar path's bitwise
+// (MetallicRoughness.h's float operations in its order, IEEE division and square root, nothing
+// fused), on packets of metallic-roughness lanes and on packets that mix both models (whose
+// Blinn-Phong lanes keep the pow bound above). Counts as the scalar path's.
+TEST_P(LightKernelTest, MetallicRoughnessMatchesScalarPathBitwise) {
+    const KernelIsa isa = GetParam();
+    RandomScene random(20261203);
+    int64_t worstMetallicRoughness = 0, worstBlinnPhong = 0;
+    double vectorError2 = 0, scalarError2 = 0, reference2 = 0;
+    uint64_t metallicRoughnessLanes = 0, shaded = 0;
+    for (int caseIndex = 0; caseIndex < 2000; ++caseIndex) {
+        const CaseModels models =
+            caseIndex % 2 == 0 ? CaseModels::MetallicRoughness : CaseModels::Mixed;
+        const RandomCase c = randomCase(random, models);
+        const KernelLights lights(c.lights);
+        const PacketAccumulator vector = shade(isa, c.packet, kAllLanes, lights, c.indices);
+        const PacketAccumulator scalar =
+            shade(KernelIsa::scalar(), c.packet, kAllLanes, lights, c.indices);
+        const std::string where = "case " + std::to_string(caseIndex);
+        expectSameCounts(vector, scalar, where);
+        shaded += vector.lightsShaded;
+        for (int lane = 0; lane < kPacketLanes; ++lane) {
+            if (!(c.packet.laneMask >> lane & 1u))
+                continue;
+            const bool metallicRoughness = c.surfaces[lane].metallicRoughness;
+            metallicRoughnessLanes += metallicRoughness ? 1 : 0;
+            const glm::dvec3 reference = referenceSum(c.surfaces[lane], c.lights, c.indices);
+            for (int k = 0; k < 3; ++k) {
+                const float v = vector.radiance[k][lane], s = scalar.radiance[k][lane];
+                ASSERT_TRUE(std::isfinite(v)) << where << " lane " << lane;
+                const int64_t ulps = ulpDistance(v, s);
+                (metallicRoughness ? worstMetallicRoughness : worstBlinnPhong) =
+                    std::max(metallicRoughness ? worstMetallicRoughness : worstBlinnPhong, ulps);
+                if (metallicRoughness) {
+                    EXPECT_EQ(std::memcmp(&v, &s, sizeof v), 0)
+                        << where << " lane " << lane << ": " << v << " vs " << s;
+                    vectorError2 += (v - reference[k]) * (v - reference[k]);
+                    scalarError2 += (s - reference[k]) * (s - reference[k]);
+                    reference2 += reference[k] * reference[k];
+                } else {
+                    EXPECT_LE(ulps, kMaxUlps) << where << " lane " << lane;
+                }
+            }
+        }
+    }
+    std::printf("[ %s ] metallic-roughness vs scalar: worst %lld ulps on %llu metallic-roughness "
+                "lanes (Blinn-Phong lanes of mixed packets: %lld); relative RMSE vs double: "
+                "vector %.3g, scalar %.3g; lights shaded %llu\n",
+                isa.name().c_str(), (long long)worstMetallicRoughness,
+                (unsigned long long)metallicRoughnessLanes, (long long)worstBlinnPhong,
+                std::sqrt(vectorError2 / reference2), std::sqrt(scalarError2 / reference2),
+                (unsigned long long)shaded);
+    EXPECT_GT(metallicRoughnessLanes, 10000u);
+    EXPECT_GT(shaded, 0u);
+}
+
 // Each light alone: when the scalar path finds it contributing at any lane, the packet must not
 // have skipped it; when the vector path skipped it, no lane of the scalar path may see it.
 TEST_P(LightKernelTest, ContributingLightIsNeverSkipped) {
@@ -157,7 +224,7 @@ TEST_P(LightKernelTest, ContributingLightIsNeverSkipped) {
     RandomScene random(7);
     int contributingLights = 0;
     for (int caseIndex = 0; caseIndex < 300; ++caseIndex) {
-        const RandomCase c = randomCase(random);
+        const RandomCase c = randomCase(random, modelsOfCase(caseIndex));
         const KernelLights lights(c.lights);
         for (uint32_t index = 0; index < c.lights.size(); ++index) {
             const std::vector<uint32_t> one{index};
@@ -312,7 +379,7 @@ TEST_P(LightKernelTest, LaneIndependence) {
     const KernelIsa isa = GetParam();
     RandomScene random(99);
     for (int caseIndex = 0; caseIndex < 200; ++caseIndex) {
-        const RandomCase base = randomCase(random);
+        const RandomCase base = randomCase(random, modelsOfCase(caseIndex));
         const KernelLights lights(base.lights);
         const Surface probe = base.surfaces[0];
         float expected[3] = {};
@@ -343,7 +410,7 @@ TEST_P(LightKernelTest, SplitListsAndLaneSubsets) {
     const KernelIsa isa = GetParam();
     RandomScene random(5);
     for (int caseIndex = 0; caseIndex < 200; ++caseIndex) {
-        const RandomCase c = randomCase(random);
+        const RandomCase c = randomCase(random, modelsOfCase(caseIndex));
         const KernelLights lights(c.lights);
         const PacketAccumulator whole = shade(isa, c.packet, kAllLanes, lights, c.indices);
 
@@ -372,7 +439,7 @@ TEST_P(LightKernelTest, PerLightLaneMasksShadeEachLaneItsOwnSubList) {
     RandomScene random(13);
     for (const KernelIsa& isa : {GetParam(), KernelIsa::scalar()})
         for (int caseIndex = 0; caseIndex < 200; ++caseIndex) {
-            const RandomCase c = randomCase(random);
+            const RandomCase c = randomCase(random, modelsOfCase(caseIndex));
             const KernelLights lights(c.lights);
             std::vector<uint16_t> masks(c.indices.size());
             for (uint16_t& mask : masks)

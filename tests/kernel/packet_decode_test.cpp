@@ -1,7 +1,9 @@
 // The packet decoder (scalar and every vector target) against the per-pixel oracle
 // GBuffer::decode: every covered lane bitwise equal, coverage exactly the G-buffer's, on the
 // layouts it supports (derived atrium layout with the material index, the float32 reference
-// layout, view-ray reconstruction from standard unorm24 depth, constant albedo and specular),
+// layout, view-ray reconstruction from standard unorm24 depth, constant albedo and specular,
+// the DamagedHelmet's metallic-roughness planes, both models in one scene with the model and
+// roughness-metallic from the material index), including each lane's material model,
 // with an image size that is not a multiple of 4 so edge packets are exercised. Unsupported
 // layouts are refused with a reason.
 #include <gtest/gtest.h>
@@ -13,6 +15,7 @@
 #include "lighting/PreparedScene.h"
 #include "lighting/kernel/PacketDecoder.h"
 #include "scenes/ProceduralScenes.h"
+#include "scenes/SceneLoader.h"
 #include "tests/kernel/GBufferPlaneCopy.h"
 #include "tests/kernel/KernelTestInputs.h"
 
@@ -40,14 +43,18 @@ bool same(float a, float b) {
     return std::memcmp(&a, &b, sizeof a) == 0;
 }
 
-// Decodes every packet with every ISA and compares covered lanes with GBuffer::decode.
-void expectDecodesLikeGBuffer(const lighting::PreparedScene& frame) {
+// Decodes every packet with every ISA and compares covered lanes with GBuffer::decode; at least
+// `minCoverage` of the view must be covered. The metallic-roughness lanes (of the last ISA) go to
+// metallicRoughnessLanes when given.
+void expectDecodesLikeGBuffer(const lighting::PreparedScene& frame, double minCoverage = 0.5,
+                              size_t* metallicRoughnessLanes = nullptr) {
     const gbuffer::GBuffer& gb = *frame.gbuffer;
     const kerneltest::GBufferPlaneCopy copy(gb);
     const PacketDecoder decoder(gb.layout(), frame.view, copy.planes());
     for (const KernelIsa& isa : KernelIsa::available()) {
         int mismatches = 0;
         size_t coveredLanes = 0;
+        size_t modelLanes[2] = {}; // Blinn-Phong, metallic-roughness
         for (int y0 = 0; y0 < gb.height(); y0 += 4)
             for (int x0 = 0; x0 < gb.width(); x0 += 4) {
                 ShadingPacket packet = kerneltest::poisonedPacket();
@@ -61,12 +68,21 @@ void expectDecodesLikeGBuffer(const lighting::PreparedScene& frame) {
                     const bool covered = inside && gb.covered(size_t(y) * gb.width() + x);
                     ASSERT_EQ(bool(packet.laneMask >> lane & 1u), covered)
                         << isa.name() << " pixel " << x << "," << y;
-                    if (!covered)
+                    if (!covered) {
+                        ASSERT_FALSE(packet.metallicRoughnessMask >> lane & 1u);
                         continue;
+                    }
                     ++coveredLanes;
                     const gbuffer::Surface s = gb.decode(x, y);
                     bool equal = same(packet.specularIntensity[lane], s.specularIntensity) &&
-                                 same(packet.specularPower[lane], s.specularPower);
+                                 same(packet.specularPower[lane], s.specularPower) &&
+                                 same(packet.roughness[lane], s.roughness) &&
+                                 same(packet.metallic[lane], s.metallic) &&
+                                 same(packet.occlusion[lane], s.occlusion);
+                    const bool metallicRoughness = packet.metallicRoughnessMask >> lane & 1u;
+                    equal = equal && metallicRoughness ==
+                                         (s.model == scenes::MaterialModel::MetallicRoughness);
+                    modelLanes[metallicRoughness ? 1 : 0]++;
                     for (int k = 0; k < 3; ++k)
                         equal = equal && same(packet.positionView[k][lane], s.positionView[k]) &&
                                 same(packet.normalView[k][lane], s.normalView[k]) &&
@@ -81,8 +97,10 @@ void expectDecodesLikeGBuffer(const lighting::PreparedScene& frame) {
                 }
             }
         EXPECT_EQ(mismatches, 0) << isa.name();
-        EXPECT_GT(coveredLanes, size_t(kWidth * kHeight / 2))
-            << "the view should be mostly covered";
+        EXPECT_GT(coveredLanes, size_t(kWidth * kHeight * minCoverage))
+            << "the view should be covered";
+        if (metallicRoughnessLanes)
+            *metallicRoughnessLanes = modelLanes[1];
     }
 }
 
@@ -186,6 +204,44 @@ TEST(PacketDecoder, MaterialLookupPathsAndIndicesPastTheTable) {
     }
 }
 
+// The DamagedHelmet (metallic-roughness, textured: float32 roughness, metallic and, with an
+// ambient light, occlusion planes).
+TEST(PacketDecoder, DamagedHelmetMetallicRoughnessPlanes) {
+    scenes::SceneRequest request;
+    request.lightCount = 4;
+    request.seed = 1;
+    scenes::Scene scene =
+        scenes::loadScene(TESTBED_GLTF_DIR "/DamagedHelmet/DamagedHelmet.gltf", request);
+    const gbuffer::GBufferLayout layout = gbuffer::deriveLayout(scene, kBruteReads);
+    ASSERT_EQ(layout.roughnessMetallic, gbuffer::RoughnessMetallicEncoding::Float32);
+    ASSERT_EQ(layout.constant.model, scenes::MaterialModel::MetallicRoughness);
+    ASSERT_TRUE(PacketDecoder::supports(layout));
+    const lighting::PreparedScene frame(std::move(scene), kWidth, kHeight, false, layout);
+    // The model covers ~8% of the view; every covered lane is metallic-roughness.
+    size_t metallicRoughnessLanes = 0;
+    expectDecodesLikeGBuffer(frame, 0.05, &metallicRoughnessLanes);
+    EXPECT_GT(metallicRoughnessLanes, 1000u);
+}
+
+// Both models in one scene: atrium with every other material made metallic-roughness, so the
+// model and roughness-metallic come from the material index.
+TEST(PacketDecoder, MixedModelsFromTheMaterialIndex) {
+    scenes::Scene scene = atrium();
+    for (size_t i = 0; i < scene.materials.size(); i += 2) {
+        scene.materials[i].model = scenes::MaterialModel::MetallicRoughness;
+        scene.materials[i].roughness = 0.1f + 0.1f * float(i);
+        scene.materials[i].metallic = i % 4 == 0 ? 1.0f : 0.25f;
+    }
+    const gbuffer::GBufferLayout layout = gbuffer::deriveLayout(scene, kBruteReads);
+    ASSERT_TRUE(layout.modelPerMaterial);
+    ASSERT_EQ(layout.roughnessMetallic, gbuffer::RoughnessMetallicEncoding::Material);
+    ASSERT_TRUE(PacketDecoder::supports(layout));
+    const lighting::PreparedScene frame(std::move(scene), kWidth, kHeight, false, layout);
+    size_t metallicRoughnessLanes = 0;
+    expectDecodesLikeGBuffer(frame, 0.5, &metallicRoughnessLanes);
+    EXPECT_GT(metallicRoughnessLanes, 1000u);
+}
+
 TEST(PacketDecoder, RefusesLayoutsItCannotDecode) {
     scenes::Scene scene = atrium();
     gbuffer::LayoutRequest request;
@@ -201,6 +257,10 @@ TEST(PacketDecoder, RefusesLayoutsItCannotDecode) {
     lighting::kernel::GBufferPlanes missing = copy.planes();
     missing.material = nullptr;
     EXPECT_THROW(PacketDecoder(derived, frame.view, missing), std::invalid_argument);
+    gbuffer::GBufferLayout packed = derived;
+    packed.roughnessMetallic = gbuffer::RoughnessMetallicEncoding::Unorm8;
+    EXPECT_FALSE(PacketDecoder::supports(packed, &why));
+    EXPECT_NE(why.find("roughness"), std::string::npos) << why;
 }
 
 } // namespace

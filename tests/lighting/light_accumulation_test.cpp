@@ -2,7 +2,9 @@
 // kernel's scalar path and its widest vector target: 1, 2 and 7 threads give bitwise the same
 // image, counts and SIMT lane slots; the scalar path is the per-pixel loop's image bitwise (a
 // layout the packet decoder refuses takes the per-pixel path); the vector path stays within a
-// few ulps of it (the figure is printed); the SIMT model's bounds hold.
+// few ulps of it (the figure is printed), and on metallic-roughness scenes (DamagedHelmet, and
+// atrium with half its materials metallic-roughness) it is the scalar path bitwise but for the
+// Blinn-Phong lanes' pow (figures printed); the SIMT model's bounds hold.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,6 +18,7 @@
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/ProceduralScenes.h"
+#include "scenes/SceneLoader.h"
 
 namespace {
 
@@ -88,6 +91,80 @@ TEST(LightAccumulation, VectorPathWithinAFewUlpsOfTheScalarPath) {
     EXPECT_LE(worst, 16);
     EXPECT_EQ(scalar.lightsEvaluated, vector.lightsEvaluated);
     EXPECT_EQ(scalar.lightsOracle, vector.lightsOracle);
+}
+
+lighting::PreparedScene& helmet() {
+    static std::unique_ptr<lighting::PreparedScene> frame = [] {
+        scenes::SceneRequest request;
+        request.lightCount = 64;
+        request.seed = 3;
+        return std::make_unique<lighting::PreparedScene>(
+            scenes::loadScene(TESTBED_GLTF_DIR "/DamagedHelmet/DamagedHelmet.gltf", request), 203,
+            117);
+    }();
+    return *frame;
+}
+
+// Atrium with every other material metallic-roughness: packets of either model and mixed ones.
+lighting::PreparedScene& mixedAtrium() {
+    static std::unique_ptr<lighting::PreparedScene> frame = [] {
+        scenes::SceneRequest request;
+        request.lightCount = 200;
+        request.seed = 5;
+        scenes::Scene scene = scenes::buildProceduralScene("atrium", request);
+        for (size_t i = 0; i < scene.materials.size(); i += 2) {
+            scene.materials[i].model = scenes::MaterialModel::MetallicRoughness;
+            scene.materials[i].roughness = 0.05f + 0.15f * float(i);
+            scene.materials[i].metallic = i % 4 == 0 ? 1.0f : 0.0f;
+        }
+        return std::make_unique<lighting::PreparedScene>(std::move(scene), 203, 117);
+    }();
+    return *frame;
+}
+
+// Vector vs scalar path of brute on a metallic-roughness frame: the ISA that ran, the worst
+// difference relative to the image's peak (and in ulps), identical counts, determinism.
+void expectVectorMatchesScalar(const char* name, const lighting::PreparedScene& frame,
+                               bool expectBitwise) {
+    const lighting::StageResult scalar = shade("brute", frame.inputs, KernelIsa::scalar(), 2);
+    const lighting::StageResult vector = shade("brute", frame.inputs, KernelIsa::best(), 2);
+    EXPECT_EQ(scalar.parameters.at("isa"), "scalar");
+    EXPECT_EQ(vector.parameters.at("isa"), KernelIsa::best().name()) << "packet path expected";
+    float peak = 0.0f, worstDifference = 0.0f;
+    int64_t worstUlps = 0;
+    for (int c = 0; c < 3; ++c)
+        for (size_t p = 0; p < scalar.radiance[c].size(); ++p) {
+            peak = std::max(peak, scalar.radiance[c][p]);
+            worstDifference =
+                std::max(worstDifference, std::abs(scalar.radiance[c][p] - vector.radiance[c][p]));
+            worstUlps = std::max(worstUlps, ulps(scalar.radiance[c][p], vector.radiance[c][p]));
+        }
+    ASSERT_GT(peak, 0.0f);
+    std::cout << "[measured] brute " << name << " 203x117, " << KernelIsa::best().name()
+              << " vs scalar: worst difference " << worstDifference / peak << " of the peak ("
+              << worstUlps << " ulps), bitwise " << (bitwiseSame(scalar, vector) ? "yes" : "no")
+              << "\n";
+    EXPECT_LE(worstDifference, 1e-5f * peak);
+    if (expectBitwise)
+        EXPECT_TRUE(bitwiseSame(scalar, vector));
+    EXPECT_EQ(scalar.lightsEvaluated, vector.lightsEvaluated);
+    EXPECT_EQ(scalar.lightsOracle, vector.lightsOracle);
+    for (const char* stage : kKernelStages) {
+        const lighting::StageResult one = shade(stage, frame.inputs, KernelIsa::best(), 1);
+        EXPECT_TRUE(bitwiseSame(one, shade(stage, frame.inputs, KernelIsa::best(), 7)))
+            << stage << " on " << name;
+    }
+}
+
+// The helmet is metallic-roughness everywhere: no pow, so the vector path is the scalar path
+// bitwise (MetallicRoughness.h's float operations, in its order, on both).
+TEST(LightAccumulation, MetallicRoughnessHelmetVectorPathIsTheScalarPath) {
+    expectVectorMatchesScalar("DamagedHelmet", helmet(), true);
+}
+
+TEST(LightAccumulation, MixedModelsVectorPathWithinAFewUlpsOfTheScalarPath) {
+    expectVectorMatchesScalar("atrium, half the materials metallic-roughness", mixedAtrium(),
+                              false);
 }
 
 // A layout the packet decoder refuses (octahedral normal codes) takes the per-pixel path: it says
