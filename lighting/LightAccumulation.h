@@ -114,6 +114,12 @@ public:
         if (!mScratchLights.empty())
             throw std::logic_error("PacketLightLists: one merged union per packet");
         const size_t begin = 0;
+        if (count == 2) {
+            // The common case (a packet across one tile edge or one slice boundary): a branch-free
+            // two-way merge, the same union and masks as the general loop below.
+            mergeTwo(heads[0], masks[0], heads[1], masks[1]);
+            heads[0] = heads[1] = {};
+        }
         for (;;) {
             uint32_t smallest = UINT32_MAX;
             for (int k = 0; k < count; ++k)
@@ -177,6 +183,37 @@ public:
     }
 
 private:
+    // Appends the ascending union of a and b to the scratch lists, each light with the mask of
+    // the lists holding it.
+    void mergeTwo(std::span<const uint32_t> a, uint32_t maskA, std::span<const uint32_t> b,
+                  uint32_t maskB) {
+        const size_t total = a.size() + b.size();
+        mScratchLights.resize(total);
+        mScratchMasks.resize(total);
+        uint32_t* lights = mScratchLights.data();
+        uint16_t* masks = mScratchMasks.data();
+        size_t i = 0, j = 0, n = 0;
+        while (i < a.size() && j < b.size()) {
+            const uint32_t x = a[i], y = b[j];
+            const uint32_t smallest = std::min(x, y);
+            lights[n] = smallest;
+            masks[n] = uint16_t((x == smallest ? maskA : 0u) | (y == smallest ? maskB : 0u));
+            ++n;
+            i += x == smallest ? 1 : 0;
+            j += y == smallest ? 1 : 0;
+        }
+        for (; i < a.size(); ++i, ++n) {
+            lights[n] = a[i];
+            masks[n] = uint16_t(maskA);
+        }
+        for (; j < b.size(); ++j, ++n) {
+            lights[n] = b[j];
+            masks[n] = uint16_t(maskB);
+        }
+        mScratchLights.resize(n);
+        mScratchMasks.resize(n);
+    }
+
     Group mGroups[kernel::kPacketLanes];
     int mCount = 0;
     // The merged union of addByKeyMerged and its lane masks (one per packet, so no span into them

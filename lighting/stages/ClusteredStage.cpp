@@ -44,6 +44,9 @@ namespace {
 // - Most packets lie in one cluster: the tile of the first and last column and row, and the slice
 //   of the nearest and farthest lane, agree (tiles and slices are monotonic in x, y and depth), so
 //   two slice searches replace sixteen.
+// - Otherwise each lane's slice lies between those two, and is the nearest lane's slice plus the
+//   boundaries in between that its depth reaches (sliceOfDepth's own comparisons; usually one);
+//   tiles come per column and row.
 // - A packet across clusters gets the union of their lists with per-light lane masks
 //   (PacketLightLists::addByKeyMerged): a light in several of them costs one packet-wide
 //   evaluation, not one per cluster.
@@ -51,30 +54,41 @@ class ClusterListSource final : public PacketListSource {
 public:
     explicit ClusterListSource(const ClusterGrid& grid) : mGrid(grid) {}
     void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
-        const int tileX = mGrid.tileXOfPixel(packet.x0);
-        const int tileY = mGrid.tileYOfPixel(packet.y0);
-        if (tileX == mGrid.tileXOfPixel(packet.x0 + kernel::kPacketWidth - 1) &&
-            tileY == mGrid.tileYOfPixel(packet.y0 + kernel::kPacketHeight - 1)) {
-            float nearest = INFINITY, farthest = -INFINITY;
-            for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
-                const float depth = -packet.positionView[2][__builtin_ctz(lanes)];
-                nearest = std::min(nearest, depth);
-                farthest = std::max(farthest, depth);
-            }
-            const int slice = mGrid.sliceOfDepth(nearest);
-            if (slice == mGrid.sliceOfDepth(farthest)) {
-                lists.add(packet.laneMask, mGrid.lightsOf(mGrid.clusterIndex(tileX, tileY, slice)));
-                return;
-            }
+        float nearest = INFINITY, farthest = -INFINITY;
+        for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+            const float depth = -packet.positionView[2][__builtin_ctz(lanes)];
+            nearest = std::min(nearest, depth);
+            farthest = std::max(farthest, depth);
+        }
+        const int nearSlice = mGrid.sliceOfDepth(nearest);
+        const int farSlice = mGrid.sliceOfDepth(farthest);
+        const int firstTileX = mGrid.tileXOfPixel(packet.x0);
+        const int firstTileY = mGrid.tileYOfPixel(packet.y0);
+        const int lastTileX = mGrid.tileXOfPixel(packet.x0 + kernel::kPacketWidth - 1);
+        const int lastTileY = mGrid.tileYOfPixel(packet.y0 + kernel::kPacketHeight - 1);
+        if (firstTileX == lastTileX && firstTileY == lastTileY && nearSlice == farSlice) {
+            lists.add(packet.laneMask,
+                      mGrid.lightsOf(mGrid.clusterIndex(firstTileX, firstTileY, nearSlice)));
+            return;
+        }
+        int tileX[kernel::kPacketWidth], tileY[kernel::kPacketHeight];
+        for (int i = 0; i < kernel::kPacketWidth; ++i)
+            tileX[i] = mGrid.tileXOfPixel(packet.x0 + i);
+        for (int i = 0; i < kernel::kPacketHeight; ++i)
+            tileY[i] = mGrid.tileYOfPixel(packet.y0 + i);
+        size_t cluster[kernel::kPacketLanes];
+        for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+            const int lane = __builtin_ctz(lanes);
+            const float depth = -packet.positionView[2][lane];
+            int slice = nearSlice;
+            for (int k = nearSlice + 1; k <= farSlice; ++k)
+                slice += mGrid.sliceDepth(k) <= depth ? 1 : 0;
+            cluster[lane] =
+                mGrid.clusterIndex(tileX[kernel::laneX(lane)], tileY[kernel::laneY(lane)], slice);
         }
         lists.addByKeyMerged(
-            packet,
-            [&](int lane) {
-                return mGrid.clusterIndex(mGrid.tileXOfPixel(packet.x0 + kernel::laneX(lane)),
-                                          mGrid.tileYOfPixel(packet.y0 + kernel::laneY(lane)),
-                                          mGrid.sliceOfDepth(-packet.positionView[2][lane]));
-            },
-            [&](size_t cluster) { return mGrid.lightsOf(cluster); });
+            packet, [&](int lane) { return cluster[lane]; },
+            [&](size_t key) { return mGrid.lightsOf(key); });
     }
 
 private:

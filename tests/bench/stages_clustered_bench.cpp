@@ -249,6 +249,20 @@ void clusteredVsIdeal(benchmark::State& state) {
     state.counters["ideal_cpu_ms"] = 1e3 * idealCpu / n;
     state.counters["speed_fraction"] = idealMin / clusteredMin;
     state.counters["cpu_speed_fraction"] = idealCpu / std::max(clusteredCpu, 1e-12);
+    // The kernel's cost drivers per frame (millions of packet-wide light iterations by outcome,
+    // LightAccumulation.h): what the clustered lists cost beyond ideal's.
+    const auto millions = [](const lighting::StageResult& r, const char* key) {
+        const auto it = r.parameters.find(key);
+        return it == r.parameters.end() ? 0.0 : 1e-6 * std::stod(it->second);
+    };
+    for (const auto& [prefix, r] :
+         {std::pair<std::string, const lighting::StageResult*>{"clustered_", &clusteredResult},
+          {"ideal_", &idealResult}}) {
+        state.counters[prefix + "range_skips_M"] = millions(*r, "packet_lights_skipped_at_range");
+        state.counters[prefix + "cone_skips_M"] =
+            millions(*r, "packet_lights_skipped_at_cone_or_facing");
+        state.counters[prefix + "shaded_M"] = millions(*r, "packet_lights_shaded");
+    }
 }
 BENCHMARK(clusteredVsIdeal)
     ->Arg(1000)
