@@ -169,6 +169,8 @@ void BlendedPass::compositeExact(std::span<const float> opaqueDepth, StageResult
                 sum += s.emissive; // as shade(): emitted plus lit, then "over"
                 colour = alphas[i] * sum + (1.0 - alphas[i]) * colour;
                 result.lightsEvaluated[pixel] += uint32_t(lights.size());
+                result.traceBlendedFragment(pixel, list[i].triangle, !list[i].backFace,
+                                            mEveryLight);
                 if (!result.lightsOracle.empty())
                     result.lightsOracle[pixel] += contributing;
             }

@@ -23,8 +23,9 @@
 // lightsOracle is non-empty (stages that count the oracle themselves, brute), its contributing
 // lights to lightsOracle; addOracle() adds the latter for the oracle the runner counts
 // (lighting/Oracle.h); compositeExact() counts both for the reference. The pass is timed as
-// pass::kBlend. The light trace of the tests holds the
-// opaque surface's lights only.
+// pass::kBlend. With the tests' light trace on (StageResult::traceLights), each composited
+// fragment's list goes into StageResult::blendedTrace (the reference: every light), so the
+// identity check covers blended fragments too (tests/lighting/LightIdentity.h).
 //
 // Emission. A blended fragment's emitted radiance (Surface::emissive) is added to its light sum,
 // once, before compositing: radiance = alpha * (lit + emitted) + (1 - alpha) * radiance. glTF
@@ -169,6 +170,7 @@ void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
         result.lightsEvaluated[pixel] += uint32_t(list.size());
         if (countOracle)
             result.lightsOracle[pixel] += contributing;
+        result.traceBlendedFragment(pixel, triangle, fragment.frontFacing, list);
     });
     result.timingsMs.emplace_back(pass::kBlend, millisecondsSince(start));
 }
