@@ -148,13 +148,16 @@ void addEmission(GBufferLayout& layout, const scenes::Scene& scene, bool readsEm
     int emitting = 0;
     bool textured = false;
     for (uint32_t index : usedMaterials(scene)) {
-        if (index >= scene.materials.size() || !scene.materials[index].emits())
+        // Blended surfaces never enter the G-buffer: the blended pass adds their emission from
+        // their own surface (lighting/BlendedPass.h).
+        if (index >= scene.materials.size() || !scene.materials[index].emits() ||
+            scene.materials[index].alphaMode == scenes::AlphaMode::Blend)
             continue;
         ++emitting;
         textured = textured || scene.materials[index].emissiveTexture >= 0;
     }
     if (emitting == 0) {
-        reason = "no used material emits: emission is zero, no plane";
+        reason = "no used material emits (blended ones add their own): emission is zero, no plane";
     } else if (textured) {
         layout.emission = EmissionEncoding::Float32;
         reason = std::to_string(emitting) +

@@ -16,7 +16,8 @@
 //             used material has the same factors, else `material`
 //   model     a constant when every used material has one model, else from the material index
 //   emission  absent when the stage does not read it (forward stages and the material passes add
-//             the emission of their own surfaces) or no used material emits; f32 RGB when an
+//             the emission of their own surfaces) or no used non-blended material emits (the
+//             blended pass adds blended surfaces' own); f32 RGB when an
 //             emissive texture varies it per pixel, else the material index
 // The derived layout is lossless with respect to what the rasterizer computes: brute on it gives
 // bitwise the image of brute on `reference`. Lossy choices are opt-in (overrides, presets).
@@ -58,7 +59,8 @@ void addMaterialModels(GBufferLayout& layout, const scenes::Scene& scene, bool r
                        bool eightBitPlanes);
 
 // Sets the emission channel of `layout` (whose `materials` must be the scene's materialTable):
-// none when the stage does not read it or no used material emits, f32 planes when an emitting
+// none when the stage does not read it or no used material emits (BLEND materials never reach the
+// G-buffer: lighting/BlendedPass adds their emission), f32 planes when an emitting
 // material has an emissive texture (emission varies per pixel), else `material`. Called by
 // deriveLayout and presetLayout, and by whoever builds a lossless layout for a scene.
 void addEmission(GBufferLayout& layout, const scenes::Scene& scene, bool readsEmission);

@@ -142,6 +142,7 @@ void BlendedPass::compositeExact(std::span<const float> opaqueDepth, StageResult
                 s.roughness = double(material.roughness);
                 s.metallic = double(material.metallic);
                 s.occlusion = double(material.occlusion);
+                s.emissive = glm::dvec3(material.emissive);
                 s.model = material.model;
                 s.material = material.material;
                 list[i].distance = glm::length(s.positionView);
@@ -165,8 +166,11 @@ void BlendedPass::compositeExact(std::span<const float> opaqueDepth, StageResult
                     sum += radiance;
                     contributing += contributes(radiance) ? 1u : 0u;
                 }
+                sum += s.emissive; // as shade(): emitted plus lit, then "over"
                 colour = alphas[i] * sum + (1.0 - alphas[i]) * colour;
                 result.lightsEvaluated[pixel] += uint32_t(lights.size());
+                result.traceBlendedFragment(pixel, list[i].triangle, !list[i].backFace,
+                                            mEveryLight);
                 if (!result.lightsOracle.empty())
                     result.lightsOracle[pixel] += contributing;
             }

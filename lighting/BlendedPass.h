@@ -23,11 +23,18 @@
 // lightsOracle is non-empty (stages that count the oracle themselves, brute), its contributing
 // lights to lightsOracle; addOracle() adds the latter for the oracle the runner counts
 // (lighting/Oracle.h); compositeExact() counts both for the reference. The pass is timed as
-// pass::kBlend. The light trace of the tests holds the
-// opaque surface's lights only.
+// pass::kBlend. With the tests' light trace on (StageResult::traceLights), each composited
+// fragment's list goes into StageResult::blendedTrace (the reference: every light), so the
+// identity check covers blended fragments too (tests/lighting/LightIdentity.h).
 //
-// Emissive light of blended surfaces is not added (the opaque passes' emissive is the stages'
-// business). Thread safety: one frame at a time per object; parallel inside (the rasterizer's
+// Emission. A blended fragment's emitted radiance (Surface::emissive) is added to its light sum,
+// once, before compositing: radiance = alpha * (lit + emitted) + (1 - alpha) * radiance. glTF
+// 2.0 (material.alphaMode, BLEND): "The rendered output is combined with the background using
+// the normal painting operation (i.e. the Porter and Duff over operator)", and the rendered
+// output of a surface is its lit colour plus its emission (Appendix B adds the emissive term to
+// the BRDF's result), so the emission is weighted by alpha like the lit colour; a pane of
+// alpha 0 neither reflects nor emits. KHR_materials_emissive_strength only scales the factor.
+// Thread safety: one frame at a time per object; parallel inside (the rasterizer's
 // tiles), each pixel composited by the thread owning its tile, in submission order, so the
 // result does not depend on the thread count.
 #pragma once
@@ -161,12 +168,14 @@ void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
             sum += radiance;
             contributing += contributes(radiance) ? 1u : 0u;
         }
+        sum += point.emissive; // once per fragment, after its lights, composited with them
         const size_t pixel = size_t(fragment.y) * width + size_t(fragment.x);
         for (int c = 0; c < 3; ++c)
             result.radiance[c][pixel] = alpha * sum[c] + (1.0f - alpha) * result.radiance[c][pixel];
         result.lightsEvaluated[pixel] += uint32_t(list.size());
         if (countOracle)
             result.lightsOracle[pixel] += contributing;
+        result.traceBlendedFragment(pixel, triangle, fragment.frontFacing, list);
     });
     blendPass.stop();
 }

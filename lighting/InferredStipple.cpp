@@ -177,7 +177,10 @@ InferredStipple::Counts InferredStipple::composite(BlendedPass& blended,
         } else {
             ++unlit[pixel];
         }
-        const glm::vec3 lit = surface.albedo * diffuse + surface.specularIntensity * specular;
+        // The fragment's own emission, at full resolution, composited with its light
+        // (BlendedPass.h, "Emission").
+        const glm::vec3 lit =
+            surface.albedo * diffuse + surface.specularIntensity * specular + surface.emissive;
         for (int c = 0; c < 3; ++c)
             result.radiance[c][pixel] = alpha * lit[c] + (1.0f - alpha) * result.radiance[c][pixel];
     });

@@ -27,7 +27,7 @@
 //   the fragment's, or a normal cosine below `normal`; then, as the opaque filter does, the
 //   samples passing depth and normal only, then the nearest stippled sample of the pattern
 //   (counted in stipple_fallbacks), else no light (stipple_unlit). lit = albedo x diffuse +
-//   specular intensity x specular, composited with "over".
+//   specular intensity x specular + the fragment's emission, composited with "over".
 // - Beyond 3 layers: instances whose ranks differ by a multiple of 3 share a pattern; where they
 //   overlap, the nearer one holds the samples, and the farther one finds none of its own (its DSF
 //   rejects them by ID, or by depth) and falls back as above: wrong light, which its error

@@ -14,6 +14,7 @@ void StageResult::resize(int w, int h, bool withOracle) {
     timingsMs.clear();
     parameters.clear();
     lightTrace.assign(traceLights ? n : 0, {});
+    blendedTrace.assign(traceLights ? n : 0, {});
 }
 
 } // namespace lighting

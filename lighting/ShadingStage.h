@@ -130,10 +130,21 @@ struct StageResult {
     // pixel, like its radiance.
     bool traceLights = false;
     std::vector<std::vector<uint32_t>> lightTrace;
+    // The same hook for blended fragments (lighting/BlendedPass.h): per pixel, one entry per
+    // blended fragment the pass composited there, in composite order, with the lights evaluated
+    // for it (the list's order). Filled by BlendedPass::shade and compositeExact when tracing;
+    // the tests check each entry against the fragment's contributing lights. Off, it costs one
+    // predictable branch per blended fragment and no memory.
+    struct BlendedFragmentTrace {
+        uint32_t triangle = 0; // scene triangle
+        bool frontFacing = true;
+        std::vector<uint32_t> lights;
+    };
+    std::vector<std::vector<BlendedFragmentTrace>> blendedTrace;
 
     // Sizes every plane to w x h, zero-filled (lightsOracle empty unless withOracle), and clears
-    // lightingSamples, timingsMs and parameters; lightTrace gets w x h empty lists when
-    // traceLights, else none.
+    // lightingSamples, timingsMs and parameters; lightTrace and blendedTrace get w x h empty
+    // lists when traceLights, else none.
     void resize(int w, int h, bool withOracle);
 
     bool tracing() const { return !lightTrace.empty(); }
@@ -149,6 +160,13 @@ struct StageResult {
             for (size_t i = 0; i < lightCount; ++i)
                 lightTrace[pixel][i] = uint32_t(i);
         }
+    }
+    // A blended fragment of `triangle` was composited at the pixel, lit by `lightIndices`.
+    void traceBlendedFragment(size_t pixel, uint32_t triangle, bool frontFacing,
+                              std::span<const uint32_t> lightIndices) {
+        if (tracing())
+            blendedTrace[pixel].push_back(
+                {triangle, frontFacing, {lightIndices.begin(), lightIndices.end()}});
     }
     // `light` was added to the pixel (a loop that accumulates light by light).
     void traceAddedLight(size_t pixel, uint32_t light) {

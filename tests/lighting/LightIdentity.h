@@ -3,7 +3,8 @@
 // comparison. Counts can hide a dropped light behind a non-contributing one that was evaluated
 // instead; the identity check cannot be fooled that way. The evaluated lights come from the
 // stage's light trace (StageResult::traceLights), the contributing ones from
-// lighting::ContributingLights on the same G-buffer.
+// lighting::ContributingLights on the same G-buffer; for blended fragments from the stage's
+// blendedTrace and BlendedPass::contributingLights on each fragment's surface.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "lighting/BlendedPass.h"
 #include "lighting/ContributingLights.h"
 #include "lighting/ShadingStage.h"
 
@@ -78,6 +80,107 @@ everyContributingLightEvaluated(const lighting::StageResult& result,
     return ::testing::AssertionFailure()
            << badPixels << " pixels fail, " << missingPairs
            << " contributing (pixel, light) pairs dropped:" << failures.str();
+}
+
+// Per pixel, the blended fragments a stage composites there (lighting/BlendedPass.h), each with
+// its contributing lights (every light tested on the fragment's surface, ascending), over the
+// opaque depth `inputs.gbuffer` holds: the expectation of the blended identity check.
+using BlendedFragments = std::vector<std::vector<lighting::StageResult::BlendedFragmentTrace>>;
+inline BlendedFragments blendedContributingLights(const lighting::StageInputs& inputs) {
+    const gbuffer::GBuffer& gb = *inputs.gbuffer;
+    BlendedFragments fragments(size_t(gb.width()) * size_t(gb.height()));
+    lighting::BlendedPass pass;
+    if (!pass.prepare(inputs))
+        return fragments;
+    pass.forEachFragment(gb.depth(), [&](const raster::Fragment& fragment, uint32_t triangle,
+                                         const gbuffer::Surface& surface, float) {
+        const std::span<const uint32_t> lights = pass.contributingLights(surface);
+        fragments[size_t(fragment.y) * size_t(gb.width()) + size_t(fragment.x)].push_back(
+            {triangle, fragment.frontFacing, {lights.begin(), lights.end()}});
+    });
+    return fragments;
+}
+
+// The identity check of blended fragments: at every pixel the stage traced (blendedTrace) the
+// same fragments as `expected` (by triangle and facing; any order, since the reference sorts
+// per pixel), each fragment's traced lights include its contributing ones, the opaque and
+// blended traces together never list more lights than lightsEvaluated counts, and with
+// `ascending` each fragment's lights are strictly ascending. Failures name up to five pixels.
+inline ::testing::AssertionResult
+everyBlendedContributingLightEvaluated(const lighting::StageResult& result,
+                                       const BlendedFragments& expected, bool ascending) {
+    if (result.blendedTrace.size() != expected.size())
+        return ::testing::AssertionFailure()
+               << "the stage left no blended light trace (" << result.blendedTrace.size()
+               << " lists for " << expected.size() << " pixels)";
+    std::ostringstream failures;
+    size_t badPixels = 0, missingPairs = 0, fragmentCount = 0;
+    using Trace = lighting::StageResult::BlendedFragmentTrace;
+    const auto byTriangle = [](const Trace* a, const Trace* b) {
+        return a->triangle != b->triangle ? a->triangle < b->triangle
+                                          : a->frontFacing < b->frontFacing;
+    };
+    std::vector<const Trace*> traced, wanted;
+    std::vector<uint32_t> evaluated, missing;
+    for (size_t pixel = 0; pixel < expected.size(); ++pixel) {
+        std::string problem;
+        traced.clear();
+        wanted.clear();
+        size_t tracedLights =
+            pixel < result.lightTrace.size() ? result.lightTrace[pixel].size() : 0;
+        for (const Trace& t : result.blendedTrace[pixel]) {
+            traced.push_back(&t);
+            tracedLights += t.lights.size();
+        }
+        for (const Trace& t : expected[pixel])
+            wanted.push_back(&t);
+        fragmentCount += wanted.size();
+        std::sort(traced.begin(), traced.end(), byTriangle);
+        std::sort(wanted.begin(), wanted.end(), byTriangle);
+        if (tracedLights > result.lightsEvaluated[pixel])
+            problem = "traces " + std::to_string(tracedLights) + " lights but counts " +
+                      std::to_string(result.lightsEvaluated[pixel]);
+        const bool sameFragments =
+            traced.size() == wanted.size() &&
+            std::equal(traced.begin(), traced.end(), wanted.begin(), [](auto* a, auto* b) {
+                return a->triangle == b->triangle && a->frontFacing == b->frontFacing;
+            });
+        if (!sameFragments)
+            problem += (problem.empty() ? "" : "; ") + std::to_string(traced.size()) +
+                       " blended fragments traced, " + std::to_string(wanted.size()) + " expected";
+        for (size_t i = 0; sameFragments && i < wanted.size(); ++i) {
+            const std::vector<uint32_t>& lights = traced[i]->lights;
+            if (ascending &&
+                std::adjacent_find(lights.begin(), lights.end(),
+                                   [](uint32_t a, uint32_t b) { return a >= b; }) != lights.end())
+                problem += (problem.empty() ? "" : "; ") + std::string("triangle ") +
+                           std::to_string(wanted[i]->triangle) + ": lights not ascending";
+            evaluated.assign(lights.begin(), lights.end());
+            std::sort(evaluated.begin(), evaluated.end());
+            missing.clear();
+            std::set_difference(wanted[i]->lights.begin(), wanted[i]->lights.end(),
+                                evaluated.begin(), evaluated.end(), std::back_inserter(missing));
+            missingPairs += missing.size();
+            if (!missing.empty()) {
+                problem += (problem.empty() ? "" : "; ") + std::string("triangle ") +
+                           std::to_string(wanted[i]->triangle) + ": " +
+                           std::to_string(missing.size()) + " of " +
+                           std::to_string(wanted[i]->lights.size()) +
+                           " contributing lights not evaluated (";
+                for (size_t k = 0; k < missing.size() && k < 4; ++k)
+                    problem += (k ? " " : "") + std::to_string(missing[k]);
+                problem += missing.size() > 4 ? " ...)" : ")";
+            }
+        }
+        if (!problem.empty() && badPixels++ < 5)
+            failures << "\n  pixel (" << pixel % size_t(result.width) << ", "
+                     << pixel / size_t(result.width) << "): " << problem;
+    }
+    if (badPixels == 0)
+        return ::testing::AssertionSuccess() << fragmentCount << " blended fragments checked";
+    return ::testing::AssertionFailure()
+           << badPixels << " pixels fail, " << missingPairs
+           << " contributing (blended fragment, light) pairs dropped:" << failures.str();
 }
 
 // Success when every radiance value has the same bits in both images; failures name up to five

@@ -5,7 +5,9 @@
 // ascending light order (StageInfo::ascendingLightOrder) when they run the same arithmetic as
 // brute (on accumulateLights, or on the scalar ISA), within 1e-5 of the image's peak otherwise;
 // and the identity check: at every pixel every contributing light is among the lights the stage
-// evaluated there (its light trace, LightIdentity.h), which implies evaluated >= oracle. New
+// evaluated there (its light trace, LightIdentity.h), which implies evaluated >= oracle, and the
+// same for every blended fragment (on glass: each fragment the stage composited, with the lights
+// it evaluated for it, against the fragment's contributing lights). New
 // stages are covered as soon as they are registered; nothing here names them. `ideal` must also
 // evaluate exactly the oracle's count at every pixel.
 #include <gtest/gtest.h>
@@ -84,6 +86,7 @@ struct PreparedCase {
     std::unique_ptr<lighting::PreparedScene> prepared;
     std::vector<uint32_t> oracle;
     lighting::ContributingLights contributing;
+    stagecheck::BlendedFragments blended; // per pixel: blended fragments, contributing lights
     lighting::StageResult brute[std::size(kIsas)];
 };
 
@@ -107,6 +110,7 @@ const PreparedCase& prepared(const SceneCase& c) {
     slot->oracle = lighting::countContributingLights(slot->prepared->inputs);
     slot->contributing.build(*slot->prepared->inputs.gbuffer,
                              slot->prepared->inputs.lights->lights);
+    slot->blended = stagecheck::blendedContributingLights(slot->prepared->inputs);
     for (size_t isa = 0; isa < std::size(kIsas); ++isa) {
         slot->prepared->inputs.isa = kIsas[isa];
         lighting::makeStage("brute")->shade(slot->prepared->inputs, slot->brute[isa]);
@@ -158,6 +162,8 @@ TEST_P(ExactStage, MatchesBruteAndEvaluatesEveryContributingLight) {
 
     EXPECT_TRUE(stagecheck::everyContributingLightEvaluated(result, f.contributing, ascending))
         << stageName << " on " << c.name;
+    EXPECT_TRUE(stagecheck::everyBlendedContributingLightEvaluated(result, f.blended, ascending))
+        << stageName << " on " << c.name << " (blended fragments)";
     if (ascending && sameArithmetic) {
         EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, brute))
             << stageName << " on " << c.name << " (ascending light order: bitwise brute's)";
