@@ -41,10 +41,14 @@ fi
 
 # The ASan + UBSan build, shared by the sanitizer suite and the fuzzers (libFuzzer coverage
 # instrumentation is compiled in; the test binaries do not link libFuzzer). -O1 -g with asserts.
+# Arguments, when given, are the only targets built (the fuzzers need only themselves and the
+# testbed, which renders their EXR seeds).
 build_asan() {
     CC=clang-14 CXX=clang++-14 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
         -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DTESTBED_SANITIZER=address -DTESTBED_FUZZERS=ON
-    cmake --build build-asan -j"$(nproc)"
+    local targets=()
+    (($#)) && targets=(--target "$@")
+    cmake --build build-asan -j"$(nproc)" "${targets[@]}"
 }
 
 # oneTBB 2021.8 (Debian's version) from Debian's source package, built with ThreadSanitizer into
@@ -99,7 +103,7 @@ if [ "$mode" = sanitize ]; then
 fi
 
 if [ "$mode" = fuzz ]; then
-    build_asan
+    build_asan testbed gltf_fuzzer json_scene_fuzzer sweep_fuzzer exr_fuzzer
     exec tests/fuzz/run_fuzzers.sh build-asan "${2:-600}"
 fi
 
