@@ -602,7 +602,9 @@ GltfDocument materialDocument(const json& material) {
     primitive["attributes"]["TEXCOORD_0"] = document.addAccessor(uv0, kFloat, "VEC2", 3);
     primitive["attributes"]["TEXCOORD_1"] = document.addAccessor(uv1, kFloat, "VEC2", 3);
     primitive["material"] = 0;
-    (*document)["materials"] = {material};
+    // json::array, not {material}: a one-element brace list is a copy of the element under clang
+    // and an array under gcc (nlohmann/json brace-initialisation), so clang built no materials.
+    (*document)["materials"] = json::array({material});
     (*document)["textures"] = {{{"source", 0}}};
     (*document)["images"] = {{{"uri", "data:image/bmp;base64," + base64(twoPixelBmp())}}};
     return document;

@@ -413,7 +413,7 @@ TEST(JsonScene, MaterialEntriesSetAlphaModeAndCutoff) {
 TEST(JsonSceneErrors, BadMaterialEntries) {
     auto with = [](json entry) {
         json document = spheresOnly();
-        document["materials"] = {entry};
+        document["materials"] = json::array({entry}); // not {entry}: clang copies the element
         return document;
     };
     expectJsonError(
