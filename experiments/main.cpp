@@ -29,6 +29,7 @@
 #include "experiments/SweepRunner.h"
 #include "experiments/studies/DepthStudy.h"
 #include "experiments/studies/NormalStudy.h"
+#include "gbuffer/LayoutDerivation.h"
 #include "scenes/ClosestName.h"
 
 namespace {
@@ -101,10 +102,12 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
     render.add_flag("--compare-reference", r.compareReference,
                     "also render the double-precision reference and record the error");
-    render.add_option(
-        "--layout", r.layout,
-        "G-buffer preset: reference, compact, stalker, clear-sky, killzone2, bf3, thesis "
-        "(default: derived from the scene's materials and the stage's needs)");
+    std::string presets; // from the presets themselves, so a new one is listed (ue4 was not)
+    for (const std::string& name : gbuffer::layoutPresetNames())
+        presets += (presets.empty() ? "" : ", ") + name;
+    render.add_option("--layout", r.layout,
+                      "G-buffer preset: " + presets +
+                          " (default: derived from the scene's materials and the stage's needs)");
     render.add_option("--normals", r.normals,
                       "normal encoding NAME:BITS, e.g. octahedral:24 (testbed list)");
     render.add_option(
