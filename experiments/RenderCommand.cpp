@@ -138,7 +138,10 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     }
     if (const std::optional<ErrorMetrics>& error = run.metrics.error) {
         std::cout << "  error vs reference: rmse " << std::scientific << error->rmse << ", max_abs "
-                  << error->maxAbs << ", relative rmse " << error->relativeRmse << "\n";
+                  << error->maxAbs << ", p99_abs " << error->p99Abs << ", relative rmse "
+                  << error->relativeRmse << "\n";
+        if (const std::string note = errorConcentrationNote(*error); !note.empty())
+            std::cout << "    (" << note << ")\n";
         if (error->flip)
             std::cout << "  HDR-FLIP (flip-evaluator " << run.flipParameters.value("version", "?")
                       << "): mean " << std::fixed << std::setprecision(4) << *error->flip << "\n";
@@ -304,6 +307,8 @@ nlohmann::json errorJson(const RenderRun& run) {
     error[metric::kFlipUnavailable] = metrics.error->flipUnavailable;
     if (!run.flipParameters.is_null())
         error["flip_parameters"] = run.flipParameters;
+    if (const std::string note = errorConcentrationNote(*metrics.error); !note.empty())
+        error["note"] = note;
     return error;
 }
 

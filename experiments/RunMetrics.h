@@ -82,6 +82,13 @@ struct ErrorMetrics {
 ErrorMetrics compareImages(const lighting::StageResult& image,
                            const lighting::StageResult& reference);
 
+// A note when the error is large but sits in under 1% of the samples (relative RMSE above 0.1
+// while the 99th percentile is below 1% of the largest error): a sharp highlight that a
+// reduced-resolution stage (inferred) misplaces dominates the RMSE of a dark frame while 99% of
+// the samples are nearly exact, and a relative RMSE near 1 would read as a broken image. Empty
+// otherwise.
+std::string errorConcentrationNote(const ErrorMetrics& error);
+
 // One pass's times over the timed repetitions.
 struct PassTiming {
     std::string pass;
