@@ -105,10 +105,12 @@ TEST(CullingTests, SphereTouchesBoxIsTheDistanceToTheBox) {
         const bool touches = glm::length(glm::dvec3(c) - glm::dvec3(nearest)) <= double(r) - 1e-4;
         const bool misses = glm::length(glm::dvec3(c) - glm::dvec3(nearest)) > double(r) + 1e-4;
         const bool test = lighting::sphereTouchesBox(c, r, lo, hi);
-        if (touches)
+        if (touches) {
             EXPECT_TRUE(test) << i;
-        if (misses)
+        }
+        if (misses) {
             EXPECT_FALSE(test) << i;
+        }
     }
     lighting::LightSphere unbounded;
     unbounded.unbounded = true;

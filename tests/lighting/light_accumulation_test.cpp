@@ -145,8 +145,9 @@ void expectVectorMatchesScalar(const char* name, const lighting::PreparedScene& 
               << worstUlps << " ulps), bitwise " << (bitwiseSame(scalar, vector) ? "yes" : "no")
               << "\n";
     EXPECT_LE(worstDifference, 1e-5f * peak);
-    if (expectBitwise)
+    if (expectBitwise) {
         EXPECT_TRUE(bitwiseSame(scalar, vector));
+    }
     EXPECT_EQ(scalar.lightsEvaluated, vector.lightsEvaluated);
     EXPECT_EQ(scalar.lightsOracle, vector.lightsOracle);
     for (const char* stage : kKernelStages) {
