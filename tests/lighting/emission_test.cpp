@@ -32,6 +32,19 @@ constexpr float kLeftStrength = 3.0f;
 const glm::vec3 kRightFactor(1.0f, 0.5f, 0.25f);
 constexpr float kRightStrength = 2.0f;
 
+// lightCount point lights in a rising row at depth z, of growing intensity.
+void addLightRow(scenes::Scene& scene, int lightCount, float z) {
+    for (int i = 0; i < lightCount; ++i) {
+        scenes::Light light;
+        light.type = scenes::LightType::Point;
+        light.positionWorld = glm::vec3(-1.0f + float(i), 0.3f * float(i), z);
+        light.color = glm::vec3(1.0f, 0.9f, 0.8f);
+        light.intensity = float(i + 1);
+        light.rangeMetres = 20.0f;
+        scene.lights.push_back(light);
+    }
+}
+
 scenes::Scene emissiveQuads(bool emissive, int lightCount) {
     scenes::Material left, right;
     left.baseColorFactor = glm::vec4(0.6f, 0.5f, 0.4f, 1.0f);
@@ -55,15 +68,7 @@ scenes::Scene emissiveQuads(bool emissive, int lightCount) {
     scene.textures.push_back(texture);
     if (emissive)
         scene.materials[1].emissiveTexture = 0;
-    for (int i = 0; i < lightCount; ++i) {
-        scenes::Light light;
-        light.type = scenes::LightType::Point;
-        light.positionWorld = glm::vec3(-1.0f + float(i), 0.3f * float(i), -2.5f);
-        light.color = glm::vec3(1.0f, 0.9f, 0.8f);
-        light.intensity = float(i + 1);
-        light.rangeMetres = 20.0f;
-        scene.lights.push_back(light);
-    }
+    addLightRow(scene, lightCount, -2.5f);
     scenes::validate(scene);
     return scene;
 }
@@ -187,15 +192,7 @@ scenes::Scene emissivePane(bool emissive, int lightCount) {
     scenes::Camera camera;
     camera.forwardWorld = {0, 0, -1};
     scene.cameras.push_back(camera);
-    for (int i = 0; i < lightCount; ++i) {
-        scenes::Light light;
-        light.type = scenes::LightType::Point;
-        light.positionWorld = glm::vec3(-1.0f + float(i), 0.3f * float(i), -2.0f);
-        light.color = glm::vec3(1.0f, 0.9f, 0.8f);
-        light.intensity = float(i + 1);
-        light.rangeMetres = 20.0f;
-        scene.lights.push_back(light);
-    }
+    addLightRow(scene, lightCount, -2.0f);
     scenes::validate(scene);
     return scene;
 }
