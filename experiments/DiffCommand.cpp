@@ -409,6 +409,7 @@ void checkExrAttributeSizes(const fs::path& path) {
             return;
         if (name.empty())
             return; // the end of a single-part header, or the empty header ending the parts
+        std::string dataWindow, displayWindow;
         while (!name.empty()) {
             if (!readName(type))
                 return;
@@ -428,11 +429,14 @@ void checkExrAttributeSizes(const fs::path& path) {
                 throw corrupt("attribute '" + name + "' of type " + type + " declares " +
                               std::to_string(size) + " bytes, its value " +
                               (read ? "holds " + std::to_string(*read) : "does not fit them"));
+            if (name == "displayWindow" && type == "box2i")
+                displayWindow = value;
             // The image size, before OpenEXR sees it: OpenImageIO opening a 5.7 KB file whose
             // data window was 983041 x 8 took 32-39 s under AddressSanitizer (13 s user, 12 s
             // system: a large allocation; exr_fuzzer's slowest input) before readImage's own
             // limit check could refuse it. The Release build refused it after the open as well.
             if (name == "dataWindow" && type == "box2i" && value.size() == 16) {
+                dataWindow = value;
                 const int64_t width = int64_t(int32_t(littleEndian32(value.data() + 8))) -
                                       int32_t(littleEndian32(value.data())) + 1;
                 const int64_t height = int64_t(int32_t(littleEndian32(value.data() + 12))) -
@@ -450,6 +454,14 @@ void checkExrAttributeSizes(const fs::path& path) {
             if (!readName(name))
                 return;
         }
+        // A data window other than the display window (overscan, or a crop) is refused: diff
+        // compares whole renders, which never have one, and OpenImageIO 2.4 (Debian 12) wrote a
+        // 80 x 8 data window's rows into a buffer sized for its 16 x 8 display window, a heap
+        // overflow (found by exr_fuzzer in CI's one-minute run).
+        if (!dataWindow.empty() && !displayWindow.empty() && dataWindow != displayWindow)
+            throw std::runtime_error("cannot read " + path.string() +
+                                     ": its data window differs from its display window "
+                                     "(overscan or a crop); diff compares whole images");
         if (!multiPart)
             return;
     }

@@ -281,6 +281,32 @@ TEST(DiffCommand, RefusesAnExrDataWindowOutsideTheLimitsBeforeOpeningIt) {
     EXPECT_NO_THROW(experiments::checkExrAttributeSizes(path)); // the unchanged file passes
 }
 
+// exr_fuzzer's heap overflow in CI: a render whose data window (80 x 8) is wider than its display
+// window (16 x 8) made OpenImageIO 2.4 write 40960 bytes into an 8192-byte buffer. Such a file is
+// refused by the header walk before OpenImageIO reads it.
+TEST(DiffCommand, RefusesAnExrWhoseDataWindowIsNotItsDisplayWindow) {
+    const fs::path dir = freshTestFolder();
+    const fs::path path = writeImage(dir / "a.exr", 0.0f, nowhere, 1.0f);
+    std::string bytes = readText(path);
+    const std::string attribute = std::string("dataWindow") + '\0' + "box2i" + '\0';
+    const size_t at = bytes.find(attribute);
+    ASSERT_NE(at, std::string::npos);
+    const size_t xMaxAt = at + attribute.size() + 4 + 8; // count, xMin, yMin
+    const uint32_t xMax = 79;
+    for (int i = 0; i < 4; ++i)
+        bytes[xMaxAt + size_t(i)] = char((xMax >> (8 * i)) & 0xff);
+    const fs::path overscan = dir / "overscan.exr";
+    std::ofstream(overscan, std::ios::binary | std::ios::trunc) << bytes;
+    try {
+        (void)diffImageFiles(overscan, path);
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("its data window differs from its display window"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 // The message diffImageFiles refuses `path` with, or "" when it compares it.
 std::string refusalOf(const fs::path& path, const fs::path& other) {
     try {
