@@ -517,12 +517,14 @@ const bool kRegistered = [] {
     registerPerIsa("kernelBruteFrame", kernelBruteFrame, {1, 2});
     for (const KernelIsa& isa : KernelIsa::available())
         if (!isa.isScalar())
-            for (auto [name, function] :
+            // Not a structured binding: clang 14 (the sanitizer and fuzzer builds) cannot
+            // capture one in a lambda.
+            for (const auto& entry :
                  {std::pair{"kernelBruteSpeedup/", &kernelBruteSpeedup},
                   std::pair{"kernelBruteSpeedupHelmet/", &kernelBruteSpeedupHelmet}})
-                benchmark::RegisterBenchmark(
-                    (name + isa.name()).c_str(),
-                    [isa, function](benchmark::State& state) { function(state, isa); })
+                benchmark::RegisterBenchmark((entry.first + isa.name()).c_str(),
+                                             [isa, function = entry.second](
+                                                 benchmark::State& state) { function(state, isa); })
                     ->UseManualTime()
                     ->MinTime(4.0)
                     ->Unit(benchmark::kMillisecond);
