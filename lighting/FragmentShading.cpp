@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -43,7 +44,8 @@ struct alignas(64) FragmentShading::TileBatch {
     uint64_t skippedAtRange = 0;
     uint64_t skippedAtConeOrFacing = 0;
     uint64_t shaded = 0;
-    std::vector<uint32_t> unionScratch; // the batch's lights, for the SIMT union
+    std::vector<uint32_t> unionScratch; // the union of the batch's lists, for the SIMT model
+    std::vector<uint32_t> unionNext;
 };
 
 FragmentShading::FragmentShading() = default;
@@ -165,18 +167,21 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
         std::all_of(batch.fragments.begin(), batch.fragments.begin() + batch.count,
                     [&](const QueuedFragment& q) { return q.listKey == firstKey; });
     if (!oneList) {
-        std::vector<uint32_t>& all = batch.unionScratch;
-        all.clear();
-        uint32_t previousKey = 0;
+        // Ascending lists: merged one after another (linear in their lengths), each run of one
+        // list taken once (runs are common: one object, one tile).
+        std::vector<uint32_t>& merged = batch.unionScratch;
+        std::vector<uint32_t>& next = batch.unionNext;
+        merged.clear();
         for (int i = 0; i < batch.count; ++i) {
             const QueuedFragment& q = batch.fragments[size_t(i)];
-            if (i > 0 && q.listKey == previousKey)
-                continue; // runs of one list are common (one object, one tile)
-            previousKey = q.listKey;
-            all.insert(all.end(), q.lights.begin(), q.lights.end());
+            if (i > 0 && q.listKey == batch.fragments[size_t(i) - 1].listKey)
+                continue;
+            next.clear();
+            std::set_union(merged.begin(), merged.end(), q.lights.begin(), q.lights.end(),
+                           std::back_inserter(next));
+            merged.swap(next);
         }
-        std::sort(all.begin(), all.end());
-        unionSize = size_t(std::unique(all.begin(), all.end()) - all.begin());
+        unionSize = merged.size();
     }
     batch.laneSlots += uint64_t(mWarpLanes) * unionSize;
     batch.count = 0;
