@@ -65,6 +65,18 @@ public:
         prepare(inputs);
     }
 
+    // The start of every forward stage's frame: sizes `result` to the view (no oracle plane),
+    // prepare() timed as "transform", then the depth pre-pass timed as "prepass"
+    // (drawDepthPrepass) or, without one, clearDepth().
+    void beginFrame(const StageInputs& inputs, StageResult& result, bool depthPrepass) {
+        result.resize(inputs.view->width, inputs.view->height, false);
+        prepare(inputs, result);
+        if (depthPrepass)
+            drawDepthPrepass(result);
+        else
+            clearDepth();
+    }
+
     // The depth pre-pass: the visibility draw into depth() and visibility().codes().
     void drawDepthPrepass() { mVisibility.draw(*mRasterizer, mDepth); }
     // The same, timed as the pass "prepass" in `result`.

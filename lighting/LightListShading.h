@@ -1,8 +1,9 @@
-// shadeWithLightList: the shading loop every culling stage ends in. At one pixel, evaluate the
-// given lights (indices into the frame's light list, ascending) with the one BRDF, accumulate
-// radiance and count evaluations. Keeping the indices ascending makes the sum bitwise equal to
-// `brute`'s whenever the skipped lights contribute exactly zero (x + 0 == x in IEEE arithmetic),
-// which is what exact culling guarantees.
+// LightListShading: the per-pixel pieces shared by the stages that do not end in one light sum per
+// pixel on the kernel: addEmission (deferred's light volumes, which accumulate light by light) and
+// the split lighting of the light buffers (light-prepass, inferred). The per-pixel "sum the lights,
+// store the pixel" loop it once held is gone: the G-buffer stages end in accumulateLights
+// (LightAccumulation.h), the forward stages in FragmentShading (FragmentShading.h), both on the
+// shared light kernel.
 #pragma once
 
 #include <cstdint>
@@ -14,33 +15,6 @@
 #include "lighting/ShadingStage.h"
 
 namespace lighting {
-
-// Shades `point`, the surface at `pixel`, with `lightIndices`, adds its emission once; writes
-// result.radiance and result.lightsEvaluated at that pixel.
-inline void shadeWithLightList(const gbuffer::Surface& point, size_t pixel,
-                               const std::vector<LightInView<float>>& lights,
-                               std::span<const uint32_t> lightIndices, StageResult& result) {
-    const glm::vec3 toViewer = glm::normalize(-point.positionView);
-    glm::vec3 sum(0.0f);
-    for (uint32_t index : lightIndices)
-        sum += evaluateLight(point, toViewer, lights[index]);
-    sum += point.emissive;
-    result.radiance[0][pixel] = sum.x;
-    result.radiance[1][pixel] = sum.y;
-    result.radiance[2][pixel] = sum.z;
-    result.lightsEvaluated[pixel] = uint32_t(lightIndices.size());
-    result.traceLightList(pixel, lightIndices);
-}
-
-// Shades pixel (x, y) of the G-buffer with `lightIndices`. Background pixels are left alone (zero
-// radiance, no evaluations).
-inline void shadeWithLightList(const gbuffer::GBuffer& gb, int x, int y,
-                               const std::vector<LightInView<float>>& lights,
-                               std::span<const uint32_t> lightIndices, StageResult& result) {
-    gbuffer::Surface point;
-    if (gb.surfaceAt(x, y, point))
-        shadeWithLightList(point, size_t(y) * gb.width() + x, lights, lightIndices, result);
-}
 
 // Adds every covered pixel's emission (GBuffer::emission) to result.radiance, for the stages that
 // accumulate light by light (deferred's volumes): once, after the last light, so the sum is the

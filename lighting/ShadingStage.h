@@ -122,8 +122,8 @@ struct StageResult {
     // Test hook, off by default: which lights were evaluated at each pixel, for the identity
     // check of the tests (every contributing light is among them, not just as many). A caller
     // sets traceLights before shade(); resize() then gives lightTrace one empty list per pixel
-    // and the shared loops fill it (shadeWithEveryLight, shadeWithLightList, and the light-volume
-    // and forward loops): the lights whose sum the pixel holds, in the order they were added (a
+    // and the shared loops fill it (shadeWithEveryLight, accumulateLights, FragmentShading and the
+    // light-volume loops): the lights whose sum the pixel holds, in the order they were added (a
     // forward stage's overdrawn fragments are replaced, as their radiance is). Approximate stages
     // do not trace. Off, it costs one predictable branch per pixel list (per light and pixel in
     // the additive loops) and no memory. Each pixel's list is written by the task that owns the

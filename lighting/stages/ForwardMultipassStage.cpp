@@ -11,21 +11,24 @@
 // per overdrawn fragment. The equal test is closer-or-equal plus the pre-pass's visible triangle
 // (gbuffer/VisibilityPass.h redrawState), so exact depth ties never add a light twice.
 //
+// Shading on the light kernel (FragmentShading.h): each light pass queues its visible fragments;
+// 16 consecutive fragments of a raster tile form a packet the kernel shades with the pass's one
+// light on inputs.isa, and each result is ADDED to its pixel (FragmentApply::Add). Every pass is
+// flushed before the next one starts, so a pixel still receives its lights in ascending order.
+// Records "isa" (what ran) and the SIMT counters (one warp = 32 or 64 consecutive visible
+// fragments of one pass, paying its one light).
+//
 // Exactness: the fragment's surface and position are the G-buffer's own (ForwardGeometry.h), and
 // per pixel the lights are added in ascending order starting from zero, the same sequence of
-// float additions as `brute` minus lights that add exactly zero, so the image is bitwise
-// brute's. lightsEvaluated counts one per (light, visible fragment) drawn. Reads no G-buffer
-// channel. Deterministic: draws run one after another; within a draw each pixel is written only
-// by the thread owning its tile.
-//
-// Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments light
-// by light, not 4x4 packets decoded from a G-buffer.
+// float additions as `brute` on the same ISA minus lights that add exactly zero, so the image is
+// bitwise brute's. lightsEvaluated counts one per (light, visible fragment) drawn. Reads no
+// G-buffer channel. Deterministic: draws run one after another; within a draw each pixel is
+// written only by the task owning its raster tile.
 #include "lighting/StageRegistry.h"
-
-#include <tbb/parallel_for.h>
 
 #include "lighting/BlendedPass.h"
 #include "lighting/ForwardGeometry.h"
+#include "lighting/FragmentShading.h"
 #include "lighting/LightBounds.h"
 #include "lighting/PassNames.h"
 
@@ -39,12 +42,7 @@ public:
     StageRequirements requirements() const override { return {{}, false}; }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
-        const gbuffer::CameraView& view = *inputs.view;
-        const int width = view.width;
-        result.resize(width, view.height, false);
-
-        mForward.prepare(inputs, result);
-        mForward.drawDepthPrepass(result);
+        mForward.beginFrame(inputs, result, true);
 
         PassTimer cull(result, pass::kCull);
         mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
@@ -52,12 +50,13 @@ public:
         cull.stop();
 
         PassTimer shading(result, pass::kShading);
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
+        const size_t lightCount = inputs.lights->size();
+        mShading.begin(inputs, mForward, FragmentApply::Add, result);
         const std::vector<ForwardObject>& objects = mForward.objects();
         const std::vector<uint32_t>& allIndices = inputs.geometry->indices;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
         const raster::RasterState state = visibility.redrawState();
-        for (uint32_t l = 0; l < lights.size(); ++l) {
+        for (uint32_t l = 0; l < lightCount; ++l) {
             const std::span<const uint32_t> set = mSets[l];
             if (set.empty())
                 continue;
@@ -79,26 +78,19 @@ public:
                 indices = mSetIndices;
                 globalTriangle = mSetTriangles.data();
             }
-            const LightInView<float>& light = lights[l];
+            const uint32_t light[1] = {l}; // the pass's list, alive until its flush
             auto addLight = [&](const raster::Fragment& fragment) {
-                const size_t pixel = size_t(fragment.y) * width + fragment.x;
                 const uint32_t triangle =
                     globalTriangle ? globalTriangle[fragment.triangle] : fragment.triangle;
-                if (!visibility.isVisible(fragment, triangle))
-                    return;
-                const gbuffer::Surface point = mForward.surfaceAt(fragment, triangle);
-                const glm::vec3 radiance =
-                    evaluateLight(point, glm::normalize(-point.positionView), light);
-                result.radiance[0][pixel] += radiance.x;
-                result.radiance[1][pixel] += radiance.y;
-                result.radiance[2][pixel] += radiance.z;
-                ++result.lightsEvaluated[pixel];
-                result.traceAddedLight(pixel, l);
+                if (visibility.isVisible(fragment, triangle))
+                    mShading.add(fragment, triangle, l, light);
             };
             mForward.draw(
                 raster::TriangleList{visibility.clipPositions(), indices}, state, addLight,
                 [&](uint32_t drawn) { return globalTriangle ? globalTriangle[drawn] : drawn; });
+            mShading.flush();
         }
+        mShading.end();
         mForward.addEmission(result);
         shading.stop();
         // Blended surfaces: one fragment at a time with its object's lights (the lists the
@@ -109,6 +101,7 @@ public:
 
 private:
     ForwardGeometry mForward;
+    FragmentShading mShading;
     LightIndexLists mObjectLights; // per object, the lights touching it, ascending
     LightIndexLists mSets;         // per light, the objects it touches, ascending (transposed)
     std::vector<uint32_t> mSetIndices;

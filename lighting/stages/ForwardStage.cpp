@@ -11,22 +11,24 @@
 //     pre-pass's visible triangle, VisibilityPass::redrawState), so each pixel is shaded once and
 //     overdraw disappears.
 //
-// Exactness: the visible fragment's surface and position are computed by the G-buffer's own
-// functions (ForwardGeometry.h) and lights are summed in ascending order, so the image is bitwise
-// `brute`'s. Reads no G-buffer channel: it rasterizes the scene itself (inputs.scene, .geometry).
-// Deterministic: one draw, each pixel written only by the thread owning its tile, in submission
-// order.
+// Shading on the light kernel (FragmentShading.h): the draw queues each fragment with its
+// object's list; 16 consecutive fragments of a raster tile form a packet the kernel shades on
+// inputs.isa, and the results replace the pixels in fragment order (FragmentApply::Replace), so
+// the last fragment drawn at a pixel is the one it keeps, as when each was shaded as drawn.
+// Records "isa" (what ran) and the SIMT counters (one warp = 32 or 64 consecutive fragments).
 //
-// Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments as they
-// are drawn, not 4x4 packets decoded from a G-buffer.
+// Exactness: the visible fragment's surface and position are computed by the G-buffer's own
+// functions (ForwardGeometry.h) and lights are summed in ascending order with the kernel's
+// arithmetic, so the image is bitwise `brute`'s on the same ISA (`--isa scalar`: evaluateLight per
+// fragment, the image of the scalar loop). Reads no G-buffer channel: it rasterizes the scene
+// itself (inputs.scene, .geometry). Deterministic: one draw, each pixel written only by the task
+// owning its raster tile, in submission order (FragmentShading.h).
 #include "lighting/StageRegistry.h"
-
-#include <tbb/parallel_for.h>
 
 #include "lighting/BlendedPass.h"
 #include "lighting/ForwardGeometry.h"
+#include "lighting/FragmentShading.h"
 #include "lighting/LightBounds.h"
-#include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 
 namespace lighting {
@@ -41,40 +43,29 @@ public:
     StageRequirements requirements() const override { return {{}, false}; }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
-        const gbuffer::CameraView& view = *inputs.view;
-        const int width = view.width;
-        result.resize(width, view.height, false);
+        mForward.beginFrame(inputs, result, mPrepass);
         result.parameters["prepass"] = mPrepass ? "1" : "0";
-
-        mForward.prepare(inputs, result);
         {
             PassTimer cull(result, pass::kCull);
             mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
         }
 
-        const gbuffer::VisibilityPass& visibility = mForward.visibility();
-        if (mPrepass)
-            mForward.drawDepthPrepass(result);
-        else
-            mForward.clearDepth();
-
         PassTimer shading(result, pass::kShading);
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
+        const gbuffer::VisibilityPass& visibility = mForward.visibility();
+        mShading.begin(inputs, mForward, FragmentApply::Replace, result);
         const bool equalOnly = mPrepass;
         auto shadeFragment = [&](const raster::Fragment& fragment) {
-            const size_t pixel = size_t(fragment.y) * width + fragment.x;
             if (equalOnly && !visibility.isVisible(fragment, fragment.triangle))
                 return;
-            // Overdraw: the pixel's radiance is replaced, its evaluations add up.
-            const uint32_t evaluatedBefore = result.lightsEvaluated[pixel];
-            shadeWithLightList(mForward.surfaceAt(fragment, fragment.triangle), pixel, lights,
-                               mObjectLights[mForward.objectOfTriangle(fragment.triangle)], result);
-            result.lightsEvaluated[pixel] += evaluatedBefore;
+            const uint32_t object = mForward.objectOfTriangle(fragment.triangle);
+            mShading.add(fragment, fragment.triangle, object, mObjectLights[object]);
         };
         // Without a pre-pass, the visibility draw's own state (every fragment that passes the
         // closer test is shaded); with one, the redraw that passes each visible fragment once.
         mForward.draw(visibility.triangles(),
                       mPrepass ? visibility.redrawState() : visibility.drawState(), shadeFragment);
+        mShading.flush();
+        mShading.end();
         shading.stop();
         // Blended surfaces: each fragment with its object's list.
         mForward.shadeBlended(inputs, mBlended, mObjectLights, result);
@@ -84,6 +75,7 @@ private:
     bool mPrepass;
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
     ForwardGeometry mForward;
+    FragmentShading mShading;
     LightIndexLists mObjectLights; // per object, ascending (ForwardGeometry::objectLightLists)
 };
 

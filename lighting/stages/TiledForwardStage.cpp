@@ -18,29 +18,30 @@
 //             tile from the pre-pass depths against each light's depth range, as in `tiled`
 // Parameters record the options and lights_after_vfc, vfc_culled and tile_light_pairs.
 //
-// Exactness: the visible fragment's surface and position are computed by the G-buffer's own
-// functions (ForwardGeometry::surfaceAt) and each pixel sums its tile's lights in ascending order,
-// so the image is bitwise `brute`'s. Per pixel, lightsEvaluated is the list length of its one
-// shaded fragment (0 for background); with the G-buffer's depth equal to the pre-pass depth this
-// equals `tiled`'s count at the same tile size.
-// Deterministic: tiles' lists are built in parallel, each by one task; the shading draw writes each
-// pixel from the thread owning its raster tile, and only one fragment per pixel passes the
-// visible-triangle test.
+// Shading on the light kernel (FragmentShading.h): the shading draw queues each visible fragment
+// with its tile's list; 16 consecutive fragments of a raster tile form a packet the kernel shades
+// on inputs.isa (lanes of different tiles masked to their own lists), and the results are stored
+// in fragment order (FragmentApply::Replace). Records "isa" (what ran) and the SIMT counters (one
+// warp = 32 or 64 consecutive visible fragments).
 //
-// Shading stays scalar (not lighting/LightAccumulation.h): it shades rasterized fragments with
-// their tile's list as they are drawn, not 4x4 packets decoded from a G-buffer.
+// Exactness: the visible fragment's surface and position are computed by the G-buffer's own
+// functions (ForwardGeometry::surfaceAt) and each pixel sums its tile's lights in ascending order
+// with the kernel's arithmetic, so the image is bitwise `brute`'s on the same ISA. Per pixel,
+// lightsEvaluated is the list length of its one shaded fragment (0 for background); with the
+// G-buffer's depth equal to the pre-pass depth this equals `tiled`'s count at the same tile size.
+// Deterministic: tiles' lists are built in parallel, each by one task; the shading draw writes each
+// pixel from the task owning its raster tile, and only one fragment per pixel passes the
+// visible-triangle test.
 #include "lighting/StageRegistry.h"
 
 #include <algorithm>
 #include <memory>
 #include <span>
 
-#include <tbb/parallel_for.h>
-
 #include "lighting/BlendedPass.h"
 #include "lighting/ForwardGeometry.h"
+#include "lighting/FragmentShading.h"
 #include "lighting/LightBounds.h"
-#include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 #include "lighting/culling/TileFrusta.h"
 
@@ -64,14 +65,10 @@ public:
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::CameraView& view = *inputs.view;
-        const int width = view.width;
-        result.resize(width, view.height, false);
-
-        mForward.prepare(inputs, result);
-        mForward.drawDepthPrepass(result);
+        mForward.beginFrame(inputs, result, true);
 
         PassTimer cull(result, pass::kCull);
-        const TileGrid grid = TileGrid::make(width, view.height, mOptions.tileSizePixels);
+        const TileGrid grid = TileGrid::make(view.width, view.height, mOptions.tileSizePixels);
         const std::vector<TileSurfaceBounds> bounds = computeTileDepthBounds(
             mForward.depthDecoder(), mForward.depth(), grid, mOptions.depthMask);
         const size_t lightsAfterVfc =
@@ -82,18 +79,19 @@ public:
         cull.stop();
 
         PassTimer shading(result, pass::kShading);
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
+        mShading.begin(inputs, mForward, FragmentApply::Replace, result);
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             if (!visibility.isVisible(fragment, fragment.triangle))
                 return;
-            const std::span<const uint32_t> list =
-                mTileLights[size_t(fragment.y / tileSize) * tileCountX + fragment.x / tileSize];
-            shadeWithLightList(mForward.surfaceAt(fragment, fragment.triangle),
-                               size_t(fragment.y) * width + fragment.x, lights, list, result);
+            const uint32_t tile =
+                uint32_t(fragment.y / tileSize) * uint32_t(tileCountX) + fragment.x / tileSize;
+            mShading.add(fragment, fragment.triangle, tile, mTileLights[tile]);
         };
         mForward.draw(visibility.triangles(), visibility.redrawState(), shadeFragment);
+        mShading.flush();
+        mShading.end();
         shading.stop();
         if (mBlended.prepare(inputs))
             mBlended.shadeWithTileLists(mForward.depth(), mOptions.tileSizePixels,
@@ -112,6 +110,7 @@ private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
     TiledForwardOptions mOptions;
     ForwardGeometry mForward;
+    FragmentShading mShading;
     LightIndexLists mTileLights; // per tile, ascending light indices (buildTileLightLists)
 };
 

@@ -1,5 +1,6 @@
 // The forward stages (`forward`, `forward:prepass=1`, `forward-multipass`) beyond the shared
-// exactness suite: bitwise equality with `brute`, overdraw counted, per-object light lists
+// exactness suite: bitwise equality with `brute`, overdraw counted, the fragment packets on the
+// light kernel (ISA, counters and SIMT lane slots; `tiled-forward` too), per-object light lists
 // (unlit objects cost nothing, a light behind the camera still lights what it reaches),
 // thread-count independence, and the shared surface function against the G-buffer it must
 // reproduce.
@@ -186,6 +187,54 @@ TEST(Forward, SameResultForAnyThreadCount) {
         tbb::task_arena(2).execute([&] { two = run(stage, f); });
         EXPECT_EQ(one.lightsEvaluated, two.lightsEvaluated) << stage;
         expectBitwiseEqual(one, two, std::string(stage) + " 1 vs 2 threads");
+    }
+}
+
+// The forward stages on the light kernel (lighting/FragmentShading.h): on the widest ISA they
+// report it and stay bitwise brute's there (overdraw included: a later fragment of a pixel, even
+// in the same 16-lane packet, replaces the earlier one); counts and the kernel's packet counters do
+// not depend on the ISA; the SIMT model's warps (32 or 64 consecutive fragments of a raster
+// tile) pay warpLanes lane slots per light of their union, so slots are a multiple of the warp,
+// at least the evaluations, and a 64-lane warp (two 32-lane warps' union) pays at least as much.
+TEST(Forward, FragmentPacketsOnTheKernelReportIsaAndSimtLaneSlots) {
+    const TestScene& f = atrium();
+    const lighting::kernel::KernelIsa best = lighting::kernel::KernelIsa::best();
+    auto runOn = [&](const std::string& stage, const lighting::kernel::KernelIsa& isa, int warp) {
+        lighting::StageResult result;
+        lighting::StageInputs inputs = f.inputs;
+        inputs.isa = isa;
+        inputs.simtWarpLanes = warp;
+        lighting::makeStage(stage)->shade(inputs, result);
+        return result;
+    };
+    const lighting::StageResult brute = runOn("brute", best, 32);
+    for (const char* stage :
+         {"forward", "forward:prepass=1", "forward-multipass", "tiled-forward"}) {
+        const lighting::StageResult vector = runOn(stage, best, 32);
+        const lighting::StageResult scalar =
+            runOn(stage, lighting::kernel::KernelIsa::scalar(), 32);
+        const lighting::StageResult wide = runOn(stage, best, 64);
+        EXPECT_EQ(vector.parameters.at("isa"), best.name()) << stage;
+        EXPECT_EQ(scalar.parameters.at("isa"), "scalar") << stage;
+        expectBitwiseEqual(vector, brute, std::string(stage) + " on " + best.name());
+        EXPECT_EQ(vector.lightsEvaluated, scalar.lightsEvaluated) << stage;
+        for (const char* counter :
+             {"packet_groups", "packet_lights_skipped_at_range",
+              "packet_lights_skipped_at_cone_or_facing", "packet_lights_shaded", "simt_lane_slots"})
+            EXPECT_EQ(vector.parameters.at(counter), scalar.parameters.at(counter))
+                << stage << " " << counter;
+        EXPECT_GT(std::stoull(vector.parameters.at("packet_lights_shaded")), 0u) << stage;
+
+        const uint64_t slots = std::stoull(vector.parameters.at("simt_lane_slots"));
+        const uint64_t wideSlots = std::stoull(wide.parameters.at("simt_lane_slots"));
+        EXPECT_EQ(vector.parameters.at("simt_warp"), "32");
+        EXPECT_EQ(wide.parameters.at("simt_warp"), "64");
+        EXPECT_EQ(slots % 32, 0u) << stage;
+        EXPECT_EQ(wideSlots % 64, 0u) << stage;
+        EXPECT_GE(slots, total(vector.lightsEvaluated)) << stage;
+        EXPECT_GE(wideSlots, slots) << stage;
+        EXPECT_EQ(wide.lightsEvaluated, vector.lightsEvaluated) << stage;
+        expectBitwiseEqual(wide, vector, std::string(stage) + " 64- vs 32-lane batches");
     }
 }
 

@@ -1,0 +1,209 @@
+#include "lighting/FragmentShading.h"
+
+#include <algorithm>
+#include <array>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/parallel_for.h>
+
+#include "lighting/ForwardGeometry.h"
+#include "lighting/LightAccumulation.h"
+#include "lighting/kernel/KernelLights.h"
+#include "lighting/kernel/LightKernel.h"
+
+namespace lighting {
+
+using kernel::kPacketLanes;
+
+namespace {
+
+constexpr int kMaxWarpLanes = 64;
+
+// A queued fragment: what surfaceAt needs, and the list it is shaded with.
+struct QueuedFragment {
+    int x = 0;
+    int y = 0;
+    float depth = 0.0f;
+    uint32_t triangle = 0; // scene triangle
+    uint32_t listKey = 0;
+    bool frontFacing = true;
+    std::span<const uint32_t> lights;
+};
+
+} // namespace
+
+// One raster tile's queue and counters; cache-line aligned since neighbouring tiles are drawn by
+// different threads.
+struct alignas(64) FragmentShading::TileBatch {
+    std::array<QueuedFragment, kMaxWarpLanes> fragments;
+    int count = 0;
+    uint64_t laneSlots = 0;
+    uint64_t groups = 0;
+    uint64_t skippedAtRange = 0;
+    uint64_t skippedAtConeOrFacing = 0;
+    uint64_t shaded = 0;
+    std::vector<uint32_t> unionScratch; // the union of the batch's lists, for the SIMT model
+    std::vector<uint32_t> unionNext;
+};
+
+FragmentShading::FragmentShading() = default;
+FragmentShading::~FragmentShading() = default;
+
+void FragmentShading::begin(const StageInputs& inputs, const ForwardGeometry& geometry,
+                            FragmentApply apply, StageResult& result) {
+    if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
+        throw std::invalid_argument("FragmentShading: simtWarpLanes must be 32 or 64, not " +
+                                    std::to_string(inputs.simtWarpLanes));
+    mGeometry = &geometry;
+    mResult = &result;
+    mApply = apply;
+    mIsa = inputs.isa;
+    mWarpLanes = inputs.simtWarpLanes;
+    mWidth = inputs.view->width;
+    mTilesX = (inputs.view->width + raster::kTileSize - 1) / raster::kTileSize;
+    const int tilesY = (inputs.view->height + raster::kTileSize - 1) / raster::kTileSize;
+    mLights = std::make_unique<kernel::KernelLights>(inputs.lights->lights);
+    mTiles.resize(size_t(mTilesX) * size_t(tilesY));
+    for (TileBatch& tile : mTiles) {
+        tile.count = 0;
+        tile.laneSlots = tile.groups = 0;
+        tile.skippedAtRange = tile.skippedAtConeOrFacing = tile.shaded = 0;
+    }
+}
+
+void FragmentShading::add(const raster::Fragment& fragment, uint32_t triangle, uint32_t listKey,
+                          std::span<const uint32_t> lights) {
+    TileBatch& batch = mTiles[size_t(fragment.y / raster::kTileSize) * size_t(mTilesX) +
+                              size_t(fragment.x / raster::kTileSize)];
+    batch.fragments[size_t(batch.count++)] = {
+        fragment.x, fragment.y, fragment.depth, triangle, listKey, fragment.frontFacing, lights};
+    if (batch.count == mWarpLanes)
+        shadeBatch(batch);
+}
+
+void FragmentShading::flush() {
+    tbb::parallel_for(size_t(0), mTiles.size(), [&](size_t tile) {
+        if (mTiles[tile].count > 0)
+            shadeBatch(mTiles[tile]);
+    });
+}
+
+void FragmentShading::shadeBatch(TileBatch& batch) {
+    StageResult& result = *mResult;
+    kernel::ShadingPacket packet;
+    kernel::PacketAccumulator accumulator;
+    PacketLightLists lists;
+    float emitted[3][kPacketLanes];
+    for (int first = 0; first < batch.count; first += kPacketLanes) {
+        const QueuedFragment* lanes = batch.fragments.data() + first;
+        const int laneCount = std::min(kPacketLanes, batch.count - first);
+        packet.clear();
+        for (int lane = 0; lane < laneCount; ++lane) {
+            const QueuedFragment& q = lanes[lane];
+            raster::Fragment fragment;
+            fragment.x = q.x;
+            fragment.y = q.y;
+            fragment.depth = q.depth;
+            fragment.frontFacing = q.frontFacing;
+            const gbuffer::Surface s = mGeometry->surfaceAt(fragment, q.triangle);
+            packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
+                           s.specularPower);
+            if (s.model == scenes::MaterialModel::MetallicRoughness)
+                packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
+            for (int c = 0; c < 3; ++c)
+                emitted[c][lane] = s.emissive[c];
+        }
+        // Lanes grouped by list: one kernel call over the union of the packet's lists, each lane
+        // masked to its own list (bitwise one call per list).
+        lists.clear();
+        lists.addByKeyMerged(
+            packet, [&](int lane) { return lanes[lane].listKey; },
+            [&](uint32_t key) {
+                int lane = 0;
+                while (lanes[lane].listKey != key)
+                    ++lane;
+                return lanes[lane].lights;
+            });
+        accumulator.clear();
+        for (int g = 0; g < lists.size(); ++g) {
+            const PacketLightLists::Group& group = lists[g];
+            if (group.lightLaneMasks.empty())
+                kernel::shadePacket(mIsa, packet, group.laneMask, *mLights, group.lights,
+                                    accumulator, false);
+            else
+                kernel::shadePacket(mIsa, packet, group.laneMask, *mLights, group.lights,
+                                    group.lightLaneMasks, accumulator, false);
+        }
+        batch.groups += uint64_t(lists.size());
+        batch.skippedAtRange += accumulator.lightsSkippedAtRange;
+        batch.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
+        batch.shaded += accumulator.lightsShaded;
+
+        // In fragment order: a later fragment of the same pixel comes after an earlier one.
+        for (int lane = 0; lane < laneCount; ++lane) {
+            const QueuedFragment& q = lanes[lane];
+            const size_t pixel = size_t(q.y) * size_t(mWidth) + size_t(q.x);
+            if (mApply == FragmentApply::Replace) {
+                for (int c = 0; c < 3; ++c)
+                    result.radiance[c][pixel] = accumulator.radiance[c][lane] + emitted[c][lane];
+                result.traceLightList(pixel, q.lights);
+            } else {
+                for (int c = 0; c < 3; ++c)
+                    result.radiance[c][pixel] += accumulator.radiance[c][lane];
+                if (result.tracing())
+                    for (uint32_t light : q.lights)
+                        result.traceAddedLight(pixel, light);
+            }
+            result.lightsEvaluated[pixel] += accumulator.lightsEvaluated[lane];
+        }
+    }
+
+    // SIMT cost model: the batch is one warp; it pays every light of its lanes' union.
+    size_t unionSize = batch.fragments[0].lights.size();
+    const uint32_t firstKey = batch.fragments[0].listKey;
+    const bool oneList =
+        std::all_of(batch.fragments.begin(), batch.fragments.begin() + batch.count,
+                    [&](const QueuedFragment& q) { return q.listKey == firstKey; });
+    if (!oneList) {
+        // Ascending lists: merged one after another (linear in their lengths), each run of one
+        // list taken once (runs are common: one object, one tile).
+        std::vector<uint32_t>& merged = batch.unionScratch;
+        std::vector<uint32_t>& next = batch.unionNext;
+        merged.clear();
+        for (int i = 0; i < batch.count; ++i) {
+            const QueuedFragment& q = batch.fragments[size_t(i)];
+            if (i > 0 && q.listKey == batch.fragments[size_t(i) - 1].listKey)
+                continue;
+            next.clear();
+            std::set_union(merged.begin(), merged.end(), q.lights.begin(), q.lights.end(),
+                           std::back_inserter(next));
+            merged.swap(next);
+        }
+        unionSize = merged.size();
+    }
+    batch.laneSlots += uint64_t(mWarpLanes) * unionSize;
+    batch.count = 0;
+}
+
+void FragmentShading::end() {
+    uint64_t laneSlots = 0, groups = 0, skippedAtRange = 0, skippedAtConeOrFacing = 0, shaded = 0;
+    for (const TileBatch& tile : mTiles) {
+        laneSlots += tile.laneSlots;
+        groups += tile.groups;
+        skippedAtRange += tile.skippedAtRange;
+        skippedAtConeOrFacing += tile.skippedAtConeOrFacing;
+        shaded += tile.shaded;
+    }
+    std::map<std::string, std::string>& parameters = mResult->parameters;
+    parameters["isa"] = mIsa.name();
+    parameters["simt_warp"] = std::to_string(mWarpLanes);
+    parameters["simt_lane_slots"] = std::to_string(laneSlots);
+    parameters["packet_groups"] = std::to_string(groups);
+    parameters["packet_lights_skipped_at_range"] = std::to_string(skippedAtRange);
+    parameters["packet_lights_skipped_at_cone_or_facing"] = std::to_string(skippedAtConeOrFacing);
+    parameters["packet_lights_shaded"] = std::to_string(shaded);
+}
+
+} // namespace lighting

@@ -1,0 +1,110 @@
+// FragmentShading: the forward stages' rasterized fragments (`forward`, `forward-multipass`,
+// `tiled-forward`) shaded on the shared light kernel (lighting/kernel/LightKernel.h), in
+// 16-lane fragment packets instead of one scalar evaluateLight loop per fragment.
+//
+// Why: a forward stage shades what the rasterizer emits, in submission order, not 4x4 blocks
+// decoded from a G-buffer, so accumulateLights (LightAccumulation.h) does not fit. But the
+// kernel's lanes are independent (each lane sums its own list in list order, bitwise
+// independently of the other lanes), so a lane can hold any surface: here a packet's lanes are
+// CONSECUTIVE FRAGMENTS of one raster tile, each filled from ForwardGeometry::surfaceAt.
+//
+// How: the draw's fragment function decides what the stage decides today (visible or not, which
+// list) and calls add() instead of shading. Fragments are queued per raster tile (the
+// rasterizer's kTileSize x kTileSize screen tiles, raster/Rasterizer.h: a tile is drawn by one
+// task at a time, in submission order) into a batch of `inputs.simtWarpLanes` (32 or 64)
+// fragments, i.e. 2 or 4 packets. A full batch is shaded at once; flush() shades every tile's
+// partial batch after the draw. Per packet: lanes grouped by list (PacketLightLists::
+// addByKeyMerged: one kernel call over the union of the lanes' lists, each lane masked to its
+// own list), shadePacket on inputs.isa, then the results applied lane by lane IN FRAGMENT ORDER
+// with the stage's semantics (FragmentApply):
+// - Replace (`forward`, `tiled-forward`): the pixel's radiance becomes the fragment's light sum
+//   plus its emission; lightsEvaluated ADDS the list length (a forward pass without pre-pass
+//   shades every fragment that passes the depth test: overdraw is real cost and stays counted
+//   and shaded, a later fragment of the same pixel, even in the same packet, replaces it);
+// - Add (`forward-multipass`): the fragment's light sum is added to the pixel's radiance, its
+//   evaluations to lightsEvaluated (one additive pass per light; the stage adds the emission).
+// The light trace follows: Replace assigns the lane's list, Add appends its lights.
+//
+// Exactness: a lane's sum is the kernel's sum over its own list in list order from 0, the same
+// sequence of float operations `brute` runs on the same ISA at the same surface (bitwise the
+// G-buffer's, ForwardGeometry.h); `--isa scalar` is evaluateLight lane by lane, bitwise the
+// per-fragment loops these stages had before. An Add pass of one light adds (0 + r) = r.
+//
+// SIMT cost model (lighting/README.md): a warp is one batch, i.e. simtWarpLanes consecutive
+// fragments of one raster tile in submission order (of one draw: batches never span draws), as a
+// GPU packs the fragments of a draw into warps in rasterization order. It pays warpLanes lane
+// slots (idle lanes of a tile's last, partial batch included) for every light of the union of its
+// fragments' lists. Recorded with the packet counters (as accumulateLights does) by end().
+//
+// Memory: per raster tile one batch of at most 64 queued fragments (40 bytes each) plus its union
+// scratch (at most the batch's list lengths); atrium at 1280x720 has 60 tiles: ~150 KB.
+//
+// Determinism: a tile's batches are cut from its own fragment stream (submission order, the same
+// for any thread count), shaded by the task that draws the tile (full batches) or by flush() (one
+// task per tile); every pixel belongs to one tile. Counters are summed in tile order. So images,
+// counts and parameters do not depend on the thread count.
+//
+// Thread safety: add() may be called concurrently for fragments of different raster tiles (the
+// rasterizer's contract); begin(), flush() and end() from the stage's thread, between draws.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "lighting/ShadingStage.h"
+#include "raster/Rasterizer.h"
+
+namespace lighting {
+
+class ForwardGeometry;
+namespace kernel {
+class KernelLights;
+}
+
+enum class FragmentApply {
+    Replace, // the fragment's light sum + emission replaces the pixel's radiance
+    Add,     // the fragment's light sum is added to the pixel's radiance
+};
+
+class FragmentShading {
+public:
+    FragmentShading();
+    ~FragmentShading();
+    FragmentShading(const FragmentShading&) = delete;
+    FragmentShading& operator=(const FragmentShading&) = delete;
+
+    // Starts a frame: the kernel's lights from inputs.lights, inputs.isa, the warp size
+    // (inputs.simtWarpLanes, 32 or 64), one batch per raster tile of the view. `geometry` gives
+    // the fragments' surfaces; `result` (resized already) receives them. Both must outlive end().
+    void begin(const StageInputs& inputs, const ForwardGeometry& geometry, FragmentApply apply,
+               StageResult& result);
+    // Queues a fragment of scene triangle `triangle` to be shaded with `lights` (ascending for
+    // exactness; must stay valid until the next flush()), a list `listKey` identifies within the
+    // draw (equal keys = the same list: an object, a tile, a light). Shades the fragment's tile
+    // batch when it is full. Called from the draw's fragment function.
+    void add(const raster::Fragment& fragment, uint32_t triangle, uint32_t listKey,
+             std::span<const uint32_t> lights);
+    // Shades every tile's queued fragments; after each draw, before its lists go away.
+    void flush();
+    // Ends the frame: records "isa", "simt_warp", "simt_lane_slots", "packet_groups" and the
+    // packet_lights_* counters (LightAccumulation.h) in result.parameters.
+    void end();
+
+private:
+    struct TileBatch;
+    void shadeBatch(TileBatch& batch);
+
+    const ForwardGeometry* mGeometry = nullptr;
+    StageResult* mResult = nullptr;
+    FragmentApply mApply = FragmentApply::Replace;
+    kernel::KernelIsa mIsa = kernel::KernelIsa::scalar();
+    int mWarpLanes = 32;
+    int mWidth = 0;
+    int mTilesX = 0;
+    std::unique_ptr<kernel::KernelLights> mLights;
+    std::vector<TileBatch> mTiles;
+};
+
+} // namespace lighting
