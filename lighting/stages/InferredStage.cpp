@@ -76,6 +76,7 @@
 
 #include "lighting/BlendedPass.h"
 #include "lighting/InferredStipple.h"
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
@@ -120,7 +121,6 @@ public:
         const int scale = mOptions.scale;
         const int lowWidth = (width + scale - 1) / scale, lowHeight = (height + scale - 1) / scale;
         result.resize(width, height, false);
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         auto sampleX = [&](int i) { return std::min(i * scale + scale / 2, width - 1); };
         auto sampleY = [&](int j) { return std::min(j * scale + scale / 2, height - 1); };
         // The pixels whose lights this stage evaluates (before any timed pass): the runner counts
@@ -151,32 +151,34 @@ public:
         // L-buffer at low resolution.
         PassTimer lightingPass(result, pass::kLighting);
         mSamples.assign(size_t(lowWidth) * lowHeight, LightSample{});
-        const int tileSamples = mOptions.tileSizeSamples;
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            if (!bounds[size_t(tile)].covered)
-                return;
-            const std::span<const uint32_t> list = mTileLights[size_t(tile)];
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            const int j1 = std::min((ty + 1) * tileSamples, lowHeight);
-            const int i1 = std::min((tx + 1) * tileSamples, lowWidth);
-            for (int j = ty * tileSamples; j < j1; ++j)
-                for (int i = tx * tileSamples; i < i1; ++i) {
-                    const int x = sampleX(i), y = sampleY(j);
-                    gbuffer::Surface point;
-                    if ((blended && mStipple.holds(size_t(j) * lowWidth + i)) ||
-                        !gb.surfaceAt(x, y, point))
-                        continue;
-                    LightSample& sample = mSamples[size_t(j) * lowWidth + i];
+        // Samples holding a stippled blended surface are lit by the stipple's own pass.
+        mExcluded.clear();
+        if (blended) {
+            mExcluded.resize(size_t(lowWidth) * lowHeight);
+            for (size_t index = 0; index < mExcluded.size(); ++index)
+                mExcluded[index] = mStipple.holds(index) ? 1 : 0;
+        }
+        const SplitLightSinkOf sink(
+            [&](const kernel::ShadingPacket& packet, const kernel::SplitPacketAccumulator& sums) {
+                for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+                    const int lane = __builtin_ctz(lanes);
+                    LightSample& sample =
+                        mSamples[size_t(packet.y0 + kernel::laneY(lane)) * size_t(lowWidth) +
+                                 size_t(packet.x0 + kernel::laneX(lane))];
                     sample.covered = true;
-                    sample.depthMetres = -point.positionView.z;
-                    sample.normalView = point.normalView;
-                    const SplitLighting lighting = splitLighting(point, lights, list);
-                    sample.diffuse = lighting.diffuse;
-                    sample.specular = lighting.specular;
-                    sample.specularEdge = lighting.specularEdge;
-                    result.lightsEvaluated[size_t(y) * width + x] = uint32_t(list.size());
+                    sample.depthMetres = -packet.positionView[2][lane];
+                    for (int c = 0; c < 3; ++c) {
+                        sample.normalView[c] = packet.normalView[c][lane];
+                        sample.diffuse[c] = sums.diffuse[c][lane];
+                        sample.specular[c] = sums.specular[c][lane];
+                        sample.specularEdge[c] = sums.specularEdge[c][lane];
+                    }
                 }
-        });
+            });
+        // Low-res tile (tx, ty) is full-res tile (tx, ty) of the culling grid (see "cull").
+        accumulateSplitLights(
+            inputs, {scale, mExcluded},
+            TileListSource(mOptions.tileSizeSamples, grid.tileCountX, mTileLights), sink, result);
         lightingPass.stop();
         if (blended) {
             blendPass.resume();
@@ -322,6 +324,7 @@ private:
     InferredOptions mOptions;
     // Per-frame scratch, kept to avoid reallocation between repetitions.
     std::vector<LightSample> mSamples;
+    std::vector<uint8_t> mExcluded; // per low-res sample: 1 = stippled (not lit by "lighting")
     std::vector<uint32_t> mSampleObjects; // object ID per low-res sample; all kNoObject with ids=0
     MaterialPass mMaterials;
     LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)

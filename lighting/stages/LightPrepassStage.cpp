@@ -42,9 +42,8 @@
 #include <algorithm>
 #include <span>
 
-#include <tbb/parallel_for.h>
-
 #include "lighting/BlendedPass.h"
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
@@ -71,7 +70,6 @@ public:
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
         PassTimer cullPass(result, pass::kCull);
         const TileGrid grid = TileGrid::make(width, height, mTileSizePixels);
@@ -85,24 +83,25 @@ public:
         mDiffuse.assign(gb.pixelCount(), glm::vec3(0.0f));
         mSpecular.assign(gb.pixelCount(), 0.0f);
         mSpecularEdge.assign(gb.pixelCount(), 0.0f);
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            if (!bounds[size_t(tile)].covered)
-                return;
-            const std::span<const uint32_t> list = mTileLights[size_t(tile)];
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
-                for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
-                    const size_t pixel = size_t(y) * width + x;
-                    gbuffer::Surface point;
-                    if (!gb.surfaceAt(x, y, point))
-                        continue;
-                    const SplitLighting lighting = splitLighting(point, lights, list);
-                    mDiffuse[pixel] = lighting.diffuse;
-                    mSpecular[pixel] = luminance(lighting.specular); // one monochrome scalar
-                    mSpecularEdge[pixel] = luminance(lighting.specularEdge);
-                    result.lightsEvaluated[pixel] = uint32_t(list.size());
+        const SplitLightSinkOf sink(
+            [&](const kernel::ShadingPacket& packet, const kernel::SplitPacketAccumulator& sums) {
+                for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+                    const int lane = __builtin_ctz(lanes);
+                    const size_t pixel = size_t(packet.y0 + kernel::laneY(lane)) * size_t(width) +
+                                         size_t(packet.x0 + kernel::laneX(lane));
+                    const glm::vec3 specular(sums.specular[0][lane], sums.specular[1][lane],
+                                             sums.specular[2][lane]);
+                    const glm::vec3 edge(sums.specularEdge[0][lane], sums.specularEdge[1][lane],
+                                         sums.specularEdge[2][lane]);
+                    mDiffuse[pixel] = {sums.diffuse[0][lane], sums.diffuse[1][lane],
+                                       sums.diffuse[2][lane]};
+                    mSpecular[pixel] = luminance(specular); // one monochrome scalar
+                    mSpecularEdge[pixel] = luminance(edge);
                 }
-        });
+            });
+        accumulateSplitLights(inputs, {},
+                              TileListSource(grid.tileSizePixels, grid.tileCountX, mTileLights),
+                              sink, result);
         lightingPass.stop();
 
         // Material pass: second geometry pass into a visibility buffer, then combine.
