@@ -13,11 +13,19 @@
 //               low-res G-buffer (whose pixel centres would lie between full-res pixels for even
 //               scales). It stores diffuse RGB (the BRDF's diffuse part without albedo, plus
 //               ambient radiance) and specular RGB (without the specular intensity), both from
-//               the one BRDF (evaluateLight with albedo 1 / intensity 0, then albedo 0 /
-//               intensity 1). Specular is kept in colour (as Pre-Lighting, Lee 2008, does) so
-//               that this stage's error is the resolution alone; `light-prepass` measures the
-//               monochromatic-specular approximation separately. With scale=1 the image equals
-//               brute's up to float summation order.
+//               the one BRDF (lighting/SplitLighting.h: albedo 1 / intensity 0, then albedo 0 /
+//               intensity 1; metallic-roughness: diffuse, F0 lobe and Fresnel edge). On the
+//               shading kernel: accumulateSplitLights (lighting/LightAccumulation.h) walks the
+//               L-buffer in packets of 4x4 SAMPLES (lanes gathered from the G-buffer pixels the
+//               samples read, GBuffer::surfaceAt; stippled samples left out), lanes grouped by
+//               culling tile, kernel::shadePacketSplit on --isa: `--isa scalar` is the per-sample
+//               splitLighting bitwise, a vector ISA differs only in Blinn-Phong specular sums
+//               (pow); a layout the packet decoder refuses takes the per-pixel path
+//               (stage_parameters.isa = scalar). SIMT counters count warps of 8x4 samples: the
+//               light pass a GPU runs at L-buffer resolution. Specular is kept in colour (as
+//               Pre-Lighting, Lee 2008, does) so that this stage's error is the resolution alone;
+//               `light-prepass` measures the monochromatic-specular approximation separately. With
+//               scale=1 the image equals brute's up to float summation order.
 //   "material"  the second geometry pass (lighting/MaterialPass.h): the scene is rasterized
 //               again with the G-buffer pass's visibility draw, and each visible pixel's albedo
 //               and specular intensity come from its triangle's surface. Object IDs (ids=1): a
@@ -55,17 +63,14 @@
 // elsewhere, so its sum is the number of light evaluations actually done. lightingSamples marks
 // those pixels, so that the oracle is counted over the same samples (culling efficiency at most 1,
 // no negative waste); the full-res oracle would count pixels this stage never lights itself.
-// Cost note (CPU): a contributing light costs two evaluateLight calls (diffuse, then specular
-// part) where `tiled` needs one; this keeps a single BRDF definition at the price of roughly
-// twice the per-light work in "lighting" (a GPU light buffer pays nothing comparable).
+// Cost note (CPU): the kernel evaluates range, direction and attenuation once per light for both
+// sums (before the kernel: two evaluateLight calls per contributing light).
 // Blended (glTF BLEND) surfaces: stippled into the L-buffer, lit by the light pass, found again
 // through the DSF in the material pass, at most 3 layers (InferredStipple.h); timed as "blend",
 // with stipple_fragments, stipple_fallbacks and stipple_unlit among the parameters.
-// Threads: tiles in parallel for culling and lighting, rows for the material pass; every sample
-// and pixel written by one task only, light sums in ascending order: deterministic.
-//
-// Shading stays scalar (not lighting/LightAccumulation.h): lighting is accumulated into split
-// diffuse/specular buffers at a lower resolution (splitLighting), not the kernel's radiance sum.
+// Threads: tiles in parallel for culling, warp rows of samples for lighting, rows for the material
+// pass; every sample and pixel written by one task only, light sums in ascending order:
+// deterministic. The stippled samples' light (InferredStipple) stays per sample and scalar.
 #include "lighting/StageRegistry.h"
 
 #include <algorithm>
