@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/Brdf.h"
+#include "lighting/SplitLighting.h"
 #include "lighting/kernel/KernelLights.h"
 #include "lighting/kernel/LightKernel.h"
 #include "lighting/kernel/PacketDecoder.h"
@@ -266,6 +267,186 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                         if (options.countOracle)
                             result.lightsOracle[pixel] = accumulator.lightsContributing[lane];
                     }
+                }
+            if (anyLane)
+                laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
+        }
+        laneSlotsPerRow[size_t(warpRow)] = laneSlots;
+        countsPerRow[size_t(warpRow)] = counts;
+    });
+
+    uint64_t laneSlots = 0;
+    for (uint64_t slots : laneSlotsPerRow)
+        laneSlots += slots;
+    PacketCounts counts;
+    for (const PacketCounts& row : countsPerRow) {
+        counts.groups += row.groups;
+        counts.skippedAtRange += row.skippedAtRange;
+        counts.skippedAtConeOrFacing += row.skippedAtConeOrFacing;
+        counts.shaded += row.shaded;
+    }
+    if (packets) {
+        result.parameters["packet_groups"] = std::to_string(counts.groups);
+        result.parameters["packet_lights_skipped_at_range"] = std::to_string(counts.skippedAtRange);
+        result.parameters["packet_lights_skipped_at_cone_or_facing"] =
+            std::to_string(counts.skippedAtConeOrFacing);
+        result.parameters["packet_lights_shaded"] = std::to_string(counts.shaded);
+    }
+    result.parameters["isa"] = isa.name();
+    result.parameters["simt_warp"] = std::to_string(inputs.simtWarpLanes);
+    result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
+}
+
+} // namespace lighting
+
+namespace lighting {
+
+namespace {
+
+// The lanes of the 4x4 samples at (i0, j0) that options.excludedSamples marks.
+uint32_t excludedLanes(std::span<const uint8_t> excluded, int sampleWidth, int sampleHeight, int i0,
+                       int j0) {
+    uint32_t lanes = 0;
+    if (excluded.empty())
+        return 0;
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        const int i = i0 + kernel::laneX(lane), j = j0 + kernel::laneY(lane);
+        if (i < sampleWidth && j < sampleHeight && excluded[size_t(j) * sampleWidth + i] != 0)
+            lanes |= 1u << lane;
+    }
+    return lanes;
+}
+
+// The 4x4 samples at (i0, j0) of the lattice, lane by lane through GBuffer::surfaceAt: the packet
+// rows (both material models) and the lanes' surfaces (for the per-pixel path).
+void gatherSamples(const gbuffer::GBuffer& gb, int scale, int sampleWidth, int sampleHeight,
+                   uint32_t excluded, int i0, int j0, kernel::ShadingPacket& packet,
+                   gbuffer::Surface (&surfaces)[kPacketLanes]) {
+    packet.clear(i0, j0);
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        const int i = i0 + kernel::laneX(lane), j = j0 + kernel::laneY(lane);
+        if (i >= sampleWidth || j >= sampleHeight || (excluded >> lane & 1u))
+            continue;
+        const int x = std::min(i * scale + scale / 2, gb.width() - 1);
+        const int y = std::min(j * scale + scale / 2, gb.height() - 1);
+        gbuffer::Surface& s = surfaces[lane];
+        if (!gb.surfaceAt(x, y, s))
+            continue;
+        packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
+                       s.specularPower);
+        if (s.model == scenes::MaterialModel::MetallicRoughness)
+            packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
+    }
+}
+
+} // namespace
+
+void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions& options,
+                           const PacketListSource& source, const SplitLightSink& sink,
+                           StageResult& result) {
+    const gbuffer::GBuffer& gb = *inputs.gbuffer;
+    const int width = gb.width(), height = gb.height();
+    const int scale = options.scale;
+    if (scale < 1)
+        throw std::invalid_argument("accumulateSplitLights: scale must be at least 1");
+    const int sampleWidth = (width + scale - 1) / scale,
+              sampleHeight = (height + scale - 1) / scale;
+    if (!options.excludedSamples.empty() &&
+        options.excludedSamples.size() != size_t(sampleWidth) * size_t(sampleHeight))
+        throw std::invalid_argument("accumulateSplitLights: one excluded flag per sample expected");
+    if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
+        throw std::invalid_argument("accumulateSplitLights: simtWarpLanes must be 32 or 64, not " +
+                                    std::to_string(inputs.simtWarpLanes));
+    const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
+    const std::vector<LightInView<float>>& lights = inputs.lights->lights;
+
+    const bool packets = packetPathFits(inputs);
+    const kernel::KernelIsa isa = packets ? inputs.isa : kernel::KernelIsa::scalar();
+    // Whole pixels (scale 1) are decoded a packet at a time; lattice samples are gathered.
+    std::optional<kernel::PacketDecoder> decoder;
+    std::optional<kernel::KernelLights> kernelLights;
+    if (packets) {
+        if (scale == 1)
+            decoder.emplace(gb.layout(), gb.view(), planesOf(gb));
+        kernelLights.emplace(lights);
+    }
+    auto pixelOf = [&](int i, int j) {
+        return size_t(std::min(j * scale + scale / 2, height - 1)) * size_t(width) +
+               size_t(std::min(i * scale + scale / 2, width - 1));
+    };
+
+    const int warpRows = (sampleHeight + warpHeight - 1) / warpHeight;
+    std::vector<uint64_t> laneSlotsPerRow(size_t(warpRows), 0);
+    std::vector<PacketCounts> countsPerRow(static_cast<size_t>(warpRows));
+    tbb::parallel_for(0, warpRows, [&](int warpRow) {
+        kernel::ShadingPacket packet;
+        kernel::SplitPacketAccumulator sums;
+        PacketLightLists lists;
+        gbuffer::Surface surfaces[kPacketLanes];
+        WarpUnion warpUnion(lights.size());
+        uint64_t laneSlots = 0;
+        PacketCounts counts;
+        for (int wi = 0; wi < sampleWidth; wi += kWarpWidth) {
+            warpUnion.begin();
+            bool anyLane = false;
+            for (int j0 = warpRow * warpHeight;
+                 j0 < std::min(sampleHeight, (warpRow + 1) * warpHeight); j0 += kPacketHeight)
+                for (int i0 = wi; i0 < std::min(sampleWidth, wi + kWarpWidth); i0 += kPacketWidth) {
+                    const uint32_t excluded =
+                        excludedLanes(options.excludedSamples, sampleWidth, sampleHeight, i0, j0);
+                    if (decoder) {
+                        decoder->decode(isa, i0, j0, packet);
+                        packet.laneMask &= ~excluded;
+                    } else {
+                        gatherSamples(gb, scale, sampleWidth, sampleHeight, excluded, i0, j0,
+                                      packet, surfaces);
+                    }
+                    if (packet.laneMask == 0)
+                        continue;
+                    lists.clear();
+                    source.listsOf(packet, lists);
+                    sums.clear();
+                    counts.groups += uint64_t(lists.size());
+                    for (int g = 0; g < lists.size(); ++g) {
+                        const PacketLightLists::Group& group = lists[g];
+                        if (!group.lightLaneMasks.empty())
+                            throw std::logic_error(
+                                "accumulateSplitLights: per-light lane masks are not supported");
+                        if (packets) {
+                            kernel::shadePacketSplit(isa, packet, group.laneMask, *kernelLights,
+                                                     group.lights, sums);
+                        } else {
+                            for (uint32_t lanes = group.laneMask & packet.laneMask; lanes != 0;
+                                 lanes &= lanes - 1) {
+                                const int lane = __builtin_ctz(lanes);
+                                const SplitLighting split =
+                                    splitLighting(surfaces[lane], lights, group.lights);
+                                for (int c = 0; c < 3; ++c) {
+                                    sums.diffuse[c][lane] = split.diffuse[c];
+                                    sums.specular[c][lane] = split.specular[c];
+                                    sums.specularEdge[c][lane] = split.specularEdge[c];
+                                }
+                                sums.lightsEvaluated[lane] = uint32_t(group.lights.size());
+                            }
+                        }
+                        if (group.scratch)
+                            warpUnion.addTransient(group.lights);
+                        else
+                            warpUnion.add(group.lights);
+                        anyLane = true;
+                        for (uint32_t lanes = group.laneMask & packet.laneMask; lanes != 0;
+                             lanes &= lanes - 1) {
+                            const int lane = __builtin_ctz(lanes);
+                            const size_t pixel =
+                                pixelOf(i0 + kernel::laneX(lane), j0 + kernel::laneY(lane));
+                            result.lightsEvaluated[pixel] = sums.lightsEvaluated[lane];
+                            result.traceLightList(pixel, group.lights);
+                        }
+                    }
+                    counts.skippedAtRange += sums.lightsSkippedAtRange;
+                    counts.skippedAtConeOrFacing += sums.lightsSkippedAtConeOrFacing;
+                    counts.shaded += sums.lightsShaded;
+                    sink.store(packet, sums);
                 }
             if (anyLane)
                 laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();

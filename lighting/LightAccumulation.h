@@ -1,6 +1,8 @@
 // accumulateLights: the one "sum the lights, store the pixel" loop of the G-buffer stages (issue
 // 14, section 1): brute, tiled, tiled-backface, clustered and light-indexed call it with their
-// light lists instead of each copying a per-pixel loop.
+// light lists instead of each copying a per-pixel loop. accumulateSplitLights (below) is its form
+// for the light-buffer stages (light-prepass, inferred): the same packets, lists, paths and SIMT
+// counters, with split diffuse / specular sums (kernel::shadePacketSplit).
 //
 // The frame is walked in SIMT warps (8x4 pixels, or 8x8), each made of 4x4-pixel packets. Per
 // packet: decode the G-buffer (lighting/kernel/PacketDecoder.h), ask the stage's PacketListSource
@@ -34,10 +36,13 @@
 #include <cstdint>
 #include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "lighting/ShadingStage.h"
+#include "lighting/culling/LightIndexLists.h"
 #include "lighting/kernel/ShadingPacket.h"
+#include "lighting/kernel/SplitLightKernel.h"
 
 namespace lighting {
 
@@ -259,5 +264,85 @@ struct AccumulationOptions {
 // "shading" pass around the call.
 void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                       const AccumulationOptions& options, StageResult& result);
+
+// A packet's lanes grouped by square tile of `tileSize` (pixels, or samples on a lattice; tile
+// (tx, ty) is number ty * tileCountX + tx), each group with its tile's list: the lists of the
+// tiled stages (a packet spans several tiles when the tile size is not a multiple of 4).
+class TileListSource final : public PacketListSource {
+public:
+    TileListSource(int tileSize, int tileCountX, const LightIndexLists& tileLights)
+        : mTileSize(tileSize), mTileCountX(tileCountX), mTileLights(tileLights) {}
+    void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
+        lists.addByKey(
+            packet,
+            [&](int lane) {
+                return ((packet.y0 + kernel::laneY(lane)) / mTileSize) * mTileCountX +
+                       (packet.x0 + kernel::laneX(lane)) / mTileSize;
+            },
+            [&](int tile) { return mTileLights[size_t(tile)]; });
+    }
+
+private:
+    int mTileSize;
+    int mTileCountX;
+    const LightIndexLists& mTileLights;
+};
+
+// Split lighting (lighting/SplitLighting.h) for the stages that accumulate light buffers,
+// `light-prepass` and `inferred`: the one loop that lights their samples, in place of two
+// per-pixel loops around splitLighting.
+//
+// Samples: a lattice over the G-buffer, sample (i, j) reading pixel
+// (min(i scale + scale / 2, W - 1), min(j scale + scale / 2, H - 1)): scale 1 is every pixel
+// (light-prepass), scale s inferred's L-buffer. Packets are 4x4 SAMPLES (packet.x0, y0 and the
+// lanes' coordinates are sample coordinates, which the list source keys its tiles by); a packet of
+// pixels (scale 1) is decoded by kernel::PacketDecoder, a strided one gathered lane by lane with
+// GBuffer::surfaceAt (the same surfaces, bitwise). Then kernel::shadePacketSplit per lane group on
+// inputs.isa, and the sink stores the lanes. The path is chosen once per frame by the same check
+// as accumulateLights (packetPathFits): a layout the packet decoder refuses takes the per-pixel
+// path (surfaceAt + splitLighting per sample, bitwise the stages' former loops; "isa" = scalar).
+// `--isa scalar` runs the kernel's scalar split path: addSplitLight lane by lane, bitwise
+// splitLighting. Vector ISAs: diffuse and metallic-roughness sums bitwise, the Blinn-Phong
+// specular sum within a few ulps (pow; kernel/SplitLightKernel.h).
+struct SplitLightingOptions {
+    int scale = 1; // lattice spacing in pixels
+    // Samples not to light (e.g. inferred's stippled samples), lowWidth x lowHeight, 1 = skip;
+    // empty: none.
+    std::span<const uint8_t> excludedSamples;
+};
+
+// Where the loop puts a packet's sums. Called once per packet that has a lit lane, from several
+// threads at once (each sample belongs to one packet, so each call writes its own samples): the
+// lit lanes are packet.laneMask (sample (packet.x0 + laneX, packet.y0 + laneY)); their view-space
+// position and normal are in the packet, their sums in `sums`.
+class SplitLightSink {
+public:
+    virtual ~SplitLightSink() = default;
+    virtual void store(const kernel::ShadingPacket& packet,
+                       const kernel::SplitPacketAccumulator& sums) const = 0;
+};
+
+// A sink from a callable store(packet, sums) (a stage's lambda; one virtual call per packet).
+template <class Store> class SplitLightSinkOf final : public SplitLightSink {
+public:
+    explicit SplitLightSinkOf(Store store) : mStore(std::move(store)) {}
+    void store(const kernel::ShadingPacket& packet,
+               const kernel::SplitPacketAccumulator& sums) const override {
+        mStore(packet, sums);
+    }
+
+private:
+    Store mStore;
+};
+
+// Lights every sample of the lattice that holds a surface with its lists and hands the sums to
+// `sink`; writes result.lightsEvaluated at each lit sample's pixel (its list length; result must be
+// resized) and the light trace there when tracing. Records "isa", "simt_warp" and
+// "simt_lane_slots" (warps of 8x4 or 8x8 SAMPLES, the lanes a GPU would run the light pass with)
+// and, on the packet path, the packet counters, as accumulateLights does. Group lists must not
+// carry per-light lane masks. Adds no timing.
+void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions& options,
+                           const PacketListSource& source, const SplitLightSink& sink,
+                           StageResult& result);
 
 } // namespace lighting

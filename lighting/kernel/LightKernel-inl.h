@@ -136,10 +136,9 @@ HWY_INLINE void accumulate(const FloatVec radiance[3], ChunkSums& sums) {
         hn::Sub(sums.contributing, hn::VecFromMask(di, hn::RebindMask(di, contributes)));
 }
 
-// Phase 3 for one chunk, Blinn-Phong: the halfway vector, the specular lobe and the radiance,
-// with evaluateLightBlinnPhong's operations except pow.
-HWY_INLINE void blinnPhongRadiance(const KernelLight& light, const ChunkSurface& s,
-                                   const ChunkLight& l, FloatVec radiance[3]) {
+// Phase 3 for one chunk, Blinn-Phong: the halfway vector and pow(n.h, power), with
+// evaluateLightBlinnPhong's operations except pow (shared with the split kernel).
+HWY_INLINE FloatVec blinnPhongLobe(const ChunkSurface& s, const ChunkLight& l) {
     const FloatTag d;
     const FloatVec one = hn::Set(d, 1.0f);
     FloatVec halfway[3];
@@ -154,7 +153,14 @@ HWY_INLINE void blinnPhongRadiance(const KernelLight& light, const ChunkSurface&
     // evaluateLight returns NaN).
     const FloatVec nDotH =
         dot3(s.normal[0], s.normal[1], s.normal[2], halfway[0], halfway[1], halfway[2]);
-    const FloatVec specular = hn::Mul(s.specularScale, powNonNegative(d, nDotH, s.specularPower));
+    return powNonNegative(d, nDotH, s.specularPower);
+}
+
+// Phase 3 for one chunk, Blinn-Phong: the specular lobe and the radiance.
+HWY_INLINE void blinnPhongRadiance(const KernelLight& light, const ChunkSurface& s,
+                                   const ChunkLight& l, FloatVec radiance[3]) {
+    const FloatTag d;
+    const FloatVec specular = hn::Mul(s.specularScale, blinnPhongLobe(s, l));
     const FloatVec scale = hn::Mul(l.attenuation, l.nDotL);
     for (int k = 0; k < 3; ++k)
         radiance[k] =
@@ -162,12 +168,17 @@ HWY_INLINE void blinnPhongRadiance(const KernelLight& light, const ChunkSurface&
                                                hn::Add(s.diffuse[k], specular)));
 }
 
-// Phase 3 for one chunk, metallic-roughness: evaluateLightMetallicRoughness's operations after
-// lightIncidence, in its order (metallicRoughnessBrdf, ggxDistribution, smithVisibility,
-// schlickWeight), with its branches as selections. evaluateLightMetallicRoughness returns 0 where
-// the attenuation is not > 0 (it can underflow inside the range); that is selected here too.
-HWY_INLINE void metallicRoughnessRadiance(const KernelLight& light, const ChunkSurface& s,
-                                          const ChunkLight& l, FloatVec radiance[3]) {
+// The light-dependent factors of the metallic-roughness BRDF for one chunk:
+// evaluateLightMetallicRoughness's operations after lightIncidence, in its order
+// (metallicRoughnessBrdf, ggxDistribution, smithVisibility, schlickWeight), with its branches as
+// selections. Shared with the split kernel (splitLightMetallicRoughness computes the same terms).
+struct GgxTerms {
+    FloatVec w;             // Schlick's weight (1 - |V.H|)^5
+    FloatVec diffuseWeight; // (1 - F_dielectric) / pi
+    FloatVec specular;      // D Vis, 0 unless V.H > 0
+};
+
+HWY_INLINE GgxTerms ggxTerms(const ChunkSurface& s, const ChunkLight& l) {
     const FloatTag d;
     const FloatVec zero = hn::Zero(d);
     const FloatVec one = hn::Set(d, 1.0f);
@@ -184,9 +195,10 @@ HWY_INLINE void metallicRoughnessRadiance(const KernelLight& light, const ChunkS
     // schlickWeight: x = clamp(1 - |V.H|, 0, 1), x^5 as (x^2 x^2) x.
     const FloatVec x = hn::Min(hn::Max(hn::Sub(one, hn::Abs(vDotH)), zero), one);
     const FloatVec x2 = hn::Mul(x, x);
-    const FloatVec w = hn::Mul(hn::Mul(x2, x2), x);
-    const FloatVec dielectricFresnel =
-        hn::Add(hn::Set(d, kDielectricF0Float), hn::Mul(hn::Set(d, kDielectricWeightFloat), w));
+    GgxTerms terms;
+    terms.w = hn::Mul(hn::Mul(x2, x2), x);
+    const FloatVec dielectricFresnel = hn::Add(
+        hn::Set(d, kDielectricF0Float), hn::Mul(hn::Set(d, kDielectricWeightFloat), terms.w));
     // ggxDistribution: k = |N x H|^2 + (N.H)^2 alpha^2 (glm::cross's operand order).
     const FloatVec nDotH = dot3(s.normal[0], s.normal[1], s.normal[2], h[0], h[1], h[2]);
     const FloatVec cross[3] = {hn::Sub(hn::Mul(s.normal[1], h[2]), hn::Mul(h[1], s.normal[2])),
@@ -205,16 +217,26 @@ HWY_INLINE void metallicRoughnessRadiance(const KernelLight& light, const ChunkS
         hn::Add(hn::Mul(s.absNDotV, lightTerm), hn::Mul(absNDotL, s.viewTerm));
     const FloatVec visibility =
         hn::Div(hn::Set(d, 0.5f), hn::Max(denominator, hn::Set(d, kMinVisibilityDenominatorFloat)));
-    const FloatVec specular =
-        hn::IfThenElseZero(hn::Gt(vDotH, zero), hn::Mul(distribution, visibility));
-    const FloatVec diffuseWeight =
-        hn::Mul(hn::Sub(one, dielectricFresnel), hn::Set(d, kInversePiFloat));
+    terms.specular = hn::IfThenElseZero(hn::Gt(vDotH, zero), hn::Mul(distribution, visibility));
+    terms.diffuseWeight = hn::Mul(hn::Sub(one, dielectricFresnel), hn::Set(d, kInversePiFloat));
+    return terms;
+}
+
+// Phase 3 for one chunk, metallic-roughness: the BRDF from ggxTerms and the radiance.
+// evaluateLightMetallicRoughness returns 0 where the attenuation is not > 0 (it can underflow
+// inside the range); that is selected here too.
+HWY_INLINE void metallicRoughnessRadiance(const KernelLight& light, const ChunkSurface& s,
+                                          const ChunkLight& l, FloatVec radiance[3]) {
+    const FloatTag d;
+    const FloatVec zero = hn::Zero(d);
+    const FloatVec one = hn::Set(d, 1.0f);
+    const GgxTerms terms = ggxTerms(s, l);
     const FloatVec scale = hn::Mul(l.attenuation, l.nDotL);
     const LaneMask pass = hn::And(l.pass, hn::Gt(l.attenuation, zero));
     for (int k = 0; k < 3; ++k) {
-        const FloatVec fresnel = hn::Add(s.f0[k], hn::Mul(hn::Sub(one, s.f0[k]), w));
-        const FloatVec brdf =
-            hn::Add(hn::Mul(s.diffuseColor[k], diffuseWeight), hn::Mul(fresnel, specular));
+        const FloatVec fresnel = hn::Add(s.f0[k], hn::Mul(hn::Sub(one, s.f0[k]), terms.w));
+        const FloatVec brdf = hn::Add(hn::Mul(s.diffuseColor[k], terms.diffuseWeight),
+                                      hn::Mul(fresnel, terms.specular));
         radiance[k] =
             hn::IfThenElseZero(pass, hn::Mul(hn::Mul(hn::Set(d, light.radiance[k]), scale), brdf));
     }

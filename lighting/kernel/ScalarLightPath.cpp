@@ -4,11 +4,15 @@
 // the packet-level early-out counters come from earlyExit, which repeats evaluateLight's three
 // rejection tests with the same float operations (so they take the same decisions), and apply the
 // vector path's rule: a light is skipped when every active lane rejects it.
+// shadePacketSplitScalar (SplitLightKernel.h) is the same loop around addSplitLight.
 #include "lighting/kernel/LightKernel.h"
 
 #include <cmath>
+#include <optional>
 
 #include "lighting/Brdf.h"
+#include "lighting/SplitLighting.h"
+#include "lighting/kernel/SplitLightKernel.h"
 
 namespace lighting::kernel {
 
@@ -38,6 +42,35 @@ EarlyExit earlyExit(const gbuffer::Surface& s, const LightInView<float>& light) 
     return glm::dot(s.normalView, toLight) > 0.0f ? EarlyExit::None : EarlyExit::ConeOrFacing;
 }
 
+// Lane `lane` of the packet as the per-pixel code's surface.
+gbuffer::Surface surfaceOfLane(const ShadingPacket& packet, int lane) {
+    gbuffer::Surface p;
+    for (int c = 0; c < 3; ++c) {
+        p.positionView[c] = packet.positionView[c][lane];
+        p.normalView[c] = packet.normalView[c][lane];
+        p.albedo[c] = packet.albedo[c][lane];
+    }
+    p.specularIntensity = packet.specularIntensity[lane];
+    p.specularPower = packet.specularPower[lane];
+    p.roughness = packet.roughness[lane];
+    p.metallic = packet.metallic[lane];
+    p.occlusion = packet.occlusion[lane];
+    p.model = packet.metallicRoughnessMask >> lane & 1u ? scenes::MaterialModel::MetallicRoughness
+                                                        : scenes::MaterialModel::BlinnPhong;
+    return p;
+}
+
+// The packet-level early-out counter a light lands in, from where each active lane left it.
+template <class Accumulator>
+void countLight(bool anyShaded, bool anyPastRange, Accumulator& accumulator) {
+    if (anyShaded)
+        ++accumulator.lightsShaded;
+    else if (anyPastRange)
+        ++accumulator.lightsSkippedAtConeOrFacing;
+    else
+        ++accumulator.lightsSkippedAtRange;
+}
+
 } // namespace
 
 void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const KernelLights& lights,
@@ -51,20 +84,7 @@ void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const Ker
     for (int lane = 0; lane < kPacketLanes; ++lane) {
         if (!(laneMask >> lane & 1u))
             continue;
-        gbuffer::Surface& p = points[lane];
-        for (int c = 0; c < 3; ++c) {
-            p.positionView[c] = packet.positionView[c][lane];
-            p.normalView[c] = packet.normalView[c][lane];
-            p.albedo[c] = packet.albedo[c][lane];
-        }
-        p.specularIntensity = packet.specularIntensity[lane];
-        p.specularPower = packet.specularPower[lane];
-        p.roughness = packet.roughness[lane];
-        p.metallic = packet.metallic[lane];
-        p.occlusion = packet.occlusion[lane];
-        p.model = packet.metallicRoughnessMask >> lane & 1u
-                      ? scenes::MaterialModel::MetallicRoughness
-                      : scenes::MaterialModel::BlinnPhong;
+        const gbuffer::Surface& p = points[lane] = surfaceOfLane(packet, lane);
         toViewer[lane] = glm::normalize(-p.positionView);
         if (lightLaneMasks.empty())
             accumulator.lightsEvaluated[lane] += uint32_t(lightIndices.size());
@@ -90,12 +110,62 @@ void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const Ker
             if (countContributing)
                 accumulator.lightsContributing[lane] += contributes(radiance) ? 1u : 0u;
         }
-        if (anyShaded)
-            ++accumulator.lightsShaded;
-        else if (anyPastRange)
-            ++accumulator.lightsSkippedAtConeOrFacing;
-        else
-            ++accumulator.lightsSkippedAtRange;
+        countLight(anyShaded, anyPastRange, accumulator);
+    }
+}
+
+void shadePacketSplitScalar(const ShadingPacket& packet, uint32_t laneMask,
+                            const KernelLights& lights, std::span<const uint32_t> lightIndices,
+                            SplitPacketAccumulator& accumulator) {
+    laneMask &= packet.laneMask;
+    if (laneMask == 0)
+        return;
+    // Per lane: its surface, the two Blinn-Phong evaluations of it, the direction to the viewer
+    // and its running sums (continuing from the accumulator, so a split list adds in order).
+    struct Lane {
+        gbuffer::Surface point;
+        SplitPoints points{point};
+        glm::vec3 toViewer{0.0f};
+        SplitLighting sum;
+    };
+    std::optional<Lane> lanes[kPacketLanes];
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        if (!(laneMask >> lane & 1u))
+            continue;
+        const gbuffer::Surface point = surfaceOfLane(packet, lane);
+        Lane& l = lanes[lane].emplace(Lane{point, SplitPoints(point), glm::vec3(0.0f), {}});
+        l.toViewer = glm::normalize(-point.positionView);
+        for (int c = 0; c < 3; ++c) {
+            l.sum.diffuse[c] = accumulator.diffuse[c][lane];
+            l.sum.specular[c] = accumulator.specular[c][lane];
+            l.sum.specularEdge[c] = accumulator.specularEdge[c][lane];
+        }
+        accumulator.lightsEvaluated[lane] += uint32_t(lightIndices.size());
+    }
+    const std::vector<LightInView<float>>& source = lights.source();
+    for (uint32_t index : lightIndices) {
+        const LightInView<float>& light = source[index];
+        bool anyShaded = false, anyPastRange = false;
+        for (int lane = 0; lane < kPacketLanes; ++lane) {
+            if (!lanes[lane])
+                continue;
+            Lane& l = *lanes[lane];
+            const EarlyExit exit = earlyExit(l.point, light);
+            anyShaded |= exit == EarlyExit::None;
+            anyPastRange |= exit != EarlyExit::Range;
+            addSplitLight(l.point, l.points, l.toViewer, light, l.sum);
+        }
+        countLight(anyShaded, anyPastRange, accumulator);
+    }
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        if (!lanes[lane])
+            continue;
+        const SplitLighting& sum = lanes[lane]->sum;
+        for (int c = 0; c < 3; ++c) {
+            accumulator.diffuse[c][lane] = sum.diffuse[c];
+            accumulator.specular[c][lane] = sum.specular[c];
+            accumulator.specularEdge[c][lane] = sum.specularEdge[c];
+        }
     }
 }
 

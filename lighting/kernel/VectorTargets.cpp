@@ -20,6 +20,7 @@
 
 #include "lighting/kernel/LightKernel-inl.h"
 #include "lighting/kernel/PacketDecode-inl.h"
+#include "lighting/kernel/SplitLightKernel-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace lighting::kernel::HWY_NAMESPACE {
@@ -27,7 +28,8 @@ namespace lighting::kernel::HWY_NAMESPACE {
 const VectorFunctions* vectorFunctions() {
     static const VectorFunctions functions{HWY_TARGET,           hwy::TargetName(HWY_TARGET),
                                            int(kLanesPerVector), &shadePacketVector,
-                                           &decodePacketVector,  &powArrayVector};
+                                           &decodePacketVector,  &powArrayVector,
+                                           &shadeSplitVector};
     return &functions;
 }
 

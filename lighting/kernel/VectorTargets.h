@@ -16,6 +16,7 @@
 
 #include "lighting/kernel/KernelLights.h"
 #include "lighting/kernel/ShadingPacket.h"
+#include "lighting/kernel/SplitLightKernel.h"
 
 namespace lighting::kernel {
 
@@ -34,6 +35,16 @@ struct ShadeArgs {
     const uint16_t* lightLaneMasks = nullptr;
 };
 
+// shadePacketSplit's arguments (SplitLightKernel.h).
+struct ShadeSplitArgs {
+    const ShadingPacket* packet;
+    uint32_t laneMask;
+    const KernelLight* lights;
+    const uint32_t* indices;
+    size_t count;
+    SplitPacketAccumulator* accumulator;
+};
+
 struct DecodeArgs {
     const PacketDecodeTables* tables;
     int x0;
@@ -50,6 +61,7 @@ struct VectorFunctions {
     // out[i] = x[i]^y[i] as the kernel computes the specular lobe (x, y >= 0): for the accuracy
     // study of tests/kernel/vector_pow_test.cpp.
     void (*pow)(const float* x, const float* y, float* out, size_t count);
+    void (*shadeSplit)(const ShadeSplitArgs&); // SplitLightKernel.h
 };
 
 // The compiled targets this CPU supports, narrowest to widest. Built once (thread-safe).

@@ -13,11 +13,19 @@
 //               low-res G-buffer (whose pixel centres would lie between full-res pixels for even
 //               scales). It stores diffuse RGB (the BRDF's diffuse part without albedo, plus
 //               ambient radiance) and specular RGB (without the specular intensity), both from
-//               the one BRDF (evaluateLight with albedo 1 / intensity 0, then albedo 0 /
-//               intensity 1). Specular is kept in colour (as Pre-Lighting, Lee 2008, does) so
-//               that this stage's error is the resolution alone; `light-prepass` measures the
-//               monochromatic-specular approximation separately. With scale=1 the image equals
-//               brute's up to float summation order.
+//               the one BRDF (lighting/SplitLighting.h: albedo 1 / intensity 0, then albedo 0 /
+//               intensity 1; metallic-roughness: diffuse, F0 lobe and Fresnel edge). On the
+//               shading kernel: accumulateSplitLights (lighting/LightAccumulation.h) walks the
+//               L-buffer in packets of 4x4 SAMPLES (lanes gathered from the G-buffer pixels the
+//               samples read, GBuffer::surfaceAt; stippled samples left out), lanes grouped by
+//               culling tile, kernel::shadePacketSplit on --isa: `--isa scalar` is the per-sample
+//               splitLighting bitwise, a vector ISA differs only in Blinn-Phong specular sums
+//               (pow); a layout the packet decoder refuses takes the per-pixel path
+//               (stage_parameters.isa = scalar). SIMT counters count warps of 8x4 samples: the
+//               light pass a GPU runs at L-buffer resolution. Specular is kept in colour (as
+//               Pre-Lighting, Lee 2008, does) so that this stage's error is the resolution alone;
+//               `light-prepass` measures the monochromatic-specular approximation separately. With
+//               scale=1 the image equals brute's up to float summation order.
 //   "material"  the second geometry pass (lighting/MaterialPass.h): the scene is rasterized
 //               again with the G-buffer pass's visibility draw, and each visible pixel's albedo
 //               and specular intensity come from its triangle's surface. Object IDs (ids=1): a
@@ -55,17 +63,14 @@
 // elsewhere, so its sum is the number of light evaluations actually done. lightingSamples marks
 // those pixels, so that the oracle is counted over the same samples (culling efficiency at most 1,
 // no negative waste); the full-res oracle would count pixels this stage never lights itself.
-// Cost note (CPU): a contributing light costs two evaluateLight calls (diffuse, then specular
-// part) where `tiled` needs one; this keeps a single BRDF definition at the price of roughly
-// twice the per-light work in "lighting" (a GPU light buffer pays nothing comparable).
+// Cost note (CPU): the kernel evaluates range, direction and attenuation once per light for both
+// sums (before the kernel: two evaluateLight calls per contributing light).
 // Blended (glTF BLEND) surfaces: stippled into the L-buffer, lit by the light pass, found again
 // through the DSF in the material pass, at most 3 layers (InferredStipple.h); timed as "blend",
 // with stipple_fragments, stipple_fallbacks and stipple_unlit among the parameters.
-// Threads: tiles in parallel for culling and lighting, rows for the material pass; every sample
-// and pixel written by one task only, light sums in ascending order: deterministic.
-//
-// Shading stays scalar (not lighting/LightAccumulation.h): lighting is accumulated into split
-// diffuse/specular buffers at a lower resolution (splitLighting), not the kernel's radiance sum.
+// Threads: tiles in parallel for culling, warp rows of samples for lighting, rows for the material
+// pass; every sample and pixel written by one task only, light sums in ascending order:
+// deterministic. The stippled samples' light (InferredStipple) stays per sample and scalar.
 #include "lighting/StageRegistry.h"
 
 #include <algorithm>
@@ -76,6 +81,7 @@
 
 #include "lighting/BlendedPass.h"
 #include "lighting/InferredStipple.h"
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
@@ -120,7 +126,6 @@ public:
         const int scale = mOptions.scale;
         const int lowWidth = (width + scale - 1) / scale, lowHeight = (height + scale - 1) / scale;
         result.resize(width, height, false);
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         auto sampleX = [&](int i) { return std::min(i * scale + scale / 2, width - 1); };
         auto sampleY = [&](int j) { return std::min(j * scale + scale / 2, height - 1); };
         // The pixels whose lights this stage evaluates (before any timed pass): the runner counts
@@ -151,32 +156,34 @@ public:
         // L-buffer at low resolution.
         PassTimer lightingPass(result, pass::kLighting);
         mSamples.assign(size_t(lowWidth) * lowHeight, LightSample{});
-        const int tileSamples = mOptions.tileSizeSamples;
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            if (!bounds[size_t(tile)].covered)
-                return;
-            const std::span<const uint32_t> list = mTileLights[size_t(tile)];
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            const int j1 = std::min((ty + 1) * tileSamples, lowHeight);
-            const int i1 = std::min((tx + 1) * tileSamples, lowWidth);
-            for (int j = ty * tileSamples; j < j1; ++j)
-                for (int i = tx * tileSamples; i < i1; ++i) {
-                    const int x = sampleX(i), y = sampleY(j);
-                    gbuffer::Surface point;
-                    if ((blended && mStipple.holds(size_t(j) * lowWidth + i)) ||
-                        !gb.surfaceAt(x, y, point))
-                        continue;
-                    LightSample& sample = mSamples[size_t(j) * lowWidth + i];
+        // Samples holding a stippled blended surface are lit by the stipple's own pass.
+        mExcluded.clear();
+        if (blended) {
+            mExcluded.resize(size_t(lowWidth) * lowHeight);
+            for (size_t index = 0; index < mExcluded.size(); ++index)
+                mExcluded[index] = mStipple.holds(index) ? 1 : 0;
+        }
+        const SplitLightSinkOf sink(
+            [&](const kernel::ShadingPacket& packet, const kernel::SplitPacketAccumulator& sums) {
+                for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+                    const int lane = __builtin_ctz(lanes);
+                    LightSample& sample =
+                        mSamples[size_t(packet.y0 + kernel::laneY(lane)) * size_t(lowWidth) +
+                                 size_t(packet.x0 + kernel::laneX(lane))];
                     sample.covered = true;
-                    sample.depthMetres = -point.positionView.z;
-                    sample.normalView = point.normalView;
-                    const SplitLighting lighting = splitLighting(point, lights, list);
-                    sample.diffuse = lighting.diffuse;
-                    sample.specular = lighting.specular;
-                    sample.specularEdge = lighting.specularEdge;
-                    result.lightsEvaluated[size_t(y) * width + x] = uint32_t(list.size());
+                    sample.depthMetres = -packet.positionView[2][lane];
+                    for (int c = 0; c < 3; ++c) {
+                        sample.normalView[c] = packet.normalView[c][lane];
+                        sample.diffuse[c] = sums.diffuse[c][lane];
+                        sample.specular[c] = sums.specular[c][lane];
+                        sample.specularEdge[c] = sums.specularEdge[c][lane];
+                    }
                 }
-        });
+            });
+        // Low-res tile (tx, ty) is full-res tile (tx, ty) of the culling grid (see "cull").
+        accumulateSplitLights(
+            inputs, {scale, mExcluded},
+            TileListSource(mOptions.tileSizeSamples, grid.tileCountX, mTileLights), sink, result);
         lightingPass.stop();
         if (blended) {
             blendPass.resume();
@@ -322,6 +329,7 @@ private:
     InferredOptions mOptions;
     // Per-frame scratch, kept to avoid reallocation between repetitions.
     std::vector<LightSample> mSamples;
+    std::vector<uint8_t> mExcluded; // per low-res sample: 1 = stippled (not lit by "lighting")
     std::vector<uint32_t> mSampleObjects; // object ID per low-res sample; all kNoObject with ids=0
     MaterialPass mMaterials;
     LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)

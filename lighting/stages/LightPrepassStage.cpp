@@ -7,13 +7,21 @@
 //               LightBounds.h, lists in ascending light index; unbounded lights in every list).
 //   "lighting"  light accumulation into the light buffer, per pixel:
 //                 diffuse RGB  = sum_i radiance_i * att_i * (n.l_i) / pi  (+ ambient radiance)
-//                 specular     = sum_i lum(radiance_i * att_i * (n.l_i) * blinnPhong_i)
+//                 specular     = lum(sum_i radiance_i * att_i * (n.l_i) * blinnPhong_i)
 //               i.e. the BRDF's diffuse part without albedo and ONE monochromatic specular scalar
 //               without the specular intensity, as the technique stores it (RGB + alpha).
-//               Both terms come from the one BRDF (Brdf.h evaluateLight), called with albedo 1 and
-//               specular intensity 0 for the diffuse part and albedo 0, intensity 1 for the
-//               specular part (the second call only for lights whose diffuse part is non-zero:
-//               a light with zero diffuse there has zero att * n.l, so zero specular too).
+//               Both terms are the one BRDF's (lighting/SplitLighting.h, addSplitLight): albedo 1
+//               and specular intensity 0 for the diffuse part, albedo 0 and intensity 1 for the
+//               specular part (only for lights whose diffuse part is non-zero: a light with zero
+//               diffuse there has zero att * n.l, so zero specular too); metallic-roughness
+//               surfaces split exactly into diffuse, F0 lobe and Fresnel edge sums.
+//               On the shading kernel: accumulateSplitLights (lighting/LightAccumulation.h)
+//               decodes 4x4-pixel packets, groups their lanes by tile and shades each group with
+//               kernel::shadePacketSplit on --isa (one evaluation per light for all the sums).
+//               `--isa scalar` gives the per-pixel splitLighting sums bitwise; a vector ISA the
+//               same diffuse and metallic-roughness sums bitwise and Blinn-Phong specular sums
+//               within pow's error (kernel/SplitLightKernel.h); a layout the packet decoder
+//               refuses takes the per-pixel path (stage_parameters.isa = scalar).
 //   "material"  the second geometry pass (lighting/MaterialPass.h): the scene is rasterized
 //               again with the G-buffer pass's visibility draw, and each visible pixel's material
 //               comes from its triangle's surface -- albedo and specular intensity are never read
@@ -29,22 +37,20 @@
 // G-buffer: depth, normal and specular (the layout has no power-only channel; only the specular
 // power is read from it). Position is reconstructed from depth (GBuffer::decode).
 // lightsEvaluated: the tile list size per covered pixel (lights accumulated in "lighting").
-// Cost note (CPU): a contributing light costs two evaluateLight calls (diffuse, then specular
-// part) where `tiled` needs one; this keeps a single BRDF definition at the price of roughly
-// twice the per-light work in "lighting" (a GPU light buffer pays nothing comparable).
-// Threads: tiles in parallel for culling and lighting, rows for the material pass; every pixel
-// written by one task only, light sums in ascending light order: deterministic.
-//
-// Shading stays scalar (not lighting/LightAccumulation.h): the light buffer holds diffuse and
-// specular sums apart (splitLighting), which the kernel's one radiance sum does not produce.
+// Cost note (CPU): the kernel evaluates range, direction and attenuation once per light for both
+// sums (before the kernel: two evaluateLight calls per contributing light, twice `tiled`'s work);
+// the specular part still adds a second lobe evaluation beside the diffuse one.
+// SIMT counters (simt_lane_slots, packet_*): warps of 8x4 pixels over the light pass, as
+// accumulateLights counts them (lighting/README.md, "SIMT cost model").
+// Threads: tiles in parallel for culling, warp rows for lighting, rows for the material pass; every
+// pixel written by one task only, light sums in ascending light order: deterministic.
 #include "lighting/StageRegistry.h"
 
 #include <algorithm>
 #include <span>
 
-#include <tbb/parallel_for.h>
-
 #include "lighting/BlendedPass.h"
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/MaterialPass.h"
@@ -71,7 +77,6 @@ public:
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         result.resize(width, height, false);
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
         PassTimer cullPass(result, pass::kCull);
         const TileGrid grid = TileGrid::make(width, height, mTileSizePixels);
@@ -85,24 +90,25 @@ public:
         mDiffuse.assign(gb.pixelCount(), glm::vec3(0.0f));
         mSpecular.assign(gb.pixelCount(), 0.0f);
         mSpecularEdge.assign(gb.pixelCount(), 0.0f);
-        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-            if (!bounds[size_t(tile)].covered)
-                return;
-            const std::span<const uint32_t> list = mTileLights[size_t(tile)];
-            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-            for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
-                for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
-                    const size_t pixel = size_t(y) * width + x;
-                    gbuffer::Surface point;
-                    if (!gb.surfaceAt(x, y, point))
-                        continue;
-                    const SplitLighting lighting = splitLighting(point, lights, list);
-                    mDiffuse[pixel] = lighting.diffuse;
-                    mSpecular[pixel] = luminance(lighting.specular); // one monochrome scalar
-                    mSpecularEdge[pixel] = luminance(lighting.specularEdge);
-                    result.lightsEvaluated[pixel] = uint32_t(list.size());
+        const SplitLightSinkOf sink(
+            [&](const kernel::ShadingPacket& packet, const kernel::SplitPacketAccumulator& sums) {
+                for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+                    const int lane = __builtin_ctz(lanes);
+                    const size_t pixel = size_t(packet.y0 + kernel::laneY(lane)) * size_t(width) +
+                                         size_t(packet.x0 + kernel::laneX(lane));
+                    const glm::vec3 specular(sums.specular[0][lane], sums.specular[1][lane],
+                                             sums.specular[2][lane]);
+                    const glm::vec3 edge(sums.specularEdge[0][lane], sums.specularEdge[1][lane],
+                                         sums.specularEdge[2][lane]);
+                    mDiffuse[pixel] = {sums.diffuse[0][lane], sums.diffuse[1][lane],
+                                       sums.diffuse[2][lane]};
+                    mSpecular[pixel] = luminance(specular); // one monochrome scalar
+                    mSpecularEdge[pixel] = luminance(edge);
                 }
-        });
+            });
+        accumulateSplitLights(inputs, {},
+                              TileListSource(grid.tileSizePixels, grid.tileCountX, mTileLights),
+                              sink, result);
         lightingPass.stop();
 
         // Material pass: second geometry pass into a visibility buffer, then combine.

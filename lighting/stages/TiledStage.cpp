@@ -44,28 +44,6 @@ namespace lighting {
 
 namespace {
 
-// A packet's lanes grouped by tile (a 4x4 packet spans several tiles when the tile size is not a
-// multiple of 4), each with its tile's ascending list.
-class TileListSource final : public PacketListSource {
-public:
-    TileListSource(const TileGrid& grid, const LightIndexLists& tileLights)
-        : mGrid(grid), mTileLights(tileLights) {}
-    void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
-        const int size = mGrid.tileSizePixels;
-        lists.addByKey(
-            packet,
-            [&](int lane) {
-                return ((packet.y0 + kernel::laneY(lane)) / size) * mGrid.tileCountX +
-                       (packet.x0 + kernel::laneX(lane)) / size;
-            },
-            [&](int tile) { return mTileLights[size_t(tile)]; });
-    }
-
-private:
-    const TileGrid& mGrid;
-    const LightIndexLists& mTileLights;
-};
-
 struct TiledOptions {
     int tileSizePixels = 16;
     bool viewFrustumCulling = true;
@@ -96,7 +74,8 @@ public:
         cull.stop();
 
         PassTimer shading(result, pass::kShading);
-        accumulateLights(inputs, TileListSource(grid, mTileLights), {}, result);
+        accumulateLights(inputs, TileListSource(grid.tileSizePixels, grid.tileCountX, mTileLights),
+                         {}, result);
         shading.stop();
 
         if (mBlended.prepare(inputs))
