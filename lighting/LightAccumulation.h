@@ -41,6 +41,10 @@
 
 namespace lighting {
 
+namespace kernel {
+struct GBufferPlanes; // PacketDecoder.h
+} // namespace kernel
+
 // The lists of one packet: groups of lanes, each with the light indices (ascending for exactness)
 // its lanes are shaded with. A lane in no group gets no light (radiance 0, evaluated 0).
 class PacketLightLists {
@@ -259,5 +263,12 @@ struct AccumulationOptions {
 // "shading" pass around the call.
 void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                       const AccumulationOptions& options, StageResult& result);
+
+// Whether a frame takes the packet path: the one check (PacketDecoder::supports on the
+// G-buffer's layout), for the stages that shade packets outside accumulateLights (`deferred`,
+// light by light) and so must fall back to the per-pixel path exactly when accumulateLights does.
+bool packetPathFits(const StageInputs& inputs);
+// The G-buffer's own planes as a PacketDecoder reads them (no copy; valid while `gb` lives).
+kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb);
 
 } // namespace lighting
