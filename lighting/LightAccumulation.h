@@ -1,6 +1,7 @@
 // accumulateLights: the one "sum the lights, store the pixel" loop of the G-buffer stages (issue
 // 14, section 1): brute, tiled, tiled-backface, clustered and light-indexed call it with their
-// light lists instead of each copying a per-pixel loop.
+// light lists instead of each copying a per-pixel loop. (`deferred`, which shades light by light
+// over its volumes' pixels, calls the kernel itself and shares the path check, packetPathFits.)
 //
 // The frame is walked in SIMT warps (8x4 pixels, or 8x8), each made of 4x4-pixel packets. Per
 // packet: decode the G-buffer (lighting/kernel/PacketDecoder.h), ask the stage's PacketListSource
