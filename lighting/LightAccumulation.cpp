@@ -38,6 +38,8 @@ struct PacketCounts {
     uint64_t shaded = 0;
 };
 
+} // namespace
+
 // The one check of which path a frame takes (see the header): the packet decoder must read the
 // layout. The kernel shades both material models (Blinn-Phong and metallic-roughness).
 bool packetPathFits(const StageInputs& inputs) {
@@ -60,6 +62,8 @@ kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb) {
     planes.material = gb.materialPlane().empty() ? nullptr : gb.materialPlane().data();
     return planes;
 }
+
+namespace {
 
 // The per-pixel path's packet: the lanes' surfaces from GBuffer::surfaceAt, and the packet rows
 // the list sources read (positions, mask).

@@ -2,7 +2,9 @@
 // 14, section 1): brute, tiled, tiled-backface, clustered and light-indexed call it with their
 // light lists instead of each copying a per-pixel loop. accumulateSplitLights (below) is its form
 // for the light-buffer stages (light-prepass, inferred): the same packets, lists, paths and SIMT
-// counters, with split diffuse / specular sums (kernel::shadePacketSplit).
+// counters, with split diffuse / specular sums (kernel::shadePacketSplit). (`deferred`, which
+// shades light by light over its volumes' pixels, calls the kernel itself and shares the path
+// check, packetPathFits.)
 //
 // The frame is walked in SIMT warps (8x4 pixels, or 8x8), each made of 4x4-pixel packets. Per
 // packet: decode the G-buffer (lighting/kernel/PacketDecoder.h), ask the stage's PacketListSource
@@ -45,6 +47,10 @@
 #include "lighting/kernel/SplitLightKernel.h"
 
 namespace lighting {
+
+namespace kernel {
+struct GBufferPlanes; // PacketDecoder.h
+} // namespace kernel
 
 // The lists of one packet: groups of lanes, each with the light indices (ascending for exactness)
 // its lanes are shaded with. A lane in no group gets no light (radiance 0, evaluated 0).
@@ -344,5 +350,12 @@ private:
 void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions& options,
                            const PacketListSource& source, const SplitLightSink& sink,
                            StageResult& result);
+
+// Whether a frame takes the packet path: the one check (PacketDecoder::supports on the
+// G-buffer's layout), for the stages that shade packets outside accumulateLights (`deferred`,
+// light by light) and so must fall back to the per-pixel path exactly when accumulateLights does.
+bool packetPathFits(const StageInputs& inputs);
+// The G-buffer's own planes as a PacketDecoder reads them (no copy; valid while `gb` lives).
+kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb);
 
 } // namespace lighting

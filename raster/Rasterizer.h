@@ -160,6 +160,9 @@ public:
     const RasterStats& lastStats() const { return mStats; }
     int tileCountX() const { return mTilesX; }
     int tileCountY() const { return mTilesY; }
+    // The screen tile of pixel (x, y): draw() calls the fragment function for one tile's pixels
+    // from one task at a time, in submission order, so state kept per tile needs no lock.
+    int tileOf(int x, int y) const { return (y / kTileSize) * mTilesX + x / kTileSize; }
 
 private:
     // Cache-line aligned: neighbouring batches are set up by different threads, and their

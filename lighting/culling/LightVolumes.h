@@ -142,6 +142,12 @@ public:
               Fn&& fn);
 
     const LightVolumeStats& stats() const { return mStats; }
+    // The rasterizer's screen tiles (raster::kTileSize pixels square, raster::Rasterizer::tileOf):
+    // draw() calls fn for the pixels of one tile from one task at a time and, inside a tile, light
+    // after light in ascending order (each light's fragments together), so a caller may keep state
+    // per tile (e.g. gather a light's pixels and shade them when the tile's light changes).
+    int tileCount() const { return mRasterizer.tileCountX() * mRasterizer.tileCountY(); }
+    int tileOf(int x, int y) const { return mRasterizer.tileOf(x, y); }
 
     // Inclusive pixel rectangle that contains the projection of the sphere (full screen when it
     // crosses the near plane); empty (minX > maxX) when it cannot be seen.

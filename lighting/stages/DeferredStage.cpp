@@ -1,15 +1,43 @@
 // `deferred`: traditional deferred shading with light volumes (Ishmukhametov 2013, 1.3 and 3.5;
 // Thaler 2011). Lights are processed one after another in ascending light order; each bounded
-// light's volume is rasterized over the G-buffer (LightVolumes.h) and, in the fragment function,
-// decodes the G-buffer surface, evaluates the light and ADDS it to the pixel. Decoding the
-// G-buffer once per light per pixel is the honest bandwidth cost of this technique. Directional
-// and ambient lights are full-screen quads at their place in the light order. Emission is added
-// once per pixel after the last light (addEmission, LightListShading.h), inside "shading".
+// light's volume is rasterized over the G-buffer (LightVolumes.h), and the pixels it covers
+// decode the G-buffer surface, evaluate that light and ADD it to the pixel. Decoding the G-buffer
+// once per light per pixel is the honest bandwidth cost of this technique (a GPU reads the
+// G-buffer again in every light volume's pixel shader). Directional and ambient lights are
+// full-screen quads at their place in the light order. Emission is added once per pixel after the
+// last light (addEmission, LightListShading.h), inside "shading".
 //
-// Exactness: every pixel receives its lights in ascending index order and skipped lights
-// contribute exactly zero, so the image is bitwise equal to `brute`'s. All volumes go through
-// one rasterizer draw in light order (LightVolumes.h: the rasterizer keeps submission order per
-// tile), parallel over tiles, a pixel written by one task only: deterministic.
+// Shading on the kernel (issue 14, "every stage uses the kernel"): the volume draw's fragment
+// function does not shade pixel by pixel; it gathers the current light's covered pixels of its
+// raster tile as a lane mask per 4x4 packet (TileBatch). When the light drawn in that tile
+// changes (and for each tile's last light after the draw), every touched packet is decoded by the
+// kernel's PacketDecoder on the StageInputs' ISA and shaded with that ONE light under that lane
+// mask (kernel::shadePacket), its lanes starting from the pixels' running sums, which are stored
+// back with lightsEvaluated + 1 and the light trace (traceAddedLight), as the per-pixel loop did.
+// So the technique keeps its character: one light at a time, the G-buffer read (a packet at a
+// time) once per light, one rasterizer draw in light order. Decoding a packet once and walking
+// per-lane light lists instead (as `ideal` and `light-indexed` do) would need every light's
+// coverage of a packet gathered before shading it, i.e. per-pixel light lists built by the volume
+// draw and one shading pass over them: that is light-indexed deferred (LightIndexedStage.cpp),
+// not this technique, so it is not offered as an option here.
+//
+// Exactness: every pixel receives its lights in ascending index order, one kernel call per light
+// adding into its running sum, and skipped lights contribute exactly zero, so the image is bitwise
+// equal to `brute`'s on the same ISA (a lane's value of a light does not depend on the other lanes
+// of its packet, LightKernel.h). `--isa scalar` is evaluateLight lane by lane: bitwise the
+// per-pixel loop this stage had before. A layout the packet decoder does not read (the check of
+// accumulateLights, packetPathFits) takes the per-pixel path, GBuffer::surfaceAt + evaluateLight
+// per gathered pixel, and records isa=scalar.
+//
+// Threads: all volumes go through one rasterizer draw in light order (LightVolumes.h: the
+// rasterizer keeps submission order per tile), parallel over tiles; a tile's batch is touched only
+// by the task rasterizing that tile, then by one task per tile for the final flush. Packets and
+// SIMT warps never straddle a tile (raster::kTileSize is a multiple of 8), so a pixel is written by
+// one task only and the result does not depend on the thread count.
+//
+// SIMT cost model (lighting/README.md): a warp (8x4 or 8x8 pixels) pays a light, warpLanes lane
+// slots, when any of its pixels is in that light's volume (passes the volume's tests), i.e. when
+// any of its lanes would run that light's pixel shader; counted per light flush of a tile.
 //
 // Options (defaults first):
 //   volume=sphere|rect  sphere: back faces of a circumscribing proxy (icosphere), depth test
@@ -22,22 +50,66 @@
 // Every volume ends with the depth-bounds test (surface view depth within centre +- radius, and
 // within the pyramid's depth range for cones).
 // Passes: "cull" (view-frustum culling), "shading" (volume rasterization and shading, interleaved).
-//
-// Shading stays scalar (evaluateLight per pixel, not lighting/LightAccumulation.h): the stage sums
-// light by light over each light volume's pixels, decoding the G-buffer once per light, so there is
-// no per-pixel list for a packet to walk; its pass structure is what the stage measures.
+// Parameters: the volume options and statistics (recordVolumeParameters), isa, simt_warp,
+// simt_lane_slots, and on the packet path packet_groups (kernel calls: one per light and touched
+// packet) and the kernel's packet_lights_* counters, as accumulateLights records them.
 #include "lighting/StageRegistry.h"
 
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
 #include "lighting/BlendedPass.h"
+#include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
 #include "lighting/PassNames.h"
 #include "lighting/culling/LightVolumes.h"
+#include "lighting/kernel/KernelLights.h"
+#include "lighting/kernel/LightKernel.h"
+#include "lighting/kernel/PacketDecoder.h"
 #include "lighting/stages/VolumeStageOptions.h"
 
 namespace lighting {
 
 namespace {
+
+using kernel::kPacketHeight;
+using kernel::kPacketLanes;
+using kernel::kPacketWidth;
+
+constexpr int kWarpWidth = 8; // pixels; a SIMT warp is 8x4 (32 lanes) or 8x8 (64 lanes)
+constexpr int kTilePackets = raster::kTileSize / kPacketWidth; // packets along a tile's side
+static_assert(raster::kTileSize % kWarpWidth == 0 && raster::kTileSize % 8 == 0,
+              "packets and warps must not straddle a raster tile");
+static_assert(kPacketWidth == kPacketHeight, "tiles hold square packet grids");
+// Warps of a tile, the most there can be (8x4 warps).
+constexpr int kTileWarps = (raster::kTileSize / kWarpWidth) * (raster::kTileSize / 4);
+constexpr uint32_t kNoLight = UINT32_MAX;
+
+// The packet-level work of the kernel path, as accumulateLights records it.
+struct PacketCounts {
+    uint64_t groups = 0; // kernel calls
+    uint64_t skippedAtRange = 0;
+    uint64_t skippedAtConeOrFacing = 0;
+    uint64_t shaded = 0;
+};
+
+// One raster tile's pixels of the light being drawn there: a lane mask per packet of the tile,
+// the packets touched (first-touch order), and the tile's SIMT and kernel counters. Used by the
+// one task rasterizing the tile at a time (LightVolumeRasterizer::tileOf).
+struct alignas(64) TileBatch {
+    uint32_t light = kNoLight;
+    std::array<uint16_t, kTilePackets * kTilePackets> masks{}; // 0 outside the current light
+    std::vector<uint16_t> touched;                             // packets with a non-zero mask
+    std::array<uint32_t, kTileWarps> warpFlush{}; // per warp: the last flush that paid it
+    uint32_t flushes = 0;
+    uint64_t laneSlots = 0;
+    PacketCounts counts;
+};
 
 class DeferredStage final : public ShadingStage {
 public:
@@ -50,29 +122,129 @@ public:
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int width = gb.width(), height = gb.height();
+        if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
+            throw std::invalid_argument("deferred: simtWarpLanes must be 32 or 64, not " +
+                                        std::to_string(inputs.simtWarpLanes));
+        const int warpLanes = inputs.simtWarpLanes;
+        const int warpPacketRows = warpLanes / kWarpWidth / kPacketHeight; // 1 or 2
         result.resize(width, height, false);
 
         VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
         PassTimer shading(result, pass::kShading);
+        const bool packets = packetPathFits(inputs);
+        const kernel::KernelIsa isa = packets ? inputs.isa : kernel::KernelIsa::scalar();
+        std::optional<kernel::PacketDecoder> decoder;
+        std::optional<kernel::KernelLights> kernelLights;
+        if (packets) {
+            decoder.emplace(gb.layout(), gb.view(), planesOf(gb));
+            kernelLights.emplace(lights);
+        }
+        const int tileCount = cull.volumes.tileCount();
+        const int tilesX = (width + raster::kTileSize - 1) / raster::kTileSize;
+        mBatches.resize(size_t(tileCount));
+        for (TileBatch& batch : mBatches) {
+            batch.light = kNoLight;
+            batch.touched.clear();
+            batch.laneSlots = 0;
+            batch.counts = {};
+        }
         float* radiance[3] = {result.radiance[0].data(), result.radiance[1].data(),
                               result.radiance[2].data()};
         uint32_t* evaluated = result.lightsEvaluated.data();
-        // Adds one light at one pixel; the pixel belongs to the calling task alone.
-        auto addLight = [&](int x, int y, size_t pixel, uint32_t light) {
-            gbuffer::Surface point;
-            if (!gb.surfaceAt(x, y, point))
+
+        // Shades the batch's light at its touched packets and empties it. Called by the task that
+        // owns the tile.
+        auto flush = [&](TileBatch& batch, int tile) {
+            if (batch.touched.empty())
                 return;
-            const glm::vec3 value =
-                evaluateLight(point, glm::normalize(-point.positionView), lights[light]);
-            radiance[0][pixel] += value.x;
-            radiance[1][pixel] += value.y;
-            radiance[2][pixel] += value.z;
-            ++evaluated[pixel];
-            result.traceAddedLight(pixel, light);
+            const uint32_t light = batch.light;
+            const int tileX0 = (tile % tilesX) * raster::kTileSize;
+            const int tileY0 = (tile / tilesX) * raster::kTileSize;
+            ++batch.flushes;
+            kernel::ShadingPacket packet;
+            kernel::PacketAccumulator accumulator;
+            for (const uint16_t index : batch.touched) {
+                const uint32_t mask = batch.masks[index];
+                batch.masks[index] = 0;
+                const int packetX = index % kTilePackets, packetY = index / kTilePackets;
+                // SIMT: the packet's warp pays this light once (warpLanes slots).
+                const int warp = (packetY / warpPacketRows) * (kTilePackets / 2) + packetX / 2;
+                if (batch.warpFlush[size_t(warp)] != batch.flushes) {
+                    batch.warpFlush[size_t(warp)] = batch.flushes;
+                    batch.laneSlots += uint64_t(warpLanes);
+                }
+                const int x0 = tileX0 + packetX * kPacketWidth;
+                const int y0 = tileY0 + packetY * kPacketHeight;
+                if (!packets) {
+                    // Per-pixel path: the loop this stage had before, pixel by pixel.
+                    for (uint32_t lanes = mask; lanes != 0; lanes &= lanes - 1) {
+                        const int lane = __builtin_ctz(lanes);
+                        const int x = x0 + kernel::laneX(lane), y = y0 + kernel::laneY(lane);
+                        const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+                        gbuffer::Surface point;
+                        if (!gb.surfaceAt(x, y, point))
+                            continue;
+                        const glm::vec3 value = evaluateLight(
+                            point, glm::normalize(-point.positionView), lights[light]);
+                        radiance[0][pixel] += value.x;
+                        radiance[1][pixel] += value.y;
+                        radiance[2][pixel] += value.z;
+                        ++evaluated[pixel];
+                        result.traceAddedLight(pixel, light);
+                    }
+                    continue;
+                }
+                // The G-buffer read again for this light, a packet at a time.
+                decoder->decode(isa, x0, y0, packet);
+                const uint32_t lanes = mask & packet.laneMask;
+                if (lanes == 0)
+                    continue;
+                accumulator.clear();
+                for (uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+                    const int lane = __builtin_ctz(rest);
+                    const size_t pixel = size_t(y0 + kernel::laneY(lane)) * size_t(width) +
+                                         size_t(x0 + kernel::laneX(lane));
+                    for (int c = 0; c < 3; ++c)
+                        accumulator.radiance[c][lane] = radiance[c][pixel];
+                }
+                kernel::shadePacket(isa, packet, lanes, *kernelLights,
+                                    std::span<const uint32_t>(&light, 1), accumulator,
+                                    /*countContributing=*/false);
+                for (uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+                    const int lane = __builtin_ctz(rest);
+                    const size_t pixel = size_t(y0 + kernel::laneY(lane)) * size_t(width) +
+                                         size_t(x0 + kernel::laneX(lane));
+                    for (int c = 0; c < 3; ++c)
+                        radiance[c][pixel] = accumulator.radiance[c][lane];
+                    evaluated[pixel] += accumulator.lightsEvaluated[lane];
+                    result.traceAddedLight(pixel, light);
+                }
+                ++batch.counts.groups;
+                batch.counts.skippedAtRange += accumulator.lightsSkippedAtRange;
+                batch.counts.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
+                batch.counts.shaded += accumulator.lightsShaded;
+            }
+            batch.touched.clear();
         };
-        cull.volumes.draw(
-            cull.spheres, cull.drawn,
-            [&](uint32_t light, int x, int y, size_t pixel) { addLight(x, y, pixel, light); });
+
+        cull.volumes.draw(cull.spheres, cull.drawn, [&](uint32_t light, int x, int y, size_t) {
+            const int tile = cull.volumes.tileOf(x, y);
+            TileBatch& batch = mBatches[size_t(tile)];
+            if (batch.light != light) {
+                flush(batch, tile);
+                batch.light = light;
+            }
+            const int localX = x % raster::kTileSize;
+            const int localY = y % raster::kTileSize;
+            const int index = (localY / kPacketHeight) * kTilePackets + localX / kPacketWidth;
+            const int lane = (localY % kPacketHeight) * kPacketWidth + localX % kPacketWidth;
+            uint16_t& mask = batch.masks[size_t(index)];
+            if (mask == 0)
+                batch.touched.push_back(uint16_t(index));
+            mask = uint16_t(mask | (1u << lane));
+        });
+        // Each tile's last light.
+        tbb::parallel_for(0, tileCount, [&](int tile) { flush(mBatches[size_t(tile)], tile); });
         addEmission(gb, result);
         shading.stop();
         // Blended surfaces: every light (light volumes are tested against the opaque depth).
@@ -80,11 +252,32 @@ public:
             mBlended.shadeWithEveryLight(gb.depth(), result);
 
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
+        uint64_t laneSlots = 0;
+        PacketCounts counts;
+        for (const TileBatch& batch : mBatches) {
+            laneSlots += batch.laneSlots;
+            counts.groups += batch.counts.groups;
+            counts.skippedAtRange += batch.counts.skippedAtRange;
+            counts.skippedAtConeOrFacing += batch.counts.skippedAtConeOrFacing;
+            counts.shaded += batch.counts.shaded;
+        }
+        if (packets) {
+            result.parameters["packet_groups"] = std::to_string(counts.groups);
+            result.parameters["packet_lights_skipped_at_range"] =
+                std::to_string(counts.skippedAtRange);
+            result.parameters["packet_lights_skipped_at_cone_or_facing"] =
+                std::to_string(counts.skippedAtConeOrFacing);
+            result.parameters["packet_lights_shaded"] = std::to_string(counts.shaded);
+        }
+        result.parameters["isa"] = isa.name();
+        result.parameters["simt_warp"] = std::to_string(warpLanes);
+        result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
     }
 
 private:
     VolumeStageOptions mVolume;
-    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
+    BlendedPass mBlended;            // blended surfaces after the opaque pass (BlendedPass.h)
+    std::vector<TileBatch> mBatches; // one per raster tile, reused across calls
 };
 
 const StageRegistrar kRegistrar(

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <optional>
@@ -13,6 +14,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "gbuffer/GBufferLayout.h"
 #include "gbuffer/GBufferPass.h"
 #include "lighting/LightBounds.h"
 #include "lighting/Oracle.h"
@@ -526,3 +528,138 @@ TEST(LightVolumes, FrustumCullingAndScreenRectAreConservative) {
 }
 
 } // namespace
+
+// ---------------------------------------------------------------------------------------------
+// `deferred` on the shared light kernel (DeferredStage.cpp): each light's volume pixels shaded a
+// 4x4 packet at a time on the requested ISA, one light per kernel call.
+
+namespace deferredkernel {
+
+using lighting::kernel::KernelIsa;
+
+// 203x117: packets and SIMT warps cut by the right and bottom edges, a partial raster tile.
+constexpr int kOddWidth = 203;
+constexpr int kOddHeight = 117;
+
+const lighting::PreparedScene& oddAtrium() {
+    static const std::unique_ptr<lighting::PreparedScene> frame = [] {
+        scenes::Scene scene = proceduralScene("atrium", 150);
+        // A few spots, so the cone proxies and the kernel's cone test are in the frame too.
+        for (size_t i = 0; i < scene.lights.size(); i += 5)
+            if (scene.lights[i].type == scenes::LightType::Point) {
+                const float a = 2.4f * float(i);
+                scene.lights[i].type = scenes::LightType::Spot;
+                scene.lights[i].directionWorld =
+                    glm::normalize(glm::vec3(std::cos(a), -0.6f, std::sin(a)));
+                scene.lights[i].spotOuterCos = std::cos(glm::radians(35.0f));
+                scene.lights[i].spotInnerCos = std::cos(glm::radians(25.0f));
+                scene.lights[i].rangeMetres *= 1.5f;
+            }
+        return std::make_unique<lighting::PreparedScene>(std::move(scene), kOddWidth, kOddHeight);
+    }();
+    return *frame;
+}
+
+lighting::StageResult shadeOn(const std::string& stage, lighting::StageInputs inputs,
+                              const KernelIsa& isa, int threads, int warpLanes = 32,
+                              bool traced = false) {
+    inputs.isa = isa;
+    inputs.simtWarpLanes = warpLanes;
+    lighting::StageResult result;
+    result.traceLights = traced;
+    tbb::task_arena(threads).execute([&] { lighting::makeStage(stage)->shade(inputs, result); });
+    return result;
+}
+
+bool sameImage(const lighting::StageResult& a, const lighting::StageResult& b) {
+    for (int c = 0; c < 3; ++c)
+        if (a.radiance[c].size() != b.radiance[c].size() ||
+            std::memcmp(a.radiance[c].data(), b.radiance[c].data(),
+                        a.radiance[c].size() * sizeof(float)) != 0)
+            return false;
+    return true;
+}
+
+const char* const kDeferredVariants[] = {"deferred",           "deferred:volume=rect",
+                                         "deferred:stencil=1", "deferred:spot=sphere",
+                                         "deferred:vfc=0",     "deferred:volume=rect,vfc=0"};
+
+} // namespace deferredkernel
+
+// Every option variant, on the scalar path and the widest vector target: the ISA that ran is
+// recorded, the image is bitwise brute's on the same ISA, the counts do not depend on the ISA,
+// and 1 and 7 threads give bitwise the same image, counts and kernel/SIMT counters.
+TEST(LightVolumes, DeferredOnTheKernelIsBitwiseBruteOnEveryIsa) {
+    using namespace deferredkernel;
+    const lighting::PreparedScene& frame = oddAtrium();
+    for (const KernelIsa& isa : {KernelIsa::scalar(), KernelIsa::best()}) {
+        const lighting::StageResult brute = shadeOn("brute", frame.inputs, isa, 2);
+        ASSERT_EQ(brute.parameters.at("isa"), isa.name());
+        for (const char* stage : kDeferredVariants) {
+            const lighting::StageResult one = shadeOn(stage, frame.inputs, isa, 1);
+            EXPECT_EQ(one.parameters.at("isa"), isa.name()) << stage;
+            EXPECT_TRUE(sameImage(one, brute)) << stage << " on " << isa.name();
+            const lighting::StageResult scalar =
+                shadeOn(stage, frame.inputs, KernelIsa::scalar(), 2);
+            EXPECT_EQ(one.lightsEvaluated, scalar.lightsEvaluated) << stage << " " << isa.name();
+            const lighting::StageResult seven = shadeOn(stage, frame.inputs, isa, 7);
+            EXPECT_TRUE(sameImage(one, seven)) << stage << " " << isa.name() << " 1 vs 7 threads";
+            EXPECT_EQ(one.lightsEvaluated, seven.lightsEvaluated) << stage;
+            EXPECT_EQ(one.parameters, seven.parameters) << stage;
+        }
+    }
+}
+
+// A layout the packet decoder refuses (octahedral normal codes) takes the per-pixel path, as
+// accumulateLights does: it says isa=scalar whatever was asked, and the image is brute's bitwise.
+TEST(LightVolumes, DeferredPerPixelPathForLayoutsThePacketDecoderRefuses) {
+    using namespace deferredkernel;
+    gbuffer::GBufferLayout layout = gbuffer::GBufferLayout::reference();
+    layout.normals = gbuffer::NormalCodecSpec::parse("octahedral:16");
+    layout.name = "octahedral-test";
+    const lighting::PreparedScene frame(proceduralScene("atrium", 100), 96, 64, false, layout);
+    const lighting::StageResult brute = shadeOn("brute", frame.inputs, KernelIsa::best(), 2);
+    ASSERT_EQ(brute.parameters.at("isa"), "scalar");
+    for (const char* stage : {"deferred", "deferred:stencil=1"}) {
+        const lighting::StageResult result = shadeOn(stage, frame.inputs, KernelIsa::best(), 2);
+        EXPECT_EQ(result.parameters.at("isa"), "scalar") << stage;
+        EXPECT_EQ(result.parameters.count("packet_groups"), 0u) << stage;
+        EXPECT_TRUE(sameImage(result, brute)) << stage;
+    }
+}
+
+// The SIMT model for deferred: a warp pays warpLanes slots for each light whose volume holds any
+// of its pixels, i.e. for each light in the union of its pixels' traced lights (the same rule as
+// accumulateLights'); recomputed here from the light trace for 8x4 and 8x8 warps, and below
+// brute's (every light in every warp with a covered pixel).
+TEST(LightVolumes, DeferredSimtLaneSlotsAreTheWarpsInEachVolume) {
+    using namespace deferredkernel;
+    const lighting::PreparedScene& frame = oddAtrium();
+    for (int warpLanes : {32, 64})
+        for (const char* stage : {"deferred", "deferred:volume=rect", "deferred:stencil=1"}) {
+            const lighting::StageResult result =
+                shadeOn(stage, frame.inputs, KernelIsa::best(), 2, warpLanes, true);
+            const int warpHeight = warpLanes / 8;
+            uint64_t expected = 0;
+            std::vector<uint32_t> lights;
+            for (int wy = 0; wy < kOddHeight; wy += warpHeight)
+                for (int wx = 0; wx < kOddWidth; wx += 8) {
+                    lights.clear();
+                    for (int y = wy; y < std::min(kOddHeight, wy + warpHeight); ++y)
+                        for (int x = wx; x < std::min(kOddWidth, wx + 8); ++x) {
+                            const auto& trace = result.lightTrace[size_t(y) * kOddWidth + x];
+                            lights.insert(lights.end(), trace.begin(), trace.end());
+                        }
+                    std::sort(lights.begin(), lights.end());
+                    expected +=
+                        uint64_t(warpLanes) *
+                        uint64_t(std::unique(lights.begin(), lights.end()) - lights.begin());
+                }
+            EXPECT_EQ(std::stoull(result.parameters.at("simt_lane_slots")), expected)
+                << stage << " warp " << warpLanes;
+            EXPECT_EQ(result.parameters.at("simt_warp"), std::to_string(warpLanes));
+            const lighting::StageResult brute =
+                shadeOn("brute", frame.inputs, KernelIsa::best(), 2, warpLanes);
+            EXPECT_LT(expected, std::stoull(brute.parameters.at("simt_lane_slots"))) << stage;
+        }
+}
