@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/ForwardGeometry.h"
+#include "lighting/KernelWork.h"
 #include "lighting/LightAccumulation.h"
 #include "lighting/kernel/KernelLights.h"
 #include "lighting/kernel/LightKernel.h"
@@ -39,11 +40,7 @@ struct QueuedFragment {
 struct alignas(64) FragmentShading::TileBatch {
     std::array<QueuedFragment, kMaxWarpLanes> fragments;
     int count = 0;
-    uint64_t laneSlots = 0;
-    uint64_t groups = 0;
-    uint64_t skippedAtRange = 0;
-    uint64_t skippedAtConeOrFacing = 0;
-    uint64_t shaded = 0;
+    KernelWork work;                    // SIMT lane slots and kernel counters
     std::vector<uint32_t> unionScratch; // the union of the batch's lists, for the SIMT model
     std::vector<uint32_t> unionNext;
 };
@@ -68,8 +65,7 @@ void FragmentShading::begin(const StageInputs& inputs, const ForwardGeometry& ge
     mTiles.resize(size_t(mTilesX) * size_t(tilesY));
     for (TileBatch& tile : mTiles) {
         tile.count = 0;
-        tile.laneSlots = tile.groups = 0;
-        tile.skippedAtRange = tile.skippedAtConeOrFacing = tile.shaded = 0;
+        tile.work = {};
     }
 }
 
@@ -136,10 +132,10 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
                 kernel::shadePacket(mIsa, packet, group.laneMask, *mLights, group.lights,
                                     group.lightLaneMasks, accumulator, false);
         }
-        batch.groups += uint64_t(lists.size());
-        batch.skippedAtRange += accumulator.lightsSkippedAtRange;
-        batch.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
-        batch.shaded += accumulator.lightsShaded;
+        batch.work.groups += uint64_t(lists.size());
+        batch.work.skippedAtRange += accumulator.lightsSkippedAtRange;
+        batch.work.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
+        batch.work.shaded += accumulator.lightsShaded;
 
         // In fragment order: a later fragment of the same pixel comes after an earlier one.
         for (int lane = 0; lane < laneCount; ++lane) {
@@ -183,27 +179,15 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
         }
         unionSize = merged.size();
     }
-    batch.laneSlots += uint64_t(mWarpLanes) * unionSize;
+    batch.work.laneSlots += uint64_t(mWarpLanes) * unionSize;
     batch.count = 0;
 }
 
 void FragmentShading::end() {
-    uint64_t laneSlots = 0, groups = 0, skippedAtRange = 0, skippedAtConeOrFacing = 0, shaded = 0;
-    for (const TileBatch& tile : mTiles) {
-        laneSlots += tile.laneSlots;
-        groups += tile.groups;
-        skippedAtRange += tile.skippedAtRange;
-        skippedAtConeOrFacing += tile.skippedAtConeOrFacing;
-        shaded += tile.shaded;
-    }
-    std::map<std::string, std::string>& parameters = mResult->parameters;
-    parameters["isa"] = mIsa.name();
-    parameters["simt_warp"] = std::to_string(mWarpLanes);
-    parameters["simt_lane_slots"] = std::to_string(laneSlots);
-    parameters["packet_groups"] = std::to_string(groups);
-    parameters["packet_lights_skipped_at_range"] = std::to_string(skippedAtRange);
-    parameters["packet_lights_skipped_at_cone_or_facing"] = std::to_string(skippedAtConeOrFacing);
-    parameters["packet_lights_shaded"] = std::to_string(shaded);
+    KernelWork work;
+    for (const TileBatch& tile : mTiles)
+        work += tile.work;
+    work.record(mIsa, mWarpLanes, true, *mResult);
 }
 
 } // namespace lighting

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/Brdf.h"
+#include "lighting/KernelWork.h"
 #include "lighting/SplitLighting.h"
 #include "lighting/kernel/KernelLights.h"
 #include "lighting/kernel/LightKernel.h"
@@ -28,15 +29,6 @@ EveryLightSource::EveryLightSource(size_t lightCount) : mIndices(lightCount) {
 namespace {
 
 constexpr int kWarpWidth = 8; // pixels; a warp is 8x4 (32 lanes) or 8x8 (64 lanes)
-
-// Packet-level work of a frame (the packet path only): kernel calls, and each packet-wide light
-// iteration by where it ended (PacketAccumulator's counters).
-struct PacketCounts {
-    uint64_t groups = 0;
-    uint64_t skippedAtRange = 0;
-    uint64_t skippedAtConeOrFacing = 0;
-    uint64_t shaded = 0;
-};
 
 } // namespace
 
@@ -186,20 +178,17 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
     }
 
     const int warpRows = (height + warpHeight - 1) / warpHeight;
-    std::vector<uint64_t> laneSlotsPerRow(size_t(warpRows), 0);
-    // Per warp row: packet-wide light iterations by outcome (PacketAccumulator's counters; the
-    // vector kernel's cost is about proportional to them, lighting/kernel/README.md) and kernel
-    // calls (one per group).
-    const size_t rowCount = size_t(warpRows);
-    std::vector<PacketCounts> countsPerRow(rowCount);
+    // Per warp row: lane slots, packet-wide light iterations by outcome (PacketAccumulator's
+    // counters; the vector kernel's cost is about proportional to them, lighting/kernel/README.md)
+    // and kernel calls (one per group).
+    std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
     tbb::parallel_for(0, warpRows, [&](int warpRow) {
         kernel::ShadingPacket packet;
         kernel::PacketAccumulator accumulator;
         PacketLightLists lists;
         gbuffer::Surface surfaces[kPacketLanes];
         WarpUnion warpUnion(lights.size());
-        uint64_t laneSlots = 0;
-        PacketCounts counts;
+        KernelWork rowWork;
         for (int wx = 0; wx < width; wx += kWarpWidth) {
             warpUnion.begin();
             bool anyLane = false;
@@ -215,7 +204,7 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                     lists.clear();
                     source.listsOf(packet, lists);
                     accumulator.clear();
-                    counts.groups += uint64_t(lists.size());
+                    rowWork.groups += uint64_t(lists.size());
                     if (packets) {
                         for (int g = 0; g < lists.size(); ++g) {
                             const PacketLightLists::Group& group = lists[g];
@@ -237,9 +226,9 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                             warpUnion.add(lists[g].lights);
                         anyLane = true;
                     }
-                    counts.skippedAtRange += accumulator.lightsSkippedAtRange;
-                    counts.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
-                    counts.shaded += accumulator.lightsShaded;
+                    rowWork.skippedAtRange += accumulator.lightsSkippedAtRange;
+                    rowWork.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
+                    rowWork.shaded += accumulator.lightsShaded;
                     // The test-only light trace (StageResult::traceLights): each lane summed
                     // exactly its group's list (with per-light masks, its lights of it).
                     if (result.tracing())
@@ -273,32 +262,15 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                     }
                 }
             if (anyLane)
-                laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
+                rowWork.laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
         }
-        laneSlotsPerRow[size_t(warpRow)] = laneSlots;
-        countsPerRow[size_t(warpRow)] = counts;
+        workPerRow[size_t(warpRow)] = rowWork;
     });
 
-    uint64_t laneSlots = 0;
-    for (uint64_t slots : laneSlotsPerRow)
-        laneSlots += slots;
-    PacketCounts counts;
-    for (const PacketCounts& row : countsPerRow) {
-        counts.groups += row.groups;
-        counts.skippedAtRange += row.skippedAtRange;
-        counts.skippedAtConeOrFacing += row.skippedAtConeOrFacing;
-        counts.shaded += row.shaded;
-    }
-    if (packets) {
-        result.parameters["packet_groups"] = std::to_string(counts.groups);
-        result.parameters["packet_lights_skipped_at_range"] = std::to_string(counts.skippedAtRange);
-        result.parameters["packet_lights_skipped_at_cone_or_facing"] =
-            std::to_string(counts.skippedAtConeOrFacing);
-        result.parameters["packet_lights_shaded"] = std::to_string(counts.shaded);
-    }
-    result.parameters["isa"] = isa.name();
-    result.parameters["simt_warp"] = std::to_string(inputs.simtWarpLanes);
-    result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
+    KernelWork work;
+    for (const KernelWork& row : workPerRow)
+        work += row;
+    work.record(isa, inputs.simtWarpLanes, packets, result);
 }
 
 } // namespace lighting
@@ -380,16 +352,14 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
     };
 
     const int warpRows = (sampleHeight + warpHeight - 1) / warpHeight;
-    std::vector<uint64_t> laneSlotsPerRow(size_t(warpRows), 0);
-    std::vector<PacketCounts> countsPerRow(static_cast<size_t>(warpRows));
+    std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
     tbb::parallel_for(0, warpRows, [&](int warpRow) {
         kernel::ShadingPacket packet;
         kernel::SplitPacketAccumulator sums;
         PacketLightLists lists;
         gbuffer::Surface surfaces[kPacketLanes];
         WarpUnion warpUnion(lights.size());
-        uint64_t laneSlots = 0;
-        PacketCounts counts;
+        KernelWork rowWork;
         for (int wi = 0; wi < sampleWidth; wi += kWarpWidth) {
             warpUnion.begin();
             bool anyLane = false;
@@ -410,7 +380,7 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
                     lists.clear();
                     source.listsOf(packet, lists);
                     sums.clear();
-                    counts.groups += uint64_t(lists.size());
+                    rowWork.groups += uint64_t(lists.size());
                     for (int g = 0; g < lists.size(); ++g) {
                         const PacketLightLists::Group& group = lists[g];
                         if (!group.lightLaneMasks.empty())
@@ -447,38 +417,21 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
                             result.traceLightList(pixel, group.lights);
                         }
                     }
-                    counts.skippedAtRange += sums.lightsSkippedAtRange;
-                    counts.skippedAtConeOrFacing += sums.lightsSkippedAtConeOrFacing;
-                    counts.shaded += sums.lightsShaded;
+                    rowWork.skippedAtRange += sums.lightsSkippedAtRange;
+                    rowWork.skippedAtConeOrFacing += sums.lightsSkippedAtConeOrFacing;
+                    rowWork.shaded += sums.lightsShaded;
                     sink.store(packet, sums);
                 }
             if (anyLane)
-                laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
+                rowWork.laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
         }
-        laneSlotsPerRow[size_t(warpRow)] = laneSlots;
-        countsPerRow[size_t(warpRow)] = counts;
+        workPerRow[size_t(warpRow)] = rowWork;
     });
 
-    uint64_t laneSlots = 0;
-    for (uint64_t slots : laneSlotsPerRow)
-        laneSlots += slots;
-    PacketCounts counts;
-    for (const PacketCounts& row : countsPerRow) {
-        counts.groups += row.groups;
-        counts.skippedAtRange += row.skippedAtRange;
-        counts.skippedAtConeOrFacing += row.skippedAtConeOrFacing;
-        counts.shaded += row.shaded;
-    }
-    if (packets) {
-        result.parameters["packet_groups"] = std::to_string(counts.groups);
-        result.parameters["packet_lights_skipped_at_range"] = std::to_string(counts.skippedAtRange);
-        result.parameters["packet_lights_skipped_at_cone_or_facing"] =
-            std::to_string(counts.skippedAtConeOrFacing);
-        result.parameters["packet_lights_shaded"] = std::to_string(counts.shaded);
-    }
-    result.parameters["isa"] = isa.name();
-    result.parameters["simt_warp"] = std::to_string(inputs.simtWarpLanes);
-    result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
+    KernelWork work;
+    for (const KernelWork& row : workPerRow)
+        work += row;
+    work.record(isa, inputs.simtWarpLanes, packets, result);
 }
 
 } // namespace lighting

@@ -63,6 +63,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/BlendedPass.h"
+#include "lighting/KernelWork.h"
 #include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
 #include "lighting/LightListShading.h"
@@ -90,14 +91,6 @@ static_assert(kPacketWidth == kPacketHeight, "tiles hold square packet grids");
 constexpr int kTileWarps = (raster::kTileSize / kWarpWidth) * (raster::kTileSize / 4);
 constexpr uint32_t kNoLight = UINT32_MAX;
 
-// The packet-level work of the kernel path, as accumulateLights records it.
-struct PacketCounts {
-    uint64_t groups = 0; // kernel calls
-    uint64_t skippedAtRange = 0;
-    uint64_t skippedAtConeOrFacing = 0;
-    uint64_t shaded = 0;
-};
-
 // One raster tile's pixels of the light being drawn there: a lane mask per packet of the tile,
 // the packets touched (first-touch order), and the tile's SIMT and kernel counters. Used by the
 // one task rasterizing the tile at a time (LightVolumeRasterizer::tileOf).
@@ -107,8 +100,7 @@ struct alignas(64) TileBatch {
     std::vector<uint16_t> touched;                             // packets with a non-zero mask
     std::array<uint32_t, kTileWarps> warpFlush{}; // per warp: the last flush that paid it
     uint32_t flushes = 0;
-    uint64_t laneSlots = 0;
-    PacketCounts counts;
+    KernelWork work; // SIMT lane slots and kernel counters
 };
 
 class DeferredStage final : public ShadingStage {
@@ -145,8 +137,7 @@ public:
         for (TileBatch& batch : mBatches) {
             batch.light = kNoLight;
             batch.touched.clear();
-            batch.laneSlots = 0;
-            batch.counts = {};
+            batch.work = {};
         }
         float* radiance[3] = {result.radiance[0].data(), result.radiance[1].data(),
                               result.radiance[2].data()};
@@ -171,7 +162,7 @@ public:
                 const int warp = (packetY / warpPacketRows) * (kTilePackets / 2) + packetX / 2;
                 if (batch.warpFlush[size_t(warp)] != batch.flushes) {
                     batch.warpFlush[size_t(warp)] = batch.flushes;
-                    batch.laneSlots += uint64_t(warpLanes);
+                    batch.work.laneSlots += uint64_t(warpLanes);
                 }
                 const int x0 = tileX0 + packetX * kPacketWidth;
                 const int y0 = tileY0 + packetY * kPacketHeight;
@@ -219,10 +210,10 @@ public:
                     evaluated[pixel] += accumulator.lightsEvaluated[lane];
                     result.traceAddedLight(pixel, light);
                 }
-                ++batch.counts.groups;
-                batch.counts.skippedAtRange += accumulator.lightsSkippedAtRange;
-                batch.counts.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
-                batch.counts.shaded += accumulator.lightsShaded;
+                ++batch.work.groups;
+                batch.work.skippedAtRange += accumulator.lightsSkippedAtRange;
+                batch.work.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
+                batch.work.shaded += accumulator.lightsShaded;
             }
             batch.touched.clear();
         };
@@ -252,26 +243,10 @@ public:
             mBlended.shadeWithEveryLight(gb.depth(), result);
 
         recordVolumeParameters(mVolume, cull.culled(), cull.volumes.stats(), result.parameters);
-        uint64_t laneSlots = 0;
-        PacketCounts counts;
-        for (const TileBatch& batch : mBatches) {
-            laneSlots += batch.laneSlots;
-            counts.groups += batch.counts.groups;
-            counts.skippedAtRange += batch.counts.skippedAtRange;
-            counts.skippedAtConeOrFacing += batch.counts.skippedAtConeOrFacing;
-            counts.shaded += batch.counts.shaded;
-        }
-        if (packets) {
-            result.parameters["packet_groups"] = std::to_string(counts.groups);
-            result.parameters["packet_lights_skipped_at_range"] =
-                std::to_string(counts.skippedAtRange);
-            result.parameters["packet_lights_skipped_at_cone_or_facing"] =
-                std::to_string(counts.skippedAtConeOrFacing);
-            result.parameters["packet_lights_shaded"] = std::to_string(counts.shaded);
-        }
-        result.parameters["isa"] = isa.name();
-        result.parameters["simt_warp"] = std::to_string(warpLanes);
-        result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
+        KernelWork work;
+        for (const TileBatch& batch : mBatches)
+            work += batch.work;
+        work.record(isa, warpLanes, packets, result);
     }
 
 private:

@@ -1,0 +1,49 @@
+// KernelWork: what the shading kernel did over a frame, as every stage that calls it records it
+// (accumulateLights, accumulateSplitLights, `deferred`, FragmentShading): the SIMT cost model's
+// lane slots (lighting/README.md) and the packet-level counters of kernel::PacketAccumulator.
+// Each task sums its own KernelWork; the stage adds them in a fixed order after its parallel loop
+// (integers: the total does not depend on the thread count) and records them once.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "lighting/ShadingStage.h"
+#include "lighting/kernel/KernelIsa.h"
+
+namespace lighting {
+
+struct KernelWork {
+    uint64_t laneSlots = 0;             // SIMT lane slots: warp lanes x lights each warp paid
+    uint64_t groups = 0;                // kernel calls (lane groups shaded)
+    uint64_t skippedAtRange = 0;        // packet-wide light iterations by where they ended
+    uint64_t skippedAtConeOrFacing = 0; // (PacketAccumulator's three counters)
+    uint64_t shaded = 0;
+
+    KernelWork& operator+=(const KernelWork& other) {
+        laneSlots += other.laneSlots;
+        groups += other.groups;
+        skippedAtRange += other.skippedAtRange;
+        skippedAtConeOrFacing += other.skippedAtConeOrFacing;
+        shaded += other.shaded;
+        return *this;
+    }
+
+    // Records "isa" (what ran), "simt_warp", "simt_lane_slots" and, when the frame took the
+    // packet path, "packet_groups" and the three "packet_lights_*" counters.
+    void record(const kernel::KernelIsa& isa, int warpLanes, bool packets,
+                StageResult& result) const {
+        result.parameters["isa"] = isa.name();
+        result.parameters["simt_warp"] = std::to_string(warpLanes);
+        result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
+        if (!packets)
+            return;
+        result.parameters["packet_groups"] = std::to_string(groups);
+        result.parameters["packet_lights_skipped_at_range"] = std::to_string(skippedAtRange);
+        result.parameters["packet_lights_skipped_at_cone_or_facing"] =
+            std::to_string(skippedAtConeOrFacing);
+        result.parameters["packet_lights_shaded"] = std::to_string(shaded);
+    }
+};
+
+} // namespace lighting
