@@ -55,6 +55,16 @@ kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb) {
     return planes;
 }
 
+PacketPath::PacketPath(const StageInputs& inputs, bool decodePixels)
+    : packets(packetPathFits(inputs)), isa(packets ? inputs.isa : kernel::KernelIsa::scalar()) {
+    if (!packets)
+        return;
+    const gbuffer::GBuffer& gb = *inputs.gbuffer;
+    if (decodePixels)
+        decoder.emplace(gb.layout(), gb.view(), planesOf(gb));
+    lights.emplace(inputs.lights->lights);
+}
+
 namespace {
 
 // The per-pixel path's packet: the lanes' surfaces from GBuffer::surfaceAt, and the packet rows
@@ -167,15 +177,12 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
     const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
-    const bool packets = packetPathFits(inputs);
     const bool emission = gb.hasEmission();
-    const kernel::KernelIsa isa = packets ? inputs.isa : kernel::KernelIsa::scalar();
-    std::optional<kernel::PacketDecoder> decoder;
-    std::optional<kernel::KernelLights> kernelLights;
-    if (packets) {
-        decoder.emplace(gb.layout(), gb.view(), planesOf(gb));
-        kernelLights.emplace(lights);
-    }
+    PacketPath path(inputs);
+    const bool packets = path.packets;
+    const kernel::KernelIsa isa = path.isa;
+    std::optional<kernel::PacketDecoder>& decoder = path.decoder;
+    std::optional<kernel::KernelLights>& kernelLights = path.lights;
 
     const int warpRows = (height + warpHeight - 1) / warpHeight;
     // Per warp row: lane slots, packet-wide light iterations by outcome (PacketAccumulator's
@@ -336,16 +343,12 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
     const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
-    const bool packets = packetPathFits(inputs);
-    const kernel::KernelIsa isa = packets ? inputs.isa : kernel::KernelIsa::scalar();
     // Whole pixels (scale 1) are decoded a packet at a time; lattice samples are gathered.
-    std::optional<kernel::PacketDecoder> decoder;
-    std::optional<kernel::KernelLights> kernelLights;
-    if (packets) {
-        if (scale == 1)
-            decoder.emplace(gb.layout(), gb.view(), planesOf(gb));
-        kernelLights.emplace(lights);
-    }
+    PacketPath path(inputs, scale == 1);
+    const bool packets = path.packets;
+    const kernel::KernelIsa isa = path.isa;
+    std::optional<kernel::PacketDecoder>& decoder = path.decoder;
+    std::optional<kernel::KernelLights>& kernelLights = path.lights;
     auto pixelOf = [&](int i, int j) {
         return size_t(std::min(j * scale + scale / 2, height - 1)) * size_t(width) +
                size_t(std::min(i * scale + scale / 2, width - 1));

@@ -36,6 +36,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <utility>
@@ -43,6 +44,9 @@
 
 #include "lighting/ShadingStage.h"
 #include "lighting/culling/LightIndexLists.h"
+#include "lighting/kernel/KernelIsa.h"
+#include "lighting/kernel/KernelLights.h"
+#include "lighting/kernel/PacketDecoder.h"
 #include "lighting/kernel/ShadingPacket.h"
 #include "lighting/kernel/SplitLightKernel.h"
 
@@ -357,5 +361,19 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
 bool packetPathFits(const StageInputs& inputs);
 // The G-buffer's own planes as a PacketDecoder reads them (no copy; valid while `gb` lives).
 kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb);
+
+// A frame's shading path, set up once by every caller of the kernel (accumulateLights,
+// accumulateSplitLights, `deferred`): whether it takes the packet path (packetPathFits), the ISA
+// that runs (the requested one, scalar on the per-pixel path), and on the packet path the
+// G-buffer's packet decoder (unless `decodePixels` is false: a caller that gathers its lanes
+// itself) and the lights in the kernel's form. Valid while the inputs live.
+struct PacketPath {
+    explicit PacketPath(const StageInputs& inputs, bool decodePixels = true);
+
+    bool packets;
+    kernel::KernelIsa isa;
+    std::optional<kernel::PacketDecoder> decoder;
+    std::optional<kernel::KernelLights> lights;
+};
 
 } // namespace lighting

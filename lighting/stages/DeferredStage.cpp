@@ -123,14 +123,11 @@ public:
 
         VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
         PassTimer shading(result, pass::kShading);
-        const bool packets = packetPathFits(inputs);
-        const kernel::KernelIsa isa = packets ? inputs.isa : kernel::KernelIsa::scalar();
-        std::optional<kernel::PacketDecoder> decoder;
-        std::optional<kernel::KernelLights> kernelLights;
-        if (packets) {
-            decoder.emplace(gb.layout(), gb.view(), planesOf(gb));
-            kernelLights.emplace(lights);
-        }
+        PacketPath path(inputs);
+        const bool packets = path.packets;
+        const kernel::KernelIsa isa = path.isa;
+        std::optional<kernel::PacketDecoder>& decoder = path.decoder;
+        std::optional<kernel::KernelLights>& kernelLights = path.lights;
         const int tileCount = cull.volumes.tileCount();
         const int tilesX = (width + raster::kTileSize - 1) / raster::kTileSize;
         mBatches.resize(size_t(tileCount));
