@@ -22,16 +22,23 @@ namespace {
 
 constexpr int kMaxWarpLanes = 64;
 
-// A queued fragment: what surfaceAt needs, and the list it is shaded with.
+// A queued fragment: its pixel, surface and alpha, and the list it is shaded with.
 struct QueuedFragment {
     int x = 0;
     int y = 0;
-    float depth = 0.0f;
     uint32_t triangle = 0; // scene triangle
-    uint32_t listKey = 0;
     bool frontFacing = true;
-    std::span<const uint32_t> lights;
+    float alpha = 1.0f;
+    uint64_t listKey = 0;
+    std::span<const uint32_t> lights; // when copied: empty, see copiedFirst
+    int64_t copiedFirst = -1;         // >= 0: the list is copiedLights[copiedFirst, + count)
+    uint32_t copiedCount = 0;
+    gbuffer::Surface surface;
 };
+
+// Keys of copied lists: one per fragment, never equal to a caller's key of the same batch
+// (callers' keys are object, tile or light indices, or addresses, all below 2^63).
+constexpr uint64_t kCopiedListKey = uint64_t(1) << 63;
 
 } // namespace
 
@@ -41,6 +48,7 @@ struct alignas(64) FragmentShading::TileBatch {
     std::array<QueuedFragment, kMaxWarpLanes> fragments;
     int count = 0;
     KernelWork work;                    // SIMT lane slots and kernel counters
+    std::vector<uint32_t> copiedLights; // the lists of addCopyingList, until the batch is shaded
     std::vector<uint32_t> unionScratch; // the union of the batch's lists, for the SIMT model
     std::vector<uint32_t> unionNext;
 };
@@ -48,14 +56,13 @@ struct alignas(64) FragmentShading::TileBatch {
 FragmentShading::FragmentShading() = default;
 FragmentShading::~FragmentShading() = default;
 
-void FragmentShading::begin(const StageInputs& inputs, const ForwardGeometry& geometry,
-                            FragmentApply apply, StageResult& result) {
+void FragmentShading::begin(const StageInputs& inputs, FragmentApply apply, StageResult& result) {
     if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
         throw std::invalid_argument("FragmentShading: simtWarpLanes must be 32 or 64, not " +
                                     std::to_string(inputs.simtWarpLanes));
-    mGeometry = &geometry;
     mResult = &result;
     mApply = apply;
+    mCountOracle = apply == FragmentApply::Over && !result.lightsOracle.empty();
     mIsa = inputs.isa;
     mWarpLanes = inputs.simtWarpLanes;
     mWidth = inputs.view->width;
@@ -66,16 +73,44 @@ void FragmentShading::begin(const StageInputs& inputs, const ForwardGeometry& ge
     for (TileBatch& tile : mTiles) {
         tile.count = 0;
         tile.work = {};
+        tile.copiedLights.clear();
     }
 }
 
-void FragmentShading::add(const raster::Fragment& fragment, uint32_t triangle, uint32_t listKey,
-                          std::span<const uint32_t> lights) {
-    TileBatch& batch = mTiles[size_t(fragment.y / raster::kTileSize) * size_t(mTilesX) +
-                              size_t(fragment.x / raster::kTileSize)];
-    batch.fragments[size_t(batch.count++)] = {
-        fragment.x, fragment.y, fragment.depth, triangle, listKey, fragment.frontFacing, lights};
+FragmentShading::TileBatch& FragmentShading::tileOf(const raster::Fragment& fragment) {
+    return mTiles[size_t(fragment.y / raster::kTileSize) * size_t(mTilesX) +
+                  size_t(fragment.x / raster::kTileSize)];
+}
+
+void FragmentShading::add(const raster::Fragment& fragment, uint32_t triangle,
+                          const gbuffer::Surface& surface, uint64_t listKey,
+                          std::span<const uint32_t> lights, float alpha) {
+    TileBatch& batch = tileOf(fragment);
+    QueuedFragment& q = batch.fragments[size_t(batch.count++)];
+    q = {fragment.x, fragment.y, triangle, fragment.frontFacing, alpha, listKey, lights,
+         -1,         0,          surface};
     if (batch.count == mWarpLanes)
+        shadeBatch(batch);
+}
+
+void FragmentShading::addCopyingList(const raster::Fragment& fragment, uint32_t triangle,
+                                     const gbuffer::Surface& surface,
+                                     std::span<const uint32_t> lights, float alpha) {
+    TileBatch& batch = tileOf(fragment);
+    const int64_t first = int64_t(batch.copiedLights.size());
+    batch.copiedLights.insert(batch.copiedLights.end(), lights.begin(), lights.end());
+    QueuedFragment& q = batch.fragments[size_t(batch.count)];
+    q = {fragment.x,
+         fragment.y,
+         triangle,
+         fragment.frontFacing,
+         alpha,
+         kCopiedListKey | uint64_t(batch.count),
+         {},
+         first,
+         uint32_t(lights.size()),
+         surface};
+    if (++batch.count == mWarpLanes)
         shadeBatch(batch);
 }
 
@@ -88,35 +123,33 @@ void FragmentShading::flush() {
 
 void FragmentShading::shadeBatch(TileBatch& batch) {
     StageResult& result = *mResult;
+    // Copied lists live in the batch's storage, which stops growing once the batch is full.
+    for (int i = 0; i < batch.count; ++i) {
+        QueuedFragment& q = batch.fragments[size_t(i)];
+        if (q.copiedFirst >= 0)
+            q.lights = std::span<const uint32_t>(batch.copiedLights)
+                           .subspan(size_t(q.copiedFirst), q.copiedCount);
+    }
     kernel::ShadingPacket packet;
     kernel::PacketAccumulator accumulator;
     PacketLightLists lists;
-    float emitted[3][kPacketLanes];
     for (int first = 0; first < batch.count; first += kPacketLanes) {
         const QueuedFragment* lanes = batch.fragments.data() + first;
         const int laneCount = std::min(kPacketLanes, batch.count - first);
         packet.clear();
         for (int lane = 0; lane < laneCount; ++lane) {
-            const QueuedFragment& q = lanes[lane];
-            raster::Fragment fragment;
-            fragment.x = q.x;
-            fragment.y = q.y;
-            fragment.depth = q.depth;
-            fragment.frontFacing = q.frontFacing;
-            const gbuffer::Surface s = mGeometry->surfaceAt(fragment, q.triangle);
+            const gbuffer::Surface& s = lanes[lane].surface;
             packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
                            s.specularPower);
             if (s.model == scenes::MaterialModel::MetallicRoughness)
                 packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
-            for (int c = 0; c < 3; ++c)
-                emitted[c][lane] = s.emissive[c];
         }
         // Lanes grouped by list: one kernel call over the union of the packet's lists, each lane
         // masked to its own list (bitwise one call per list).
         lists.clear();
         lists.addByKeyMerged(
             packet, [&](int lane) { return lanes[lane].listKey; },
-            [&](uint32_t key) {
+            [&](uint64_t key) {
                 int lane = 0;
                 while (lanes[lane].listKey != key)
                     ++lane;
@@ -127,10 +160,10 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
             const PacketLightLists::Group& group = lists[g];
             if (group.lightLaneMasks.empty())
                 kernel::shadePacket(mIsa, packet, group.laneMask, *mLights, group.lights,
-                                    accumulator, false);
+                                    accumulator, mCountOracle);
             else
                 kernel::shadePacket(mIsa, packet, group.laneMask, *mLights, group.lights,
-                                    group.lightLaneMasks, accumulator, false);
+                                    group.lightLaneMasks, accumulator, mCountOracle);
         }
         batch.work.groups += uint64_t(lists.size());
         batch.work.skippedAtRange += accumulator.lightsSkippedAtRange;
@@ -141,16 +174,30 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
         for (int lane = 0; lane < laneCount; ++lane) {
             const QueuedFragment& q = lanes[lane];
             const size_t pixel = size_t(q.y) * size_t(mWidth) + size_t(q.x);
-            if (mApply == FragmentApply::Replace) {
+            switch (mApply) {
+            case FragmentApply::Replace:
                 for (int c = 0; c < 3; ++c)
-                    result.radiance[c][pixel] = accumulator.radiance[c][lane] + emitted[c][lane];
+                    result.radiance[c][pixel] =
+                        accumulator.radiance[c][lane] + q.surface.emissive[c];
                 result.traceLightList(pixel, q.lights);
-            } else {
+                break;
+            case FragmentApply::Add:
                 for (int c = 0; c < 3; ++c)
                     result.radiance[c][pixel] += accumulator.radiance[c][lane];
                 if (result.tracing())
                     for (uint32_t light : q.lights)
                         result.traceAddedLight(pixel, light);
+                break;
+            case FragmentApply::Over:
+                for (int c = 0; c < 3; ++c) {
+                    const float lit = accumulator.radiance[c][lane] + q.surface.emissive[c];
+                    result.radiance[c][pixel] =
+                        q.alpha * lit + (1.0f - q.alpha) * result.radiance[c][pixel];
+                }
+                if (mCountOracle)
+                    result.lightsOracle[pixel] += accumulator.lightsContributing[lane];
+                result.traceBlendedFragment(pixel, q.triangle, q.frontFacing, q.lights);
+                break;
             }
             result.lightsEvaluated[pixel] += accumulator.lightsEvaluated[lane];
         }
@@ -158,7 +205,7 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
 
     // SIMT cost model: the batch is one warp; it pays every light of its lanes' union.
     size_t unionSize = batch.fragments[0].lights.size();
-    const uint32_t firstKey = batch.fragments[0].listKey;
+    const uint64_t firstKey = batch.fragments[0].listKey;
     const bool oneList =
         std::all_of(batch.fragments.begin(), batch.fragments.begin() + batch.count,
                     [&](const QueuedFragment& q) { return q.listKey == firstKey; });
@@ -181,6 +228,7 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
     }
     batch.work.laneSlots += uint64_t(mWarpLanes) * unionSize;
     batch.count = 0;
+    batch.copiedLights.clear();
 }
 
 void FragmentShading::end() {

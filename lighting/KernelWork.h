@@ -2,7 +2,11 @@
 // (accumulateLights, accumulateSplitLights, `deferred`, FragmentShading): the SIMT cost model's
 // lane slots (lighting/README.md) and the packet-level counters of kernel::PacketAccumulator.
 // Each task sums its own KernelWork; the stage adds them in a fixed order after its parallel loop
-// (integers: the total does not depend on the thread count) and records them once.
+// (integers: the total does not depend on the thread count) and records them once per kernel
+// pass. A frame can have two kernel passes (the opaque surfaces, then the blended ones,
+// BlendedPass.h): the second record adds to the first, so the frame's figures are its whole
+// work and simt_efficiency (the oracle, which counts blended fragments too, over the lane slots)
+// compares like with like.
 #pragma once
 
 #include <cstdint>
@@ -29,20 +33,28 @@ struct KernelWork {
         return *this;
     }
 
-    // Records "isa" (what ran), "simt_warp", "simt_lane_slots" and, when the frame took the
-    // packet path, "packet_groups" and the three "packet_lights_*" counters.
+    // Records "isa" (what ran), "simt_warp", "simt_lane_slots" and, when the pass took the
+    // packet path, "packet_groups" and the three "packet_lights_*" counters; each counter adds
+    // to the value an earlier pass of the frame recorded.
     void record(const kernel::KernelIsa& isa, int warpLanes, bool packets,
                 StageResult& result) const {
         result.parameters["isa"] = isa.name();
         result.parameters["simt_warp"] = std::to_string(warpLanes);
-        result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
+        add(result, "simt_lane_slots", laneSlots);
         if (!packets)
             return;
-        result.parameters["packet_groups"] = std::to_string(groups);
-        result.parameters["packet_lights_skipped_at_range"] = std::to_string(skippedAtRange);
-        result.parameters["packet_lights_skipped_at_cone_or_facing"] =
-            std::to_string(skippedAtConeOrFacing);
-        result.parameters["packet_lights_shaded"] = std::to_string(shaded);
+        add(result, "packet_groups", groups);
+        add(result, "packet_lights_skipped_at_range", skippedAtRange);
+        add(result, "packet_lights_skipped_at_cone_or_facing", skippedAtConeOrFacing);
+        add(result, "packet_lights_shaded", shaded);
+    }
+
+private:
+    static void add(StageResult& result, const std::string& key, uint64_t value) {
+        const auto earlier = result.parameters.find(key);
+        if (earlier != result.parameters.end())
+            value += std::stoull(earlier->second);
+        result.parameters[key] = std::to_string(value);
     }
 };
 
