@@ -137,13 +137,8 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
         const QueuedFragment* lanes = batch.fragments.data() + first;
         const int laneCount = std::min(kPacketLanes, batch.count - first);
         packet.clear();
-        for (int lane = 0; lane < laneCount; ++lane) {
-            const gbuffer::Surface& s = lanes[lane].surface;
-            packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
-                           s.specularPower);
-            if (s.model == scenes::MaterialModel::MetallicRoughness)
-                packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
-        }
+        for (int lane = 0; lane < laneCount; ++lane)
+            setLaneSurface(packet, lane, lanes[lane].surface);
         // Lanes grouped by list: one kernel call over the union of the packet's lists, each lane
         // masked to its own list (bitwise one call per list).
         lists.clear();

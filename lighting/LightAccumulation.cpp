@@ -315,10 +315,24 @@ void gatherSamples(const gbuffer::GBuffer& gb, int scale, int sampleWidth, int s
         gbuffer::Surface& s = surfaces[lane];
         if (!gb.surfaceAt(x, y, s))
             continue;
-        packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
-                       s.specularPower);
-        if (s.model == scenes::MaterialModel::MetallicRoughness)
-            packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
+        setLaneSurface(packet, lane, s);
+    }
+}
+
+// The same for surfaces the caller holds per sample (SplitLightingOptions::sampleSurfaces).
+void gatherOwnSamples(const std::function<const gbuffer::Surface*(size_t)>& surfaceOf,
+                      int sampleWidth, int sampleHeight, uint32_t excluded, int i0, int j0,
+                      kernel::ShadingPacket& packet, gbuffer::Surface (&surfaces)[kPacketLanes]) {
+    packet.clear(i0, j0);
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        const int i = i0 + kernel::laneX(lane), j = j0 + kernel::laneY(lane);
+        if (i >= sampleWidth || j >= sampleHeight || (excluded >> lane & 1u))
+            continue;
+        const gbuffer::Surface* held = surfaceOf(size_t(j) * size_t(sampleWidth) + size_t(i));
+        if (held == nullptr)
+            continue;
+        const gbuffer::Surface& s = surfaces[lane] = *held;
+        setLaneSurface(packet, lane, s);
     }
 }
 
@@ -343,8 +357,9 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
     const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
-    // Whole pixels (scale 1) are decoded a packet at a time; lattice samples are gathered.
-    PacketPath path(inputs, scale == 1);
+    // Whole pixels (scale 1) are decoded a packet at a time; lattice samples and the caller's
+    // own surfaces are gathered.
+    PacketPath path(inputs, scale == 1 && !options.sampleSurfaces);
     const bool packets = path.packets;
     const kernel::KernelIsa isa = path.isa;
     std::optional<kernel::PacketDecoder>& decoder = path.decoder;
@@ -371,7 +386,10 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
                 for (int i0 = wi; i0 < std::min(sampleWidth, wi + kWarpWidth); i0 += kPacketWidth) {
                     const uint32_t excluded =
                         excludedLanes(options.excludedSamples, sampleWidth, sampleHeight, i0, j0);
-                    if (decoder) {
+                    if (options.sampleSurfaces) {
+                        gatherOwnSamples(options.sampleSurfaces, sampleWidth, sampleHeight,
+                                         excluded, i0, j0, packet, surfaces);
+                    } else if (decoder) {
                         decoder->decode(isa, i0, j0, packet);
                         packet.laneMask &= ~excluded;
                     } else {

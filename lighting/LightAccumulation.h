@@ -36,6 +36,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -314,11 +315,24 @@ private:
 // `--isa scalar` runs the kernel's scalar split path: addSplitLight lane by lane, bitwise
 // splitLighting. Vector ISAs: diffuse and metallic-roughness sums bitwise, the Blinn-Phong
 // specular sum within a few ulps (pow; kernel/SplitLightKernel.h).
+// Fills lane `lane` of `packet` with surface `s`, either material model: how every loop that
+// gathers its lanes (lattice samples, queued fragments, held surfaces) fills one.
+inline void setLaneSurface(kernel::ShadingPacket& packet, int lane, const gbuffer::Surface& s) {
+    packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
+                   s.specularPower);
+    if (s.model == scenes::MaterialModel::MetallicRoughness)
+        packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
+}
+
 struct SplitLightingOptions {
     int scale = 1; // lattice spacing in pixels
     // Samples not to light (e.g. inferred's stippled samples), lowWidth x lowHeight, 1 = skip;
     // empty: none.
     std::span<const uint8_t> excludedSamples;
+    // Surfaces to light instead of the G-buffer's (inferred's stippled blended samples,
+    // InferredStipple.h): when set, sample index j lowWidth + i is lit iff this returns a surface
+    // for it (gathered into the packets; never decoded).
+    std::function<const gbuffer::Surface*(size_t sample)> sampleSurfaces;
 };
 
 // Where the loop puts a packet's sums. Called once per packet that has a lit lane, from several

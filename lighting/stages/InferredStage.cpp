@@ -181,25 +181,27 @@ public:
                 }
             });
         // Low-res tile (tx, ty) is full-res tile (tx, ty) of the culling grid (see "cull").
+        SplitLightingOptions lightOptions;
+        lightOptions.scale = scale;
+        lightOptions.excludedSamples = mExcluded;
         accumulateSplitLights(
-            inputs, {scale, mExcluded},
+            inputs, lightOptions,
             TileListSource(mOptions.tileSizeSamples, grid.tileCountX, mTileLights), sink, result);
         lightingPass.stop();
         if (blended) {
             blendPass.resume();
-            mStipple.light(inputs, gb.depth(), mOptions.tileSizeSamples * scale);
-            for (int j = 0; j < lowHeight; ++j)
-                for (int i = 0; i < lowWidth; ++i) {
-                    const size_t index = size_t(j) * lowWidth + i;
-                    if (!mStipple.holds(index))
-                        continue;
-                    const InferredStipple::Sample& stippled = mStipple.sample(index);
-                    mSamples[index] = {true, -stippled.surface.positionView.z,
-                                       stippled.surface.normalView, stippled.diffuse,
-                                       stippled.specular};
-                    result.lightsEvaluated[size_t(sampleY(j)) * width + sampleX(i)] =
-                        stippled.lightCount;
-                }
+            mStipple.light(inputs, gb.depth(), mOptions.tileSizeSamples, result);
+            for (size_t index = 0; index < mSamples.size(); ++index) {
+                if (!mStipple.holds(index))
+                    continue;
+                const InferredStipple::Sample& stippled = mStipple.sample(index);
+                mSamples[index] = {true,
+                                   -stippled.surface.positionView.z,
+                                   stippled.surface.normalView,
+                                   stippled.diffuse,
+                                   stippled.specular,
+                                   stippled.specularEdge};
+            }
             blendPass.pause();
         }
 
