@@ -33,8 +33,41 @@ struct QueuedFragment {
     std::span<const uint32_t> lights; // when copied: empty, see copiedFirst
     int64_t copiedFirst = -1;         // >= 0: the list is copiedLights[copiedFirst, + count)
     uint32_t copiedCount = 0;
+    bool beyondRange = false; // addBeyondRange: not shaded, its sums are zero (surface unset)
     gbuffer::Surface surface;
 };
+
+// Fills `q` (a batch's next slot) with what every kind of queued fragment has; returns it.
+QueuedFragment& queued(QueuedFragment& q, const raster::Fragment& fragment, uint32_t triangle,
+                       uint64_t listKey, std::span<const uint32_t> lights, float alpha) {
+    q.x = fragment.x;
+    q.y = fragment.y;
+    q.triangle = triangle;
+    q.frontFacing = fragment.frontFacing;
+    q.alpha = alpha;
+    q.listKey = listKey;
+    q.lights = lights;
+    q.copiedFirst = -1;
+    q.copiedCount = 0;
+    q.beyondRange = false;
+    return q;
+}
+
+// The union of the ascending lists of `fragments` (runs of one key taken once) into `merged`.
+void unionOfLists(std::span<const QueuedFragment* const> fragments, std::vector<uint32_t>& merged,
+                  std::vector<uint32_t>& next) {
+    merged.clear();
+    const QueuedFragment* previous = nullptr;
+    for (const QueuedFragment* q : fragments) {
+        if (previous != nullptr && q->listKey == previous->listKey)
+            continue;
+        previous = q;
+        next.clear();
+        std::set_union(merged.begin(), merged.end(), q->lights.begin(), q->lights.end(),
+                       std::back_inserter(next));
+        merged.swap(next);
+    }
+}
 
 // Keys of copied lists: one per fragment, never equal to a caller's key of the same batch
 // (callers' keys are object, tile or light indices, or addresses, all below 2^63).
@@ -51,6 +84,7 @@ struct alignas(64) FragmentShading::TileBatch {
     std::vector<uint32_t> copiedLights; // the lists of addCopyingList, until the batch is shaded
     std::vector<uint32_t> unionScratch; // the union of the batch's lists, for the SIMT model
     std::vector<uint32_t> unionNext;
+    std::vector<uint32_t> beyondLights; // per packet, the lights of its beyond-range lanes
 };
 
 FragmentShading::FragmentShading() = default;
@@ -86,10 +120,9 @@ void FragmentShading::add(const raster::Fragment& fragment, uint32_t triangle,
                           const gbuffer::Surface& surface, uint64_t listKey,
                           std::span<const uint32_t> lights, float alpha) {
     TileBatch& batch = tileOf(fragment);
-    QueuedFragment& q = batch.fragments[size_t(batch.count++)];
-    q = {fragment.x, fragment.y, triangle, fragment.frontFacing, alpha, listKey, lights,
-         -1,         0,          surface};
-    if (batch.count == mWarpLanes)
+    queued(batch.fragments[size_t(batch.count)], fragment, triangle, listKey, lights, alpha)
+        .surface = surface;
+    if (++batch.count == mWarpLanes)
         shadeBatch(batch);
 }
 
@@ -97,19 +130,37 @@ void FragmentShading::addCopyingList(const raster::Fragment& fragment, uint32_t 
                                      const gbuffer::Surface& surface,
                                      std::span<const uint32_t> lights, float alpha) {
     TileBatch& batch = tileOf(fragment);
-    const int64_t first = int64_t(batch.copiedLights.size());
+    QueuedFragment& q = queued(batch.fragments[size_t(batch.count)], fragment, triangle,
+                               kCopiedListKey | uint64_t(batch.count), {}, alpha);
+    q.copiedFirst = int64_t(batch.copiedLights.size());
+    q.copiedCount = uint32_t(lights.size());
     batch.copiedLights.insert(batch.copiedLights.end(), lights.begin(), lights.end());
-    QueuedFragment& q = batch.fragments[size_t(batch.count)];
-    q = {fragment.x,
-         fragment.y,
-         triangle,
-         fragment.frontFacing,
-         alpha,
-         kCopiedListKey | uint64_t(batch.count),
-         {},
-         first,
-         uint32_t(lights.size()),
-         surface};
+    q.surface = surface;
+    if (++batch.count == mWarpLanes)
+        shadeBatch(batch);
+}
+
+bool FragmentShading::beyondRange(uint32_t light, const glm::vec3& positionView) const {
+    const kernel::KernelLight& record = mLights->records()[light];
+    const auto type = scenes::LightType(record.type);
+    if (type != scenes::LightType::Point && type != scenes::LightType::Spot)
+        return false;
+    const float dx = record.positionView[0] - positionView.x;
+    const float dy = record.positionView[1] - positionView.y;
+    const float dz = record.positionView[2] - positionView.z;
+    // The kernel's test is distance^2 < rangeSquared with these operations; the margin (2^-16,
+    // ~100x a 3-term dot product's rounding) makes "beyond" hold whatever the rounding or
+    // contraction on either side, so a fragment said beyond is rejected at range on every path.
+    return (dx * dx + dy * dy) + dz * dz > record.rangeSquared * (1.0f + 0x1p-16f);
+}
+
+void FragmentShading::addBeyondRange(const raster::Fragment& fragment, uint32_t triangle,
+                                     uint64_t listKey, std::span<const uint32_t> lights) {
+    if (mApply != FragmentApply::Add)
+        throw std::logic_error("FragmentShading::addBeyondRange: for FragmentApply::Add only");
+    TileBatch& batch = tileOf(fragment);
+    queued(batch.fragments[size_t(batch.count)], fragment, triangle, listKey, lights, 1.0f)
+        .beyondRange = true;
     if (++batch.count == mWarpLanes)
         shadeBatch(batch);
 }
@@ -137,8 +188,13 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
         const QueuedFragment* lanes = batch.fragments.data() + first;
         const int laneCount = std::min(kPacketLanes, batch.count - first);
         packet.clear();
-        for (int lane = 0; lane < laneCount; ++lane)
-            setLaneSurface(packet, lane, lanes[lane].surface);
+        bool anyBeyond = false;
+        for (int lane = 0; lane < laneCount; ++lane) {
+            if (lanes[lane].beyondRange)
+                anyBeyond = true;
+            else
+                setLaneSurface(packet, lane, lanes[lane].surface);
+        }
         // Lanes grouped by list: one kernel call over the union of the packet's lists, each lane
         // masked to its own list (bitwise one call per list).
         lists.clear();
@@ -161,6 +217,26 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
                                     group.lightLaneMasks, accumulator, mCountOracle);
         }
         batch.work.groups += uint64_t(lists.size());
+        if (anyBeyond) {
+            // The beyond-range lanes were not shaded. With them active the kernel would have made
+            // the packet's one group (addByKeyMerged) and found every light that only they have
+            // rejected at range by all its lanes: count exactly that, so the counters are the
+            // ones of shading every lane.
+            std::array<const QueuedFragment*, kPacketLanes> beyond{};
+            size_t beyondCount = 0;
+            for (int lane = 0; lane < laneCount; ++lane)
+                if (lanes[lane].beyondRange)
+                    beyond[beyondCount++] = &lanes[lane];
+            unionOfLists(std::span(beyond.data(), beyondCount), batch.beyondLights,
+                         batch.unionNext);
+            const std::span<const uint32_t> shadedLights =
+                lists.size() > 0 ? lists[0].lights : std::span<const uint32_t>();
+            for (uint32_t light : batch.beyondLights)
+                if (!std::binary_search(shadedLights.begin(), shadedLights.end(), light))
+                    ++batch.work.skippedAtRange;
+            if (lists.size() == 0)
+                batch.work.groups += 1;
+        }
         batch.work.skippedAtRange += accumulator.lightsSkippedAtRange;
         batch.work.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
         batch.work.shaded += accumulator.lightsShaded;
@@ -194,7 +270,8 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
                 result.traceBlendedFragment(pixel, q.triangle, q.frontFacing, q.lights);
                 break;
             }
-            result.lightsEvaluated[pixel] += accumulator.lightsEvaluated[lane];
+            result.lightsEvaluated[pixel] +=
+                q.beyondRange ? uint32_t(q.lights.size()) : accumulator.lightsEvaluated[lane];
         }
     }
 
@@ -205,21 +282,12 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
         std::all_of(batch.fragments.begin(), batch.fragments.begin() + batch.count,
                     [&](const QueuedFragment& q) { return q.listKey == firstKey; });
     if (!oneList) {
-        // Ascending lists: merged one after another (linear in their lengths), each run of one
-        // list taken once (runs are common: one object, one tile).
-        std::vector<uint32_t>& merged = batch.unionScratch;
-        std::vector<uint32_t>& next = batch.unionNext;
-        merged.clear();
-        for (int i = 0; i < batch.count; ++i) {
-            const QueuedFragment& q = batch.fragments[size_t(i)];
-            if (i > 0 && q.listKey == batch.fragments[size_t(i) - 1].listKey)
-                continue;
-            next.clear();
-            std::set_union(merged.begin(), merged.end(), q.lights.begin(), q.lights.end(),
-                           std::back_inserter(next));
-            merged.swap(next);
-        }
-        unionSize = merged.size();
+        std::array<const QueuedFragment*, kMaxWarpLanes> all{};
+        for (int i = 0; i < batch.count; ++i)
+            all[size_t(i)] = &batch.fragments[size_t(i)];
+        unionOfLists(std::span(all.data(), size_t(batch.count)), batch.unionScratch,
+                     batch.unionNext);
+        unionSize = batch.unionScratch.size();
     }
     batch.work.laneSlots += uint64_t(mWarpLanes) * unionSize;
     batch.count = 0;

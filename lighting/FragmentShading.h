@@ -102,6 +102,17 @@ public:
     void addCopyingList(const raster::Fragment& fragment, uint32_t triangle,
                         const gbuffer::Surface& surface, std::span<const uint32_t> lights,
                         float alpha = 1.0f);
+    // For FragmentApply::Add: whether `positionView` is certainly beyond the range of `light`
+    // (a point or spot light; false for the others), with a margin so that the kernel's range
+    // test rejects it on every ISA. A light then adds exactly zero there.
+    bool beyondRange(uint32_t light, const glm::vec3& positionView) const;
+    // Queues a fragment every light of whose list is beyondRange there (FragmentApply::Add only):
+    // it takes its lane of the warp and counts its evaluations like any fragment, but is neither
+    // given a surface nor shaded (its sums are zero), and the packet counters are those of
+    // shading it (its lights are rejected at range by all its lanes). What makes a light pass of
+    // `forward-multipass` cheap where most of the illumination set lies outside the light's range.
+    void addBeyondRange(const raster::Fragment& fragment, uint32_t triangle, uint64_t listKey,
+                        std::span<const uint32_t> lights);
     // Shades every tile's queued fragments; after each draw, before its lists go away.
     void flush();
     // Ends the pass: records "isa", "simt_warp", "simt_lane_slots", "packet_groups" and the

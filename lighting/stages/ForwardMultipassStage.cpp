@@ -82,7 +82,13 @@ public:
             auto addLight = [&](const raster::Fragment& fragment) {
                 const uint32_t triangle =
                     globalTriangle ? globalTriangle[fragment.triangle] : fragment.triangle;
-                if (visibility.isVisible(fragment, triangle))
+                if (!visibility.isVisible(fragment, triangle))
+                    return;
+                // Outside the light's range it adds exactly zero: queued for its lane and its
+                // count, without decoding its surface (FragmentShading::addBeyondRange).
+                if (mShading.beyondRange(l, mForward.positionAt(fragment)))
+                    mShading.addBeyondRange(fragment, triangle, l, light);
+                else
                     mShading.add(fragment, triangle, mForward.surfaceAt(fragment, triangle), l,
                                  light);
             };
