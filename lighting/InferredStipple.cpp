@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/BlendedTileLists.h"
+#include "lighting/DsfFilter.h"
 #include "lighting/LightAccumulation.h"
 #include "lighting/SplitLighting.h"
 
@@ -92,9 +93,9 @@ void InferredStipple::light(const StageInputs& inputs, std::span<const float> op
             Sample& sample = mSamples[size_t(packet.y0 + kernel::laneY(lane)) * size_t(l.lowWidth) +
                                       size_t(packet.x0 + kernel::laneX(lane))];
             for (int c = 0; c < 3; ++c) {
-                sample.diffuse[c] = sums.diffuse[c][lane];
-                sample.specular[c] = sums.specular[c][lane];
-                sample.specularEdge[c] = sums.specularEdge[c][lane];
+                sample.light.diffuse[c] = sums.diffuse[c][lane];
+                sample.light.specular[c] = sums.specular[c][lane];
+                sample.light.specularEdge[c] = sums.specularEdge[c][lane];
             }
         }
     });
@@ -144,57 +145,37 @@ InferredStipple::Counts InferredStipple::composite(BlendedPass& blended,
         const int tapI[4] = {ia, ib, ia, ib}, tapJ[4] = {ja, ja, jb, jb};
         const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
         const float depth = -surface.positionView.z;
-        glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f), sameEdge(0.0f), surfaceDiffuse(0.0f),
-            surfaceSpecular(0.0f), surfaceEdge(0.0f);
-        float sameWeight = 0.0f, surfaceWeight = 0.0f, nearestWeight = -1.0f;
-        const Sample* nearestSample = nullptr;
+        DsfFilter filter;
         for (int k = 0; k < 4; ++k) {
             if (tapI[k] < 0 || tapJ[k] < 0)
                 continue;
             const Sample& t = mSamples[size_t(tapJ[k]) * size_t(l.lowWidth) + size_t(tapI[k])];
             if (!t.covered)
                 continue;
-            if (bilinear[k] > nearestWeight) {
-                nearestWeight = bilinear[k];
-                nearestSample = &t;
-            }
-            if (std::abs(-t.surface.positionView.z - depth) > options.depthThreshold * depth ||
-                glm::dot(t.surface.normalView, surface.normalView) < options.normalThreshold)
-                continue;
-            surfaceDiffuse += bilinear[k] * t.diffuse;
-            surfaceSpecular += bilinear[k] * t.specular;
-            surfaceEdge += bilinear[k] * t.specularEdge;
-            surfaceWeight += bilinear[k];
-            if (options.objectIds && t.instance != instance)
-                continue;
-            sameDiffuse += bilinear[k] * t.diffuse;
-            sameSpecular += bilinear[k] * t.specular;
-            sameEdge += bilinear[k] * t.specularEdge;
-            sameWeight += bilinear[k];
+            const bool passesSurface =
+                !(std::abs(-t.surface.positionView.z - depth) > options.depthThreshold * depth ||
+                  glm::dot(t.surface.normalView, surface.normalView) < options.normalThreshold);
+            filter.add(bilinear[k], t.light, passesSurface,
+                       !options.objectIds || t.instance == instance);
         }
-        glm::vec3 diffuse(0.0f), specular(0.0f), edge(0.0f);
-        if (sameWeight > 0.0f) {
-            diffuse = sameDiffuse / sameWeight;
-            specular = sameSpecular / sameWeight;
-            edge = sameEdge / sameWeight;
-        } else if (surfaceWeight > 0.0f) {
-            diffuse = surfaceDiffuse / surfaceWeight;
-            specular = surfaceSpecular / surfaceWeight;
-            edge = surfaceEdge / surfaceWeight;
+        SplitLighting light;
+        switch (filter.resolve(light)) {
+        case DsfFilter::Source::Same:
+            break;
+        case DsfFilter::Source::Surface:
+        case DsfFilter::Source::Nearest:
             ++fallbacks[pixel];
-        } else if (nearestSample) {
-            diffuse = nearestSample->diffuse;
-            specular = nearestSample->specular;
-            edge = nearestSample->specularEdge;
-            ++fallbacks[pixel];
-        } else {
+            break;
+        case DsfFilter::Source::None:
             ++unlit[pixel];
+            break;
         }
         // The material's half of the split (both models, as the opaque material pass), then the
         // fragment's own emission, at full resolution, composited with its light (BlendedPass.h,
         // "Emission").
         const glm::vec3 lit =
-            combineSplitLighting(surface, diffuse, specular, edge) + surface.emissive;
+            combineSplitLighting(surface, light.diffuse, light.specular, light.specularEdge) +
+            surface.emissive;
         for (int c = 0; c < 3; ++c)
             result.radiance[c][pixel] = alpha * lit[c] + (1.0f - alpha) * result.radiance[c][pixel];
     });

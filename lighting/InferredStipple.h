@@ -48,6 +48,7 @@
 #include "gbuffer/Surface.h"
 #include "lighting/BlendedPass.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/SplitLighting.h"
 
 namespace lighting {
 
@@ -61,9 +62,7 @@ public:
         bool covered = false;
         uint32_t instance = 0;
         gbuffer::Surface surface; // positionView from the fragment's depth
-        glm::vec3 diffuse{0.0f};
-        glm::vec3 specular{0.0f};
-        glm::vec3 specularEdge{0.0f}; // metallic-roughness only (SplitLighting.h)
+        SplitLighting light;      // diffuse, specular, metallic-roughness Fresnel edge
     };
 
     // The L-buffer geometry of the stage: lowWidth x lowHeight samples, sample (i, j) reading
