@@ -298,7 +298,7 @@ void FragmentShading::end() {
     KernelWork work;
     for (const TileBatch& tile : mTiles)
         work += tile.work;
-    work.record(mIsa, mWarpLanes, true, *mResult);
+    work.record(mIsa, mWarpLanes, *mResult);
 }
 
 } // namespace lighting

@@ -33,16 +33,13 @@ struct KernelWork {
         return *this;
     }
 
-    // Records "isa" (what ran), "simt_warp", "simt_lane_slots" and, when the pass took the
-    // packet path, "packet_groups" and the three "packet_lights_*" counters; each counter adds
-    // to the value an earlier pass of the frame recorded.
-    void record(const kernel::KernelIsa& isa, int warpLanes, bool packets,
-                StageResult& result) const {
+    // Records "isa" (what ran), "simt_warp", "simt_lane_slots", "packet_groups" and the three
+    // "packet_lights_*" counters; each counter adds to the value an earlier pass of the frame
+    // recorded.
+    void record(const kernel::KernelIsa& isa, int warpLanes, StageResult& result) const {
         result.parameters["isa"] = isa.name();
         result.parameters["simt_warp"] = std::to_string(warpLanes);
         add(result, "simt_lane_slots", laneSlots);
-        if (!packets)
-            return;
         add(result, "packet_groups", groups);
         add(result, "packet_lights_skipped_at_range", skippedAtRange);
         add(result, "packet_lights_skipped_at_cone_or_facing", skippedAtConeOrFacing);
