@@ -237,9 +237,7 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
             if (lists.size() == 0)
                 batch.work.groups += 1;
         }
-        batch.work.skippedAtRange += accumulator.lightsSkippedAtRange;
-        batch.work.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
-        batch.work.shaded += accumulator.lightsShaded;
+        batch.work.addCounters(accumulator);
 
         // In fragment order: a later fragment of the same pixel comes after an earlier one.
         for (int lane = 0; lane < laneCount; ++lane) {

@@ -24,6 +24,14 @@ struct KernelWork {
     uint64_t skippedAtConeOrFacing = 0; // (PacketAccumulator's three counters)
     uint64_t shaded = 0;
 
+    // Adds a packet's three early-out counters (kernel::PacketAccumulator's or
+    // SplitPacketAccumulator's).
+    template <class Accumulator> void addCounters(const Accumulator& accumulator) {
+        skippedAtRange += accumulator.lightsSkippedAtRange;
+        skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
+        shaded += accumulator.lightsShaded;
+    }
+
     KernelWork& operator+=(const KernelWork& other) {
         laneSlots += other.laneSlots;
         groups += other.groups;

@@ -134,6 +134,59 @@ private:
     uint64_t mCount = 0;
 };
 
+// What one warp-row task of walkWarps keeps between packets.
+template <class Accumulator> struct PacketScratch {
+    kernel::ShadingPacket packet;
+    Accumulator accumulator;
+    PacketLightLists lists;
+};
+
+// The SIMT model's bill for a packet: the lists its lanes walked join the warp's union; true when
+// it had a lane group (the warp then pays).
+bool payLists(const PacketLightLists& lists, WarpUnion& warpUnion) {
+    for (int g = 0; g < lists.size(); ++g) {
+        if (lists[g].scratch)
+            warpUnion.addTransient(lists[g].lights);
+        else
+            warpUnion.add(lists[g].lights);
+    }
+    return lists.size() > 0;
+}
+
+// The walk accumulateLights and accumulateSplitLights share: a grid of columns x rows units
+// (pixels or lattice samples) in 4x4 packets and warps of 8 x (warpLanes / 8) units, warp rows in
+// parallel (one task per row, with its own scratch), the packets of a warp in order.
+// shade(scratch, x0, y0, warpUnion, work) shades the packet at (x0, y0), pays its lists
+// (payLists) and adds its kernel counters to `work`, and returns whether the warp pays; a warp that
+// pays costs warpLanes lane slots per light of its union. Returns the frame's work summed in row
+// order (integers: the same for any thread count).
+template <class Accumulator, class Shade>
+KernelWork walkWarps(int columns, int rows, int warpLanes, size_t lightCount, const Shade& shade) {
+    const int warpHeight = warpLanes / kWarpWidth;
+    const int warpRows = (rows + warpHeight - 1) / warpHeight;
+    std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
+    tbb::parallel_for(0, warpRows, [&](int warpRow) {
+        PacketScratch<Accumulator> scratch;
+        WarpUnion warpUnion(lightCount);
+        KernelWork rowWork;
+        for (int wx = 0; wx < columns; wx += kWarpWidth) {
+            warpUnion.begin();
+            bool pays = false;
+            for (int y0 = warpRow * warpHeight; y0 < std::min(rows, (warpRow + 1) * warpHeight);
+                 y0 += kPacketHeight)
+                for (int x0 = wx; x0 < std::min(columns, wx + kWarpWidth); x0 += kPacketWidth)
+                    pays |= shade(scratch, x0, y0, warpUnion, rowWork);
+            if (pays)
+                rowWork.laneSlots += uint64_t(warpLanes) * warpUnion.count();
+        }
+        workPerRow[size_t(warpRow)] = rowWork;
+    });
+    KernelWork work;
+    for (const KernelWork& row : workPerRow)
+        work += row;
+    return work;
+}
+
 } // namespace
 
 void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
@@ -143,98 +196,71 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
     if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
         throw std::invalid_argument("accumulateLights: simtWarpLanes must be 32 or 64, not " +
                                     std::to_string(inputs.simtWarpLanes));
-    const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
     const bool emission = gb.hasEmission();
     const PacketPath path(inputs);
     const kernel::KernelIsa isa = path.isa;
 
-    const int warpRows = (height + warpHeight - 1) / warpHeight;
-    // Per warp row: lane slots, packet-wide light iterations by outcome (PacketAccumulator's
-    // counters; the vector kernel's cost is about proportional to them, lighting/kernel/README.md)
-    // and kernel calls (one per group).
-    std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
-    tbb::parallel_for(0, warpRows, [&](int warpRow) {
-        kernel::ShadingPacket packet;
-        kernel::PacketAccumulator accumulator;
-        PacketLightLists lists;
-        WarpUnion warpUnion(lights.size());
-        KernelWork rowWork;
-        for (int wx = 0; wx < width; wx += kWarpWidth) {
-            warpUnion.begin();
-            bool anyLane = false;
-            for (int y0 = warpRow * warpHeight; y0 < std::min(height, (warpRow + 1) * warpHeight);
-                 y0 += kPacketHeight)
-                for (int x0 = wx; x0 < std::min(width, wx + kWarpWidth); x0 += kPacketWidth) {
-                    path.decode(x0, y0, packet);
-                    if (packet.laneMask == 0)
-                        continue;
-                    lists.clear();
-                    source.listsOf(packet, lists);
-                    accumulator.clear();
-                    rowWork.groups += uint64_t(lists.size());
-                    for (int g = 0; g < lists.size(); ++g) {
-                        const PacketLightLists::Group& group = lists[g];
-                        if (group.lightLaneMasks.empty())
-                            kernel::shadePacket(isa, packet, group.laneMask, path.lights,
-                                                group.lights, accumulator, options.countOracle);
-                        else
-                            kernel::shadePacket(isa, packet, group.laneMask, path.lights,
-                                                group.lights, group.lightLaneMasks, accumulator,
-                                                options.countOracle);
-                    }
-                    for (int g = 0; g < lists.size(); ++g) {
-                        if (lists[g].scratch)
-                            warpUnion.addTransient(lists[g].lights);
-                        else
-                            warpUnion.add(lists[g].lights);
-                        anyLane = true;
-                    }
-                    rowWork.skippedAtRange += accumulator.lightsSkippedAtRange;
-                    rowWork.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
-                    rowWork.shaded += accumulator.lightsShaded;
-                    // The test-only light trace (StageResult::traceLights): each lane summed
-                    // exactly its group's list (with per-light masks, its lights of it).
-                    if (result.tracing())
-                        for (int g = 0; g < lists.size(); ++g)
-                            for (uint32_t lanes = lists[g].laneMask & packet.laneMask; lanes != 0;
-                                 lanes &= lanes - 1) {
-                                const int lane = __builtin_ctz(lanes);
-                                std::vector<uint32_t> own;
-                                for (size_t i = 0; i < lists[g].lights.size(); ++i)
-                                    if (lists[g].evaluates(lane, i))
-                                        own.push_back(lists[g].lights[i]);
-                                result.traceLightList(size_t(y0 + kernel::laneY(lane)) *
-                                                              size_t(width) +
-                                                          size_t(x0 + kernel::laneX(lane)),
-                                                      own);
-                            }
-                    for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+    // Per warp: lane slots; per packet: packet-wide light iterations by outcome
+    // (PacketAccumulator's counters; the vector kernel's cost is about proportional to them,
+    // lighting/kernel/README.md) and kernel calls (one per group).
+    const KernelWork work = walkWarps<kernel::PacketAccumulator>(
+        width, height, inputs.simtWarpLanes, lights.size(),
+        [&](PacketScratch<kernel::PacketAccumulator>& scratch, int x0, int y0, WarpUnion& warpUnion,
+            KernelWork& rowWork) {
+            kernel::ShadingPacket& packet = scratch.packet;
+            kernel::PacketAccumulator& accumulator = scratch.accumulator;
+            PacketLightLists& lists = scratch.lists;
+            path.decode(x0, y0, packet);
+            if (packet.laneMask == 0)
+                return false;
+            lists.clear();
+            source.listsOf(packet, lists);
+            accumulator.clear();
+            rowWork.groups += uint64_t(lists.size());
+            for (int g = 0; g < lists.size(); ++g) {
+                const PacketLightLists::Group& group = lists[g];
+                if (group.lightLaneMasks.empty())
+                    kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
+                                        accumulator, options.countOracle);
+                else
+                    kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
+                                        group.lightLaneMasks, accumulator, options.countOracle);
+            }
+            rowWork.addCounters(accumulator);
+            // The test-only light trace (StageResult::traceLights): each lane summed exactly its
+            // group's list (with per-light masks, its lights of it).
+            if (result.tracing())
+                for (int g = 0; g < lists.size(); ++g)
+                    for (uint32_t lanes = lists[g].laneMask & packet.laneMask; lanes != 0;
+                         lanes &= lanes - 1) {
                         const int lane = __builtin_ctz(lanes);
-                        const size_t pixel = size_t(y0 + kernel::laneY(lane)) * size_t(width) +
-                                             size_t(x0 + kernel::laneX(lane));
-                        for (int c = 0; c < 3; ++c)
-                            result.radiance[c][pixel] = accumulator.radiance[c][lane];
-                        if (emission) {
-                            const glm::vec3 emitted = gb.emission(pixel);
-                            for (int c = 0; c < 3; ++c)
-                                result.radiance[c][pixel] += emitted[c];
-                        }
-                        result.lightsEvaluated[pixel] = accumulator.lightsEvaluated[lane];
-                        if (options.countOracle)
-                            result.lightsOracle[pixel] = accumulator.lightsContributing[lane];
+                        std::vector<uint32_t> own;
+                        for (size_t i = 0; i < lists[g].lights.size(); ++i)
+                            if (lists[g].evaluates(lane, i))
+                                own.push_back(lists[g].lights[i]);
+                        result.traceLightList(size_t(y0 + kernel::laneY(lane)) * size_t(width) +
+                                                  size_t(x0 + kernel::laneX(lane)),
+                                              own);
                     }
+            for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+                const int lane = __builtin_ctz(lanes);
+                const size_t pixel = size_t(y0 + kernel::laneY(lane)) * size_t(width) +
+                                     size_t(x0 + kernel::laneX(lane));
+                for (int c = 0; c < 3; ++c)
+                    result.radiance[c][pixel] = accumulator.radiance[c][lane];
+                if (emission) {
+                    const glm::vec3 emitted = gb.emission(pixel);
+                    for (int c = 0; c < 3; ++c)
+                        result.radiance[c][pixel] += emitted[c];
                 }
-            if (anyLane)
-                rowWork.laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
-        }
-        workPerRow[size_t(warpRow)] = rowWork;
-    });
-
-    KernelWork work;
-    for (const KernelWork& row : workPerRow)
-        work += row;
+                result.lightsEvaluated[pixel] = accumulator.lightsEvaluated[lane];
+                if (options.countOracle)
+                    result.lightsOracle[pixel] = accumulator.lightsContributing[lane];
+            }
+            return payLists(lists, warpUnion);
+        });
     work.record(isa, inputs.simtWarpLanes, result);
     path.record(result);
 }
@@ -308,7 +334,6 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
     if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
         throw std::invalid_argument("accumulateSplitLights: simtWarpLanes must be 32 or 64, not " +
                                     std::to_string(inputs.simtWarpLanes));
-    const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
     // Whole pixels (scale 1) are decoded a packet at a time; lattice samples and the caller's
@@ -320,73 +345,50 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
                size_t(std::min(i * scale + scale / 2, width - 1));
     };
 
-    const int warpRows = (sampleHeight + warpHeight - 1) / warpHeight;
-    std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
-    tbb::parallel_for(0, warpRows, [&](int warpRow) {
-        kernel::ShadingPacket packet;
-        kernel::SplitPacketAccumulator sums;
-        PacketLightLists lists;
-        WarpUnion warpUnion(lights.size());
-        KernelWork rowWork;
-        for (int wi = 0; wi < sampleWidth; wi += kWarpWidth) {
-            warpUnion.begin();
-            bool anyLane = false;
-            for (int j0 = warpRow * warpHeight;
-                 j0 < std::min(sampleHeight, (warpRow + 1) * warpHeight); j0 += kPacketHeight)
-                for (int i0 = wi; i0 < std::min(sampleWidth, wi + kWarpWidth); i0 += kPacketWidth) {
-                    const uint32_t excluded =
-                        excludedLanes(options.excludedSamples, sampleWidth, sampleHeight, i0, j0);
-                    if (options.sampleSurfaces) {
-                        gatherOwnSamples(options.sampleSurfaces, sampleWidth, sampleHeight,
-                                         excluded, i0, j0, packet);
-                    } else if (scale == 1) {
-                        path.decode(i0, j0, packet);
-                        packet.laneMask &= ~excluded;
-                    } else {
-                        gatherSamples(gb, scale, sampleWidth, sampleHeight, excluded, i0, j0,
-                                      packet);
-                    }
-                    if (packet.laneMask == 0)
-                        continue;
-                    lists.clear();
-                    source.listsOf(packet, lists);
-                    sums.clear();
-                    rowWork.groups += uint64_t(lists.size());
-                    for (int g = 0; g < lists.size(); ++g) {
-                        const PacketLightLists::Group& group = lists[g];
-                        if (!group.lightLaneMasks.empty())
-                            throw std::logic_error(
-                                "accumulateSplitLights: per-light lane masks are not supported");
-                        kernel::shadePacketSplit(isa, packet, group.laneMask, path.lights,
-                                                 group.lights, sums);
-                        if (group.scratch)
-                            warpUnion.addTransient(group.lights);
-                        else
-                            warpUnion.add(group.lights);
-                        anyLane = true;
-                        for (uint32_t lanes = group.laneMask & packet.laneMask; lanes != 0;
-                             lanes &= lanes - 1) {
-                            const int lane = __builtin_ctz(lanes);
-                            const size_t pixel =
-                                pixelOf(i0 + kernel::laneX(lane), j0 + kernel::laneY(lane));
-                            result.lightsEvaluated[pixel] = sums.lightsEvaluated[lane];
-                            result.traceLightList(pixel, group.lights);
-                        }
-                    }
-                    rowWork.skippedAtRange += sums.lightsSkippedAtRange;
-                    rowWork.skippedAtConeOrFacing += sums.lightsSkippedAtConeOrFacing;
-                    rowWork.shaded += sums.lightsShaded;
-                    sink.store(packet, sums);
+    const KernelWork work = walkWarps<kernel::SplitPacketAccumulator>(
+        sampleWidth, sampleHeight, inputs.simtWarpLanes, lights.size(),
+        [&](PacketScratch<kernel::SplitPacketAccumulator>& scratch, int i0, int j0,
+            WarpUnion& warpUnion, KernelWork& rowWork) {
+            kernel::ShadingPacket& packet = scratch.packet;
+            kernel::SplitPacketAccumulator& sums = scratch.accumulator;
+            PacketLightLists& lists = scratch.lists;
+            const uint32_t excluded =
+                excludedLanes(options.excludedSamples, sampleWidth, sampleHeight, i0, j0);
+            if (options.sampleSurfaces) {
+                gatherOwnSamples(options.sampleSurfaces, sampleWidth, sampleHeight, excluded, i0,
+                                 j0, packet);
+            } else if (scale == 1) {
+                path.decode(i0, j0, packet);
+                packet.laneMask &= ~excluded;
+            } else {
+                gatherSamples(gb, scale, sampleWidth, sampleHeight, excluded, i0, j0, packet);
+            }
+            if (packet.laneMask == 0)
+                return false;
+            lists.clear();
+            source.listsOf(packet, lists);
+            sums.clear();
+            rowWork.groups += uint64_t(lists.size());
+            for (int g = 0; g < lists.size(); ++g) {
+                const PacketLightLists::Group& group = lists[g];
+                if (!group.lightLaneMasks.empty())
+                    throw std::logic_error(
+                        "accumulateSplitLights: per-light lane masks are not supported");
+                kernel::shadePacketSplit(isa, packet, group.laneMask, path.lights, group.lights,
+                                         sums);
+                for (uint32_t lanes = group.laneMask & packet.laneMask; lanes != 0;
+                     lanes &= lanes - 1) {
+                    const int lane = __builtin_ctz(lanes);
+                    const size_t pixel =
+                        pixelOf(i0 + kernel::laneX(lane), j0 + kernel::laneY(lane));
+                    result.lightsEvaluated[pixel] = sums.lightsEvaluated[lane];
+                    result.traceLightList(pixel, group.lights);
                 }
-            if (anyLane)
-                rowWork.laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
-        }
-        workPerRow[size_t(warpRow)] = rowWork;
-    });
-
-    KernelWork work;
-    for (const KernelWork& row : workPerRow)
-        work += row;
+            }
+            rowWork.addCounters(sums);
+            sink.store(packet, sums);
+            return payLists(lists, warpUnion);
+        });
     work.record(isa, inputs.simtWarpLanes, result);
     path.record(result);
 }

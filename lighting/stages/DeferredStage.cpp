@@ -112,7 +112,6 @@ public:
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int width = gb.width(), height = gb.height();
         if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
             throw std::invalid_argument("deferred: simtWarpLanes must be 32 or 64, not " +
@@ -185,9 +184,7 @@ public:
                     result.traceAddedLight(pixel, light);
                 }
                 ++batch.work.groups;
-                batch.work.skippedAtRange += accumulator.lightsSkippedAtRange;
-                batch.work.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
-                batch.work.shaded += accumulator.lightsShaded;
+                batch.work.addCounters(accumulator);
             }
             batch.touched.clear();
         };
