@@ -78,6 +78,21 @@ std::span<const uint32_t> BlendedPass::contributingLights(const gbuffer::Surface
     return list;
 }
 
+void BlendedPass::shadeWithContributingLights(std::span<const float> opaqueDepth,
+                                              StageResult& result) {
+    PassTimer blendPass(result, pass::kBlend);
+    mShading.begin(*mInputs, FragmentApply::Over, result);
+    draw(opaqueDepth, [&](const raster::Fragment& fragment) {
+        const uint32_t triangle = mSceneTriangle[fragment.triangle];
+        float alpha = 0.0f;
+        const gbuffer::Surface point = surfaceOf(fragment, triangle, alpha);
+        mShading.addCopyingList(fragment, triangle, point, contributingLights(point), alpha);
+    });
+    mShading.flush();
+    mShading.end();
+    blendPass.stop();
+}
+
 void BlendedPass::shadeWithTileLists(std::span<const float> opaqueDepth, int tileSizePixels,
                                      bool viewFrustumCulling, StageResult& result) {
     PassTimer blendPass(result, pass::kBlend);

@@ -14,16 +14,23 @@
 // (compositeExact) instead sorts every pixel's fragments by their exact distance.
 //
 // Light lists. shade() takes lightsAt(x, y, surface, triangle), which returns the stage's
-// light list for that fragment (ascending indices; a std::span<const uint32_t>, valid until the
-// next call from the same thread): every light (everyLight()), the tile's or cluster's list, the
-// object's list. A fragment's radiance sums its list in that order with evaluateLight, so stages
-// whose lists keep every contributing light give bitwise brute's composite.
+// light list for that fragment (ascending indices; a std::span<const uint32_t> into storage that
+// stays put until shade() returns, whose address identifies the list): every light
+// (everyLight()), the tile's or cluster's list, the object's list. `ideal`'s per-fragment lists
+// go through shadeWithContributingLights(). A fragment's radiance sums its list in that order on
+// the shared light kernel, so stages whose lists keep every contributing light give bitwise
+// brute's composite on the same ISA.
+//
+// Shading. Fragments are queued and shaded on the light kernel in packets of 16 consecutive
+// fragments of a raster tile (FragmentShading.h, FragmentApply::Over), on inputs.isa, and
+// composited lane by lane in fragment order; the pass's SIMT lane slots and kernel counters are
+// added to the opaque pass's (KernelWork.h), so a stage's figures cover its whole frame.
 //
 // Counting. shade() adds each fragment's list length to lightsEvaluated, and, when
 // lightsOracle is non-empty (stages that count the oracle themselves, brute), its contributing
-// lights to lightsOracle; addOracle() adds the latter for the oracle the runner counts
-// (lighting/Oracle.h); compositeExact() counts both for the reference. The pass is timed as
-// pass::kBlend. With the tests' light trace on (StageResult::traceLights), each composited
+// lights (the kernel's count) to lightsOracle; addOracle() adds the latter for the oracle the
+// runner counts (lighting/Oracle.h); compositeExact() counts both for the reference. The pass is
+// timed as pass::kBlend. With the tests' light trace on (StageResult::traceLights), each composited
 // fragment's list goes into StageResult::blendedTrace (the reference: every light), so the
 // identity check covers blended fragments too (tests/lighting/LightIdentity.h).
 //
@@ -48,6 +55,7 @@
 #include "gbuffer/DepthFormat.h"
 #include "gbuffer/VisibilityPass.h"
 #include "lighting/Brdf.h"
+#include "lighting/FragmentShading.h"
 #include "lighting/PassNames.h"
 #include "lighting/ShadingStage.h"
 #include "raster/Rasterizer.h"
@@ -91,6 +99,9 @@ public:
     // The lights that contribute at a blended fragment's surface (every light tested,
     // ascending; valid until the calling thread's next call): the lists of `ideal`.
     std::span<const uint32_t> contributingLights(const gbuffer::Surface& point) const;
+    // shade() with each fragment's contributingLights(): `ideal`, whose blended lists are built
+    // inside the blend pass's time (its untimed lists are the opaque surfaces').
+    void shadeWithContributingLights(std::span<const float> opaqueDepth, StageResult& result);
     // shade() with the tile lists of BlendedTileLists.h on tiles of tileSizePixels (the tiled
     // stages; the list building is timed in the blend pass).
     void shadeWithTileLists(std::span<const float> opaqueDepth, int tileSizePixels,
@@ -138,6 +149,7 @@ private:
     std::vector<uint32_t> mSortedIndices; // vertex indices of the sorted triangles
     std::vector<uint32_t> mSceneTriangle; // drawn triangle -> scene triangle
     std::vector<uint32_t> mEveryLight;
+    FragmentShading mShading; // the blended fragments on the light kernel
 };
 
 template <class FragmentFn>
@@ -152,31 +164,17 @@ void BlendedPass::draw(std::span<const float> opaqueDepth, FragmentFn&& fragment
 template <class LightsAt>
 void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
                         StageResult& result, PassTimer& blendPass) {
-    const std::vector<LightInView<float>>& lights = mInputs->lights->lights;
-    const size_t width = size_t(result.width);
-    const bool countOracle = !result.lightsOracle.empty();
+    mShading.begin(*mInputs, FragmentApply::Over, result);
     draw(opaqueDepth, [&](const raster::Fragment& fragment) {
         const uint32_t triangle = mSceneTriangle[fragment.triangle];
         float alpha = 0.0f;
         const gbuffer::Surface point = surfaceOf(fragment, triangle, alpha);
-        const glm::vec3 toViewer = glm::normalize(-point.positionView);
         const std::span<const uint32_t> list = lightsAt(fragment.x, fragment.y, point, triangle);
-        glm::vec3 sum(0.0f);
-        uint32_t contributing = 0;
-        for (const uint32_t index : list) {
-            const glm::vec3 radiance = evaluateLight(point, toViewer, lights[index]);
-            sum += radiance;
-            contributing += contributes(radiance) ? 1u : 0u;
-        }
-        sum += point.emissive; // once per fragment, after its lights, composited with them
-        const size_t pixel = size_t(fragment.y) * width + size_t(fragment.x);
-        for (int c = 0; c < 3; ++c)
-            result.radiance[c][pixel] = alpha * sum[c] + (1.0f - alpha) * result.radiance[c][pixel];
-        result.lightsEvaluated[pixel] += uint32_t(list.size());
-        if (countOracle)
-            result.lightsOracle[pixel] += contributing;
-        result.traceBlendedFragment(pixel, triangle, fragment.frontFacing, list);
+        mShading.add(fragment, triangle, point, uint64_t(reinterpret_cast<uintptr_t>(list.data())),
+                     list, alpha);
     });
+    mShading.flush();
+    mShading.end();
     blendPass.stop();
 }
 

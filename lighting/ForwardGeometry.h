@@ -121,11 +121,15 @@ public:
     void objectLightLists(const std::vector<LightSphere>& spheres, LightIndexLists& lists);
     uint32_t objectOfTriangle(uint32_t triangle) const { return mObjectOfTriangle[triangle]; }
 
+    // The fragment's view-space position, bitwise surfaceAt's (the depth decode alone).
+    glm::vec3 positionAt(const raster::Fragment& fragment) const {
+        return mDepthDecoder->positionView(fragment.x, fragment.y, fragment.depth);
+    }
     // The fragment's surface as `brute` sees it in the G-buffer (see the file comment).
     gbuffer::Surface surfaceAt(const raster::Fragment& fragment, uint32_t triangle) const {
         gbuffer::Surface s = mVisibility.surfaceAt(
             gbuffer::VisibilityPass::code(triangle, fragment.frontFacing), fragment.x, fragment.y);
-        s.positionView = mDepthDecoder->positionView(fragment.x, fragment.y, fragment.depth);
+        s.positionView = positionAt(fragment);
         return s;
     }
     // Adds the emission of every pixel's visible triangle (the pre-pass's visibility buffer,

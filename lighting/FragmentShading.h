@@ -1,16 +1,18 @@
-// FragmentShading: the forward stages' rasterized fragments (`forward`, `forward-multipass`,
-// `tiled-forward`) shaded on the shared light kernel (lighting/kernel/LightKernel.h), in
-// 16-lane fragment packets instead of one scalar evaluateLight loop per fragment.
+// FragmentShading: rasterized fragments shaded on the shared light kernel
+// (lighting/kernel/LightKernel.h), in 16-lane fragment packets instead of one scalar
+// evaluateLight loop per fragment: the forward stages' opaque fragments (`forward`,
+// `forward-multipass`, `tiled-forward`) and every stage's blended fragments (BlendedPass.h).
 //
 // Why: a forward stage shades what the rasterizer emits, in submission order, not 4x4 blocks
 // decoded from a G-buffer, so accumulateLights (LightAccumulation.h) does not fit. But the
 // kernel's lanes are independent (each lane sums its own list in list order, bitwise
 // independently of the other lanes), so a lane can hold any surface: here a packet's lanes are
-// CONSECUTIVE FRAGMENTS of one raster tile, each filled from ForwardGeometry::surfaceAt.
+// CONSECUTIVE FRAGMENTS of one raster tile, each with the surface the caller gives for it
+// (ForwardGeometry::surfaceAt, BlendedPass's blended surface).
 //
 // How: the draw's fragment function decides what the stage decides today (visible or not, which
-// list) and calls add() instead of shading. Fragments are queued per raster tile (the
-// rasterizer's kTileSize x kTileSize screen tiles, raster/Rasterizer.h: a tile is drawn by one
+// surface, which list) and calls add() instead of shading. Fragments are queued per raster tile
+// (the rasterizer's kTileSize x kTileSize screen tiles, raster/Rasterizer.h: a tile is drawn by one
 // task at a time, in submission order) into a batch of `inputs.simtWarpLanes` (32 or 64)
 // fragments, i.e. 2 or 4 packets. A full batch is shaded at once; flush() shades every tile's
 // partial batch after the draw. Per packet: lanes grouped by list (PacketLightLists::
@@ -22,8 +24,14 @@
 //   shades every fragment that passes the depth test: overdraw is real cost and stays counted
 //   and shaded, a later fragment of the same pixel, even in the same packet, replaces it);
 // - Add (`forward-multipass`): the fragment's light sum is added to the pixel's radiance, its
-//   evaluations to lightsEvaluated (one additive pass per light; the stage adds the emission).
-// The light trace follows: Replace assigns the lane's list, Add appends its lights.
+//   evaluations to lightsEvaluated (one additive pass per light; the stage adds the emission);
+// - Over (blended fragments): the fragment's light sum plus its emission is composited over the
+//   pixel with its alpha, radiance = alpha (sum + emitted) + (1 - alpha) radiance, the same
+//   float expression BlendedPass's scalar loop had; lightsEvaluated adds the list length and,
+//   when the stage counts the oracle itself (result.lightsOracle non-empty: `brute`),
+//   lightsOracle adds the lane's contributing lights (the kernel's count).
+// The light trace follows: Replace assigns the lane's list, Add appends its lights, Over appends
+// a blended fragment (StageResult::traceBlendedFragment).
 //
 // Exactness: a lane's sum is the kernel's sum over its own list in list order from 0, the same
 // sequence of float operations `brute` runs on the same ISA at the same surface (bitwise the
@@ -36,8 +44,10 @@
 // slots (idle lanes of a tile's last, partial batch included) for every light of the union of its
 // fragments' lists. Recorded with the packet counters (as accumulateLights does) by end().
 //
-// Memory: per raster tile one batch of at most 64 queued fragments (40 bytes each) plus its union
-// scratch (at most the batch's list lengths); atrium at 1280x720 has 60 tiles: ~150 KB.
+// Memory: per raster tile one batch of at most 64 queued fragments (~130 bytes each: the surface
+// is queued, so that the caller's surface, not a recomputed one, is shaded) plus its union
+// scratch and copied lists (at most the batch's list lengths); atrium at 1280x720 has 60 tiles:
+// ~0.5 MB.
 //
 // Determinism: a tile's batches are cut from its own fragment stream (submission order, the same
 // for any thread count), shaded by the task that draws the tile (full batches) or by flush() (one
@@ -53,12 +63,12 @@
 #include <span>
 #include <vector>
 
+#include "gbuffer/Surface.h"
 #include "lighting/ShadingStage.h"
 #include "raster/Rasterizer.h"
 
 namespace lighting {
 
-class ForwardGeometry;
 namespace kernel {
 class KernelLights;
 }
@@ -66,6 +76,7 @@ class KernelLights;
 enum class FragmentApply {
     Replace, // the fragment's light sum + emission replaces the pixel's radiance
     Add,     // the fragment's light sum is added to the pixel's radiance
+    Over,    // the fragment's light sum + emission is composited over the pixel with its alpha
 };
 
 class FragmentShading {
@@ -75,30 +86,48 @@ public:
     FragmentShading(const FragmentShading&) = delete;
     FragmentShading& operator=(const FragmentShading&) = delete;
 
-    // Starts a frame: the kernel's lights from inputs.lights, inputs.isa, the warp size
-    // (inputs.simtWarpLanes, 32 or 64), one batch per raster tile of the view. `geometry` gives
-    // the fragments' surfaces; `result` (resized already) receives them. Both must outlive end().
-    void begin(const StageInputs& inputs, const ForwardGeometry& geometry, FragmentApply apply,
-               StageResult& result);
-    // Queues a fragment of scene triangle `triangle` to be shaded with `lights` (ascending for
-    // exactness; must stay valid until the next flush()), a list `listKey` identifies within the
-    // draw (equal keys = the same list: an object, a tile, a light). Shades the fragment's tile
-    // batch when it is full. Called from the draw's fragment function.
-    void add(const raster::Fragment& fragment, uint32_t triangle, uint32_t listKey,
-             std::span<const uint32_t> lights);
+    // Starts a pass: the kernel's lights from inputs.lights, inputs.isa, the warp size
+    // (inputs.simtWarpLanes, 32 or 64), one batch per raster tile of the view. `result` (resized
+    // already) receives the fragments and must outlive end().
+    void begin(const StageInputs& inputs, FragmentApply apply, StageResult& result);
+    // Queues a fragment of scene triangle `triangle` with surface `surface` (and, for Over, its
+    // alpha) to be shaded with `lights` (ascending for exactness; must stay valid until the next
+    // flush()), a list `listKey` identifies within the draw (equal keys = the same list: an
+    // object, a tile, a light). Shades the fragment's tile batch when it is full. Called from the
+    // draw's fragment function.
+    void add(const raster::Fragment& fragment, uint32_t triangle, const gbuffer::Surface& surface,
+             uint64_t listKey, std::span<const uint32_t> lights, float alpha = 1.0f);
+    // As add(), for a list that is the fragment's own and may go away when this returns (a
+    // thread_local scratch list): copied into the tile's batch, never grouped with another.
+    void addCopyingList(const raster::Fragment& fragment, uint32_t triangle,
+                        const gbuffer::Surface& surface, std::span<const uint32_t> lights,
+                        float alpha = 1.0f);
+    // For FragmentApply::Add: whether `positionView` is certainly beyond the range of `light`
+    // (a point or spot light; false for the others), with a margin so that the kernel's range
+    // test rejects it on every ISA. A light then adds exactly zero there.
+    bool beyondRange(uint32_t light, const glm::vec3& positionView) const;
+    // Queues a fragment every light of whose list is beyondRange there (FragmentApply::Add only):
+    // it takes its lane of the warp and counts its evaluations like any fragment, but is neither
+    // given a surface nor shaded (its sums are zero), and the packet counters are those of
+    // shading it (its lights are rejected at range by all its lanes). What makes a light pass of
+    // `forward-multipass` cheap where most of the illumination set lies outside the light's range.
+    void addBeyondRange(const raster::Fragment& fragment, uint32_t triangle, uint64_t listKey,
+                        std::span<const uint32_t> lights);
     // Shades every tile's queued fragments; after each draw, before its lists go away.
     void flush();
-    // Ends the frame: records "isa", "simt_warp", "simt_lane_slots", "packet_groups" and the
-    // packet_lights_* counters (LightAccumulation.h) in result.parameters.
+    // Ends the pass: records "isa", "simt_warp", "simt_lane_slots", "packet_groups" and the
+    // packet_lights_* counters (LightAccumulation.h) in result.parameters, added to those an
+    // earlier kernel pass of the frame recorded (KernelWork::record).
     void end();
 
 private:
     struct TileBatch;
+    TileBatch& tileOf(const raster::Fragment& fragment);
     void shadeBatch(TileBatch& batch);
 
-    const ForwardGeometry* mGeometry = nullptr;
     StageResult* mResult = nullptr;
     FragmentApply mApply = FragmentApply::Replace;
+    bool mCountOracle = false;
     kernel::KernelIsa mIsa = kernel::KernelIsa::scalar();
     int mWarpLanes = 32;
     int mWidth = 0;

@@ -8,7 +8,9 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/BlendedTileLists.h"
-#include "lighting/LightListShading.h"
+#include "lighting/DsfFilter.h"
+#include "lighting/LightAccumulation.h"
+#include "lighting/SplitLighting.h"
 
 namespace lighting {
 
@@ -79,25 +81,32 @@ void InferredStipple::stipple(const StageInputs& inputs, BlendedPass& blended,
 }
 
 void InferredStipple::light(const StageInputs& inputs, std::span<const float> opaqueDepth,
-                            int tileSizePixels) {
-    const TileGrid grid = TileGrid::make(mLattice.width, mLattice.height, tileSizePixels);
-    const std::vector<std::vector<uint32_t>> lists =
-        blendedTileLightLists(inputs, opaqueDepth, grid, true);
-    const std::vector<LightInView<float>>& lights = inputs.lights->lights;
-    tbb::parallel_for(0, mLattice.lowHeight, [&](int j) {
-        for (int i = 0; i < mLattice.lowWidth; ++i) {
-            Sample& sample = mSamples[size_t(j) * size_t(mLattice.lowWidth) + size_t(i)];
-            if (!sample.covered)
-                continue;
-            const int x = mLattice.sampleX(i), y = mLattice.sampleY(j);
-            const std::vector<uint32_t>& list =
-                lists[size_t((y / tileSizePixels) * grid.tileCountX + x / tileSizePixels)];
-            const SplitLighting lighting = splitLighting(sample.surface, lights, list);
-            sample.diffuse = lighting.diffuse;
-            sample.specular = lighting.specular;
-            sample.lightCount = uint32_t(list.size());
+                            int tileSizeSamples, StageResult& result) {
+    const Lattice& l = mLattice;
+    const TileGrid grid = TileGrid::make(l.width, l.height, tileSizeSamples * l.scale);
+    LightIndexLists lists;
+    lists.assign(blendedTileLightLists(inputs, opaqueDepth, grid, true));
+    const SplitLightSinkOf sink([&](const kernel::ShadingPacket& packet,
+                                    const kernel::SplitPacketAccumulator& sums) {
+        for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+            const int lane = __builtin_ctz(lanes);
+            Sample& sample = mSamples[size_t(packet.y0 + kernel::laneY(lane)) * size_t(l.lowWidth) +
+                                      size_t(packet.x0 + kernel::laneX(lane))];
+            for (int c = 0; c < 3; ++c) {
+                sample.light.diffuse[c] = sums.diffuse[c][lane];
+                sample.light.specular[c] = sums.specular[c][lane];
+                sample.light.specularEdge[c] = sums.specularEdge[c][lane];
+            }
         }
     });
+    SplitLightingOptions options;
+    options.scale = l.scale;
+    options.sampleSurfaces = [&](size_t index) -> const gbuffer::Surface* {
+        return mSamples[index].covered ? &mSamples[index].surface : nullptr;
+    };
+    // Sample tile (tx, ty) is full-res tile (tx, ty) of `grid` (as the stage's own light pass).
+    accumulateSplitLights(inputs, options, TileListSource(tileSizeSamples, grid.tileCountX, lists),
+                          sink, result);
 }
 
 InferredStipple::Counts InferredStipple::composite(BlendedPass& blended,
@@ -136,51 +145,37 @@ InferredStipple::Counts InferredStipple::composite(BlendedPass& blended,
         const int tapI[4] = {ia, ib, ia, ib}, tapJ[4] = {ja, ja, jb, jb};
         const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
         const float depth = -surface.positionView.z;
-        glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f), surfaceDiffuse(0.0f),
-            surfaceSpecular(0.0f);
-        float sameWeight = 0.0f, surfaceWeight = 0.0f, nearestWeight = -1.0f;
-        const Sample* nearestSample = nullptr;
+        DsfFilter filter;
         for (int k = 0; k < 4; ++k) {
             if (tapI[k] < 0 || tapJ[k] < 0)
                 continue;
             const Sample& t = mSamples[size_t(tapJ[k]) * size_t(l.lowWidth) + size_t(tapI[k])];
             if (!t.covered)
                 continue;
-            if (bilinear[k] > nearestWeight) {
-                nearestWeight = bilinear[k];
-                nearestSample = &t;
-            }
-            if (std::abs(-t.surface.positionView.z - depth) > options.depthThreshold * depth ||
-                glm::dot(t.surface.normalView, surface.normalView) < options.normalThreshold)
-                continue;
-            surfaceDiffuse += bilinear[k] * t.diffuse;
-            surfaceSpecular += bilinear[k] * t.specular;
-            surfaceWeight += bilinear[k];
-            if (options.objectIds && t.instance != instance)
-                continue;
-            sameDiffuse += bilinear[k] * t.diffuse;
-            sameSpecular += bilinear[k] * t.specular;
-            sameWeight += bilinear[k];
+            const bool passesSurface =
+                !(std::abs(-t.surface.positionView.z - depth) > options.depthThreshold * depth ||
+                  glm::dot(t.surface.normalView, surface.normalView) < options.normalThreshold);
+            filter.add(bilinear[k], t.light, passesSurface,
+                       !options.objectIds || t.instance == instance);
         }
-        glm::vec3 diffuse(0.0f), specular(0.0f);
-        if (sameWeight > 0.0f) {
-            diffuse = sameDiffuse / sameWeight;
-            specular = sameSpecular / sameWeight;
-        } else if (surfaceWeight > 0.0f) {
-            diffuse = surfaceDiffuse / surfaceWeight;
-            specular = surfaceSpecular / surfaceWeight;
+        SplitLighting light;
+        switch (filter.resolve(light)) {
+        case DsfFilter::Source::Same:
+            break;
+        case DsfFilter::Source::Surface:
+        case DsfFilter::Source::Nearest:
             ++fallbacks[pixel];
-        } else if (nearestSample) {
-            diffuse = nearestSample->diffuse;
-            specular = nearestSample->specular;
-            ++fallbacks[pixel];
-        } else {
+            break;
+        case DsfFilter::Source::None:
             ++unlit[pixel];
+            break;
         }
-        // The fragment's own emission, at full resolution, composited with its light
-        // (BlendedPass.h, "Emission").
+        // The material's half of the split (both models, as the opaque material pass), then the
+        // fragment's own emission, at full resolution, composited with its light (BlendedPass.h,
+        // "Emission").
         const glm::vec3 lit =
-            surface.albedo * diffuse + surface.specularIntensity * specular + surface.emissive;
+            combineSplitLighting(surface, light.diffuse, light.specular, light.specularEdge) +
+            surface.emissive;
         for (int c = 0; c < 3; ++c)
             result.radiance[c][pixel] = alpha * lit[c] + (1.0f - alpha) * result.radiance[c][pixel];
     });

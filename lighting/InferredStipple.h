@@ -19,15 +19,19 @@
 //   resolution drops where transparent surfaces cover it).
 // - Light pass (light()): those samples are lit like any other (diffuse and specular split, the
 //   stage's L-buffer), with the near-to-opaque tile lists (BlendedTileLists.h) of the stage's
-//   culling tiles, since the stage's own lists are bounded by the opaque depth.
+//   culling tiles, since the stage's own lists are bounded by the opaque depth: on the shared
+//   light kernel, by the stage's own loop (accumulateSplitLights over the held surfaces,
+//   LightAccumulation.h), which also counts their warps (8x4 or 8x8 samples) in the SIMT model.
 // - Material pass (composite()): every blended fragment (BlendedPass's per-triangle back-to-front
 //   order) takes the 4 nearest samples of its instance's pattern (a lattice of spacing 2 in
 //   samples) with bilinear weights, zeroed by the stage's DSF tests: the sample holds no
 //   stippled surface, another instance (with ids=1), a view depth off by more than `depth` times
 //   the fragment's, or a normal cosine below `normal`; then, as the opaque filter does, the
 //   samples passing depth and normal only, then the nearest stippled sample of the pattern
-//   (counted in stipple_fallbacks), else no light (stipple_unlit). lit = albedo x diffuse +
-//   specular intensity x specular + the fragment's emission, composited with "over".
+//   (counted in stipple_fallbacks), else no light (stipple_unlit). lit = the material's half of
+//   the split (combineSplitLighting, SplitLighting.h: albedo x diffuse + specular intensity x
+//   specular, or for metallic-roughness c_diff x diffuse + f0 x specular + the Fresnel edge
+//   term, which the samples carry too) + the fragment's emission, composited with "over".
 // - Beyond 3 layers: instances whose ranks differ by a multiple of 3 share a pattern; where they
 //   overlap, the nearer one holds the samples, and the farther one finds none of its own (its DSF
 //   rejects them by ID, or by depth) and falls back as above: wrong light, which its error
@@ -44,6 +48,7 @@
 #include "gbuffer/Surface.h"
 #include "lighting/BlendedPass.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/SplitLighting.h"
 
 namespace lighting {
 
@@ -57,9 +62,7 @@ public:
         bool covered = false;
         uint32_t instance = 0;
         gbuffer::Surface surface; // positionView from the fragment's depth
-        glm::vec3 diffuse{0.0f};
-        glm::vec3 specular{0.0f};
-        uint32_t lightCount = 0; // lights evaluated for it
+        SplitLighting light;      // diffuse, specular, metallic-roughness Fresnel edge
     };
 
     // The L-buffer geometry of the stage: lowWidth x lowHeight samples, sample (i, j) reading
@@ -81,8 +84,11 @@ public:
     bool holds(size_t sample) const { return mSamples[sample].covered; }
     const Sample& sample(size_t index) const { return mSamples[index]; }
 
-    // The light pass for the stippled samples, on tiles of tileSizePixels full-res pixels.
-    void light(const StageInputs& inputs, std::span<const float> opaqueDepth, int tileSizePixels);
+    // The light pass for the stippled samples, on tiles of tileSizeSamples x tileSizeSamples
+    // samples (the stage's culling tiles): writes result.lightsEvaluated at each held sample's
+    // pixel (its list length) and adds its kernel work to the frame's (KernelWork.h).
+    void light(const StageInputs& inputs, std::span<const float> opaqueDepth, int tileSizeSamples,
+               StageResult& result);
 
     struct DsfOptions {
         float depthThreshold = 0.1f;

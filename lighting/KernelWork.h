@@ -2,7 +2,11 @@
 // (accumulateLights, accumulateSplitLights, `deferred`, FragmentShading): the SIMT cost model's
 // lane slots (lighting/README.md) and the packet-level counters of kernel::PacketAccumulator.
 // Each task sums its own KernelWork; the stage adds them in a fixed order after its parallel loop
-// (integers: the total does not depend on the thread count) and records them once.
+// (integers: the total does not depend on the thread count) and records them once per kernel
+// pass. A frame can have two kernel passes (the opaque surfaces, then the blended ones,
+// BlendedPass.h): the second record adds to the first, so the frame's figures are its whole
+// work and simt_efficiency (the oracle, which counts blended fragments too, over the lane slots)
+// compares like with like.
 #pragma once
 
 #include <cstdint>
@@ -20,6 +24,14 @@ struct KernelWork {
     uint64_t skippedAtConeOrFacing = 0; // (PacketAccumulator's three counters)
     uint64_t shaded = 0;
 
+    // Adds a packet's three early-out counters (kernel::PacketAccumulator's or
+    // SplitPacketAccumulator's).
+    template <class Accumulator> void addCounters(const Accumulator& accumulator) {
+        skippedAtRange += accumulator.lightsSkippedAtRange;
+        skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
+        shaded += accumulator.lightsShaded;
+    }
+
     KernelWork& operator+=(const KernelWork& other) {
         laneSlots += other.laneSlots;
         groups += other.groups;
@@ -29,20 +41,25 @@ struct KernelWork {
         return *this;
     }
 
-    // Records "isa" (what ran), "simt_warp", "simt_lane_slots" and, when the frame took the
-    // packet path, "packet_groups" and the three "packet_lights_*" counters.
-    void record(const kernel::KernelIsa& isa, int warpLanes, bool packets,
-                StageResult& result) const {
+    // Records "isa" (what ran), "simt_warp", "simt_lane_slots", "packet_groups" and the three
+    // "packet_lights_*" counters; each counter adds to the value an earlier pass of the frame
+    // recorded.
+    void record(const kernel::KernelIsa& isa, int warpLanes, StageResult& result) const {
         result.parameters["isa"] = isa.name();
         result.parameters["simt_warp"] = std::to_string(warpLanes);
-        result.parameters["simt_lane_slots"] = std::to_string(laneSlots);
-        if (!packets)
-            return;
-        result.parameters["packet_groups"] = std::to_string(groups);
-        result.parameters["packet_lights_skipped_at_range"] = std::to_string(skippedAtRange);
-        result.parameters["packet_lights_skipped_at_cone_or_facing"] =
-            std::to_string(skippedAtConeOrFacing);
-        result.parameters["packet_lights_shaded"] = std::to_string(shaded);
+        add(result, "simt_lane_slots", laneSlots);
+        add(result, "packet_groups", groups);
+        add(result, "packet_lights_skipped_at_range", skippedAtRange);
+        add(result, "packet_lights_skipped_at_cone_or_facing", skippedAtConeOrFacing);
+        add(result, "packet_lights_shaded", shaded);
+    }
+
+private:
+    static void add(StageResult& result, const std::string& key, uint64_t value) {
+        const auto earlier = result.parameters.find(key);
+        if (earlier != result.parameters.end())
+            value += std::stoull(earlier->second);
+        result.parameters[key] = std::to_string(value);
     }
 };
 

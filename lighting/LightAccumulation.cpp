@@ -56,61 +56,30 @@ kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb) {
 }
 
 PacketPath::PacketPath(const StageInputs& inputs, bool decodePixels)
-    : packets(packetPathFits(inputs)), isa(packets ? inputs.isa : kernel::KernelIsa::scalar()) {
-    if (!packets)
-        return;
-    const gbuffer::GBuffer& gb = *inputs.gbuffer;
-    if (decodePixels)
-        decoder.emplace(gb.layout(), gb.view(), planesOf(gb));
-    lights.emplace(inputs.lights->lights);
+    : gbuffer(*inputs.gbuffer), isa(inputs.isa), lights(inputs.lights->lights) {
+    if (decodePixels && packetPathFits(inputs))
+        decoder.emplace(gbuffer.layout(), gbuffer.view(), planesOf(gbuffer));
 }
 
-namespace {
-
-// The per-pixel path's packet: the lanes' surfaces from GBuffer::surfaceAt, and the packet rows
-// the list sources read (positions, mask).
-void decodePerPixel(const gbuffer::GBuffer& gb, int x0, int y0, kernel::ShadingPacket& packet,
-                    gbuffer::Surface (&surfaces)[kPacketLanes]) {
+void PacketPath::decode(int x0, int y0, kernel::ShadingPacket& packet) const {
+    if (decoder) {
+        decoder->decode(isa, x0, y0, packet);
+        return;
+    }
     packet.clear(x0, y0);
     for (int lane = 0; lane < kPacketLanes; ++lane) {
         const int x = x0 + kernel::laneX(lane), y = y0 + kernel::laneY(lane);
-        if (x >= gb.width() || y >= gb.height())
-            continue;
-        gbuffer::Surface& s = surfaces[lane];
-        if (gb.surfaceAt(x, y, s))
-            packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
-                           s.specularPower);
+        gbuffer::Surface s;
+        if (x < gbuffer.width() && y < gbuffer.height() && gbuffer.surfaceAt(x, y, s))
+            setLaneSurface(packet, lane, s);
     }
 }
 
-// evaluateLight over each lane's list, as the stages' per-pixel loops did (shadeWithLightList).
-void shadePerPixel(const gbuffer::Surface (&surfaces)[kPacketLanes], const PacketLightLists& lists,
-                   const std::vector<LightInView<float>>& lights, bool countOracle,
-                   kernel::PacketAccumulator& accumulator) {
-    for (int g = 0; g < lists.size(); ++g)
-        for (uint32_t lanes = lists[g].laneMask; lanes != 0; lanes &= lanes - 1) {
-            const int lane = __builtin_ctz(lanes);
-            const gbuffer::Surface& point = surfaces[lane];
-            const glm::vec3 toViewer = glm::normalize(-point.positionView);
-            glm::vec3 sum(0.0f);
-            uint32_t contributing = 0;
-            uint32_t evaluated = 0;
-            for (size_t i = 0; i < lists[g].lights.size(); ++i) {
-                if (!lists[g].evaluates(lane, i))
-                    continue;
-                const glm::vec3 radiance =
-                    evaluateLight(point, toViewer, lights[lists[g].lights[i]]);
-                sum += radiance;
-                ++evaluated;
-                if (countOracle)
-                    contributing += contributes(radiance) ? 1u : 0u;
-            }
-            for (int c = 0; c < 3; ++c)
-                accumulator.radiance[c][lane] = sum[c];
-            accumulator.lightsEvaluated[lane] = evaluated;
-            accumulator.lightsContributing[lane] = contributing;
-        }
+void PacketPath::record(StageResult& result) const {
+    result.parameters["gbuffer_decode"] = decoder ? "packet" : "per-pixel";
 }
+
+namespace {
 
 // Lights in the union of a warp's lists: the common case (one list for the whole warp) directly,
 // otherwise by stamping each light index with the warp's number.
@@ -165,6 +134,59 @@ private:
     uint64_t mCount = 0;
 };
 
+// What one warp-row task of walkWarps keeps between packets.
+template <class Accumulator> struct PacketScratch {
+    kernel::ShadingPacket packet;
+    Accumulator accumulator;
+    PacketLightLists lists;
+};
+
+// The SIMT model's bill for a packet: the lists its lanes walked join the warp's union; true when
+// it had a lane group (the warp then pays).
+bool payLists(const PacketLightLists& lists, WarpUnion& warpUnion) {
+    for (int g = 0; g < lists.size(); ++g) {
+        if (lists[g].scratch)
+            warpUnion.addTransient(lists[g].lights);
+        else
+            warpUnion.add(lists[g].lights);
+    }
+    return lists.size() > 0;
+}
+
+// The walk accumulateLights and accumulateSplitLights share: a grid of columns x rows units
+// (pixels or lattice samples) in 4x4 packets and warps of 8 x (warpLanes / 8) units, warp rows in
+// parallel (one task per row, with its own scratch), the packets of a warp in order.
+// shade(scratch, x0, y0, warpUnion, work) shades the packet at (x0, y0), pays its lists
+// (payLists) and adds its kernel counters to `work`, and returns whether the warp pays; a warp that
+// pays costs warpLanes lane slots per light of its union. Returns the frame's work summed in row
+// order (integers: the same for any thread count).
+template <class Accumulator, class Shade>
+KernelWork walkWarps(int columns, int rows, int warpLanes, size_t lightCount, const Shade& shade) {
+    const int warpHeight = warpLanes / kWarpWidth;
+    const int warpRows = (rows + warpHeight - 1) / warpHeight;
+    std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
+    tbb::parallel_for(0, warpRows, [&](int warpRow) {
+        PacketScratch<Accumulator> scratch;
+        WarpUnion warpUnion(lightCount);
+        KernelWork rowWork;
+        for (int wx = 0; wx < columns; wx += kWarpWidth) {
+            warpUnion.begin();
+            bool pays = false;
+            for (int y0 = warpRow * warpHeight; y0 < std::min(rows, (warpRow + 1) * warpHeight);
+                 y0 += kPacketHeight)
+                for (int x0 = wx; x0 < std::min(columns, wx + kWarpWidth); x0 += kPacketWidth)
+                    pays |= shade(scratch, x0, y0, warpUnion, rowWork);
+            if (pays)
+                rowWork.laneSlots += uint64_t(warpLanes) * warpUnion.count();
+        }
+        workPerRow[size_t(warpRow)] = rowWork;
+    });
+    KernelWork work;
+    for (const KernelWork& row : workPerRow)
+        work += row;
+    return work;
+}
+
 } // namespace
 
 void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
@@ -174,110 +196,73 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
     if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
         throw std::invalid_argument("accumulateLights: simtWarpLanes must be 32 or 64, not " +
                                     std::to_string(inputs.simtWarpLanes));
-    const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
     const bool emission = gb.hasEmission();
-    PacketPath path(inputs);
-    const bool packets = path.packets;
+    const PacketPath path(inputs);
     const kernel::KernelIsa isa = path.isa;
-    std::optional<kernel::PacketDecoder>& decoder = path.decoder;
-    std::optional<kernel::KernelLights>& kernelLights = path.lights;
 
-    const int warpRows = (height + warpHeight - 1) / warpHeight;
-    // Per warp row: lane slots, packet-wide light iterations by outcome (PacketAccumulator's
-    // counters; the vector kernel's cost is about proportional to them, lighting/kernel/README.md)
-    // and kernel calls (one per group).
-    std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
-    tbb::parallel_for(0, warpRows, [&](int warpRow) {
-        kernel::ShadingPacket packet;
-        kernel::PacketAccumulator accumulator;
-        PacketLightLists lists;
-        gbuffer::Surface surfaces[kPacketLanes];
-        WarpUnion warpUnion(lights.size());
-        KernelWork rowWork;
-        for (int wx = 0; wx < width; wx += kWarpWidth) {
-            warpUnion.begin();
-            bool anyLane = false;
-            for (int y0 = warpRow * warpHeight; y0 < std::min(height, (warpRow + 1) * warpHeight);
-                 y0 += kPacketHeight)
-                for (int x0 = wx; x0 < std::min(width, wx + kWarpWidth); x0 += kPacketWidth) {
-                    if (packets)
-                        decoder->decode(isa, x0, y0, packet);
-                    else
-                        decodePerPixel(gb, x0, y0, packet, surfaces);
-                    if (packet.laneMask == 0)
-                        continue;
-                    lists.clear();
-                    source.listsOf(packet, lists);
-                    accumulator.clear();
-                    rowWork.groups += uint64_t(lists.size());
-                    if (packets) {
-                        for (int g = 0; g < lists.size(); ++g) {
-                            const PacketLightLists::Group& group = lists[g];
-                            if (group.lightLaneMasks.empty())
-                                kernel::shadePacket(isa, packet, group.laneMask, *kernelLights,
-                                                    group.lights, accumulator, options.countOracle);
-                            else
-                                kernel::shadePacket(isa, packet, group.laneMask, *kernelLights,
-                                                    group.lights, group.lightLaneMasks, accumulator,
-                                                    options.countOracle);
-                        }
-                    } else {
-                        shadePerPixel(surfaces, lists, lights, options.countOracle, accumulator);
-                    }
-                    for (int g = 0; g < lists.size(); ++g) {
-                        if (lists[g].scratch)
-                            warpUnion.addTransient(lists[g].lights);
-                        else
-                            warpUnion.add(lists[g].lights);
-                        anyLane = true;
-                    }
-                    rowWork.skippedAtRange += accumulator.lightsSkippedAtRange;
-                    rowWork.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
-                    rowWork.shaded += accumulator.lightsShaded;
-                    // The test-only light trace (StageResult::traceLights): each lane summed
-                    // exactly its group's list (with per-light masks, its lights of it).
-                    if (result.tracing())
-                        for (int g = 0; g < lists.size(); ++g)
-                            for (uint32_t lanes = lists[g].laneMask & packet.laneMask; lanes != 0;
-                                 lanes &= lanes - 1) {
-                                const int lane = __builtin_ctz(lanes);
-                                std::vector<uint32_t> own;
-                                for (size_t i = 0; i < lists[g].lights.size(); ++i)
-                                    if (lists[g].evaluates(lane, i))
-                                        own.push_back(lists[g].lights[i]);
-                                result.traceLightList(size_t(y0 + kernel::laneY(lane)) *
-                                                              size_t(width) +
-                                                          size_t(x0 + kernel::laneX(lane)),
-                                                      own);
-                            }
-                    for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+    // Per warp: lane slots; per packet: packet-wide light iterations by outcome
+    // (PacketAccumulator's counters; the vector kernel's cost is about proportional to them,
+    // lighting/kernel/README.md) and kernel calls (one per group).
+    const KernelWork work = walkWarps<kernel::PacketAccumulator>(
+        width, height, inputs.simtWarpLanes, lights.size(),
+        [&](PacketScratch<kernel::PacketAccumulator>& scratch, int x0, int y0, WarpUnion& warpUnion,
+            KernelWork& rowWork) {
+            kernel::ShadingPacket& packet = scratch.packet;
+            kernel::PacketAccumulator& accumulator = scratch.accumulator;
+            PacketLightLists& lists = scratch.lists;
+            path.decode(x0, y0, packet);
+            if (packet.laneMask == 0)
+                return false;
+            lists.clear();
+            source.listsOf(packet, lists);
+            accumulator.clear();
+            rowWork.groups += uint64_t(lists.size());
+            for (int g = 0; g < lists.size(); ++g) {
+                const PacketLightLists::Group& group = lists[g];
+                if (group.lightLaneMasks.empty())
+                    kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
+                                        accumulator, options.countOracle);
+                else
+                    kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
+                                        group.lightLaneMasks, accumulator, options.countOracle);
+            }
+            rowWork.addCounters(accumulator);
+            // The test-only light trace (StageResult::traceLights): each lane summed exactly its
+            // group's list (with per-light masks, its lights of it).
+            if (result.tracing())
+                for (int g = 0; g < lists.size(); ++g)
+                    for (uint32_t lanes = lists[g].laneMask & packet.laneMask; lanes != 0;
+                         lanes &= lanes - 1) {
                         const int lane = __builtin_ctz(lanes);
-                        const size_t pixel = size_t(y0 + kernel::laneY(lane)) * size_t(width) +
-                                             size_t(x0 + kernel::laneX(lane));
-                        for (int c = 0; c < 3; ++c)
-                            result.radiance[c][pixel] = accumulator.radiance[c][lane];
-                        if (emission) {
-                            const glm::vec3 emitted = gb.emission(pixel);
-                            for (int c = 0; c < 3; ++c)
-                                result.radiance[c][pixel] += emitted[c];
-                        }
-                        result.lightsEvaluated[pixel] = accumulator.lightsEvaluated[lane];
-                        if (options.countOracle)
-                            result.lightsOracle[pixel] = accumulator.lightsContributing[lane];
+                        std::vector<uint32_t> own;
+                        for (size_t i = 0; i < lists[g].lights.size(); ++i)
+                            if (lists[g].evaluates(lane, i))
+                                own.push_back(lists[g].lights[i]);
+                        result.traceLightList(size_t(y0 + kernel::laneY(lane)) * size_t(width) +
+                                                  size_t(x0 + kernel::laneX(lane)),
+                                              own);
                     }
+            for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+                const int lane = __builtin_ctz(lanes);
+                const size_t pixel = size_t(y0 + kernel::laneY(lane)) * size_t(width) +
+                                     size_t(x0 + kernel::laneX(lane));
+                for (int c = 0; c < 3; ++c)
+                    result.radiance[c][pixel] = accumulator.radiance[c][lane];
+                if (emission) {
+                    const glm::vec3 emitted = gb.emission(pixel);
+                    for (int c = 0; c < 3; ++c)
+                        result.radiance[c][pixel] += emitted[c];
                 }
-            if (anyLane)
-                rowWork.laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
-        }
-        workPerRow[size_t(warpRow)] = rowWork;
-    });
-
-    KernelWork work;
-    for (const KernelWork& row : workPerRow)
-        work += row;
-    work.record(isa, inputs.simtWarpLanes, packets, result);
+                result.lightsEvaluated[pixel] = accumulator.lightsEvaluated[lane];
+                if (options.countOracle)
+                    result.lightsOracle[pixel] = accumulator.lightsContributing[lane];
+            }
+            return payLists(lists, warpUnion);
+        });
+    work.record(isa, inputs.simtWarpLanes, result);
+    path.record(result);
 }
 
 } // namespace lighting
@@ -300,11 +285,9 @@ uint32_t excludedLanes(std::span<const uint8_t> excluded, int sampleWidth, int s
     return lanes;
 }
 
-// The 4x4 samples at (i0, j0) of the lattice, lane by lane through GBuffer::surfaceAt: the packet
-// rows (both material models) and the lanes' surfaces (for the per-pixel path).
+// The 4x4 samples at (i0, j0) of the lattice, lane by lane through GBuffer::surfaceAt.
 void gatherSamples(const gbuffer::GBuffer& gb, int scale, int sampleWidth, int sampleHeight,
-                   uint32_t excluded, int i0, int j0, kernel::ShadingPacket& packet,
-                   gbuffer::Surface (&surfaces)[kPacketLanes]) {
+                   uint32_t excluded, int i0, int j0, kernel::ShadingPacket& packet) {
     packet.clear(i0, j0);
     for (int lane = 0; lane < kPacketLanes; ++lane) {
         const int i = i0 + kernel::laneX(lane), j = j0 + kernel::laneY(lane);
@@ -312,13 +295,24 @@ void gatherSamples(const gbuffer::GBuffer& gb, int scale, int sampleWidth, int s
             continue;
         const int x = std::min(i * scale + scale / 2, gb.width() - 1);
         const int y = std::min(j * scale + scale / 2, gb.height() - 1);
-        gbuffer::Surface& s = surfaces[lane];
-        if (!gb.surfaceAt(x, y, s))
+        gbuffer::Surface s;
+        if (gb.surfaceAt(x, y, s))
+            setLaneSurface(packet, lane, s);
+    }
+}
+
+// The same for surfaces the caller holds per sample (SplitLightingOptions::sampleSurfaces).
+void gatherOwnSamples(const std::function<const gbuffer::Surface*(size_t)>& surfaceOf,
+                      int sampleWidth, int sampleHeight, uint32_t excluded, int i0, int j0,
+                      kernel::ShadingPacket& packet) {
+    packet.clear(i0, j0);
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        const int i = i0 + kernel::laneX(lane), j = j0 + kernel::laneY(lane);
+        if (i >= sampleWidth || j >= sampleHeight || (excluded >> lane & 1u))
             continue;
-        packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
-                       s.specularPower);
-        if (s.model == scenes::MaterialModel::MetallicRoughness)
-            packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
+        const gbuffer::Surface* held = surfaceOf(size_t(j) * size_t(sampleWidth) + size_t(i));
+        if (held != nullptr)
+            setLaneSurface(packet, lane, *held);
     }
 }
 
@@ -340,101 +334,63 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
     if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
         throw std::invalid_argument("accumulateSplitLights: simtWarpLanes must be 32 or 64, not " +
                                     std::to_string(inputs.simtWarpLanes));
-    const int warpHeight = inputs.simtWarpLanes / kWarpWidth;
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
 
-    // Whole pixels (scale 1) are decoded a packet at a time; lattice samples are gathered.
-    PacketPath path(inputs, scale == 1);
-    const bool packets = path.packets;
+    // Whole pixels (scale 1) are decoded a packet at a time; lattice samples and the caller's
+    // own surfaces are gathered.
+    const PacketPath path(inputs, scale == 1 && !options.sampleSurfaces);
     const kernel::KernelIsa isa = path.isa;
-    std::optional<kernel::PacketDecoder>& decoder = path.decoder;
-    std::optional<kernel::KernelLights>& kernelLights = path.lights;
     auto pixelOf = [&](int i, int j) {
         return size_t(std::min(j * scale + scale / 2, height - 1)) * size_t(width) +
                size_t(std::min(i * scale + scale / 2, width - 1));
     };
 
-    const int warpRows = (sampleHeight + warpHeight - 1) / warpHeight;
-    std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
-    tbb::parallel_for(0, warpRows, [&](int warpRow) {
-        kernel::ShadingPacket packet;
-        kernel::SplitPacketAccumulator sums;
-        PacketLightLists lists;
-        gbuffer::Surface surfaces[kPacketLanes];
-        WarpUnion warpUnion(lights.size());
-        KernelWork rowWork;
-        for (int wi = 0; wi < sampleWidth; wi += kWarpWidth) {
-            warpUnion.begin();
-            bool anyLane = false;
-            for (int j0 = warpRow * warpHeight;
-                 j0 < std::min(sampleHeight, (warpRow + 1) * warpHeight); j0 += kPacketHeight)
-                for (int i0 = wi; i0 < std::min(sampleWidth, wi + kWarpWidth); i0 += kPacketWidth) {
-                    const uint32_t excluded =
-                        excludedLanes(options.excludedSamples, sampleWidth, sampleHeight, i0, j0);
-                    if (decoder) {
-                        decoder->decode(isa, i0, j0, packet);
-                        packet.laneMask &= ~excluded;
-                    } else {
-                        gatherSamples(gb, scale, sampleWidth, sampleHeight, excluded, i0, j0,
-                                      packet, surfaces);
-                    }
-                    if (packet.laneMask == 0)
-                        continue;
-                    lists.clear();
-                    source.listsOf(packet, lists);
-                    sums.clear();
-                    rowWork.groups += uint64_t(lists.size());
-                    for (int g = 0; g < lists.size(); ++g) {
-                        const PacketLightLists::Group& group = lists[g];
-                        if (!group.lightLaneMasks.empty())
-                            throw std::logic_error(
-                                "accumulateSplitLights: per-light lane masks are not supported");
-                        if (packets) {
-                            kernel::shadePacketSplit(isa, packet, group.laneMask, *kernelLights,
-                                                     group.lights, sums);
-                        } else {
-                            for (uint32_t lanes = group.laneMask & packet.laneMask; lanes != 0;
-                                 lanes &= lanes - 1) {
-                                const int lane = __builtin_ctz(lanes);
-                                const SplitLighting split =
-                                    splitLighting(surfaces[lane], lights, group.lights);
-                                for (int c = 0; c < 3; ++c) {
-                                    sums.diffuse[c][lane] = split.diffuse[c];
-                                    sums.specular[c][lane] = split.specular[c];
-                                    sums.specularEdge[c][lane] = split.specularEdge[c];
-                                }
-                                sums.lightsEvaluated[lane] = uint32_t(group.lights.size());
-                            }
-                        }
-                        if (group.scratch)
-                            warpUnion.addTransient(group.lights);
-                        else
-                            warpUnion.add(group.lights);
-                        anyLane = true;
-                        for (uint32_t lanes = group.laneMask & packet.laneMask; lanes != 0;
-                             lanes &= lanes - 1) {
-                            const int lane = __builtin_ctz(lanes);
-                            const size_t pixel =
-                                pixelOf(i0 + kernel::laneX(lane), j0 + kernel::laneY(lane));
-                            result.lightsEvaluated[pixel] = sums.lightsEvaluated[lane];
-                            result.traceLightList(pixel, group.lights);
-                        }
-                    }
-                    rowWork.skippedAtRange += sums.lightsSkippedAtRange;
-                    rowWork.skippedAtConeOrFacing += sums.lightsSkippedAtConeOrFacing;
-                    rowWork.shaded += sums.lightsShaded;
-                    sink.store(packet, sums);
+    const KernelWork work = walkWarps<kernel::SplitPacketAccumulator>(
+        sampleWidth, sampleHeight, inputs.simtWarpLanes, lights.size(),
+        [&](PacketScratch<kernel::SplitPacketAccumulator>& scratch, int i0, int j0,
+            WarpUnion& warpUnion, KernelWork& rowWork) {
+            kernel::ShadingPacket& packet = scratch.packet;
+            kernel::SplitPacketAccumulator& sums = scratch.accumulator;
+            PacketLightLists& lists = scratch.lists;
+            const uint32_t excluded =
+                excludedLanes(options.excludedSamples, sampleWidth, sampleHeight, i0, j0);
+            if (options.sampleSurfaces) {
+                gatherOwnSamples(options.sampleSurfaces, sampleWidth, sampleHeight, excluded, i0,
+                                 j0, packet);
+            } else if (scale == 1) {
+                path.decode(i0, j0, packet);
+                packet.laneMask &= ~excluded;
+            } else {
+                gatherSamples(gb, scale, sampleWidth, sampleHeight, excluded, i0, j0, packet);
+            }
+            if (packet.laneMask == 0)
+                return false;
+            lists.clear();
+            source.listsOf(packet, lists);
+            sums.clear();
+            rowWork.groups += uint64_t(lists.size());
+            for (int g = 0; g < lists.size(); ++g) {
+                const PacketLightLists::Group& group = lists[g];
+                if (!group.lightLaneMasks.empty())
+                    throw std::logic_error(
+                        "accumulateSplitLights: per-light lane masks are not supported");
+                kernel::shadePacketSplit(isa, packet, group.laneMask, path.lights, group.lights,
+                                         sums);
+                for (uint32_t lanes = group.laneMask & packet.laneMask; lanes != 0;
+                     lanes &= lanes - 1) {
+                    const int lane = __builtin_ctz(lanes);
+                    const size_t pixel =
+                        pixelOf(i0 + kernel::laneX(lane), j0 + kernel::laneY(lane));
+                    result.lightsEvaluated[pixel] = sums.lightsEvaluated[lane];
+                    result.traceLightList(pixel, group.lights);
                 }
-            if (anyLane)
-                rowWork.laneSlots += uint64_t(inputs.simtWarpLanes) * warpUnion.count();
-        }
-        workPerRow[size_t(warpRow)] = rowWork;
-    });
-
-    KernelWork work;
-    for (const KernelWork& row : workPerRow)
-        work += row;
-    work.record(isa, inputs.simtWarpLanes, packets, result);
+            }
+            rowWork.addCounters(sums);
+            sink.store(packet, sums);
+            return payLists(lists, warpUnion);
+        });
+    work.record(isa, inputs.simtWarpLanes, result);
+    path.record(result);
 }
 
 } // namespace lighting

@@ -36,6 +36,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -238,7 +239,7 @@ private:
 };
 
 // What a stage gives the loop: the lists of a packet (its x0, y0, laneMask and decoded
-// view-space positions are set; other rows are unspecified on the per-pixel path). Called once per
+// view-space positions are set). Called once per
 // packet from several threads at once: it must only read shared state.
 class PacketListSource {
 public:
@@ -308,17 +309,29 @@ private:
 // lanes' coordinates are sample coordinates, which the list source keys its tiles by); a packet of
 // pixels (scale 1) is decoded by kernel::PacketDecoder, a strided one gathered lane by lane with
 // GBuffer::surfaceAt (the same surfaces, bitwise). Then kernel::shadePacketSplit per lane group on
-// inputs.isa, and the sink stores the lanes. The path is chosen once per frame by the same check
-// as accumulateLights (packetPathFits): a layout the packet decoder refuses takes the per-pixel
-// path (surfaceAt + splitLighting per sample, bitwise the stages' former loops; "isa" = scalar).
-// `--isa scalar` runs the kernel's scalar split path: addSplitLight lane by lane, bitwise
-// splitLighting. Vector ISAs: diffuse and metallic-roughness sums bitwise, the Blinn-Phong
-// specular sum within a few ulps (pow; kernel/SplitLightKernel.h).
+// inputs.isa, and the sink stores the lanes. A layout the packet decoder refuses is gathered
+// pixel by pixel at scale 1 too (PacketPath), and shaded the same way. `--isa scalar` runs the
+// kernel's scalar split path: addSplitLight lane by lane, bitwise splitLighting. Vector ISAs:
+// diffuse and metallic-roughness sums bitwise, the Blinn-Phong specular sum within a few ulps (pow;
+// kernel/SplitLightKernel.h). Fills lane `lane` of `packet` with surface `s`, either material
+// model: how every loop that gathers its lanes (lattice samples, queued fragments, held surfaces)
+// fills one.
+inline void setLaneSurface(kernel::ShadingPacket& packet, int lane, const gbuffer::Surface& s) {
+    packet.setLane(lane, s.positionView, s.normalView, s.albedo, s.specularIntensity,
+                   s.specularPower);
+    if (s.model == scenes::MaterialModel::MetallicRoughness)
+        packet.setMetallicRoughness(lane, s.roughness, s.metallic, s.occlusion);
+}
+
 struct SplitLightingOptions {
     int scale = 1; // lattice spacing in pixels
     // Samples not to light (e.g. inferred's stippled samples), lowWidth x lowHeight, 1 = skip;
     // empty: none.
     std::span<const uint8_t> excludedSamples;
+    // Surfaces to light instead of the G-buffer's (inferred's stippled blended samples,
+    // InferredStipple.h): when set, sample index j lowWidth + i is lit iff this returns a surface
+    // for it (gathered into the packets; never decoded).
+    std::function<const gbuffer::Surface*(size_t sample)> sampleSurfaces;
 };
 
 // Where the loop puts a packet's sums. Called once per packet that has a lit lane, from several
@@ -355,25 +368,33 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
                            const PacketListSource& source, const SplitLightSink& sink,
                            StageResult& result);
 
-// Whether a frame takes the packet path: the one check (PacketDecoder::supports on the
-// G-buffer's layout), for the stages that shade packets outside accumulateLights (`deferred`,
-// light by light) and so must fall back to the per-pixel path exactly when accumulateLights does.
+// Whether the packet decoder reads the frame's G-buffer layout: the one check (PacketDecoder::
+// supports), made by PacketPath for every caller; otherwise pixels are gathered with surfaceAt.
 bool packetPathFits(const StageInputs& inputs);
 // The G-buffer's own planes as a PacketDecoder reads them (no copy; valid while `gb` lives).
 kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb);
 
 // A frame's shading path, set up once by every caller of the kernel (accumulateLights,
-// accumulateSplitLights, `deferred`): whether it takes the packet path (packetPathFits), the ISA
-// that runs (the requested one, scalar on the per-pixel path), and on the packet path the
-// G-buffer's packet decoder (unless `decodePixels` is false: a caller that gathers its lanes
-// itself) and the lights in the kernel's form. Valid while the inputs live.
+// accumulateSplitLights, `deferred`): the ISA that runs (the requested one, for every layout),
+// the lights in the kernel's form, and how the G-buffer reaches the kernel's packets: a packet at
+// a time by the PacketDecoder when the layout fits it (packetPathFits) and the caller decodes
+// whole pixels (`decodePixels`), else lane by lane through GBuffer::surfaceAt (layouts with normal
+// codes or packed channels, which the vector decoder does not read yet). Either way the surfaces
+// are bitwise GBuffer::decode's and the shading is the kernel's, so a layout changes the decode
+// cost and its own error, never the shading path. Valid while the inputs live.
 struct PacketPath {
     explicit PacketPath(const StageInputs& inputs, bool decodePixels = true);
 
-    bool packets;
+    // Fills `packet` with the 4x4 pixels at (x0, y0) (the decoder's rule for the lane mask: covered
+    // pixels inside the image).
+    void decode(int x0, int y0, kernel::ShadingPacket& packet) const;
+    // Records "gbuffer_decode": "packet" (the vector decoder) or "per-pixel".
+    void record(StageResult& result) const;
+
+    const gbuffer::GBuffer& gbuffer;
     kernel::KernelIsa isa;
     std::optional<kernel::PacketDecoder> decoder;
-    std::optional<kernel::KernelLights> lights;
+    kernel::KernelLights lights;
 };
 
 } // namespace lighting

@@ -26,8 +26,8 @@
 // equal to `brute`'s on the same ISA (a lane's value of a light does not depend on the other lanes
 // of its packet, LightKernel.h). `--isa scalar` is evaluateLight lane by lane: bitwise the
 // per-pixel loop this stage had before. A layout the packet decoder does not read (the check of
-// accumulateLights, packetPathFits) takes the per-pixel path, GBuffer::surfaceAt + evaluateLight
-// per gathered pixel, and records isa=scalar.
+// accumulateLights, packetPathFits) is gathered pixel by pixel with GBuffer::surfaceAt
+// (PacketPath::decode) and shaded on the kernel all the same.
 //
 // Threads: all volumes go through one rasterizer draw in light order (LightVolumes.h: the
 // rasterizer keeps submission order per tile), parallel over tiles; a tile's batch is touched only
@@ -112,7 +112,6 @@ public:
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        const std::vector<LightInView<float>>& lights = inputs.lights->lights;
         const int width = gb.width(), height = gb.height();
         if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
             throw std::invalid_argument("deferred: simtWarpLanes must be 32 or 64, not " +
@@ -123,11 +122,8 @@ public:
 
         VolumeCull cull = cullLightVolumes(gb, *inputs.lights, mVolume, result);
         PassTimer shading(result, pass::kShading);
-        PacketPath path(inputs);
-        const bool packets = path.packets;
+        const PacketPath path(inputs);
         const kernel::KernelIsa isa = path.isa;
-        std::optional<kernel::PacketDecoder>& decoder = path.decoder;
-        std::optional<kernel::KernelLights>& kernelLights = path.lights;
         const int tileCount = cull.volumes.tileCount();
         const int tilesX = (width + raster::kTileSize - 1) / raster::kTileSize;
         mBatches.resize(size_t(tileCount));
@@ -163,27 +159,7 @@ public:
                 }
                 const int x0 = tileX0 + packetX * kPacketWidth;
                 const int y0 = tileY0 + packetY * kPacketHeight;
-                if (!packets) {
-                    // Per-pixel path: the loop this stage had before, pixel by pixel.
-                    for (uint32_t lanes = mask; lanes != 0; lanes &= lanes - 1) {
-                        const int lane = __builtin_ctz(lanes);
-                        const int x = x0 + kernel::laneX(lane), y = y0 + kernel::laneY(lane);
-                        const size_t pixel = size_t(y) * size_t(width) + size_t(x);
-                        gbuffer::Surface point;
-                        if (!gb.surfaceAt(x, y, point))
-                            continue;
-                        const glm::vec3 value = evaluateLight(
-                            point, glm::normalize(-point.positionView), lights[light]);
-                        radiance[0][pixel] += value.x;
-                        radiance[1][pixel] += value.y;
-                        radiance[2][pixel] += value.z;
-                        ++evaluated[pixel];
-                        result.traceAddedLight(pixel, light);
-                    }
-                    continue;
-                }
-                // The G-buffer read again for this light, a packet at a time.
-                decoder->decode(isa, x0, y0, packet);
+                path.decode(x0, y0, packet);
                 const uint32_t lanes = mask & packet.laneMask;
                 if (lanes == 0)
                     continue;
@@ -195,7 +171,7 @@ public:
                     for (int c = 0; c < 3; ++c)
                         accumulator.radiance[c][lane] = radiance[c][pixel];
                 }
-                kernel::shadePacket(isa, packet, lanes, *kernelLights,
+                kernel::shadePacket(isa, packet, lanes, path.lights,
                                     std::span<const uint32_t>(&light, 1), accumulator,
                                     /*countContributing=*/false);
                 for (uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
@@ -208,9 +184,7 @@ public:
                     result.traceAddedLight(pixel, light);
                 }
                 ++batch.work.groups;
-                batch.work.skippedAtRange += accumulator.lightsSkippedAtRange;
-                batch.work.skippedAtConeOrFacing += accumulator.lightsSkippedAtConeOrFacing;
-                batch.work.shaded += accumulator.lightsShaded;
+                batch.work.addCounters(accumulator);
             }
             batch.touched.clear();
         };
@@ -243,7 +217,8 @@ public:
         KernelWork work;
         for (const TileBatch& batch : mBatches)
             work += batch.work;
-        work.record(isa, warpLanes, packets, result);
+        work.record(isa, warpLanes, result);
+        path.record(result);
     }
 
 private:

@@ -51,7 +51,7 @@ public:
 
         PassTimer shading(result, pass::kShading);
         const size_t lightCount = inputs.lights->size();
-        mShading.begin(inputs, mForward, FragmentApply::Add, result);
+        mShading.begin(inputs, FragmentApply::Add, result);
         const std::vector<ForwardObject>& objects = mForward.objects();
         const std::vector<uint32_t>& allIndices = inputs.geometry->indices;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
@@ -82,8 +82,15 @@ public:
             auto addLight = [&](const raster::Fragment& fragment) {
                 const uint32_t triangle =
                     globalTriangle ? globalTriangle[fragment.triangle] : fragment.triangle;
-                if (visibility.isVisible(fragment, triangle))
-                    mShading.add(fragment, triangle, l, light);
+                if (!visibility.isVisible(fragment, triangle))
+                    return;
+                // Outside the light's range it adds exactly zero: queued for its lane and its
+                // count, without decoding its surface (FragmentShading::addBeyondRange).
+                if (mShading.beyondRange(l, mForward.positionAt(fragment)))
+                    mShading.addBeyondRange(fragment, triangle, l, light);
+                else
+                    mShading.add(fragment, triangle, mForward.surfaceAt(fragment, triangle), l,
+                                 light);
             };
             mForward.draw(
                 raster::TriangleList{visibility.clipPositions(), indices}, state, addLight,
@@ -93,7 +100,7 @@ public:
         mShading.end();
         mForward.addEmission(result);
         shading.stop();
-        // Blended surfaces: one fragment at a time with its object's lights (the lists the
+        // Blended surfaces: each fragment with its object's lights (the lists the
         // illumination sets were transposed from: ascending per object). "Over" does not
         // distribute over one additive pass per light, so the blended layers are shaded whole.
         mForward.shadeBlended(inputs, mBlended, mObjectLights, result);

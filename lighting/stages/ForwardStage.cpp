@@ -52,13 +52,15 @@ public:
 
         PassTimer shading(result, pass::kShading);
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
-        mShading.begin(inputs, mForward, FragmentApply::Replace, result);
+        mShading.begin(inputs, FragmentApply::Replace, result);
         const bool equalOnly = mPrepass;
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             if (equalOnly && !visibility.isVisible(fragment, fragment.triangle))
                 return;
             const uint32_t object = mForward.objectOfTriangle(fragment.triangle);
-            mShading.add(fragment, fragment.triangle, object, mObjectLights[object]);
+            mShading.add(fragment, fragment.triangle,
+                         mForward.surfaceAt(fragment, fragment.triangle), object,
+                         mObjectLights[object]);
         };
         // Without a pre-pass, the visibility draw's own state (every fragment that passes the
         // closer test is shaded); with one, the redraw that passes each visible fragment once.

@@ -54,12 +54,7 @@ public:
         // Blended surfaces: each fragment's contributing lights, found by testing every light at
         // the fragment (the lists above are the opaque surface's), inside the blend pass's time.
         if (mBlended.prepare(inputs))
-            mBlended.shade(
-                gb.depth(),
-                [&](int, int, const gbuffer::Surface& point, uint32_t) {
-                    return mBlended.contributingLights(point);
-                },
-                result);
+            mBlended.shadeWithContributingLights(gb.depth(), result);
         result.parameters["untimed_list_build_ms"] = std::to_string(listBuildMs);
         result.parameters["contributing_pairs"] = std::to_string(mPixelLists.pairCount());
         result.parameters["packet_light_pairs"] = std::to_string(mPacketLists.pairCount());

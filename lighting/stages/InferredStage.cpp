@@ -80,6 +80,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/BlendedPass.h"
+#include "lighting/DsfFilter.h"
 #include "lighting/InferredStipple.h"
 #include "lighting/LightAccumulation.h"
 #include "lighting/LightBounds.h"
@@ -108,9 +109,7 @@ struct LightSample {
     bool covered = false;
     float depthMetres = 0.0f;
     glm::vec3 normalView{0.0f, 0.0f, 1.0f};
-    glm::vec3 diffuse{0.0f};
-    glm::vec3 specular{0.0f};
-    glm::vec3 specularEdge{0.0f}; // metallic-roughness (SplitLighting)
+    SplitLighting light; // diffuse, specular, metallic-roughness Fresnel edge
 };
 
 class InferredStage final : public ShadingStage {
@@ -174,32 +173,30 @@ public:
                     sample.depthMetres = -packet.positionView[2][lane];
                     for (int c = 0; c < 3; ++c) {
                         sample.normalView[c] = packet.normalView[c][lane];
-                        sample.diffuse[c] = sums.diffuse[c][lane];
-                        sample.specular[c] = sums.specular[c][lane];
-                        sample.specularEdge[c] = sums.specularEdge[c][lane];
+                        sample.light.diffuse[c] = sums.diffuse[c][lane];
+                        sample.light.specular[c] = sums.specular[c][lane];
+                        sample.light.specularEdge[c] = sums.specularEdge[c][lane];
                     }
                 }
             });
         // Low-res tile (tx, ty) is full-res tile (tx, ty) of the culling grid (see "cull").
+        SplitLightingOptions lightOptions;
+        lightOptions.scale = scale;
+        lightOptions.excludedSamples = mExcluded;
         accumulateSplitLights(
-            inputs, {scale, mExcluded},
+            inputs, lightOptions,
             TileListSource(mOptions.tileSizeSamples, grid.tileCountX, mTileLights), sink, result);
         lightingPass.stop();
         if (blended) {
             blendPass.resume();
-            mStipple.light(inputs, gb.depth(), mOptions.tileSizeSamples * scale);
-            for (int j = 0; j < lowHeight; ++j)
-                for (int i = 0; i < lowWidth; ++i) {
-                    const size_t index = size_t(j) * lowWidth + i;
-                    if (!mStipple.holds(index))
-                        continue;
-                    const InferredStipple::Sample& stippled = mStipple.sample(index);
-                    mSamples[index] = {true, -stippled.surface.positionView.z,
-                                       stippled.surface.normalView, stippled.diffuse,
-                                       stippled.specular};
-                    result.lightsEvaluated[size_t(sampleY(j)) * width + sampleX(i)] =
-                        stippled.lightCount;
-                }
+            mStipple.light(inputs, gb.depth(), mOptions.tileSizeSamples, result);
+            for (size_t index = 0; index < mSamples.size(); ++index) {
+                if (!mStipple.holds(index))
+                    continue;
+                const InferredStipple::Sample& stippled = mStipple.sample(index);
+                mSamples[index] = {true, -stippled.surface.positionView.z,
+                                   stippled.surface.normalView, stippled.light};
+            }
             blendPass.pause();
         }
 
@@ -239,55 +236,34 @@ public:
             const size_t tapIndex[4] = {size_t(ja) * lowWidth + ia, size_t(ja) * lowWidth + ib,
                                         size_t(jb) * lowWidth + ia, size_t(jb) * lowWidth + ib};
             const float bilinear[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-            // Two filters at once: `same` applies the ID, depth and normal tests, `surface` the
+            // The DSF (DsfFilter.h): `same` applies the ID, depth and normal tests, `surface` the
             // depth and normal tests only (with ids=0 they coincide).
-            glm::vec3 sameDiffuse(0.0f), sameSpecular(0.0f), sameEdge(0.0f);
-            glm::vec3 surfaceDiffuse(0.0f), surfaceSpecular(0.0f), surfaceEdge(0.0f);
-            float sameWeight = 0.0f, surfaceWeight = 0.0f;
-            int nearest = -1;
-            float nearestWeight = -1.0f;
+            DsfFilter filter;
             for (int k = 0; k < 4; ++k) {
                 const LightSample& t = mSamples[tapIndex[k]];
                 if (!t.covered)
                     continue;
-                if (bilinear[k] > nearestWeight) {
-                    nearestWeight = bilinear[k];
-                    nearest = k;
-                }
-                if (std::abs(t.depthMetres - depth) > mOptions.depthThreshold * depth ||
-                    glm::dot(t.normalView, here.normalView) < mOptions.normalThreshold)
-                    continue;
-                surfaceDiffuse += bilinear[k] * t.diffuse;
-                surfaceSpecular += bilinear[k] * t.specular;
-                surfaceEdge += bilinear[k] * t.specularEdge;
-                surfaceWeight += bilinear[k];
-                if (mSampleObjects[tapIndex[k]] != object)
-                    continue;
-                sameDiffuse += bilinear[k] * t.diffuse;
-                sameSpecular += bilinear[k] * t.specular;
-                sameEdge += bilinear[k] * t.specularEdge;
-                sameWeight += bilinear[k];
+                const bool passesSurface =
+                    !(std::abs(t.depthMetres - depth) > mOptions.depthThreshold * depth ||
+                      glm::dot(t.normalView, here.normalView) < mOptions.normalThreshold);
+                filter.add(bilinear[k], t.light, passesSurface,
+                           mSampleObjects[tapIndex[k]] == object);
             }
-            glm::vec3 diffuse(0.0f), specular(0.0f), edge(0.0f);
-            if (sameWeight > 0.0f) {
-                diffuse = sameDiffuse / sameWeight;
-                specular = sameSpecular / sameWeight;
-                edge = sameEdge / sameWeight;
-            } else if (surfaceWeight > 0.0f) {
-                diffuse = surfaceDiffuse / surfaceWeight;
-                specular = surfaceSpecular / surfaceWeight;
-                edge = surfaceEdge / surfaceWeight;
+            SplitLighting light;
+            switch (filter.resolve(light)) {
+            case DsfFilter::Source::Same:
+                break;
+            case DsfFilter::Source::Surface:
                 ++idFallbacks;
-            } else if (nearest >= 0) {
-                diffuse = mSamples[tapIndex[nearest]].diffuse;
-                specular = mSamples[tapIndex[nearest]].specular;
-                edge = mSamples[tapIndex[nearest]].specularEdge;
+                break;
+            case DsfFilter::Source::Nearest:
+            case DsfFilter::Source::None:
                 ++fallbacks;
-            } else {
-                ++fallbacks;
+                break;
             }
             const glm::vec3 radiance =
-                combineSplitLighting(s, diffuse, specular, edge) + s.emissive;
+                combineSplitLighting(s, light.diffuse, light.specular, light.specularEdge) +
+                s.emissive;
             result.radiance[0][pixel] = radiance.r;
             result.radiance[1][pixel] = radiance.g;
             result.radiance[2][pixel] = radiance.b;

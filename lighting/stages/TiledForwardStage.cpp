@@ -81,13 +81,14 @@ public:
         PassTimer shading(result, pass::kShading);
         const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
-        mShading.begin(inputs, mForward, FragmentApply::Replace, result);
+        mShading.begin(inputs, FragmentApply::Replace, result);
         auto shadeFragment = [&](const raster::Fragment& fragment) {
             if (!visibility.isVisible(fragment, fragment.triangle))
                 return;
             const uint32_t tile =
                 uint32_t(fragment.y / tileSize) * uint32_t(tileCountX) + fragment.x / tileSize;
-            mShading.add(fragment, fragment.triangle, tile, mTileLights[tile]);
+            mShading.add(fragment, fragment.triangle,
+                         mForward.surfaceAt(fragment, fragment.triangle), tile, mTileLights[tile]);
         };
         mForward.draw(visibility.triangles(), visibility.redrawState(), shadeFragment);
         mShading.flush();

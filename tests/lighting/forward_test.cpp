@@ -15,6 +15,7 @@
 
 #include "gbuffer/GBufferPass.h"
 #include "lighting/ForwardGeometry.h"
+#include "lighting/FragmentShading.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/MeshBuilder.h"
@@ -284,6 +285,65 @@ TEST(Forward, SharedSurfaceFunctionReproducesTheGBuffer) {
 TEST(Forward, RejectsBadOptions) {
     EXPECT_THROW(lighting::makeStage("forward:prepass=2"), lighting::StageError);
     EXPECT_THROW(lighting::makeStage("forward-multipass:prepass=1"), lighting::StageError);
+}
+
+// FragmentShading::addBeyondRange (what `forward-multipass` queues for a fragment outside its
+// pass's light): against queueing every fragment with its surface, the additive light passes
+// give bitwise the same radiance, the same counts, trace and kernel counters (on every ISA),
+// and a light pass over fragments mostly beyond range leaves most of them unshaded. Fragments
+// here are the G-buffer's pixels of atrium, one additive pass per light, 16-lane packets of
+// consecutive pixels of a raster tile.
+TEST(Forward, BeyondRangeFragmentsAddNothingAndCountAsShaded) {
+    const TestScene& f = atrium();
+    const gbuffer::GBuffer& gb = *f.inputs.gbuffer;
+    const size_t lightCount = f.inputs.lights->size();
+    for (const lighting::kernel::KernelIsa& isa :
+         {lighting::kernel::KernelIsa::scalar(), lighting::kernel::KernelIsa::best()}) {
+        lighting::StageInputs inputs = f.inputs;
+        inputs.isa = isa;
+        auto passes = [&](bool skipBeyond, uint64_t& beyondCount) {
+            lighting::StageResult result;
+            result.traceLights = true;
+            result.resize(gb.width(), gb.height(), false);
+            lighting::FragmentShading shading;
+            shading.begin(inputs, lighting::FragmentApply::Add, result);
+            beyondCount = 0;
+            for (uint32_t l = 0; l < lightCount; ++l) {
+                const uint32_t light[1] = {l};
+                for (int y = 0; y < gb.height(); ++y)
+                    for (int x = 0; x < gb.width(); ++x) {
+                        gbuffer::Surface s;
+                        if (!gb.surfaceAt(x, y, s))
+                            continue;
+                        raster::Fragment fragment;
+                        fragment.x = x;
+                        fragment.y = y;
+                        if (skipBeyond && shading.beyondRange(l, s.positionView)) {
+                            ++beyondCount;
+                            shading.addBeyondRange(fragment, 0, l, light);
+                        } else {
+                            shading.add(fragment, 0, s, l, light);
+                        }
+                    }
+                shading.flush();
+            }
+            shading.end();
+            return result;
+        };
+        uint64_t none = 0, beyond = 0;
+        const lighting::StageResult all = passes(false, none);
+        const lighting::StageResult skipped = passes(true, beyond);
+        const std::string what = std::string("beyond-range lanes on ") + isa.name();
+        expectBitwiseEqual(skipped, all, what);
+        EXPECT_EQ(skipped.lightsEvaluated, all.lightsEvaluated) << what;
+        EXPECT_EQ(skipped.lightTrace, all.lightTrace) << what;
+        EXPECT_EQ(skipped.parameters, all.parameters) << what;
+        const uint64_t evaluations = total(all.lightsEvaluated);
+        std::cout << "[measured] " << isa.name() << ": " << beyond << " of " << evaluations
+                  << " fragment-light pairs beyond range (not shaded)\n";
+        EXPECT_EQ(none, 0u);
+        EXPECT_GT(beyond, evaluations / 2) << what;
+    }
 }
 
 } // namespace

@@ -610,20 +610,22 @@ TEST(LightVolumes, DeferredOnTheKernelIsBitwiseBruteOnEveryIsa) {
     }
 }
 
-// A layout the packet decoder refuses (octahedral normal codes) takes the per-pixel path, as
-// accumulateLights does: it says isa=scalar whatever was asked, and the image is brute's bitwise.
-TEST(LightVolumes, DeferredPerPixelPathForLayoutsThePacketDecoderRefuses) {
+// A layout the packet decoder refuses (octahedral normal codes) is gathered pixel by pixel and
+// shaded on the kernel, as accumulateLights does: it says the ISA asked for and
+// gbuffer_decode=per-pixel, and the image is brute's bitwise.
+TEST(LightVolumes, DeferredGathersLayoutsThePacketDecoderRefuses) {
     using namespace deferredkernel;
     gbuffer::GBufferLayout layout = gbuffer::GBufferLayout::reference();
     layout.normals = gbuffer::NormalCodecSpec::parse("octahedral:16");
     layout.name = "octahedral-test";
     const lighting::PreparedScene frame(proceduralScene("atrium", 100), 96, 64, false, layout);
     const lighting::StageResult brute = shadeOn("brute", frame.inputs, KernelIsa::best(), 2);
-    ASSERT_EQ(brute.parameters.at("isa"), "scalar");
+    ASSERT_EQ(brute.parameters.at("isa"), KernelIsa::best().name());
     for (const char* stage : {"deferred", "deferred:stencil=1"}) {
         const lighting::StageResult result = shadeOn(stage, frame.inputs, KernelIsa::best(), 2);
-        EXPECT_EQ(result.parameters.at("isa"), "scalar") << stage;
-        EXPECT_EQ(result.parameters.count("packet_groups"), 0u) << stage;
+        EXPECT_EQ(result.parameters.at("isa"), KernelIsa::best().name()) << stage;
+        EXPECT_EQ(result.parameters.at("gbuffer_decode"), "per-pixel") << stage;
+        EXPECT_GT(std::stoull(result.parameters.at("packet_groups")), 0u) << stage;
         EXPECT_TRUE(sameImage(result, brute)) << stage;
     }
 }
