@@ -42,6 +42,8 @@
 #include "lighting/kernel/VectorTargets.h"
 #include "scenes/Scene.h"
 
+#include <type_traits>
+
 #if defined(LIGHTING_KERNEL_LIGHT_KERNEL_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef LIGHTING_KERNEL_LIGHT_KERNEL_INL_H_
 #undef LIGHTING_KERNEL_LIGHT_KERNEL_INL_H_
@@ -75,6 +77,21 @@ HWY_INLINE FloatVec dot3(FloatVec ax, FloatVec ay, FloatVec az, FloatVec bx, Flo
 
 // Which material models a call's active lanes use (ShadingPacket::metallicRoughnessMask).
 enum class Models { BlinnPhong, MetallicRoughness, Mixed };
+
+// Runs `shade` with the narrowest instantiation that covers the call's lanes (one model alone
+// skips the other's arithmetic and the per-lane select); the radiance and split kernels dispatch
+// here alike. `shade` takes a std::integral_constant<Models, M>.
+template <class Shade>
+HWY_INLINE void withLaneModels(const ShadingPacket& packet, uint32_t laneMask, Shade&& shade) {
+    const uint32_t lanes = laneMask & packet.laneMask;
+    const uint32_t metallicRoughness = lanes & packet.metallicRoughnessMask;
+    if (metallicRoughness == 0)
+        shade(std::integral_constant<Models, Models::BlinnPhong>());
+    else if (metallicRoughness == lanes)
+        shade(std::integral_constant<Models, Models::MetallicRoughness>());
+    else
+        shade(std::integral_constant<Models, Models::Mixed>());
+}
 
 // The float constants of MetallicRoughness.h as its float instantiation rounds them.
 constexpr float kDielectricF0Float = float(kDielectricF0);
@@ -563,14 +580,8 @@ template <Models kModels> void shadeWithModels(const ShadeArgs& args) {
 }
 
 void shadePacketVector(const ShadeArgs& args) {
-    const uint32_t lanes = args.laneMask & args.packet->laneMask;
-    const uint32_t metallicRoughness = lanes & args.packet->metallicRoughnessMask;
-    if (metallicRoughness == 0)
-        shadeWithModels<Models::BlinnPhong>(args);
-    else if (metallicRoughness == lanes)
-        shadeWithModels<Models::MetallicRoughness>(args);
-    else
-        shadeWithModels<Models::Mixed>(args);
+    withLaneModels(*args.packet, args.laneMask,
+                   [&](auto models) HWY_ATTR { shadeWithModels<decltype(models)::value>(args); });
 }
 
 } // namespace lighting::kernel::HWY_NAMESPACE

@@ -223,14 +223,8 @@ template <Models kModels> void shadeSplitLights(const ShadeSplitArgs& args) {
 }
 
 void shadeSplitVector(const ShadeSplitArgs& args) {
-    const uint32_t lanes = args.laneMask & args.packet->laneMask;
-    const uint32_t metallicRoughness = lanes & args.packet->metallicRoughnessMask;
-    if (metallicRoughness == 0)
-        shadeSplitLights<Models::BlinnPhong>(args);
-    else if (metallicRoughness == lanes)
-        shadeSplitLights<Models::MetallicRoughness>(args);
-    else
-        shadeSplitLights<Models::Mixed>(args);
+    withLaneModels(*args.packet, args.laneMask,
+                   [&](auto models) HWY_ATTR { shadeSplitLights<decltype(models)::value>(args); });
 }
 
 } // namespace lighting::kernel::HWY_NAMESPACE
