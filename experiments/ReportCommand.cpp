@@ -46,7 +46,7 @@ constexpr const char* kMethodColumns[] = {"stage",        "layout", "normals",
 // The columns of the results table a reader compares first, after the method columns; the rest
 // are behind the "all columns" toggle.
 constexpr const char* kMainMetricColumns[] = {"time_total_median_ms", "relative_rmse", "flip",
-                                              "culling_efficiency"};
+                                              "culling_efficiency", "simt_efficiency"};
 // Settings known to be axis columns, for results that do not list theirs.
 constexpr const char* kKnownAxisColumns[] = {
     "scene",    "stage",   "lights", "seed",        "resolution",   "width",
@@ -255,15 +255,26 @@ void appendPublishedSection(std::ostringstream& html, const json& table, int ind
     html << "; ratios are value / value of column &ldquo;"
          << htmlEscape(columns[ratioTo.get<size_t>()].get<std::string>())
          << "&rdquo; of the same row. Measured values are medians over the matching ok jobs; "
-            "a cell whose jobs differ in a setting says which.</p>\n";
+            "a cell whose jobs differ in a setting says which.";
+    const bool modelled = table.value("modelled", json()).is_string();
+    if (modelled)
+        html << " Modelled ratios are those of <code>"
+             << htmlEscape(table["modelled"].get<std::string>())
+             << "</code> over the same jobs: what the cost model (for simt_lane_slots, a SIMT GPU "
+                "whose warp pays for a light when any lane evaluates it) predicts for the "
+                "published ratio.";
+    html << "</p>\n";
+    const int cellColumns = modelled ? 6 : 5;
     html << "<div class=\"scroll\"><table class=\"published\">\n<tr><th class=\"text\" "
             "rowspan=\"2\">row</th>";
     for (const json& column : columns)
-        html << "<th colspan=\"5\">" << htmlEscape(column.get<std::string>()) << "</th>";
+        html << "<th colspan=\"" << cellColumns << "\">" << htmlEscape(column.get<std::string>())
+             << "</th>";
     html << "</tr>\n<tr>";
     for (size_t c = 0; c < columns.size(); ++c)
         html << "<th>published</th><th>measured</th><th>published ratio</th>"
-                "<th>measured ratio</th><th>jobs</th>";
+             << (modelled ? "<th>modelled ratio</th>" : "")
+             << "<th>measured ratio</th><th>jobs</th>";
     html << "</tr>\n";
     for (const json& row : table["rows"]) {
         html << "<tr><td class=\"text\">" << htmlEscape(row["label"].get<std::string>()) << "</td>";
@@ -271,6 +282,9 @@ void appendPublishedSection(std::ostringstream& html, const json& table, int ind
             html << "<td>" << formatOptional(cell["published"]) << "</td><td>"
                  << formatOptional(cell["measured"]) << "</td><td>"
                  << formatOptional(cell["published_ratio"], "&times;") << "</td><td>"
+                 << (modelled ? formatOptional(cell.value("modelled_ratio", json()), "&times;") +
+                                    "</td><td>"
+                              : "")
                  << formatOptional(cell["measured_ratio"], "&times;") << "</td><td>"
                  << cell["matched_jobs"].get<int>() << differNote(cell) << "</td>";
         html << "</tr>\n";
@@ -873,6 +887,11 @@ json comparePublished(const json& published, const json& jobs,
         throw fail("\"ratio_to\" must be a column index from 0 to " +
                    std::to_string(columns.size() - 1));
     const size_t ratioTo = ratioToValue.get<size_t>();
+    // The column of a cost model whose ratios predict the metric's (the reproductions name
+    // simt_lane_slots, what a SIMT GPU would pay): shown beside published and measured.
+    const json modelled = published.value("modelled", json());
+    if (!modelled.is_null() && !modelled.is_string())
+        throw fail("\"modelled\" must be a column name");
 
     json table = {{"title", title},
                   {"source", stringField(published, "source")},
@@ -880,6 +899,7 @@ json comparePublished(const json& published, const json& jobs,
                   {"metric_label", metricLabel(metric)},
                   {"finding", stringField(published, "finding")},
                   {"ratio_to", ratioTo},
+                  {"modelled", modelled},
                   {"columns", json::array()},
                   {"rows", json::array()}};
     for (size_t c = 0; c < columns.size(); ++c) {
@@ -896,7 +916,7 @@ json comparePublished(const json& published, const json& jobs,
         if (!values.is_array() || values.size() != columns.size())
             throw fail(where + ".values must have one entry per column (" +
                        std::to_string(columns.size()) + ")");
-        std::vector<std::optional<double>> publishedValues, measuredValues;
+        std::vector<std::optional<double>> publishedValues, measuredValues, modelledValues;
         std::vector<int> matchCounts;
         std::vector<json> differIn;
         for (size_t c = 0; c < columns.size(); ++c) {
@@ -904,7 +924,7 @@ json comparePublished(const json& published, const json& jobs,
                 throw fail(where + ".values[" + std::to_string(c) + "] must be a number or null");
             publishedValues.push_back(values[c].is_null() ? std::nullopt
                                                           : std::optional(values[c].get<double>()));
-            std::vector<double> measured;
+            std::vector<double> measured, model;
             int matched = 0;
             std::map<std::string, std::set<std::string>> values; // per axis column
             for (const json& job : jobs) {
@@ -914,10 +934,14 @@ json comparePublished(const json& published, const json& jobs,
                 ++matched;
                 if (const auto value = jobMetric(job, metric))
                     measured.push_back(*value);
+                if (!modelled.is_null())
+                    if (const auto value = jobMetric(job, modelled))
+                        model.push_back(*value);
                 for (const std::string& column : axisColumns)
                     values[column].insert(normalisedSelectValue(job.value(column, json())));
             }
             measuredValues.push_back(median(measured));
+            modelledValues.push_back(median(model));
             matchCounts.push_back(matched);
             json differ = json::array();
             for (const std::string& column : axisColumns)
@@ -937,6 +961,8 @@ json comparePublished(const json& published, const json& jobs,
                              {"measured", toJson(measuredValues[c])},
                              {"published_ratio", ratio(publishedValues, c)},
                              {"measured_ratio", ratio(measuredValues, c)},
+                             {"modelled", toJson(modelledValues[c])},
+                             {"modelled_ratio", ratio(modelledValues, c)},
                              {"matched_jobs", matchCounts[c]},
                              {"differ_in", differIn[c]}});
         table["rows"].push_back(

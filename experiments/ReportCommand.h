@@ -132,9 +132,10 @@ std::optional<double> median(std::vector<double> values);
 
 // One published entry compared with the jobs: a JSON object
 //   { "title", "source", "metric" (as given), "metric_label", "finding", "ratio_to",
-//     "columns": [labels...],
+//     "modelled" (the cost model's column, e.g. simt_lane_slots, or null), "columns": [labels...],
 //     "rows": [ { "label", "cells": [ { "published", "measured", "published_ratio",
-//                                       "measured_ratio", "matched_jobs", "differ_in" } ] } ] }
+//                                       "measured_ratio", "modelled", "modelled_ratio",
+//                                       "matched_jobs", "differ_in" } ] } ] }
 // where differ_in lists the columns of `axisColumns` whose values differ among the matched jobs
 // (what the median is taken over; empty when they agree or only one matched).
 // with null for anything unknown (not published, no matching job, baseline missing or zero).

@@ -169,9 +169,10 @@ void checkPublished(const Json& published, const std::string& origin,
         const std::string where = "published[" + std::to_string(t) + "]";
         if (!table.is_object())
             fail(origin, "'" + where + "' must be an object");
-        rejectUnknownKeys(table,
-                          {"title", "source", "metric", "columns", "rows", "ratio_to", "finding"},
-                          origin, where + ".");
+        rejectUnknownKeys(
+            table,
+            {"title", "source", "metric", "columns", "rows", "ratio_to", "finding", "modelled"},
+            origin, where + ".");
         for (const char* key : {"title", "metric", "columns", "rows"})
             if (!table.contains(key))
                 fail(origin, "'" + where + "' lacks '" + key + "'");
@@ -182,6 +183,8 @@ void checkPublished(const Json& published, const std::string& origin,
                                                [](const Json& m) { return m.is_string(); }));
         if (!metricOk)
             fail(origin, "'" + where + ".metric' must be a column name or a list of them");
+        if (table.contains("modelled") && !table["modelled"].is_string())
+            fail(origin, "'" + where + ".modelled' must be a column name (e.g. simt_lane_slots)");
         const Json& tableColumns = table["columns"];
         if (!tableColumns.is_array() || tableColumns.empty())
             fail(origin, "'" + where + ".columns' must be a non-empty array");

@@ -291,17 +291,21 @@ def published_ratios(report, table, index):
     if not rows or all(c["measured_ratio"] is None for r in rows for c in r["cells"]):
         report.skip(title, "no measured ratio (no matching ok jobs)", "", "published")
         return
+    # Published, then (when the table names a cost model) modelled, then measured ratios.
+    kinds = [("published_ratio", "published", None, 0.55)]
+    if table.get("modelled"):
+        kinds.append(("modelled_ratio", "modelled", "..", 0.75))
+    kinds.append(("measured_ratio", "measured", "//", 0.95))
     fig, ax = plt.subplots(figsize=(min(9.0, max(6.0, 1.1 * len(rows) * len(columns))), 4.8))
-    width = 0.8 / (2 * len(columns))
+    width = 0.8 / (len(kinds) * len(columns))
     positions = np.arange(len(rows))
     for c, column in enumerate(columns):
-        for kind, offset, hatch in (("published_ratio", 0, None), ("measured_ratio", 1, "//")):
-            values = [r["cells"][c][kind] for r in rows]
+        for offset, (kind, label, hatch, alpha) in enumerate(kinds):
+            values = [r["cells"][c].get(kind) for r in rows]
             heights = [v if v is not None else 0.0 for v in values]
-            bars = ax.bar(positions - 0.4 + width * (2 * c + offset + 0.5), heights, width,
-                          color=colour_of(c), alpha=0.55 if offset == 0 else 0.95, hatch=hatch,
-                          edgecolor="0.2", linewidth=0.5,
-                          label="%s (%s)" % (column, "published" if offset == 0 else "measured"))
+            bars = ax.bar(positions - 0.4 + width * (len(kinds) * c + offset + 0.5), heights,
+                          width, color=colour_of(c), alpha=alpha, hatch=hatch, edgecolor="0.2",
+                          linewidth=0.5, label="%s (%s)" % (column, label))
             for bar, value in zip(bars, values):
                 if value is None:
                     ax.annotate("n/a", (bar.get_x() + bar.get_width() / 2, 0), ha="center",
@@ -313,9 +317,12 @@ def published_ratios(report, table, index):
     ax.grid(True, axis="y", alpha=0.3)
     ax.legend(fontsize=6, ncol=max(1, len(columns)), loc="best")
     fig.tight_layout()
+    modelled = ("dotted bars: the ratio %s predicts (the same jobs); " % table["modelled"]
+                if table.get("modelled") else "")
     report.save(fig, "published_%d" % index, title,
-                "Light bars: published ratio; hatched bars: measured ratio (median of matching "
-                "jobs; the table says which settings those jobs differ in).", "", "published")
+                "Light bars: published ratio; " + modelled + "hatched bars: measured ratio "
+                "(median of matching jobs; the table says which settings those jobs differ in).",
+                "", "published")
 
 
 def plot_results(args):

@@ -119,6 +119,35 @@ TEST(ReportPublished, KnownNumbersGiveKnownMediansAndRatios) {
     EXPECT_DOUBLE_EQ(test3[1]["published_ratio"].get<double>(), 2.0);
 }
 
+TEST(ReportPublished, ModelledColumnGivesMediansAndRatiosOfTheSameJobs) {
+    json jobs = json::array({okJob("0", "a", 10, 4.0), okJob("1", "a", 10, 6.0),
+                             okJob("2", "b", 10, 2.0), okJob("3", "b", 10, 2.0)});
+    const double slots[] = {100.0, 300.0, 50.0, 70.0};
+    for (size_t j = 0; j < jobs.size(); ++j)
+        jobs[j]["simt_lane_slots"] = slots[j];
+    json published = {{"title", "model"},
+                      {"metric", "time_total_median_ms"},
+                      {"modelled", "simt_lane_slots"},
+                      {"columns",
+                       {{{"label", "a"}, {"select", {{"stage", "a"}}}},
+                        {{"label", "b"}, {"select", {{"stage", "b"}}}}}},
+                      {"rows", {{{"label", "r"}, {"values", {8.0, 2.0}}}}}};
+    const json table = comparePublished(published, jobs);
+    EXPECT_EQ(table["modelled"], "simt_lane_slots");
+    const json& cells = table["rows"][0]["cells"];
+    EXPECT_DOUBLE_EQ(cells[0]["modelled"].get<double>(), 200.0);
+    EXPECT_DOUBLE_EQ(cells[1]["modelled"].get<double>(), 60.0);
+    EXPECT_DOUBLE_EQ(cells[1]["modelled_ratio"].get<double>(), 0.3);
+    EXPECT_DOUBLE_EQ(cells[1]["measured_ratio"].get<double>(), 0.4);
+    EXPECT_DOUBLE_EQ(cells[1]["published_ratio"].get<double>(), 0.25);
+    // Without a model the cells say so with nulls; a model that is not a column name is refused.
+    published.erase("modelled");
+    EXPECT_TRUE(
+        comparePublished(published, jobs)["rows"][0]["cells"][1]["modelled_ratio"].is_null());
+    published["modelled"] = 3;
+    EXPECT_THROW(comparePublished(published, jobs), std::runtime_error);
+}
+
 TEST(ReportPublished, SummedMetricAndAnotherBaseline) {
     json jobs = json::array({okJob("0", "a", 10, 4.0), okJob("1", "b", 10, 7.0)});
     const json published = {{"title", "sum"},
@@ -229,6 +258,8 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
                             {"time_total_max_ms", time * 1.2},
                             {"light_evaluations", (brute ? 1.0 : 0.2) * lights * w * h},
                             {"culling_efficiency", brute ? 0.05 : 0.4 + 0.001 * lights},
+                            {"simt_lane_slots", (brute ? 1.0 : 0.3) * lights * w * h},
+                            {"simt_efficiency", brute ? 0.05 : 0.2},
                             {"counted_pixels", w * h},
                             {"bytes_per_pixel", 16},
                             {"rmse", brute ? 1e-7 * (ordinal + 1) : 2e-6 * (ordinal + 1)},
@@ -253,6 +284,8 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
                     {"time_total_max_ms", nullptr},
                     {"light_evaluations", nullptr},
                     {"culling_efficiency", nullptr},
+                    {"simt_lane_slots", nullptr},
+                    {"simt_efficiency", nullptr},
                     {"counted_pixels", nullptr},
                     {"bytes_per_pixel", nullptr},
                     {"rmse", nullptr},
@@ -275,6 +308,8 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
                           "time_total_max_ms",
                           "light_evaluations",
                           "culling_efficiency",
+                          "simt_lane_slots",
+                          "simt_efficiency",
                           "counted_pixels",
                           "bytes_per_pixel",
                           "rmse",
@@ -287,6 +322,7 @@ fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
         {{{"title", "Thesis-like table"},
           {"source", "made up"},
           {"metric", "time_total_median_ms"},
+          {"modelled", "simt_lane_slots"},
           {"columns",
            {{{"label", "brute"}, {"select", {{"stage", "brute"}}}},
             {{"label", "tiled"}, {"select", {{"stage", "tiled"}}}}}},
@@ -339,11 +375,12 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
     EXPECT_NE(html.find("tiled wins &lt;by far&gt;"), std::string::npos);
     // Published table, row "Test 64": brute measured 129 (2*64 + ordinal 1), tiled 36 (0.5*64 +
     // ordinal 4): published ratio 32/128 = 0.25, measured 36/129 = 0.2791.
-    EXPECT_NE(html.find("<td>128</td><td>129</td><td>1&times;</td><td>1&times;</td><td>1</td>"),
+    EXPECT_NE(html.find("<td>128</td><td>129</td><td>1&times;</td><td>1&times;</td><td>1&times;</"
+                        "td><td>1</td>"),
               std::string::npos);
-    EXPECT_NE(
-        html.find("<td>32</td><td>36</td><td>0.25&times;</td><td>0.2791&times;</td><td>1</td>"),
-        std::string::npos);
+    EXPECT_NE(html.find("<td>32</td><td>36</td><td>0.25&times;</td><td>0.3&times;</"
+                        "td><td>0.2791&times;</td><td>1</td>"),
+              std::string::npos);
     EXPECT_NE(html.find("no error.png"), std::string::npos) << "job 0005 has no error image";
     EXPECT_NE(html.find("id=\"page-check\""), std::string::npos);
     EXPECT_EQ(html.find("http://"), std::string::npos) << "nothing from the network";
@@ -410,6 +447,11 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
     const json published = json::parse(readText(dir / "report" / "published.json"));
     EXPECT_NEAR(published[0]["rows"][0]["cells"][1]["measured_ratio"].get<double>(), 36.0 / 129.0,
                 1e-12);
+    // The SIMT model beside published and measured: its ratio in the table, its efficiency
+    // among the main columns.
+    EXPECT_NEAR(published[0]["rows"][0]["cells"][1]["modelled_ratio"].get<double>(), 0.3, 1e-12);
+    EXPECT_NE(html.find("<th>modelled ratio</th>"), std::string::npos);
+    EXPECT_NE(html.find("<th class=\"col\" data-column=\"simt_efficiency\">"), std::string::npos);
 }
 
 TEST(ReportCommand, SingleValuedAxesSayNotEnoughDataInsteadOfEmptyPlots) {

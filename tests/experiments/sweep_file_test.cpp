@@ -397,6 +397,14 @@ TEST(SweepFile, ChecksPublishedTables) {
         "columns": [{"label": "brute", "select": {"stage": "brute"}}],
         "rows": [{"label": "4 lights", "select": {"lights": 4}, "values": [1.5]}], "ratio_to": 0}])");
     EXPECT_NO_THROW(experiments::parseSweep(file, "pub.json"));
+    file["published"][0]["modelled"] = "simt_lane_slots";
+    EXPECT_NO_THROW(experiments::parseSweep(file, "pub.json"));
+    file["published"][0]["modelled"] = Json::array({"simt_lane_slots"});
+    EXPECT_NE(errorOf([&] {
+                  experiments::parseSweep(file, "pub.json");
+              }).find("'published[0].modelled' must be a column name"),
+              std::string::npos);
+    file["published"][0].erase("modelled");
     file["published"][0]["rows"][0]["values"] = Json::array({1.0, 2.0});
     EXPECT_NE(errorOf([&] { experiments::parseSweep(file, "pub.json"); }).find("values"),
               std::string::npos);
