@@ -80,6 +80,22 @@ void report(int fd, const Json& line) {
     }
 }
 
+// ThreadSanitizer kills a child forked from a process of several threads (here the idle pools
+// libraries start before main(), which fork otherwise tolerates) as soon as the child starts a
+// thread ("starting new threads after multi-threaded fork is not supported"), as every job does:
+// that build always spawns.
+#if defined(__SANITIZE_THREAD__)
+constexpr bool kForkSupported = false;
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+constexpr bool kForkSupported = false;
+#else
+constexpr bool kForkSupported = true;
+#endif
+#else
+constexpr bool kForkSupported = true;
+#endif
+
 // The threads libraries started before main() (noteStartupThreads); 1 when not noted.
 int gStartupThreads = 1;
 
@@ -229,7 +245,8 @@ JobProcessOutcome runJobProcess(const SweepJob& job, const fs::path& out, JobSta
     // would stay locked in the child for ever, so a process that started threads starts a fresh
     // one (see the file comment for the idle threads of libraries, which do not count).
     const int threads = threadsOfThisProcess();
-    const bool useFork = start == JobStart::Fork && threads >= 1 && threads <= gStartupThreads;
+    const bool useFork =
+        kForkSupported && start == JobStart::Fork && threads >= 1 && threads <= gStartupThreads;
     if (!useFork && executable.empty())
         throw std::runtime_error("cannot start a job process: this process started threads "
                                  "and no testbed executable was given");

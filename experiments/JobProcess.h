@@ -12,7 +12,8 @@
 // idle pools that libraries start from their constructors (log4cplus, through OpenVDB, starts 4),
 // which the parent never calls into. A process that started threads (TBB's workers, OIIO's pool)
 // starts `executable sweep-job --parent PID --report-fd 3 '<job JSON>'` instead (JobStart::Spawn,
-// posix_spawn; "sweep-job" is a hidden subcommand).
+// posix_spawn; "sweep-job" is a hidden subcommand), and so does every ThreadSanitizer build (it
+// kills a child forked from a process of several threads once the child starts one).
 //
 // The child reports on a pipe (its fd 3 when spawned) and the parent reads until the child closes
 // it, then waits for it. Each report line is one JSON object:
