@@ -90,6 +90,7 @@ void checkLinearExr(const fs::path& path, const OIIO::ImageBuf& image) {
 // are allocated (scenes/Limits.h: the render limits, and limits::kMaxImageChannels), and a file
 // that holds no linear colour before anything is compared (checkLinearExr).
 OIIO::ImageBuf readImage(const fs::path& path) {
+    runImageLibraryOnTheCallingThread();
     checkExrAttributeSizes(path);
     OIIO::ImageBuf image(path.string());
     if (!image.init_spec(path.string(), 0, 0))

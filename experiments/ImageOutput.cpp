@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <stdexcept>
 #include <string_view>
@@ -123,8 +124,14 @@ std::unique_ptr<OIIO::ImageOutput> checkedImageOutput(const fs::path& path, cons
 
 } // namespace
 
+void runImageLibraryOnTheCallingThread() {
+    static std::once_flag once;
+    std::call_once(once, [] { OIIO::attribute("threads", 1); });
+}
+
 void writeImageAtomically(const fs::path& path, const OIIO::ImageBuf& image,
                           OIIO::TypeDesc fileType, const char* formatName) {
+    runImageLibraryOnTheCallingThread();
     writeFileAtomically(path, [&](const fs::path& tempPath) {
         auto fail = [&](const std::string& reason) {
             return std::runtime_error("cannot write " + path.string() + ": " + reason);
@@ -284,6 +291,7 @@ void drawHeatmapLegend(const fs::path& path, OIIO::ImageBuf& canvas, int dataHei
 void writeMultiLayerExr(const fs::path& path, int width, int height,
                         const std::vector<ImagePlane>& planes,
                         const std::vector<std::pair<std::string, std::string>>& metadata) {
+    runImageLibraryOnTheCallingThread();
     checkImageSize(path, width, height);
     if (planes.empty())
         throw std::invalid_argument("cannot write " + path.string() + ": no image planes");
@@ -340,6 +348,7 @@ void writeMultiLayerExr(const fs::path& path, int width, int height,
 
 void writePreviewPng(const fs::path& path, int width, int height, const float* r, const float* g,
                      const float* b, float exposure) {
+    runImageLibraryOnTheCallingThread();
     checkImageSize(path, width, height);
     checkPointer(path, r, "the red plane");
     checkPointer(path, g, "the green plane");
@@ -361,6 +370,7 @@ void writePreviewPng(const fs::path& path, int width, int height, const float* r
 
 void writeHeatmapPng(const fs::path& path, int width, int height, const uint32_t* counts,
                      uint32_t scaleMax) {
+    runImageLibraryOnTheCallingThread();
     checkImageSize(path, width, height);
     checkPointer(path, counts, "the count plane");
     const size_t pixelCount = size_t(width) * height;
@@ -409,6 +419,7 @@ std::pair<float, float> scalarMapRange(const float* values, size_t n, const Scal
 
 void writeScalarMapPng(const fs::path& path, int width, int height, const float* values,
                        const ScalarMapStyle& style) {
+    runImageLibraryOnTheCallingThread();
     checkImageSize(path, width, height);
     checkPointer(path, values, "the value plane");
     if (style.scale == MapScale::Log && !(style.logDecades > 0.0f && style.logDecades <= 30.0f))

@@ -29,6 +29,21 @@
 
 namespace experiments {
 
+// Makes OpenImageIO run its algorithms and pixel conversions on the calling thread
+// (OIIO::attribute("threads", 1)), once per process; every function of the testbed that hands
+// pixels to OpenImageIO calls it first (the writers below, compareImages, diff, the report's
+// images, reading a sweep's reference). Their work is measurement and output, outside every timed
+// pass, and OpenImageIO's own pool would
+// - start a thread per core beside the --threads the user chose;
+// - split reductions (compare, computePixelStats) however it likes, where error figures must not
+//   depend on the machine;
+// - hand work over inside the uninstrumented libOpenImageIO_Util, which ThreadSanitizer reported
+//   as races (./run.sh sanitize: the RenderJob, RenderCommand and SweepRunner tests).
+// Not set at start-up: setting it creates OpenImageIO's pool (a thread that then ends) in every
+// process, `testbed sweep` included, which must have no thread but its start-up ones when it
+// forks a job (JobProcess.h). Thread-safe.
+void runImageLibraryOnTheCallingThread();
+
 // Writes an in-memory image in the named OpenImageIO format ("png", "openexr"), pixels converted
 // to fileType, through writeFileAtomically. Every byte goes through a file proxy that checks the
 // write and the final flush (OpenImageIO's own file output ignores short writes), so a full disk

@@ -77,6 +77,7 @@ std::array<std::vector<float>, 3> errorPlanes(const RenderRun& run) {
     std::array<std::vector<float>, 3> planes;
     if (!run.metrics.error)
         return planes;
+    runImageLibraryOnTheCallingThread();
     const int w = run.result.width, h = run.result.height;
     auto toBuffer = [&](const lighting::StageResult& image) {
         OIIO::ImageBuf buffer(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::FLOAT));

@@ -150,6 +150,7 @@ bool jobOk(const json& job) {
 // Writes a thumbnail of source (at most width pixels wide, aspect kept) unless an up-to-date
 // one exists. Returns false when source is missing or unreadable (the page then says so).
 bool makeThumbnail(const fs::path& source, const fs::path& thumbnail, int width) {
+    runImageLibraryOnTheCallingThread();
     std::error_code error;
     if (!fs::is_regular_file(source, error))
         return false;
@@ -407,6 +408,7 @@ struct JobMaps {
 };
 
 std::optional<JobMaps> readJobMaps(const fs::path& exr) {
+    runImageLibraryOnTheCallingThread();
     std::error_code missing;
     if (!fs::is_regular_file(exr, missing))
         return std::nullopt;

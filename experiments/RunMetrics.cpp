@@ -9,6 +9,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
+#include "experiments/ImageOutput.h"
 #include "lighting/PassNames.h"
 
 namespace experiments {
@@ -163,6 +164,7 @@ std::vector<std::string> runFigureColumns() {
 
 ErrorMetrics compareImages(const lighting::StageResult& image,
                            const lighting::StageResult& reference) {
+    runImageLibraryOnTheCallingThread();
     const OIIO::ImageBuf a = toImageBuf(image), b = toImageBuf(reference);
     const auto comparison = OIIO::ImageBufAlgo::compare(a, b, 0.0f, 0.0f);
     const auto referenceStats = OIIO::ImageBufAlgo::computePixelStats(b);

@@ -34,6 +34,7 @@ std::optional<lighting::StageResult> readReferenceExr(const fs::path& path, cons
                                                       int width, int height) {
     if (!fs::is_regular_file(path))
         return std::nullopt;
+    runImageLibraryOnTheCallingThread();
     OIIO::ImageBuf buffer(path.string());
     if (!buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT))
         return std::nullopt;

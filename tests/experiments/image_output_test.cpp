@@ -333,6 +333,17 @@ TEST(MultiLayerExr, MissingFolderThrowsNamingThePath) {
 // ---------------------------------------------------------------------------------------------
 // writePreviewPng
 
+// runImageLibraryOnTheCallingThread (ImageOutput.h): once the testbed has handed pixels to
+// OpenImageIO, its algorithms run on the calling thread, not in a pool of its own.
+TEST(ImageLibrary, RunsOnTheCallingThreadOnceTheTestbedWritesAnImage) {
+    const std::vector<float> grey(4, 0.18f);
+    writePreviewPng(freshTestFolder() / "one-thread.png", 2, 2, grey.data(), grey.data(),
+                    grey.data());
+    int threads = -1;
+    ASSERT_TRUE(OIIO::getattribute("threads", threads));
+    EXPECT_EQ(threads, 1);
+}
+
 TEST(PreviewPng, ToneMapsAndMapsNanAndInfinityToBlackAndWhite) {
     const fs::path path = freshTestFolder() / "preview.png";
     constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
