@@ -21,6 +21,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "experiments/SanitizerBuild.h"
 #include "experiments/SweepJobRun.h"
 
 extern char** environ;
@@ -84,17 +85,7 @@ void report(int fd, const Json& line) {
 // libraries start before main(), which fork otherwise tolerates) as soon as the child starts a
 // thread ("starting new threads after multi-threaded fork is not supported"), as every job does:
 // that build always spawns.
-#if defined(__SANITIZE_THREAD__)
-constexpr bool kForkSupported = false;
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-constexpr bool kForkSupported = false;
-#else
-constexpr bool kForkSupported = true;
-#endif
-#else
-constexpr bool kForkSupported = true;
-#endif
+constexpr bool kForkSupported = !kThreadSanitizerBuild;
 
 // The threads libraries started before main() (noteStartupThreads); 1 when not noted.
 int gStartupThreads = 1;

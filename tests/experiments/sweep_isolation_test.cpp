@@ -32,6 +32,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/SanitizerBuild.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -49,17 +51,7 @@ fs::path freshDir(const std::string& name) {
 
 // Starts testbed with args, stdout and stderr to `log`; returns the child's pid.
 // Whether this test binary (and so the testbed it runs: one build) has AddressSanitizer.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kUnderAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kUnderAddressSanitizer = true;
-#else
-constexpr bool kUnderAddressSanitizer = false;
-#endif
-#else
-constexpr bool kUnderAddressSanitizer = false;
-#endif
+constexpr bool kUnderAddressSanitizer = experiments::kAddressSanitizerBuild;
 
 pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
     return experimentstest::spawnTestbed(args, log, experimentstest::LogMode::Truncate);
