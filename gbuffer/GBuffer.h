@@ -26,11 +26,11 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/CameraView.h"
-#include "gbuffer/DepthFormat.h"
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/Plane.h"
 #include "gbuffer/Surface.h"
+#include "gbuffer/codecs/DepthFormat.h"
+#include "gbuffer/visibility/CameraView.h"
 
 namespace gbuffer {
 

@@ -35,9 +35,9 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/DepthFormat.h"
-#include "gbuffer/NormalCodec.h"
-#include "scenes/Material.h"
+#include "gbuffer/codecs/DepthFormat.h"
+#include "gbuffer/codecs/NormalCodec.h"
+#include "scenes/materials/Material.h"
 
 namespace gbuffer {
 

@@ -7,10 +7,10 @@
 // count (see raster/Rasterizer.h).
 #pragma once
 
-#include "gbuffer/ExactSurface.h"
 #include "gbuffer/GBuffer.h"
-#include "gbuffer/SceneGeometry.h"
-#include "gbuffer/VisibilityPass.h"
+#include "gbuffer/visibility/ExactSurface.h"
+#include "gbuffer/visibility/SceneGeometry.h"
+#include "gbuffer/visibility/VisibilityPass.h"
 #include "raster/Rasterizer.h"
 #include "scenes/Scene.h"
 

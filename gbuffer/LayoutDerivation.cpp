@@ -149,7 +149,7 @@ void addEmission(GBufferLayout& layout, const scenes::Scene& scene, bool readsEm
     bool textured = false;
     for (uint32_t index : usedMaterials(scene)) {
         // Blended surfaces never enter the G-buffer: the blended pass adds their emission from
-        // their own surface (lighting/BlendedPass.h).
+        // their own surface (lighting/passes/BlendedPass.h).
         if (index >= scene.materials.size() || !scene.materials[index].emits() ||
             scene.materials[index].alphaMode == scenes::AlphaMode::Blend)
             continue;

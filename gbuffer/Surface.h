@@ -1,7 +1,7 @@
 // Surface: the shading inputs at one surface point, the one struct the G-buffer stores and
 // decodes, the visibility pass resolves, the exact surface gives the reference and the lighting
-// function (lighting/Brdf.h evaluateLight) shades with the sample's material model. Templated on
-// the scalar type: float everywhere, double for the reference (BasicSurface<double>, from
+// function (lighting/brdf/Brdf.h evaluateLight) shades with the sample's material model. Templated
+// on the scalar type: float everywhere, double for the reference (BasicSurface<double>, from
 // gbuffer::ExactSurface).
 //
 // Conventions: view space right-handed, camera at the origin looking down -Z, metres. The
@@ -20,7 +20,7 @@
 
 #include <glm/glm.hpp>
 
-#include "scenes/Material.h"
+#include "scenes/materials/Material.h"
 
 namespace gbuffer {
 

@@ -9,14 +9,14 @@
 
 #include <memory>
 
-#include "gbuffer/CameraView.h"
-#include "gbuffer/ExactSurface.h"
 #include "gbuffer/GBuffer.h"
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/GBufferPass.h"
-#include "gbuffer/SceneGeometry.h"
-#include "lighting/LightList.h"
+#include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/ExactSurface.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/culling/LightList.h"
 #include "raster/Rasterizer.h"
 #include "scenes/Scene.h"
 

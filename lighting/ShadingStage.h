@@ -63,12 +63,12 @@
 #include <utility>
 #include <vector>
 
-#include "gbuffer/CameraView.h"
-#include "gbuffer/ExactSurface.h"
 #include "gbuffer/GBuffer.h"
 #include "gbuffer/GBufferLayout.h"
-#include "gbuffer/SceneGeometry.h"
-#include "lighting/LightList.h"
+#include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/ExactSurface.h"
+#include "gbuffer/visibility/SceneGeometry.h"
+#include "lighting/culling/LightList.h"
 #include "lighting/kernel/KernelIsa.h"
 #include "scenes/Scene.h"
 
@@ -130,7 +130,7 @@ struct StageResult {
     // pixel, like its radiance.
     bool traceLights = false;
     std::vector<std::vector<uint32_t>> lightTrace;
-    // The same hook for blended fragments (lighting/BlendedPass.h): per pixel, one entry per
+    // The same hook for blended fragments (lighting/passes/BlendedPass.h): per pixel, one entry per
     // blended fragment the pass composited there, in composite order, with the lights evaluated
     // for it (the list's order). Filled by BlendedPass::shade and compositeExact when tracing;
     // the tests check each entry against the fragment's contributing lights. Off, it costs one

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "lighting/StageRegistry.h"
-#include "scenes/ClosestName.h"
+#include "scenes/input/ClosestName.h"
 
 namespace lighting {
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <exception>
 
-#include "scenes/ClosestName.h"
+#include "scenes/input/ClosestName.h"
 
 namespace lighting {
 

@@ -15,8 +15,8 @@
 
 #include <glm/glm.hpp>
 
-#include "scenes/Material.h"
-#include "scenes/Texture.h"
+#include "scenes/materials/Material.h"
+#include "scenes/materials/Texture.h"
 
 namespace scenes {
 

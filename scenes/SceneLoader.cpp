@@ -14,8 +14,8 @@
 #include <iostream>
 #include <system_error>
 
-#include "scenes/LightGenerator.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/LightGenerator.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace scenes {
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <map>
 
-#include "scenes/ClosestName.h"
 #include "scenes/SceneLoader.h"
+#include "scenes/input/ClosestName.h"
 
 namespace scenes {
 

@@ -1,18 +1,18 @@
-#include "experiments/ListCommand.h"
+#include "experiments/cli/ListCommand.h"
 
 #include <iostream>
 #include <vector>
 
 #include "experiments/CommandErrors.h"
-#include "experiments/RenderOptions.h"
-#include "experiments/RenderPlan.h"
-#include "gbuffer/DepthFormat.h"
+#include "experiments/render/RenderOptions.h"
+#include "experiments/render/RenderPlan.h"
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/LayoutDerivation.h"
-#include "gbuffer/NormalCodec.h"
+#include "gbuffer/codecs/DepthFormat.h"
+#include "gbuffer/codecs/NormalCodec.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
 #include "scenes/Viewpoints.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace experiments {
 
@@ -58,7 +58,7 @@ void printStages(std::ostream& out) {
 }
 
 void printNormalCodecs(std::ostream& out) {
-    out << "normal encodings (--normals NAME:BITS, total bits; gbuffer/NormalCodec.h):\n";
+    out << "normal encodings (--normals NAME:BITS, total bits; gbuffer/codecs/NormalCodec.h):\n";
     const std::vector<gbuffer::NormalCodecSpec> specs = gbuffer::allNormalCodecSpecs();
     for (size_t i = 0; i < specs.size(); ++i) { // grouped by codec, in registry order
         const bool first = i == 0 || specs[i - 1].kind != specs[i].kind;

@@ -9,7 +9,7 @@
 # ssh (OUT_DIR then on a shared file system). TESTBED names the binary (default
 # build/bin/testbed). A failed shard does not stop the others nor the merge (its failed jobs are
 # in the merged table with their errors); the exit status is then parallel's (the number of
-# failed shards). Tested by tests/experiments/cluster_parallel_test.sh.
+# failed shards). Tested by tests/experiments/sweep/cluster_parallel_test.sh.
 set -euo pipefail
 if (($# < 3)); then
     echo "usage: $0 SWEEP_FILE OUT_DIR SHARDS [SWEEP_OPTION...]" >&2

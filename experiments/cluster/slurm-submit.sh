@@ -10,7 +10,7 @@
 # SWEEP_OPTIONs to every `testbed sweep` (e.g. --quick). TESTBED names the binary (default
 # build/bin/testbed). Run it from the folder the jobs should start in (their slurm-*.out land
 # there); OUT_DIR must be on a file system every node sees. Prints "ARRAY_JOB_ID MERGE_JOB_ID".
-# Tested on a one-node Slurm by tests/experiments/cluster_slurm_test.sh.
+# Tested on a one-node Slurm by tests/experiments/sweep/cluster_slurm_test.sh.
 set -euo pipefail
 if (($# < 3)); then
     echo "usage: $0 SWEEP_FILE OUT_DIR SHARDS [SBATCH_OPTION...] [-- SWEEP_OPTION...]" >&2

@@ -1,4 +1,4 @@
-#include "experiments/DiffCommand.h"
+#include "experiments/compare/DiffCommand.h"
 
 #include <algorithm>
 #include <cctype>
@@ -17,14 +17,14 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
-#include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
-#include "experiments/FlipMetric.h"
-#include "experiments/ImageOutput.h"
-#include "experiments/RenderCommand.h"
-#include "experiments/ReportCommand.h"
-#include "experiments/RunMetrics.h"
-#include "scenes/Limits.h"
+#include "experiments/compare/FlipMetric.h"
+#include "experiments/compare/ImageMetrics.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/output/PlotScript.h"
+#include "experiments/output/ReportHtml.h"
+#include "scenes/input/Limits.h"
 
 namespace experiments {
 
@@ -87,8 +87,8 @@ void checkLinearExr(const fs::path& path, const OIIO::ImageBuf& image) {
 }
 
 // The header is read first, so a file that declares an absurd size is refused before its pixels
-// are allocated (scenes/Limits.h: the render limits, and limits::kMaxImageChannels), and a file
-// that holds no linear colour before anything is compared (checkLinearExr).
+// are allocated (scenes/input/Limits.h: the render limits, and limits::kMaxImageChannels), and a
+// file that holds no linear colour before anything is compared (checkLinearExr).
 OIIO::ImageBuf readImage(const fs::path& path) {
     runImageLibraryOnTheCallingThread();
     checkExrAttributeSizes(path);

@@ -6,7 +6,7 @@
 //                      "channels": [{"name", "a": {min,max,mean,nan,inf}, "b": {...},
 //                      "difference": {min,max,mean}, "abs_difference": {max,mean}}],
 //                      "only_in_a", "only_in_b"}
-//   DIR/a.png, b.png   tone-mapped previews of the beauty (experiments/ImageOutput.h)
+//   DIR/a.png, b.png   tone-mapped previews of the beauty (experiments/output/ImageOutput.h)
 //   DIR/absdiff.png    max over R,G,B of |A - B|, turbo colour map from 0 to max_abs with a colour
 //                      bar (matplotlib, experiments/plots/report.py diff)
 //   DIR/absdiff.exr    |A - B| per beauty channel as float32 R, G, B, for inspection in a viewer
@@ -48,7 +48,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/RunMetrics.h"
+#include "experiments/compare/ImageMetrics.h"
 
 namespace experiments {
 

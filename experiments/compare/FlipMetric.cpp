@@ -1,4 +1,4 @@
-#include "experiments/FlipMetric.h"
+#include "experiments/compare/FlipMetric.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -11,7 +11,7 @@
 
 #include <unistd.h>
 
-#include "experiments/PlotScript.h"
+#include "experiments/output/PlotScript.h"
 
 namespace experiments {
 
@@ -179,6 +179,14 @@ FlipResult computeFlip(const lighting::StageResult& test, const lighting::StageR
     } catch (const std::exception& e) {
         return unavailable(std::string("ꟻLIP failed: ") + e.what());
     }
+}
+
+ScalarMapStyle flipMapStyle() {
+    ScalarMapStyle style;
+    style.max = 1.0f;
+    style.colourMap = "magma";
+    style.title = "HDR-FLIP error (flip-evaluator), 0..1";
+    return style;
 }
 
 } // namespace experiments

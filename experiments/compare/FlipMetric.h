@@ -28,6 +28,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/output/ImageOutput.h"
 #include "lighting/ShadingStage.h"
 
 namespace experiments {
@@ -56,5 +57,8 @@ std::string flipUnavailableReason();
 // unavailable package, non-finite pixels or a failing script give a result without a mean and
 // with the reason.
 FlipResult computeFlip(const lighting::StageResult& test, const lighting::StageResult& reference);
+
+// The style of flip.png: magma, linear from 0 to 1 (ꟻLIP's range), the same for every image.
+ScalarMapStyle flipMapStyle();
 
 } // namespace experiments

@@ -1,7 +1,7 @@
 // Atomic file output through a temporary sibling and rename(2); see AtomicFile.h for the naming
 // scheme and what is (and is not) guaranteed. C stdio is used for the byte writes because it
 // reports the system error (errno) that our messages must name; iostreams do not.
-#include "experiments/AtomicFile.h"
+#include "experiments/output/AtomicFile.h"
 
 #include <atomic>
 #include <cerrno>

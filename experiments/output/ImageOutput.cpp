@@ -6,7 +6,7 @@
 // Apache-2.0): colormap design by Anton Mikhailov, GLSL approximation by Ruofei Du
 // (gist mikhailov-work/0d177465a8151eb6ede1768d51d476c7; ai.googleblog.com/2019/08/
 // turbo-improved-rainbow-colormap-for.html). It returns display (sRGB-encoded) values.
-#include "experiments/ImageOutput.h"
+#include "experiments/output/ImageOutput.h"
 
 #include <algorithm>
 #include <array>
@@ -26,7 +26,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
-#include "experiments/AtomicFile.h"
+#include "experiments/output/AtomicFile.h"
 
 namespace experiments {
 

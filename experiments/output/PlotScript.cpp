@@ -1,4 +1,4 @@
-#include "experiments/PlotScript.h"
+#include "experiments/output/PlotScript.h"
 
 #include <cerrno>
 #include <cstdio>

@@ -4,7 +4,7 @@ reference, computed by NVIDIA's official implementation: the Python package flip
 (`import flip_evaluator`), which ./run.sh installs into the project's virtual environment .venv/.
 This script only moves data in and out of that package; it computes nothing itself.
 
-Called by the C++ commands (experiments/FlipMetric.h), not by hand (but it can be):
+Called by the C++ commands (experiments/compare/FlipMetric.h), not by hand (but it can be):
 
   flip.py check --out JSON
       Writes {"version": "<flip-evaluator's version>"} to JSON and exits 0 when the package

@@ -7,7 +7,7 @@ UTF-8 text file at path. Both write under a hidden temporary name in the same fo
 (os.replace), so an interrupted run leaves no partial file under the final name; the figure is
 closed whatever happens.
 
-The temporary name is the one experiments/AtomicFile.h describes,
+The temporary name is the one experiments/output/AtomicFile.h describes,
 ".<stem>.tmp-<pid>-<counter>-<host><ext>" beside the final file (<host>: 8 hex digits of the
 FNV-1a hash of the host name), so that the testbed recognises a temporary left by a killed script
 and removes it on its next run into that folder.

@@ -5,7 +5,7 @@ Called by the C++ commands, not by hand (but it can be, for debugging):
 
   report.py results --results DIR/results.json --published DIR/report/published.json
             --groups DIR/report/groups.json [--error-metric relative_rmse] --out DIR/report
-      Plots of a sweep's results (see experiments/ReportCommand.h). groups.json (written by the
+      Plots of a sweep's results (see experiments/report/ReportCommand.h). groups.json (written by the
       report command) lists the comparable groups: jobs with the same value of every setting but
       the method columns (stage, layout, normals, ...). Per group: time against the error metric
       with the Pareto front and the repetitions' min-max time as error bars ("pareto"), and bytes

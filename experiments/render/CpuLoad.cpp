@@ -1,4 +1,4 @@
-#include "experiments/CpuLoad.h"
+#include "experiments/render/CpuLoad.h"
 
 #include <algorithm>
 #include <cstdio>

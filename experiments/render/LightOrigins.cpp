@@ -1,6 +1,6 @@
-#include "experiments/LightOrigins.h"
+#include "experiments/render/LightOrigins.h"
 
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace experiments {
 

@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/RenderOptions.h"
+#include "experiments/render/RenderOptions.h"
 #include "scenes/Scene.h"
 
 namespace experiments {

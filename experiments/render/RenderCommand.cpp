@@ -1,5 +1,7 @@
-#include "experiments/RenderCommand.h"
+#include "experiments/render/RenderCommand.h"
+
 #include "experiments/BuildCommit.h"
+#include "experiments/compare/FlipMetric.h"
 
 #include <algorithm>
 #include <array>
@@ -14,13 +16,13 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <tbb/parallel_for.h>
 
-#include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
-#include "experiments/ImageOutput.h"
-#include "experiments/LightOrigins.h"
-#include "experiments/Progress.h"
-#include "lighting/PassNames.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/output/Progress.h"
+#include "experiments/render/LightOrigins.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/passes/PassNames.h"
 #include "scenes/Scene.h"
 #include "scenes/Viewpoints.h"
 
@@ -167,14 +169,6 @@ ScalarMapStyle errorMapStyle(const RenderOutputScales& scales) {
     style.colourMap = "turbo";
     style.title = std::string("|render - reference|, largest of R,G,B (") +
                   mapScaleName(scales.errorScale) + " scale)";
-    return style;
-}
-
-ScalarMapStyle flipMapStyle() {
-    ScalarMapStyle style;
-    style.max = 1.0f;
-    style.colourMap = "magma";
-    style.title = "HDR-FLIP error (flip-evaluator), 0..1";
     return style;
 }
 

@@ -18,8 +18,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/ImageOutput.h"
-#include "experiments/RenderJob.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/render/RenderJob.h"
 
 namespace experiments {
 
@@ -40,8 +40,6 @@ struct RenderCommandOptions {
 
 // The style of error.png for the scales (title, colour map, scale, maximum).
 ScalarMapStyle errorMapStyle(const RenderOutputScales& scales);
-// The style of flip.png: magma, linear from 0 to 1 (ꟻLIP's range), the same for every image.
-ScalarMapStyle flipMapStyle();
 
 // stats.json: the run's configuration, layout and machine, and its RunMetrics (RunMetrics.h
 // names the figures).

@@ -1,15 +1,15 @@
-#include "experiments/RenderJob.h"
+#include "experiments/render/RenderJob.h"
 
 #include <chrono>
 #include <thread>
 
 #include <tbb/task_arena.h>
 
-#include "experiments/CpuLoad.h"
-#include "experiments/FlipMetric.h"
+#include "experiments/compare/FlipMetric.h"
+#include "experiments/render/CpuLoad.h"
 #include "lighting/Oracle.h"
-#include "lighting/PassNames.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/passes/PassNames.h"
 
 namespace experiments {
 

@@ -12,9 +12,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/RenderOptions.h"
-#include "experiments/RenderPlan.h"
-#include "experiments/RunMetrics.h"
+#include "experiments/render/RenderOptions.h"
+#include "experiments/render/RenderPlan.h"
+#include "experiments/render/RunMetrics.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/ShadingStage.h"
 #include "scenes/Scene.h"

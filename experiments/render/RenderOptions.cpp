@@ -1,4 +1,4 @@
-#include "experiments/RenderOptions.h"
+#include "experiments/render/RenderOptions.h"
 
 #include <algorithm>
 #include <cctype>
@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "lighting/StageRegistry.h"
-#include "scenes/ClosestName.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/input/ClosestName.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace experiments {
 

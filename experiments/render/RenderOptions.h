@@ -18,7 +18,7 @@
 
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/ShadingStage.h"
-#include "scenes/Limits.h"
+#include "scenes/input/Limits.h"
 
 namespace experiments {
 
@@ -84,7 +84,7 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
 std::vector<std::string> renderOptionKeys();
 
 // Limits checked before any work or allocation (issue: 100000x100000 must be refused up front);
-// the memory-sizing ones are defined, with their reasons, in scenes/Limits.h.
+// the memory-sizing ones are defined, with their reasons, in scenes/input/Limits.h.
 inline constexpr int kMaxImageSide = scenes::limits::kMaxImageSide;
 inline constexpr uint64_t kMaxPixels = scenes::limits::kMaxPixels;
 inline constexpr int kMaxLights = scenes::limits::kMaxLights;

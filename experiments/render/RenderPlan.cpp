@@ -1,4 +1,4 @@
-#include "experiments/RenderPlan.h"
+#include "experiments/render/RenderPlan.h"
 
 #include <algorithm>
 #include <thread>

@@ -11,7 +11,7 @@
 
 #include <memory>
 
-#include "experiments/RenderOptions.h"
+#include "experiments/render/RenderOptions.h"
 #include "gbuffer/GBufferLayout.h"
 #include "lighting/ShadingStage.h"
 #include "scenes/Scene.h"

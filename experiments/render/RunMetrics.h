@@ -5,8 +5,9 @@
 //
 // What is measured:
 //   passes        one PassTiming per pass in execution order: gbuffer, exact_surface (reference
-//                 stage only), the stage's own passes (lighting/PassNames.h), total (G-buffer plus
-//                 the stage's passes). Samples are the timed repetitions, after the warm-up runs.
+//                 stage only), the stage's own passes (lighting/passes/PassNames.h), total
+//                 (G-buffer plus the stage's passes). Samples are the timed repetitions, after the
+//                 warm-up runs.
 //   stage         the stage's own passes summed per repetition (total without the G-buffer pass):
 //                 what papers that exclude the G-buffer pass report (Örtegren's "Total").
 //   light evaluations   lights the stage evaluated, summed over pixels; the oracle's count is the
@@ -17,9 +18,9 @@
 //                 light_counts_note says why when that is not the whole image.
 //   SIMT cost model     lane slots a SIMT GPU would spend on the stage's light evaluations (warps
 //                 of 32 or 64 lanes pay every lane for each light any lane evaluates; reported by
-//                 the stages on lighting/LightAccumulation.h as the parameter simt_lane_slots,
-//                 lighting/README.md); simt efficiency = oracle evaluations / lane slots. Both
-//                 null for stages without the model.
+//                 the stages on lighting/passes/LightAccumulation.h as the parameter
+//                 simt_lane_slots, lighting/README.md); simt efficiency = oracle evaluations / lane
+//                 slots. Both null for stages without the model.
 //   bytes per pixel     the layout's bits as a GPU packs them, and what this run allocates.
 //   CPU load      process CPU seconds per wall second over the timed repetitions, against the
 //                 threads (CpuLoad.h): whether the machine was loaded while the times were taken.
@@ -36,7 +37,8 @@
 #include <utility>
 #include <vector>
 
-#include "experiments/CpuLoad.h"
+#include "experiments/compare/ImageMetrics.h"
+#include "experiments/render/CpuLoad.h"
 #include "lighting/ShadingStage.h"
 
 namespace experiments {
@@ -51,43 +53,13 @@ inline constexpr const char* kSimtLaneSlots = "simt_lane_slots";
 inline constexpr const char* kSimtEfficiency = "simt_efficiency";
 inline constexpr const char* kBytesPerPixel = "bytes_per_pixel";
 inline constexpr const char* kAllocatedBytesPerPixel = "allocated_bytes_per_pixel";
-inline constexpr const char* kRmse = "rmse";
-inline constexpr const char* kRelativeRmse = "relative_rmse";
-inline constexpr const char* kPsnr = "psnr";
-inline constexpr const char* kMaxAbs = "max_abs";
-inline constexpr const char* kRelativeMean = "relative_mean";
-inline constexpr const char* kP99Abs = "p99_abs";
-inline constexpr const char* kFlip = "flip";
-inline constexpr const char* kFlipUnavailable = "flip_unavailable";
 } // namespace metric
 
-// Passes the runner adds around the stage's (lighting/PassNames.h has the frame's passes).
+// Passes the runner adds around the stage's (lighting/passes/PassNames.h has the frame's passes).
 namespace pass {
 inline constexpr const char* kStage = "stage"; // the stage's own passes summed
 inline constexpr const char* kTotal = "total"; // G-buffer plus the stage's passes
 } // namespace pass
-
-// Over all pixels and the three colour channels.
-struct ErrorMetrics {
-    double rmse = 0.0;
-    double relativeRmse = 0.0; // rmse / rms of the reference
-    double maxAbs = 0.0;
-    double psnr = 0.0;           // dB, peak = the reference's maximum channel value
-    double relativeMean = 0.0;   // mean |image - reference| / mean |reference|
-    double p99Abs = 0.0;         // 99th percentile of |image - reference|
-    std::optional<double> flip;  // mean HDR-ꟻLIP (FlipMetric.h); nullopt when not computed
-    std::string flipUnavailable; // why flip is missing ("" when computed)
-};
-
-ErrorMetrics compareImages(const lighting::StageResult& image,
-                           const lighting::StageResult& reference);
-
-// A note when the error is large but sits in under 1% of the samples (relative RMSE above 0.1
-// while the 99th percentile is below 1% of the largest error): a sharp highlight that a
-// reduced-resolution stage (inferred) misplaces dominates the RMSE of a dark frame while 99% of
-// the samples are nearly exact, and a relative RMSE near 1 would read as a broken image. Empty
-// otherwise.
-std::string errorConcentrationNote(const ErrorMetrics& error);
 
 // One pass's times over the timed repetitions.
 struct PassTiming {

@@ -1,4 +1,4 @@
-#include "experiments/ReportCommand.h"
+#include "experiments/report/ReportCommand.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -22,13 +22,14 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
-#include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
-#include "experiments/ImageOutput.h"
-#include "experiments/RenderCommand.h"
-#include "experiments/RunMetrics.h"
-#include "scenes/Limits.h"
-#include "scenes/NestingDepth.h"
+#include "experiments/compare/FlipMetric.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/render/RenderCommand.h"
+#include "experiments/render/RunMetrics.h"
+#include "scenes/input/Limits.h"
+#include "scenes/input/NestingDepth.h"
 
 namespace experiments {
 
@@ -40,21 +41,12 @@ namespace {
 // The job images the report shows as thumbnails, in column order; all but the preview are
 // redrawn at their group's scale from render.exr when it is there.
 constexpr const char* kJobImages[] = {"preview", "heatmap", "error", "flip"};
-// Method columns: what a group compares (everything else makes the group).
-constexpr const char* kMethodColumns[] = {"stage",        "layout", "normals",
-                                          "normal-space", "depth",  "position"};
 // The columns of the results table a reader compares first, after the method columns; the rest
 // are behind the "all columns" toggle.
 constexpr const char* kMainMetricColumns[] = {"time_total_median_ms", "relative_rmse", "flip",
                                               "culling_efficiency", "simt_efficiency"};
-// Settings known to be axis columns, for results that do not list theirs.
-constexpr const char* kKnownAxisColumns[] = {
-    "scene",    "stage",   "lights", "seed",        "resolution",   "width",
-    "height",   "threads", "layout", "normals",     "normal-space", "depth",
-    "position", "view",    "views",  "repetitions", "warmup"};
-
 // Results are ours but may have been edited: the nesting is bounded before parsing, as for every
-// JSON input (scenes/Limits.h), since the report copies values recursively.
+// JSON input (scenes/input/Limits.h), since the report copies values recursively.
 json readJsonFile(const fs::path& path) {
     std::ifstream file(path, std::ios::binary);
     if (!file)
@@ -70,81 +62,6 @@ json readJsonFile(const fs::path& path) {
     } catch (const json::exception& e) {
         throw std::runtime_error("cannot parse " + path.string() + ": " + e.what());
     }
-}
-
-// A relative path as a URL: every byte outside the unreserved set and '/' percent-encoded.
-std::string urlPath(const std::string& path) {
-    static const char* kHex = "0123456789ABCDEF";
-    std::string out;
-    for (unsigned char c : path) {
-        if (std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '~' || c == '/') {
-            out += char(c);
-        } else {
-            out += '%';
-            out += kHex[c >> 4];
-            out += kHex[c & 15];
-        }
-    }
-    return out;
-}
-
-// Integers without a fraction, everything else with 4 significant digits.
-std::string formatNumber(double value) {
-    return displayNumber(value, 4, true);
-}
-
-std::string formatCell(const json& value) {
-    if (value.is_null())
-        return "&mdash;";
-    if (value.is_number())
-        return formatNumber(value.get<double>());
-    if (value.is_boolean())
-        return value.get<bool>() ? "true" : "false";
-    if (value.is_string())
-        return htmlEscape(value.get<std::string>());
-    return htmlEscape(value.dump());
-}
-
-std::string formatOptional(const json& value, const char* suffix = "") {
-    if (value.is_null())
-        return "&mdash;";
-    return formatCell(value) + suffix;
-}
-
-std::string metricLabel(const json& metric) {
-    if (metric.is_string())
-        return metric.get<std::string>();
-    std::string label;
-    for (const json& part : metric)
-        label += (label.empty() ? "" : " + ") + part.get<std::string>();
-    return label;
-}
-
-std::string stringField(const json& object, const char* key) {
-    const auto it = object.find(key);
-    return it != object.end() && it->is_string() ? it->get<std::string>() : std::string();
-}
-
-// The columns of the results table: "columns" when present, else every key of the jobs in
-// first-seen order.
-std::vector<std::string> resultColumns(const json& results) {
-    std::vector<std::string> columns;
-    if (results.contains("columns") && results["columns"].is_array()) {
-        for (const json& column : results["columns"])
-            if (column.is_string())
-                columns.push_back(column.get<std::string>());
-        return columns;
-    }
-    std::set<std::string> seen;
-    for (const json& job : results["jobs"])
-        for (const auto& [key, value] : job.items())
-            if (seen.insert(key).second)
-                columns.push_back(key);
-    return columns;
-}
-
-bool jobOk(const json& job) {
-    return stringField(job, "status") == "ok";
 }
 
 // Writes a thumbnail of source (at most width pixels wide, aspect kept) unless an up-to-date
@@ -171,130 +88,6 @@ bool makeThumbnail(const fs::path& source, const fs::path& thumbnail, int width)
                                  small.geterror());
     writeImageAtomically(thumbnail, small, OIIO::TypeDesc::UINT8, "png");
     return true;
-}
-
-// Records script errors and images that fail to load into #page-check once the page has
-// loaded: "PAGE-CHECK: OK (N images)" or "PAGE-CHECK: FAILED" and one problem per line. Runs
-// in <head>, before any <img>, so that no load error is missed.
-constexpr const char* kPageCheckScript = R"(<script>
-(function () {
-  var problems = [];
-  window.addEventListener('error', function (e) {
-    var t = e.target;
-    if (t && t.tagName === 'IMG') problems.push('image failed to load: ' + t.getAttribute('src'));
-    else problems.push('script error: ' + (e.message || e));
-  }, true);
-  window.addEventListener('load', function () {
-    var images = document.images;
-    for (var i = 0; i < images.length; ++i) {
-      if (!images[i].complete || images[i].naturalWidth === 0)
-        problems.push('image not loaded: ' + images[i].getAttribute('src'));
-    }
-    var check = document.getElementById('page-check');
-    check.textContent = problems.length === 0 ? 'PAGE-CHECK: OK (' + images.length + ' images)'
-                                              : 'PAGE-CHECK: FAILED\n' + problems.join('\n');
-    check.setAttribute('data-status', problems.length === 0 ? 'ok' : 'failed');
-  });
-})();
-</script>
-)";
-
-constexpr const char* kStyle = R"(<style>
-body { font-family: DejaVu Sans, sans-serif; margin: 1.5em; color: #222; }
-h1 { font-size: 1.5em; } h2 { font-size: 1.25em; margin-top: 2em; border-bottom: 1px solid #ccc; }
-table { border-collapse: collapse; font-size: 0.8em; margin: 0.5em 0; }
-th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: right; white-space: nowrap; }
-th { background: #eee; position: sticky; top: 0; }
-td.text, th.text { text-align: left; }
-tr.failed td { background: #fdd; }
-td.error { color: #a00; text-align: left; white-space: normal; min-width: 20em; }
-.scroll { overflow: auto; max-height: 40em; border: 1px solid #ddd; }
-figure { display: inline-block; margin: 0.5em; vertical-align: top; }
-figure img { max-width: 640px; border: 1px solid #ddd; }
-figcaption { font-size: 0.8em; max-width: 640px; }
-.note { color: #666; font-style: italic; }
-.finding { background: #f6f6e8; border-left: 4px solid #cc9; padding: 0.5em; max-width: 60em; }
-.thumbs td { vertical-align: top; text-align: left; white-space: normal; }
-.thumbs img { display: block; }
-.missing { color: #999; font-style: italic; }
-#page-check { font-size: 0.7em; color: #888; }
-table.results.compact .extra { display: none; }
-section.group { border-left: 4px solid #9bd; padding-left: 0.8em; margin: 1.5em 0; }
-details.per-view { margin: 0.3em 0 1em 0; } details.per-view summary { cursor: pointer; }
-section.view-family { border-left: 4px solid #bd9; padding-left: 0.8em; margin: 1.5em 0; }
-.flip-note, .counts-note { background: #fff4e0; border-left: 4px solid #e90; padding: 0.5em;
-  max-width: 60em; }
-</style>
-<script>
-function toggleColumns(button) {
-  var table = document.getElementById('results-table');
-  var compact = table.classList.toggle('compact');
-  button.textContent = compact ? 'Show all columns' : 'Show the main columns only';
-}
-</script>
-)";
-
-// ", median over different X, Y" when the matched jobs of a cell differ in some axis columns.
-std::string differNote(const json& cell) {
-    if (!cell.contains("differ_in") || cell["differ_in"].empty())
-        return "";
-    std::string columns;
-    for (const json& column : cell["differ_in"])
-        columns += (columns.empty() ? "" : ", ") + htmlEscape(column.get<std::string>());
-    return "<br><small>median over different " + columns + "</small>";
-}
-
-void appendPublishedSection(std::ostringstream& html, const json& table, int index) {
-    html << "<h3 id=\"published-" << index << "\">" << htmlEscape(stringField(table, "title"))
-         << "</h3>\n";
-    const std::string source = stringField(table, "source");
-    if (!source.empty())
-        html << "<p>Source: " << htmlEscape(source) << "</p>\n";
-    html << "<p>Metric: <code>" << htmlEscape(stringField(table, "metric_label")) << "</code>";
-    const json& ratioTo = table["ratio_to"];
-    const json& columns = table["columns"];
-    html << "; ratios are value / value of column &ldquo;"
-         << htmlEscape(columns[ratioTo.get<size_t>()].get<std::string>())
-         << "&rdquo; of the same row. Measured values are medians over the matching ok jobs; "
-            "a cell whose jobs differ in a setting says which.";
-    const bool modelled = table.value("modelled", json()).is_string();
-    if (modelled)
-        html << " Modelled ratios are those of <code>"
-             << htmlEscape(table["modelled"].get<std::string>())
-             << "</code> over the same jobs: what the cost model (for simt_lane_slots, a SIMT GPU "
-                "whose warp pays for a light when any lane evaluates it) predicts for the "
-                "published ratio.";
-    html << "</p>\n";
-    const int cellColumns = modelled ? 6 : 5;
-    html << "<div class=\"scroll\"><table class=\"published\">\n<tr><th class=\"text\" "
-            "rowspan=\"2\">row</th>";
-    for (const json& column : columns)
-        html << "<th colspan=\"" << cellColumns << "\">" << htmlEscape(column.get<std::string>())
-             << "</th>";
-    html << "</tr>\n<tr>";
-    for (size_t c = 0; c < columns.size(); ++c)
-        html << "<th>published</th><th>measured</th><th>published ratio</th>"
-             << (modelled ? "<th>modelled ratio</th>" : "")
-             << "<th>measured ratio</th><th>jobs</th>";
-    html << "</tr>\n";
-    for (const json& row : table["rows"]) {
-        html << "<tr><td class=\"text\">" << htmlEscape(row["label"].get<std::string>()) << "</td>";
-        for (const json& cell : row["cells"])
-            html << "<td>" << formatOptional(cell["published"]) << "</td><td>"
-                 << formatOptional(cell["measured"]) << "</td><td>"
-                 << formatOptional(cell["published_ratio"], "&times;") << "</td><td>"
-                 << (modelled ? formatOptional(cell.value("modelled_ratio", json()), "&times;") +
-                                    "</td><td>"
-                              : "")
-                 << formatOptional(cell["measured_ratio"], "&times;") << "</td><td>"
-                 << cell["matched_jobs"].get<int>() << differNote(cell) << "</td>";
-        html << "</tr>\n";
-    }
-    html << "</table></div>\n";
-    const std::string finding = stringField(table, "finding");
-    if (!finding.empty())
-        html << "<p class=\"finding\"><b>Published finding:</b> " << htmlEscape(finding)
-             << "</p>\n";
 }
 
 bool isMainColumn(const std::string& column, const std::vector<std::string>& varyingMethods,
@@ -571,421 +364,6 @@ std::string shellQuote(const std::string& text) {
 
 } // namespace
 
-std::string htmlEscape(const std::string& text) {
-    std::string out;
-    out.reserve(text.size());
-    for (char c : text) {
-        switch (c) {
-        case '&':
-            out += "&amp;";
-            break;
-        case '<':
-            out += "&lt;";
-            break;
-        case '>':
-            out += "&gt;";
-            break;
-        case '"':
-            out += "&quot;";
-            break;
-        case '\'':
-            out += "&#39;";
-            break;
-        default:
-            out += c;
-        }
-    }
-    return out;
-}
-
-const char* pageCheckScript() {
-    return kPageCheckScript;
-}
-
-std::string normalisedSelectValue(const json& value) {
-    auto number = [](double x) {
-        char buffer[64];
-        if (x == std::floor(x) && std::fabs(x) < 1e15) {
-            std::snprintf(buffer, sizeof buffer, "%.0f", x);
-            return std::string(buffer);
-        }
-        const auto result = std::to_chars(buffer, buffer + sizeof buffer, x);
-        return std::string(buffer, result.ptr);
-    };
-    if (value.is_null())
-        return "";
-    if (value.is_boolean())
-        return value.get<bool>() ? "true" : "false";
-    if (value.is_number())
-        return number(value.get<double>());
-    if (value.is_string()) {
-        const std::string text = value.get<std::string>();
-        double x = 0.0;
-        const char* end = text.data() + text.size();
-        const auto result = std::from_chars(text.data(), end, x);
-        if (!text.empty() && result.ec == std::errc() && result.ptr == end && std::isfinite(x))
-            return number(x);
-        return text;
-    }
-    return value.dump();
-}
-
-bool jobMatchesSelect(const json& job, const json& select) {
-    if (select.is_null())
-        return true;
-    for (const auto& [key, wanted] : select.items()) {
-        const auto it = job.find(key);
-        if (it == job.end() || normalisedSelectValue(*it) != normalisedSelectValue(wanted))
-            return false;
-    }
-    return true;
-}
-
-std::optional<double> jobMetric(const json& job, const json& metric) {
-    const std::vector<json> names =
-        metric.is_array() ? metric.get<std::vector<json>>() : std::vector<json>{metric};
-    double sum = 0.0;
-    for (const json& name : names) {
-        if (!name.is_string())
-            return std::nullopt;
-        const auto it = job.find(name.get<std::string>());
-        if (it == job.end() || !it->is_number())
-            return std::nullopt;
-        const double value = it->get<double>();
-        if (!std::isfinite(value))
-            return std::nullopt;
-        sum += value;
-    }
-    return sum;
-}
-
-std::optional<double> median(std::vector<double> values) {
-    if (values.empty())
-        return std::nullopt;
-    std::sort(values.begin(), values.end());
-    const size_t middle = values.size() / 2;
-    return values.size() % 2 ? values[middle] : 0.5 * (values[middle - 1] + values[middle]);
-}
-
-std::vector<std::string> reportErrorMetrics() {
-    return {"relative_rmse", "rmse", "flip", "psnr", "max_abs", "relative_mean", "p99_abs"};
-}
-
-bool isMethodColumn(const std::string& column) {
-    for (const char* method : kMethodColumns)
-        if (column == method)
-            return true;
-    return false;
-}
-
-std::vector<std::string> axisColumnsOf(const json& results) {
-    std::vector<std::string> axes;
-    if (results.contains("axis_columns") && results["axis_columns"].is_array()) {
-        for (const json& column : results["axis_columns"])
-            if (column.is_string())
-                axes.push_back(column.get<std::string>());
-        return axes;
-    }
-    for (const std::string& column : resultColumns(results)) {
-        const bool known = std::any_of(std::begin(kKnownAxisColumns), std::end(kKnownAxisColumns),
-                                       [&](const char* name) { return column == name; }) ||
-                           column.rfind("scene-option.", 0) == 0;
-        if (known)
-            axes.push_back(column);
-    }
-    return axes;
-}
-
-std::vector<JobGroup> comparableGroups(const json& jobs, const std::vector<std::string>& axes) {
-    std::vector<std::string> grouping;
-    for (const std::string& column : axes)
-        if (!isMethodColumn(column) && column != "resolution")
-            grouping.push_back(column);
-    // Which grouping columns vary: those are named in every label, with the always-named ones.
-    std::vector<std::string> varying;
-    for (const std::string& column : grouping) {
-        std::set<std::string> values;
-        for (const json& job : jobs)
-            values.insert(normalisedSelectValue(job.value(column, json())));
-        if (values.size() > 1)
-            varying.push_back(column);
-    }
-    std::vector<JobGroup> groups;
-    std::map<std::string, size_t> byKey;
-    for (size_t j = 0; j < jobs.size(); ++j) {
-        const json& job = jobs[j];
-        std::string key;
-        for (const std::string& column : grouping)
-            key += column + "=" + normalisedSelectValue(job.value(column, json())) + "\n";
-        auto [it, inserted] = byKey.emplace(key, groups.size());
-        if (inserted) {
-            JobGroup group;
-            group.id = "g" + std::to_string(groups.size() + 1);
-            group.fixed = nlohmann::ordered_json::object();
-            std::string label;
-            auto add = [&](const std::string& part) {
-                label += (label.empty() ? "" : ", ") + part;
-            };
-            auto text = [&](const char* column) {
-                return normalisedSelectValue(job.value(column, json()));
-            };
-            for (const std::string& column : grouping) {
-                group.fixed[column] = job.value(column, json());
-                const bool named =
-                    std::find(varying.begin(), varying.end(), column) != varying.end();
-                if (job.value(column, json()).is_null())
-                    continue;
-                if (column == "scene")
-                    add(text("scene"));
-                else if (column == "lights")
-                    add(text("lights") + " lights");
-                else if (column == "width")
-                    add(text("width") + "x" + text("height"));
-                else if (column == "threads")
-                    add(text("threads") + " threads");
-                else if (named && column != "height")
-                    add(column + " " + normalisedSelectValue(job.value(column, json())));
-            }
-            group.label = label.empty() ? "all jobs" : label;
-            groups.push_back(std::move(group));
-        }
-        groups[it->second].jobs.push_back(j);
-    }
-    return groups;
-}
-
-json aggregateOverViews(const json& jobs, const std::vector<JobGroup>& groups,
-                        const std::vector<std::string>& axes, const std::string& errorMetric) {
-    std::vector<std::string> metrics = {"time_total_median_ms", errorMetric};
-    if (errorMetric != metric::kFlip)
-        metrics.push_back(metric::kFlip);
-    json result = {{"aggregated_over", "view"},
-                   {"statistic", "median, min and max over the views"},
-                   {"metrics", metrics},
-                   {"families", json::array()}};
-    if (std::find(axes.begin(), axes.end(), "view") == axes.end())
-        return result;
-    // Families: the comparable groups of the same jobs without the view as a grouping column.
-    std::vector<std::string> withoutView;
-    for (const std::string& column : axes)
-        if (column != "view")
-            withoutView.push_back(column);
-    std::vector<std::string> groupOf(jobs.size());
-    for (const JobGroup& group : groups)
-        for (size_t j : group.jobs)
-            groupOf[j] = group.id;
-    std::vector<std::string> methodColumns;
-    for (const std::string& column : axes)
-        if (isMethodColumn(column))
-            methodColumns.push_back(column);
-    int familyNumber = 0;
-    for (const JobGroup& family : comparableGroups(jobs, withoutView)) {
-        std::vector<std::string> views, familyGroups;
-        for (size_t j : family.jobs) {
-            const std::string view = normalisedSelectValue(jobs[j].value("view", json()));
-            if (std::find(views.begin(), views.end(), view) == views.end())
-                views.push_back(view);
-            if (std::find(familyGroups.begin(), familyGroups.end(), groupOf[j]) ==
-                familyGroups.end())
-                familyGroups.push_back(groupOf[j]);
-        }
-        if (views.size() < 2)
-            continue; // one view: nothing to aggregate, the group says it all
-        // Methods in order of first appearance; the label names the method columns that vary
-        // in the family (stage always).
-        std::vector<std::string> varying;
-        for (const std::string& column : methodColumns) {
-            std::set<std::string> values;
-            for (size_t j : family.jobs)
-                values.insert(normalisedSelectValue(jobs[j].value(column, json())));
-            if (column == "stage" || values.size() > 1)
-                varying.push_back(column);
-        }
-        std::vector<std::string> methodKeys;
-        std::map<std::string, json> methods;
-        for (size_t j : family.jobs) {
-            const json& job = jobs[j];
-            std::string key, label;
-            json settings = json::object();
-            for (const std::string& column : methodColumns) {
-                key += column + "=" + normalisedSelectValue(job.value(column, json())) + "\n";
-                settings[column] = job.value(column, json());
-            }
-            for (const std::string& column : varying)
-                label += (label.empty() ? "" : ", ") + (column == "stage" ? "" : column + " ") +
-                         normalisedSelectValue(job.value(column, json()));
-            if (!methods.count(key)) {
-                methodKeys.push_back(key);
-                methods[key] = {{"label", label},
-                                {"settings", settings},
-                                {"views_ok", 0},
-                                {"views_failed", 0},
-                                {"rows", json::array()}};
-            }
-            json& method = methods[key];
-            json row = {{"view", job.value("view", json())},
-                        {"job_id", job.value("job_id", json())},
-                        {"group", groupOf[j]},
-                        {"status", job.value("status", json())}};
-            for (const std::string& m : metrics) {
-                const std::optional<double> value = jobMetric(job, json(m));
-                row[m] = value && jobOk(job) ? json(*value) : json();
-            }
-            method[jobOk(job) ? "views_ok" : "views_failed"] =
-                method[jobOk(job) ? "views_ok" : "views_failed"].get<int>() + 1;
-            method["rows"].push_back(row);
-        }
-        json familyJson = {{"id", "v" + std::to_string(++familyNumber)},
-                           {"label", family.label},
-                           {"fixed", family.fixed},
-                           {"views", views},
-                           {"groups", familyGroups},
-                           {"methods", json::array()}};
-        for (const std::string& key : methodKeys) {
-            json method = methods[key];
-            for (const std::string& m : metrics) {
-                std::vector<double> values;
-                for (const json& row : method["rows"])
-                    if (row[m].is_number())
-                        values.push_back(row[m].get<double>());
-                if (values.empty()) {
-                    method[m] = nullptr;
-                    continue;
-                }
-                method[m] = {{"median", *median(values)},
-                             {"min", *std::min_element(values.begin(), values.end())},
-                             {"max", *std::max_element(values.begin(), values.end())},
-                             {"count", values.size()}};
-            }
-            familyJson["methods"].push_back(method);
-        }
-        result["families"].push_back(familyJson);
-    }
-    return result;
-}
-
-json comparePublished(const json& published, const json& jobs,
-                      const std::vector<std::string>& axisColumns) {
-    const std::string title = published.is_object() ? stringField(published, "title") : "";
-    auto fail = [&](const std::string& what) -> std::runtime_error {
-        return std::runtime_error("published entry '" + title + "': " + what);
-    };
-    if (!published.is_object())
-        throw fail("expected an object");
-    const json metric = published.value("metric", json());
-    if (!(metric.is_string() ||
-          (metric.is_array() && !metric.empty() &&
-           std::all_of(metric.begin(), metric.end(), [](const json& m) { return m.is_string(); }))))
-        throw fail("\"metric\" must be a column name or a non-empty list of column names");
-    const json columns = published.value("columns", json());
-    const json rows = published.value("rows", json());
-    if (!columns.is_array() || columns.empty())
-        throw fail("\"columns\" must be a non-empty list");
-    if (!rows.is_array())
-        throw fail("\"rows\" must be a list");
-    const json ratioToValue = published.value("ratio_to", json(0));
-    if (!ratioToValue.is_number_integer() || ratioToValue.get<long>() < 0 ||
-        ratioToValue.get<size_t>() >= columns.size())
-        throw fail("\"ratio_to\" must be a column index from 0 to " +
-                   std::to_string(columns.size() - 1));
-    const size_t ratioTo = ratioToValue.get<size_t>();
-    // The column of a cost model whose ratios predict the metric's (the reproductions name
-    // simt_lane_slots, what a SIMT GPU would pay): shown beside published and measured.
-    const json modelled = published.value("modelled", json());
-    if (!modelled.is_null() && !modelled.is_string())
-        throw fail("\"modelled\" must be a column name");
-
-    json table = {{"title", title},
-                  {"source", stringField(published, "source")},
-                  {"metric", metric},
-                  {"metric_label", metricLabel(metric)},
-                  {"finding", stringField(published, "finding")},
-                  {"ratio_to", ratioTo},
-                  {"modelled", modelled},
-                  {"columns", json::array()},
-                  {"rows", json::array()}};
-    for (size_t c = 0; c < columns.size(); ++c) {
-        if (!columns[c].is_object())
-            throw fail("columns[" + std::to_string(c) + "] must be an object");
-        table["columns"].push_back(columns[c].value("label", "column " + std::to_string(c)));
-    }
-    for (size_t r = 0; r < rows.size(); ++r) {
-        const json& row = rows[r];
-        const std::string where = "rows[" + std::to_string(r) + "]";
-        if (!row.is_object())
-            throw fail(where + " must be an object");
-        const json values = row.value("values", json::array());
-        if (!values.is_array() || values.size() != columns.size())
-            throw fail(where + ".values must have one entry per column (" +
-                       std::to_string(columns.size()) + ")");
-        std::vector<std::optional<double>> publishedValues, measuredValues, modelledValues;
-        std::vector<int> matchCounts;
-        std::vector<json> differIn;
-        for (size_t c = 0; c < columns.size(); ++c) {
-            if (!values[c].is_null() && !values[c].is_number())
-                throw fail(where + ".values[" + std::to_string(c) + "] must be a number or null");
-            publishedValues.push_back(values[c].is_null() ? std::nullopt
-                                                          : std::optional(values[c].get<double>()));
-            std::vector<double> measured, model;
-            int matched = 0;
-            std::map<std::string, std::set<std::string>> values; // per axis column
-            for (const json& job : jobs) {
-                if (!jobOk(job) || !jobMatchesSelect(job, row.value("select", json::object())) ||
-                    !jobMatchesSelect(job, columns[c].value("select", json::object())))
-                    continue;
-                ++matched;
-                if (const auto value = jobMetric(job, metric))
-                    measured.push_back(*value);
-                if (!modelled.is_null())
-                    if (const auto value = jobMetric(job, modelled))
-                        model.push_back(*value);
-                for (const std::string& column : axisColumns)
-                    values[column].insert(normalisedSelectValue(job.value(column, json())));
-            }
-            measuredValues.push_back(median(measured));
-            modelledValues.push_back(median(model));
-            matchCounts.push_back(matched);
-            json differ = json::array();
-            for (const std::string& column : axisColumns)
-                if (values[column].size() > 1)
-                    differ.push_back(column);
-            differIn.push_back(differ);
-        }
-        auto ratio = [&](const std::vector<std::optional<double>>& v, size_t c) -> json {
-            if (!v[c] || !v[ratioTo] || *v[ratioTo] == 0.0)
-                return json();
-            return *v[c] / *v[ratioTo];
-        };
-        auto toJson = [](const std::optional<double>& v) { return v ? json(*v) : json(); };
-        json cells = json::array();
-        for (size_t c = 0; c < columns.size(); ++c)
-            cells.push_back({{"published", toJson(publishedValues[c])},
-                             {"measured", toJson(measuredValues[c])},
-                             {"published_ratio", ratio(publishedValues, c)},
-                             {"measured_ratio", ratio(measuredValues, c)},
-                             {"modelled", toJson(modelledValues[c])},
-                             {"modelled_ratio", ratio(modelledValues, c)},
-                             {"matched_jobs", matchCounts[c]},
-                             {"differ_in", differIn[c]}});
-        table["rows"].push_back(
-            {{"label", row.value("label", "row " + std::to_string(r))}, {"cells", cells}});
-    }
-    return table;
-}
-
-std::string displayNumber(double value, int significantDigits, bool wholeIntegers) {
-    if (std::isnan(value))
-        return "NaN";
-    if (std::isinf(value))
-        return value > 0 ? "inf" : "-inf";
-    char buffer[64];
-    if (wholeIntegers && value == std::floor(value) && std::fabs(value) < 1e15)
-        std::snprintf(buffer, sizeof buffer, "%.0f", value);
-    else
-        std::snprintf(buffer, sizeof buffer, "%.*g", significantDigits, value);
-    return buffer;
-}
-
 fs::path defaultPlotsScript() {
     return plotScriptPath("report.py");
 }
@@ -1033,9 +411,9 @@ RenderOutputScales mapScales(const json& sweep, const ReportCommandOptions& opti
 std::string aggregateCell(const json& aggregate) {
     if (!aggregate.is_object())
         return "&mdash;";
-    return formatNumber(aggregate["median"].get<double>()) + " (" +
-           formatNumber(aggregate["min"].get<double>()) + "&ndash;" +
-           formatNumber(aggregate["max"].get<double>()) + ")";
+    return formatTableNumber(aggregate["median"].get<double>()) + " (" +
+           formatTableNumber(aggregate["min"].get<double>()) + "&ndash;" +
+           formatTableNumber(aggregate["max"].get<double>()) + ")";
 }
 
 // The "Across views" section: per view family, the aggregate per method, then the per-view rows
@@ -1259,7 +637,7 @@ int runReportCommand(const ReportCommandOptions& options) {
         std::ostringstream html;
         html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>"
              << htmlEscape(title) << "</title>\n"
-             << kPageCheckScript << kStyle << "</head>\n<body>\n";
+             << pageCheckScript() << reportStyle() << "</head>\n<body>\n";
         html << "<h1>" << htmlEscape(title) << "</h1>\n<p>";
         const std::string sweepFile = stringField(results, "sweep_file");
         if (!sweepFile.empty())

@@ -60,8 +60,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/ImageOutput.h"
-#include "experiments/PlotScript.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/output/PlotScript.h"
+#include "experiments/output/ReportHtml.h"
+#include "experiments/report/PublishedFigures.h"
+#include "experiments/sweep/ResultGroups.h"
 
 namespace experiments {
 
@@ -75,91 +78,11 @@ struct ReportCommandOptions {
     std::optional<MapScale> errorScale;        // the error maps' scale; default: the sweep's
 };
 
-// The error columns --error-metric accepts; psnr is the one where higher is better.
-std::vector<std::string> reportErrorMetrics();
-
-// Settings that name a method (what a group compares); every other setting makes the group.
-bool isMethodColumn(const std::string& column);
-
-// The axis columns of a results object: its "axis_columns", else (older or hand-made results)
-// the columns that are neither metrics nor job_id/status/error.
-std::vector<std::string> axisColumnsOf(const nlohmann::json& results);
-
-struct JobGroup {
-    std::string id;               // "g1", "g2", ... in the order of the jobs' first appearance
-    std::string label;            // e.g. "atrium, 256 lights, 320x180, 2 threads"
-    nlohmann::ordered_json fixed; // {column: value} of every grouping column, in axis order
-    std::vector<size_t> jobs;     // indices into the jobs array, in order
-};
-
-// The comparable groups of jobs (every job, failed ones included): equal normalised values of
-// every axis column that is not a method column nor "resolution" (width and height carry it).
-std::vector<JobGroup> comparableGroups(const nlohmann::json& jobs,
-                                       const std::vector<std::string>& axisColumns);
-
-// The aggregates over views (see Views above) as JSON, empty "families" when no family has two
-// views or more:
-//   { "aggregated_over": "view", "statistic": "median, min and max over the views",
-//     "metrics": ["time_total_median_ms", ERROR_METRIC, "flip"],
-//     "families": [ { "id": "v1", "label", "fixed": {column: value but view},
-//                     "views": [names in order of appearance], "groups": [group ids],
-//                     "methods": [ { "label", "settings": {method column: value},
-//                                    "views_ok": n, "views_failed": n,
-//                                    METRIC: {"median", "min", "max", "count"} (null: no view
-//                                            has the figure),
-//                                    "rows": [ {"view", "job_id", "group", "status",
-//                                               METRIC: value} ] } ] } ] }
-// The duplicate metric when errorMetric is flip is listed once.
-nlohmann::json aggregateOverViews(const nlohmann::json& jobs, const std::vector<JobGroup>& groups,
-                                  const std::vector<std::string>& axisColumns,
-                                  const std::string& errorMetric);
-
-// The text a value is compared as when matching "select" entries: numbers (and strings that
-// parse completely as numbers) in their shortest round-trip form with integers printed without
-// a fraction ("1500", "0.25"), booleans as "true"/"false", other strings unchanged, null as "".
-std::string normalisedSelectValue(const nlohmann::json& value);
-
-// True when job[key] equals every select[key] after normalisation (a key missing from the job
-// never matches).
-bool jobMatchesSelect(const nlohmann::json& job, const nlohmann::json& select);
-
-// The metric of one job: a column name or a list of column names (summed). nullopt when the job
-// lacks one of them, or one of them is null or not a finite number.
-std::optional<double> jobMetric(const nlohmann::json& job, const nlohmann::json& metric);
-
-// The median of values (mean of the two middle ones for an even count); nullopt when empty.
-std::optional<double> median(std::vector<double> values);
-
-// One published entry compared with the jobs: a JSON object
-//   { "title", "source", "metric" (as given), "metric_label", "finding", "ratio_to",
-//     "modelled" (the cost model's column, e.g. simt_lane_slots, or null), "columns": [labels...],
-//     "rows": [ { "label", "cells": [ { "published", "measured", "published_ratio",
-//                                       "measured_ratio", "modelled", "modelled_ratio",
-//                                       "matched_jobs", "differ_in" } ] } ] }
-// where differ_in lists the columns of `axisColumns` whose values differ among the matched jobs
-// (what the median is taken over; empty when they agree or only one matched).
-// with null for anything unknown (not published, no matching job, baseline missing or zero).
-// Throws std::runtime_error naming the entry and the field when the entry is malformed (no
-// columns, a row whose values do not have one entry per column, ratio_to out of range, ...).
-nlohmann::json comparePublished(const nlohmann::json& published, const nlohmann::json& jobs,
-                                const std::vector<std::string>& axisColumns = {});
-
 // Writes DIR/report.html and DIR/report/; returns the exit code (0 on success). Prints the
 // path of the page on stdout; errors go to stderr as "testbed: error: ...".
 int runReportCommand(const ReportCommandOptions& options);
 
 // The default plot script (the source tree's experiments/plots/report.py, fixed at build time).
 std::filesystem::path defaultPlotsScript();
-
-// A number as the report and diff pages show it: `significantDigits` (%g), integers whole when
-// wholeIntegers (below 1e15), "NaN", "inf", "-inf".
-std::string displayNumber(double value, int significantDigits, bool wholeIntegers = false);
-
-// HTML pieces shared by the report and the diff pages.
-std::string htmlEscape(const std::string& text);
-// An inline <script> for <head> that, once the page has loaded, writes "PAGE-CHECK: OK (N images)"
-// or "PAGE-CHECK: FAILED" plus one line per script error or image that failed to load into the
-// element with id "page-check" (which the page must contain).
-const char* pageCheckScript();
 
 } // namespace experiments

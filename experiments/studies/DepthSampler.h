@@ -9,8 +9,8 @@
 #include <glm/glm.hpp>
 
 #include "experiments/studies/DepthStudy.h"
-#include "gbuffer/CameraView.h"
-#include "gbuffer/DepthFormat.h"
+#include "gbuffer/codecs/DepthFormat.h"
+#include "gbuffer/visibility/CameraView.h"
 
 namespace experiments {
 

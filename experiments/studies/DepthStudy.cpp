@@ -8,13 +8,13 @@
 
 #include <tbb/parallel_for.h>
 
-#include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
-#include "experiments/CsvTable.h"
-#include "experiments/PlotScript.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/output/PlotScript.h"
 #include "experiments/studies/DepthSampler.h"
 #include "experiments/studies/DepthStudyOutputs.h"
 #include "experiments/studies/StudyPlots.h"
+#include "experiments/sweep/CsvTable.h"
 
 namespace experiments {
 

@@ -1,8 +1,8 @@
 // DepthStudy: `testbed depth --out DIR [--quick]`, the depth-format and position-reconstruction
-// study of issue #4. For every depth format (gbuffer/DepthFormat.h, finite and infinite far plane)
-// x reconstruction method (inverse projection, view ray) x camera (near/far planes), it measures
-// the view-space position the G-buffer gives back against the exact position, as a function of
-// distance, and the depth step (metres between neighbouring codes) of each format.
+// study of issue #4. For every depth format (gbuffer/codecs/DepthFormat.h, finite and infinite far
+// plane) x reconstruction method (inverse projection, view ray) x camera (near/far planes), it
+// measures the view-space position the G-buffer gives back against the exact position, as a
+// function of distance, and the depth step (metres between neighbouring codes) of each format.
 //
 // The model of one sample, as the G-buffer pass does it (gbuffer/GBufferPass.cpp, raster/):
 //   1. the exact view-space point p (double) at view depth d on the ray through a pixel centre of
@@ -51,7 +51,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
-#include "gbuffer/DepthFormat.h"
+#include "gbuffer/codecs/DepthFormat.h"
 
 namespace experiments {
 
@@ -135,7 +135,7 @@ struct DepthCommandOptions {
     bool quick = false;
     // Empty = experiments/plots/depth.py of the source tree this binary was built from.
     std::filesystem::path plotsScript;
-    // Empty = found by findPythonWithMatplotlib (experiments/PlotScript.h).
+    // Empty = found by findPythonWithMatplotlib (experiments/output/PlotScript.h).
     std::string python;
 };
 

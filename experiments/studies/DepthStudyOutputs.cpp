@@ -6,7 +6,7 @@
 #include <sstream>
 #include <thread>
 
-#include "experiments/CsvTable.h"
+#include "experiments/sweep/CsvTable.h"
 
 namespace experiments {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "gbuffer/NormalCodec.h"
+#include "gbuffer/codecs/NormalCodec.h"
 
 namespace experiments {
 

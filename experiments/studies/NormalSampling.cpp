@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "gbuffer/NormalCodec.h"
+#include "gbuffer/codecs/NormalCodec.h"
 #include "lighting/PreparedScene.h"
 #include "scenes/SceneLoader.h"
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "experiments/studies/NormalSampling.h"
-#include "gbuffer/NormalCodec.h"
+#include "gbuffer/codecs/NormalCodec.h"
 
 namespace experiments::normal_study {
 

@@ -13,14 +13,14 @@
 
 #include <tbb/task_arena.h>
 
-#include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
-#include "experiments/PlotScript.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/output/PlotScript.h"
 #include "experiments/studies/NormalSampling.h"
 #include "experiments/studies/NormalStatistics.h"
 #include "experiments/studies/NormalStudyOutputs.h"
 #include "experiments/studies/StudyPlots.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace experiments {
 

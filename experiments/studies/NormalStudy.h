@@ -1,5 +1,6 @@
 // NormalStudy: `testbed normals`, the precision study of the G-buffer normal encodings
-// (gbuffer/NormalCodec.h). For every codec x supported bit count it measures the angular error on
+// (gbuffer/codecs/NormalCodec.h). For every codec x supported bit count it measures the angular
+// error on
 //   sphere        N directions uniform on the sphere (Archimedes: z and azimuth uniform);
 //   visible-60    N normals as a pinhole camera sees them: a uniformly random pixel of a 16:9
 //                 image with a 60 degree vertical field of view, and a surface orientation facing
@@ -59,7 +60,7 @@ struct NormalStudyOptions {
     bool quick = false;      // small sizes for tests, see above
     bool plots = true;       // run the matplotlib script
     std::string plotsScript; // "" = <source dir>/experiments/plots/normals.py
-    std::string python;      // "" = found by findPythonWithMatplotlib (experiments/PlotScript.h)
+    std::string python; // "" = found by findPythonWithMatplotlib (experiments/output/PlotScript.h)
 };
 
 // One hard input: a normal, the view ray it is seen along (pixel-view reads it) and its group.

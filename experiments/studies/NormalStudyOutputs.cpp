@@ -8,8 +8,8 @@
 #include <thread>
 #include <utility>
 
-#include "experiments/AtomicFile.h"
-#include "experiments/CsvTable.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/sweep/CsvTable.h"
 
 namespace experiments::normal_study {
 

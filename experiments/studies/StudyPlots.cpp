@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "experiments/PlotScript.h"
+#include "experiments/output/PlotScript.h"
 
 namespace experiments {
 

@@ -1,4 +1,4 @@
-#include "experiments/CsvTable.h"
+#include "experiments/sweep/CsvTable.h"
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "experiments/JobProcess.h"
+#include "experiments/sweep/JobProcess.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -21,8 +21,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "experiments/SanitizerBuild.h"
-#include "experiments/SweepJobRun.h"
+#include "experiments/sweep/SanitizerBuild.h"
+#include "experiments/sweep/SweepJobRun.h"
 
 extern char** environ;
 

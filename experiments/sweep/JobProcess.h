@@ -44,7 +44,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/SweepFile.h"
+#include "experiments/sweep/SweepFile.h"
 
 namespace experiments {
 

@@ -1,4 +1,4 @@
-#include "experiments/ResultsTable.h"
+#include "experiments/sweep/ResultsTable.h"
 
 #include <algorithm>
 #include <fstream>
@@ -7,13 +7,13 @@
 #include <sstream>
 #include <system_error>
 
-#include "experiments/AtomicFile.h"
-#include "experiments/CsvTable.h"
-#include "experiments/RunMetrics.h"
-#include "experiments/SweepFile.h"
-#include "lighting/PassNames.h"
-#include "scenes/Limits.h"
-#include "scenes/NestingDepth.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/render/RunMetrics.h"
+#include "experiments/sweep/CsvTable.h"
+#include "experiments/sweep/SweepFile.h"
+#include "lighting/passes/PassNames.h"
+#include "scenes/input/Limits.h"
+#include "scenes/input/NestingDepth.h"
 
 namespace experiments {
 

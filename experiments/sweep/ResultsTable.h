@@ -6,10 +6,10 @@
 //                 quoted when they hold a comma, quote, line break or outer space (RFC 4180)
 // Columns: job_id, status ("ok" | "failed"), error, the axis columns (SweepFile's axisColumns),
 // then the metric columns: time_<pass>_{median,min,max}_ms for every pass any row has (passes in
-// pipeline order, lighting/PassNames.h: gbuffer, exact_surface, transform, prepass, cull, assign,
-// index, shading, lighting, material, then stage, others by name, total last; "stage" is the sum
-// of the stage's own passes, i.e. total without the G-buffer pass), then RunMetrics' figures
-// (runFigureColumns): light_evaluations, oracle_light_evaluations, culling_efficiency,
+// pipeline order, lighting/passes/PassNames.h: gbuffer, exact_surface, transform, prepass, cull,
+// assign, index, shading, lighting, material, then stage, others by name, total last; "stage" is
+// the sum of the stage's own passes, i.e. total without the G-buffer pass), then RunMetrics'
+// figures (runFigureColumns): light_evaluations, oracle_light_evaluations, culling_efficiency,
 // bytes_per_pixel, rmse, relative_rmse, psnr, max_abs, relative_mean, p99_abs. A missing value
 // is null (JSON) / empty (CSV); psnr is null when rmse is 0.
 //

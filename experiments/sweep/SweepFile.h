@@ -17,6 +17,8 @@
 // scene-option.KEY: whatever renderOptionKeys() lists) plus warmup and repetitions. Values are
 // strings or numbers and reach setRenderOption as text, so this file knows no stage, encoding or
 // scene: anything registered later works unchanged.
+// Reading and checking a file is SweepFile.cpp; expanding a spec into jobs, their ids and shards is
+// SweepExpansion.cpp.
 //
 // Jobs: the full expansion (cases x axes) numbers jobs 0..n-1 in that order; a job's id is its
 // zero-padded ordinal and a hash of every setting that makes it ("0007-1a2b3c4d"), identical in
@@ -45,6 +47,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -52,8 +55,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/ImageOutput.h"
-#include "experiments/RenderOptions.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/render/RenderOptions.h"
 
 namespace experiments {
 
@@ -234,5 +237,21 @@ std::string settingText(const nlohmann::ordered_json& value, const std::string& 
 
 // "key=value key=value" for progress lines and messages.
 std::string describeSettings(const std::vector<SweepSetting>& settings);
+
+// Upper bound of warmup and repetitions: a typo must not keep a sweep running for days.
+inline constexpr int kMaxRunCount = 1000;
+
+// Throws SweepError("ORIGIN: MESSAGE").
+[[noreturn]] void failSweep(const std::string& origin, const std::string& message);
+
+// view = "all" cannot sit beside named views in one axis (the named ones would run twice).
+// Throws SweepError naming the axis.
+void checkEveryViewAlone(const SweepSpec& spec);
+
+// Every key the spec sets, in fixed, axes or cases.
+std::set<std::string> settingKeys(const SweepSpec& spec);
+
+// True for the setting view = "all" (every view of the job's scene).
+bool isEveryView(const SweepSetting& setting);
 
 } // namespace experiments

@@ -1,12 +1,12 @@
-#include "experiments/SweepJobRun.h"
+#include "experiments/sweep/SweepJobRun.h"
 
 #include <cmath>
 
 #include <OpenImageIO/imagebuf.h>
 
-#include "experiments/ImageOutput.h"
-#include "experiments/RenderCommand.h"
-#include "experiments/RenderJob.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/render/RenderCommand.h"
+#include "experiments/render/RenderJob.h"
 
 namespace experiments {
 

@@ -20,8 +20,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/RunMetrics.h"
-#include "experiments/SweepFile.h"
+#include "experiments/render/RunMetrics.h"
+#include "experiments/sweep/SweepFile.h"
 #include "lighting/ShadingStage.h"
 
 namespace experiments {

@@ -1,4 +1,4 @@
-#include "experiments/SweepLock.h"
+#include "experiments/sweep/SweepLock.h"
 
 #include <cerrno>
 #include <cstring>

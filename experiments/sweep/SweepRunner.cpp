@@ -1,4 +1,4 @@
-#include "experiments/SweepRunner.h"
+#include "experiments/sweep/SweepRunner.h"
 
 #include <chrono>
 #include <ctime>
@@ -8,14 +8,14 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "experiments/AtomicFile.h"
 #include "experiments/CommandErrors.h"
-#include "experiments/JobProcess.h"
-#include "experiments/Progress.h"
-#include "experiments/ResultsTable.h"
-#include "experiments/SweepFile.h"
-#include "experiments/SweepJobRun.h"
-#include "experiments/SweepLock.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/output/Progress.h"
+#include "experiments/sweep/JobProcess.h"
+#include "experiments/sweep/ResultsTable.h"
+#include "experiments/sweep/SweepFile.h"
+#include "experiments/sweep/SweepJobRun.h"
+#include "experiments/sweep/SweepLock.h"
 
 namespace experiments {
 

@@ -1,7 +1,7 @@
 // DepthFormat implementation. Mappings are evaluated in double and rounded once, so that a
 // format's error is its quantisation, not the arithmetic around it. IEEE half comes from Imath
 // (OpenEXR's half type), not hand-written bit twiddling.
-#include "gbuffer/DepthFormat.h"
+#include "gbuffer/codecs/DepthFormat.h"
 
 #include <algorithm>
 #include <bit>

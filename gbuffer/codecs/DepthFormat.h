@@ -26,7 +26,7 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/CameraView.h"
+#include "gbuffer/visibility/CameraView.h"
 
 namespace gbuffer {
 

@@ -3,7 +3,7 @@
 // the decoded direction; the quantisation error then dominates even at 16 bits per component.
 // Singular points of each map (poles, -Z, folds) are handled with atan2/tan forms and explicit
 // clamps instead of the shader formulas of the papers, which divide by zero there.
-#include "gbuffer/NormalCodec.h"
+#include "gbuffer/codecs/NormalCodec.h"
 
 #include <algorithm>
 #include <bit>
@@ -14,7 +14,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "scenes/ClosestName.h"
+#include "scenes/input/ClosestName.h"
 
 namespace gbuffer {
 

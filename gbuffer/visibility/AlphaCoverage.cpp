@@ -1,6 +1,6 @@
-#include "gbuffer/AlphaCoverage.h"
+#include "gbuffer/visibility/AlphaCoverage.h"
 
-#include "gbuffer/TriangleCorners.h"
+#include "gbuffer/visibility/TriangleCorners.h"
 
 namespace gbuffer {
 

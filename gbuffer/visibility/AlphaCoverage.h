@@ -6,7 +6,7 @@
 // - Opaque: kept (alpha ignored);
 // - Mask: kept when alpha >= alphaCutoff, discarded otherwise (glTF 2.0, "Alpha Coverage");
 // - Blend: always discarded from the opaque draws: blended surfaces are shaded and composited
-//   afterwards (lighting/BlendedPass.h).
+//   afterwards (lighting/passes/BlendedPass.h).
 // alpha = baseColorFactor.a * base colour texture alpha (linear) at the pixel centre, the uv found
 // with the same perspective-correct weights as the G-buffer resolve (TriangleCorners.h). The
 // loaders read no vertex colours, so there is no vertex-colour alpha.
@@ -24,8 +24,8 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/CameraView.h"
-#include "gbuffer/SceneGeometry.h"
+#include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 #include "scenes/Scene.h"
 
 namespace gbuffer {
@@ -43,7 +43,7 @@ public:
     void build(const scenes::Scene& scene);
     // True when some material is Mask or Blend: the draws then test every fragment.
     bool active() const { return mActive; }
-    // True when some material is Blend (lighting/BlendedPass.h has work).
+    // True when some material is Blend (lighting/passes/BlendedPass.h has work).
     bool anyBlend() const { return mAnyBlend; }
     Rule rule(uint32_t material) const { return mRules[material]; }
 

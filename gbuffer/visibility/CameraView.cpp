@@ -1,4 +1,4 @@
-#include "gbuffer/CameraView.h"
+#include "gbuffer/visibility/CameraView.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 

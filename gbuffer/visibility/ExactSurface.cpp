@@ -1,8 +1,8 @@
-#include "gbuffer/ExactSurface.h"
+#include "gbuffer/visibility/ExactSurface.h"
 
 #include <tbb/parallel_for.h>
 
-#include "gbuffer/NormalMapping.h"
+#include "gbuffer/visibility/NormalMapping.h"
 
 namespace gbuffer {
 

@@ -14,9 +14,9 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/CameraView.h"
-#include "gbuffer/SceneGeometry.h"
 #include "gbuffer/Surface.h"
+#include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 #include "scenes/Scene.h"
 
 namespace gbuffer {
@@ -62,9 +62,9 @@ struct ExactSurface {
     void computeGeometry(const scenes::Scene& scene, const SceneGeometry& geometry,
                          const CameraView& view);
     // The exact hit of pixel (x, y)'s view ray with triangle t (computeGeometry's per-pixel
-    // work, also what the reference's blended composite uses, lighting/BlendedPass.h): view-space
-    // position and shading normal in double, the normal negated for a back face and normal
-    // mapped. False (outputs untouched) when the ray is parallel to the triangle's plane.
+    // work, also what the reference's blended composite uses, lighting/passes/BlendedPass.h):
+    // view-space position and shading normal in double, the normal negated for a back face and
+    // normal mapped. False (outputs untouched) when the ray is parallel to the triangle's plane.
     static bool hit(const scenes::Scene& scene, const SceneGeometry& geometry,
                     const CameraView& view, uint32_t t, bool backFace, int x, int y,
                     glm::dvec3& positionView, glm::dvec3& normalView);

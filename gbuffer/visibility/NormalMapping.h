@@ -1,6 +1,6 @@
 // NormalMapping: the shading normal of a tangent-space normal map, the one formula the G-buffer
 // resolve (float, TriangleCorners.h) and the reference's exact surface (double, ExactSurface.cpp)
-// share. glTF 2.0 conventions (scenes/Material.h): the texel's rgb in [0,1] maps to
+// share. glTF 2.0 conventions (scenes/materials/Material.h): the texel's rgb in [0,1] maps to
 // m = (2 rgb - 1) * (scale, scale, 1) in the frame (T, B, N), with T the interpolated tangent made
 // orthogonal to N (Gram-Schmidt), B = w cross(N, T) pointing up the image, w = +-1 the tangent's
 // bitangent sign; the result is normalize(m.x T + m.y B + m.z N).

@@ -1,4 +1,4 @@
-#include "gbuffer/SceneGeometry.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 
 #include <stdexcept>
 

@@ -19,9 +19,9 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/NormalMapping.h"
-#include "gbuffer/SceneGeometry.h"
 #include "gbuffer/Surface.h"
+#include "gbuffer/visibility/NormalMapping.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 #include "raster/Rasterizer.h"
 #include "scenes/Scene.h"
 

@@ -1,4 +1,4 @@
-#include "gbuffer/VisibilityPass.h"
+#include "gbuffer/visibility/VisibilityPass.h"
 
 #include <algorithm>
 #include <stdexcept>

@@ -33,12 +33,12 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/AlphaCoverage.h"
-#include "gbuffer/CameraView.h"
 #include "gbuffer/Plane.h"
-#include "gbuffer/SceneGeometry.h"
 #include "gbuffer/Surface.h"
-#include "gbuffer/TriangleCorners.h"
+#include "gbuffer/visibility/AlphaCoverage.h"
+#include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/SceneGeometry.h"
+#include "gbuffer/visibility/TriangleCorners.h"
 #include "raster/Rasterizer.h"
 #include "scenes/Scene.h"
 

@@ -23,9 +23,9 @@
 #include <glm/glm.hpp>
 
 #include "gbuffer/Surface.h"
-#include "lighting/LightInView.h"
-#include "lighting/LightIncidence.h"
-#include "lighting/MetallicRoughness.h"
+#include "lighting/brdf/LightInView.h"
+#include "lighting/brdf/LightIncidence.h"
+#include "lighting/brdf/MetallicRoughness.h"
 #include "scenes/Scene.h"
 
 namespace lighting {

@@ -3,8 +3,8 @@
 // material model attenuates lights with the very same arithmetic (and culling by a light's sphere
 // or cone stays exact for all of them). Both of Brdf.h's models call it; its arithmetic is,
 // operation for operation, what Brdf.h computed inline before (the Blinn-Phong outputs did not
-// change); tests/lighting/brdf_closed_form_test.cpp checks it against closed forms. Templated on
-// the scalar type (float for the stages, double for the reference).
+// change); tests/lighting/brdf/brdf_closed_form_test.cpp checks it against closed forms. Templated
+// on the scalar type (float for the stages, double for the reference).
 //
 //     attenuation(d) = saturate(1 - (d/r)^4)^2 / (d^2 + 1)      exactly 0 at and beyond d = r
 //     spot(cos)      = smoothstep(outerCos, innerCos, cos)      exactly 0 at and outside outerCos
@@ -17,7 +17,7 @@
 
 #include <glm/glm.hpp>
 
-#include "lighting/LightInView.h"
+#include "lighting/brdf/LightInView.h"
 
 namespace lighting {
 

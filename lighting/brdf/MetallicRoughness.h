@@ -47,8 +47,8 @@
 
 #include <glm/glm.hpp>
 
-#include "lighting/LightInView.h"
-#include "lighting/LightIncidence.h"
+#include "lighting/brdf/LightInView.h"
+#include "lighting/brdf/LightIncidence.h"
 
 namespace lighting {
 

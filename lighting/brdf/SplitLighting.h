@@ -22,9 +22,9 @@
 #include <glm/glm.hpp>
 
 #include "gbuffer/Surface.h"
-#include "lighting/Brdf.h"
-#include "lighting/LightInView.h"
-#include "lighting/MetallicRoughness.h"
+#include "lighting/brdf/Brdf.h"
+#include "lighting/brdf/LightInView.h"
+#include "lighting/brdf/MetallicRoughness.h"
 
 namespace lighting {
 

@@ -15,10 +15,9 @@
 // Culling volumes. Each cluster has a view-space AABB of its 8 corners, widened by the receiver
 // slack of culling/CullingTests.h (rule 3: widenedBox) so that a reconstructed position that
 // rounding pushed just outside its cluster is still inside the box; the light spheres
-// (lighting/LightBounds.h) are widened far more. The side planes and the candidate ranges below
-// use the same kBoundSlack.
-// test=aabb tests sphere vs AABB; test=frustum additionally rejects a sphere wholly outside one
-// of the cluster's four side planes (tighter, still conservative).
+// (lighting/culling/LightBounds.h) are widened far more. The side planes and the candidate ranges
+// below use the same kBoundSlack. test=aabb tests sphere vs AABB; test=frustum additionally rejects
+// a sphere wholly outside one of the cluster's four side planes (tighter, still conservative).
 //
 // Assignment. For each bounded light the candidate column, row and slice ranges come from a
 // conservative box around the part of its sphere inside the grid's depth range; `walk` finds
@@ -40,9 +39,9 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/CameraView.h"
-#include "lighting/LightBounds.h"
+#include "gbuffer/visibility/CameraView.h"
 #include "lighting/culling/CullingTests.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/LightIndexLists.h"
 
 namespace lighting {

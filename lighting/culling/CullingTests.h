@@ -24,8 +24,8 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/CameraView.h"
-#include "lighting/LightBounds.h"
+#include "gbuffer/visibility/CameraView.h"
+#include "lighting/culling/LightBounds.h"
 
 namespace lighting {
 

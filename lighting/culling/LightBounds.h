@@ -22,7 +22,7 @@
 
 #include <glm/glm.hpp>
 
-#include "lighting/LightList.h"
+#include "lighting/culling/LightList.h"
 
 namespace lighting {
 

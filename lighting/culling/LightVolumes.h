@@ -62,8 +62,8 @@
 #include <glm/glm.hpp>
 
 #include "gbuffer/GBuffer.h"
-#include "lighting/LightBounds.h"
 #include "lighting/culling/CullingTests.h"
+#include "lighting/culling/LightBounds.h"
 #include "raster/Rasterizer.h"
 
 namespace lighting {

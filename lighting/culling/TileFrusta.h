@@ -23,10 +23,10 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/CameraView.h"
 #include "gbuffer/GBuffer.h"
-#include "lighting/LightBounds.h"
+#include "gbuffer/visibility/CameraView.h"
 #include "lighting/culling/CullingTests.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/LightIndexLists.h"
 
 namespace lighting {

@@ -1,5 +1,5 @@
 // KernelIsa: which implementation of the shading kernel runs, chosen at run time. "scalar" is the
-// per-pixel path (lighting/Brdf.h's evaluateLight lane by lane, GBuffer::decode's arithmetic
+// per-pixel path (lighting/brdf/Brdf.h's evaluateLight lane by lane, GBuffer::decode's arithmetic
 // pixel by pixel): the tests' oracle and the baseline a speed-up is measured against in the same
 // build. The vector paths are the Highway targets compiled into the binary (VectorTargets.h) that
 // this CPU supports; "auto" is the one Highway's dynamic dispatch picks, the widest (AVX3 =

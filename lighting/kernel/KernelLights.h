@@ -1,7 +1,7 @@
 // KernelLights: a frame's view-space lights as the shading kernel reads them, built once per frame
-// from the float LightInView list (lighting/Brdf.h). Each light is one 64-byte record (one cache
-// line) whose fields the vector kernel broadcasts to every lane; the parts of the formula that
-// depend only on the light (range squared, spot cone width) are computed here once instead of
+// from the float LightInView list (lighting/brdf/Brdf.h). Each light is one 64-byte record (one
+// cache line) whose fields the vector kernel broadcasts to every lane; the parts of the formula
+// that depend only on the light (range squared, spot cone width) are computed here once instead of
 // once per pixel, with the very same float operations evaluateLight performs, so the values are
 // bitwise the ones it would compute. The source list is kept for the scalar path, which calls
 // evaluateLight itself. Immutable after construction: safe to share between threads.
@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "lighting/Brdf.h"
+#include "lighting/brdf/Brdf.h"
 
 namespace lighting::kernel {
 

@@ -1,5 +1,5 @@
 // shadePacketVector: the vector light loop of the shading kernel, once per compiled instruction
-// set (included by VectorTargets.cpp through foreach_target.h). It evaluates lighting/Brdf.h's
+// set (included by VectorTargets.cpp through foreach_target.h). It evaluates lighting/brdf/Brdf.h's
 // evaluateLight (windowed inverse-square falloff, spot smoothstep, directional and ambient lights)
 // with each lane's material model, Lambert + normalised Blinn-Phong (Brdf.h) or glTF
 // metallic-roughness (MetallicRoughness.h: GGX, Smith height-correlated visibility, Schlick), for
@@ -38,7 +38,7 @@
 // 10^4 ulps; not worth losing the tight comparison.)
 
 // Ordinary headers outside the per-target region, so they are compiled for the baseline only.
-#include "lighting/MetallicRoughness.h"
+#include "lighting/brdf/MetallicRoughness.h"
 #include "lighting/kernel/VectorTargets.h"
 #include "scenes/Scene.h"
 

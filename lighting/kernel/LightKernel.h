@@ -1,6 +1,6 @@
 // shadePacket: the one shading loop of issue 14. For a packet of 4x4 pixels and a list of light
-// indices, evaluate lighting/Brdf.h's lighting model for every active lane and every light of the
-// list, in list order, and add each lane's radiance and counts into a PacketAccumulator.
+// indices, evaluate lighting/brdf/Brdf.h's lighting model for every active lane and every light of
+// the list, in list order, and add each lane's radiance and counts into a PacketAccumulator.
 //
 // Contract (both paths, every instruction set):
 // - Lanes: those set in laneMask & packet.laneMask. Other lanes of the accumulator are untouched.

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "gbuffer/DepthFormat.h"
+#include "gbuffer/codecs/DepthFormat.h"
 #include "lighting/kernel/VectorTargets.h"
 
 namespace lighting::kernel {

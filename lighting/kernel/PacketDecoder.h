@@ -31,8 +31,8 @@
 #include <string>
 #include <vector>
 
-#include "gbuffer/CameraView.h"
 #include "gbuffer/GBufferLayout.h"
+#include "gbuffer/visibility/CameraView.h"
 #include "lighting/kernel/KernelIsa.h"
 #include "lighting/kernel/ShadingPacket.h"
 

@@ -1,17 +1,17 @@
 // shadePacketScalar: the kernel's scalar path and the vector path's oracle. Each lane calls
-// lighting/Brdf.h's evaluateLight<float> for each light with the lane's material model (Blinn-Phong
-// or metallic-roughness), exactly as the per-pixel path does;
-// the packet-level early-out counters come from earlyExit, which repeats evaluateLight's three
-// rejection tests with the same float operations (so they take the same decisions), and apply the
-// vector path's rule: a light is skipped when every active lane rejects it.
-// shadePacketSplitScalar (SplitLightKernel.h) is the same loop around addSplitLight.
+// lighting/brdf/Brdf.h's evaluateLight<float> for each light with the lane's material model
+// (Blinn-Phong or metallic-roughness), exactly as the per-pixel path does; the packet-level
+// early-out counters come from earlyExit, which repeats evaluateLight's three rejection tests with
+// the same float operations (so they take the same decisions), and apply the vector path's rule: a
+// light is skipped when every active lane rejects it. shadePacketSplitScalar (SplitLightKernel.h)
+// is the same loop around addSplitLight.
 #include "lighting/kernel/LightKernel.h"
 
 #include <cmath>
 #include <optional>
 
-#include "lighting/Brdf.h"
-#include "lighting/SplitLighting.h"
+#include "lighting/brdf/Brdf.h"
+#include "lighting/brdf/SplitLighting.h"
 #include "lighting/kernel/SplitLightKernel.h"
 
 namespace lighting::kernel {

@@ -13,7 +13,7 @@
 //   like any other); the kernel computes them and selects their results away.
 // - Arrays are 64-byte aligned so a 16-lane float row is one aligned AVX-512 load.
 // - Material model per lane: bit l of metallicRoughnessMask set = lane l uses the glTF
-//   metallic-roughness model (lighting/MetallicRoughness.h): albedo is its base colour and the
+//   metallic-roughness model (lighting/brdf/MetallicRoughness.h): albedo is its base colour and the
 //   roughness, metallic and occlusion rows are read; clear = Lambert + Blinn-Phong, which reads
 //   albedo and the specular rows. The rows of the other model are ignored (any value).
 // Memory: 1024 bytes of surface per packet (16 rows of 16 floats), 320 bytes of accumulator.

@@ -3,8 +3,8 @@
 // it reuses: loadSurface, rangeChunk, coneAndFacingChunk, facingChunk, blinnPhongLobe, ggxTerms).
 //
 // Per light the three phases of LightKernel-inl.h with its early-out rule and counters; phase 3
-// adds addSplitLight's terms (lighting/SplitLighting.h) instead of one radiance, with its float
-// operations in its order:
+// adds addSplitLight's terms (lighting/brdf/SplitLighting.h) instead of one radiance, with its
+// float operations in its order:
 // - Blinn-Phong lanes: diffuse = (radiance x (att n.l)) x (1 / pi). evaluateLight with albedo 1
 //   and intensity 0 computes (radiance x (att n.l)) x (1 x (1 / pi) + 0 x lobe); 1 x (1 / pi) and
 //   the + 0 are exact (the lobe is finite: pow of n.h <= 1), so this is its value bitwise and pow
@@ -22,7 +22,7 @@
 // shadePacket does on AVX-512 (a 6% gain there): kept simple until measured worth it here.
 
 // Ordinary headers outside the per-target region, so they are compiled for the baseline only.
-#include "lighting/MetallicRoughness.h"
+#include "lighting/brdf/MetallicRoughness.h"
 #include "lighting/kernel/VectorTargets.h"
 #include "scenes/Scene.h"
 

@@ -1,6 +1,6 @@
 // shadePacketSplit: the shading kernel's second output form, for the stages that accumulate light
 // buffers (light-prepass, inferred): for a packet and a light list it sums, per lane, the split
-// lighting of lighting/SplitLighting.h (addSplitLight) instead of one radiance:
+// lighting of lighting/brdf/SplitLighting.h (addSplitLight) instead of one radiance:
 //   Blinn-Phong lanes: diffuse = the BRDF with albedo 1 and specular intensity 0, specular = the
 //     BRDF with albedo 0 and intensity 1, added only where the light's diffuse part is non-zero
 //     and the light is not ambient; specularEdge stays 0;

@@ -1,4 +1,4 @@
-#include "lighting/ContributingLights.h"
+#include "lighting/lists/ContributingLights.h"
 
 #include <tbb/parallel_for.h>
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "gbuffer/GBuffer.h"
-#include "lighting/Brdf.h"
+#include "lighting/brdf/Brdf.h"
 #include "lighting/culling/LightIndexLists.h"
 
 namespace lighting {

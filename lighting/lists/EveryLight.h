@@ -12,9 +12,9 @@
 #include <tbb/parallel_for.h>
 
 #include "gbuffer/Surface.h"
-#include "lighting/Brdf.h"
-#include "lighting/PassNames.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/brdf/Brdf.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

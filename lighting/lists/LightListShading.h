@@ -11,9 +11,9 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/Brdf.h"
 #include "lighting/ShadingStage.h"
-#include "lighting/SplitLighting.h"
+#include "lighting/brdf/Brdf.h"
+#include "lighting/brdf/SplitLighting.h"
 
 namespace lighting {
 

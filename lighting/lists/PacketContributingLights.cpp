@@ -1,4 +1,4 @@
-#include "lighting/PacketContributingLights.h"
+#include "lighting/lists/PacketContributingLights.h"
 
 #include <algorithm>
 #include <stdexcept>

@@ -18,8 +18,8 @@
 #include <span>
 #include <vector>
 
-#include "lighting/ContributingLights.h"
-#include "lighting/LightAccumulation.h"
+#include "lighting/lists/ContributingLights.h"
+#include "lighting/passes/LightAccumulation.h"
 
 namespace lighting {
 

@@ -1,15 +1,15 @@
-#include "lighting/BlendedPass.h"
+#include "lighting/passes/BlendedPass.h"
 
 #include <algorithm>
 #include <numeric>
 
 #include <tbb/parallel_for.h>
 
-#include "gbuffer/AlphaCoverage.h"
-#include "gbuffer/ExactSurface.h"
 #include "gbuffer/GBufferLayout.h"
-#include "lighting/BlendedTileLists.h"
-#include "lighting/ForwardGeometry.h"
+#include "gbuffer/visibility/AlphaCoverage.h"
+#include "gbuffer/visibility/ExactSurface.h"
+#include "lighting/culling/BlendedTileLists.h"
+#include "lighting/passes/ForwardGeometry.h"
 
 namespace lighting {
 

@@ -52,12 +52,12 @@
 #include <span>
 #include <vector>
 
-#include "gbuffer/DepthFormat.h"
-#include "gbuffer/VisibilityPass.h"
-#include "lighting/Brdf.h"
-#include "lighting/FragmentShading.h"
-#include "lighting/PassNames.h"
+#include "gbuffer/codecs/DepthFormat.h"
+#include "gbuffer/visibility/VisibilityPass.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/brdf/Brdf.h"
+#include "lighting/passes/FragmentShading.h"
+#include "lighting/passes/PassNames.h"
 #include "raster/Rasterizer.h"
 
 namespace lighting {

@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include "lighting/SplitLighting.h"
+#include "lighting/brdf/SplitLighting.h"
 
 namespace lighting {
 

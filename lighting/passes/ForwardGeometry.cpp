@@ -1,4 +1,4 @@
-#include "lighting/ForwardGeometry.h"
+#include "lighting/passes/ForwardGeometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "gbuffer/GBufferLayout.h"
-#include "lighting/BlendedPass.h"
+#include "lighting/passes/BlendedPass.h"
 
 namespace lighting {
 

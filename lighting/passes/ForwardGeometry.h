@@ -31,14 +31,14 @@
 
 #include <glm/glm.hpp>
 
-#include "gbuffer/DepthFormat.h"
 #include "gbuffer/Surface.h"
-#include "gbuffer/VisibilityPass.h"
-#include "lighting/LightBounds.h"
-#include "lighting/PassNames.h"
+#include "gbuffer/codecs/DepthFormat.h"
+#include "gbuffer/visibility/VisibilityPass.h"
 #include "lighting/ShadingStage.h"
 #include "lighting/culling/CullingTests.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/LightIndexLists.h"
+#include "lighting/passes/PassNames.h"
 #include "raster/Rasterizer.h"
 
 namespace lighting {

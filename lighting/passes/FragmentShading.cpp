@@ -1,4 +1,4 @@
-#include "lighting/FragmentShading.h"
+#include "lighting/passes/FragmentShading.h"
 
 #include <algorithm>
 #include <array>
@@ -8,11 +8,11 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/ForwardGeometry.h"
-#include "lighting/KernelWork.h"
-#include "lighting/LightAccumulation.h"
 #include "lighting/kernel/KernelLights.h"
 #include "lighting/kernel/LightKernel.h"
+#include "lighting/passes/ForwardGeometry.h"
+#include "lighting/passes/KernelWork.h"
+#include "lighting/passes/LightAccumulation.h"
 
 namespace lighting {
 

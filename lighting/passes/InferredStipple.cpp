@@ -1,4 +1,4 @@
-#include "lighting/InferredStipple.h"
+#include "lighting/passes/InferredStipple.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,10 +7,10 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/BlendedTileLists.h"
-#include "lighting/DsfFilter.h"
-#include "lighting/LightAccumulation.h"
-#include "lighting/SplitLighting.h"
+#include "lighting/brdf/SplitLighting.h"
+#include "lighting/culling/BlendedTileLists.h"
+#include "lighting/passes/DsfFilter.h"
+#include "lighting/passes/LightAccumulation.h"
 
 namespace lighting {
 

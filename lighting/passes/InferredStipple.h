@@ -46,9 +46,9 @@
 #include <vector>
 
 #include "gbuffer/Surface.h"
-#include "lighting/BlendedPass.h"
 #include "lighting/ShadingStage.h"
-#include "lighting/SplitLighting.h"
+#include "lighting/brdf/SplitLighting.h"
+#include "lighting/passes/BlendedPass.h"
 
 namespace lighting {
 

@@ -1,4 +1,4 @@
-#include "lighting/LightAccumulation.h"
+#include "lighting/passes/LightAccumulation.h"
 
 #include <algorithm>
 #include <optional>
@@ -8,12 +8,12 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/Brdf.h"
-#include "lighting/KernelWork.h"
-#include "lighting/SplitLighting.h"
+#include "lighting/brdf/Brdf.h"
+#include "lighting/brdf/SplitLighting.h"
 #include "lighting/kernel/KernelLights.h"
 #include "lighting/kernel/LightKernel.h"
 #include "lighting/kernel/PacketDecoder.h"
+#include "lighting/passes/KernelWork.h"
 
 namespace lighting {
 

@@ -28,7 +28,7 @@
 // SIMT cost model (issue 14, section 3; lighting/README.md): a warp pays one lane slot per lane
 // (all of its warpLanes, covered or not) for every light that any of its lanes evaluates, i.e.
 // warpLanes x |union of its lanes' lists|. The loop sums this into "simt_lane_slots"; the runner
-// divides the oracle's evaluations by it (simt_efficiency, experiments/RunMetrics.h).
+// divides the oracle's evaluations by it (simt_efficiency, experiments/render/RunMetrics.h).
 //
 // Determinism: warps rows in parallel (TBB), each pixel written by one task, the per-row counters
 // summed in row order after the loop: the result does not depend on the thread count.
@@ -299,7 +299,7 @@ private:
     const LightIndexLists& mTileLights;
 };
 
-// Split lighting (lighting/SplitLighting.h) for the stages that accumulate light buffers,
+// Split lighting (lighting/brdf/SplitLighting.h) for the stages that accumulate light buffers,
 // `light-prepass` and `inferred`: the one loop that lights their samples, in place of two
 // per-pixel loops around splitLighting.
 //

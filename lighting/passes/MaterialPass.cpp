@@ -1,8 +1,8 @@
-#include "lighting/MaterialPass.h"
+#include "lighting/passes/MaterialPass.h"
 
 #include <stdexcept>
 
-#include "lighting/ForwardGeometry.h"
+#include "lighting/passes/ForwardGeometry.h"
 
 namespace lighting {
 

@@ -17,7 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include "gbuffer/GBuffer.h"
-#include "gbuffer/VisibilityPass.h"
+#include "gbuffer/visibility/VisibilityPass.h"
 #include "lighting/ShadingStage.h"
 #include "raster/Rasterizer.h"
 

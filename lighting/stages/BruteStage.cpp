@@ -6,9 +6,9 @@
 
 #include <optional>
 
-#include "lighting/BlendedPass.h"
-#include "lighting/LightAccumulation.h"
-#include "lighting/PassNames.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

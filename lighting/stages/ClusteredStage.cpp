@@ -25,13 +25,13 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include "lighting/LightAccumulation.h"
-#include "lighting/LightBounds.h"
-#include "lighting/PassNames.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/ClusterGrid.h"
+#include "lighting/culling/LightBounds.h"
+#include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/PassNames.h"
 
-#include "lighting/BlendedPass.h"
+#include "lighting/passes/BlendedPass.h"
 
 namespace lighting {
 

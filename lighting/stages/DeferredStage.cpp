@@ -62,16 +62,16 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/BlendedPass.h"
-#include "lighting/KernelWork.h"
-#include "lighting/LightAccumulation.h"
-#include "lighting/LightBounds.h"
-#include "lighting/LightListShading.h"
-#include "lighting/PassNames.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/kernel/KernelLights.h"
 #include "lighting/kernel/LightKernel.h"
 #include "lighting/kernel/PacketDecoder.h"
+#include "lighting/lists/LightListShading.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/KernelWork.h"
+#include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/PassNames.h"
 #include "lighting/stages/VolumeStageOptions.h"
 
 namespace lighting {

@@ -9,7 +9,7 @@
 //
 // Why the pre-pass is mandatory: additive passes without an equal test would add the light once
 // per overdrawn fragment. The equal test is closer-or-equal plus the pre-pass's visible triangle
-// (gbuffer/VisibilityPass.h redrawState), so exact depth ties never add a light twice.
+// (gbuffer/visibility/VisibilityPass.h redrawState), so exact depth ties never add a light twice.
 //
 // Shading on the light kernel (FragmentShading.h): each light pass queues its visible fragments;
 // 16 consecutive fragments of a raster tile form a packet the kernel shades with the pass's one
@@ -26,11 +26,11 @@
 // written only by the task owning its raster tile.
 #include "lighting/StageRegistry.h"
 
-#include "lighting/BlendedPass.h"
-#include "lighting/ForwardGeometry.h"
-#include "lighting/FragmentShading.h"
-#include "lighting/LightBounds.h"
-#include "lighting/PassNames.h"
+#include "lighting/culling/LightBounds.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/ForwardGeometry.h"
+#include "lighting/passes/FragmentShading.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

@@ -7,9 +7,9 @@
 //
 // Options:
 //   prepass=0|1 (default 0): 1 draws a depth-only pre-pass first ("prepass": the visibility draw,
-//     gbuffer/VisibilityPass.h), then shades with a depth-equal test (closer-or-equal plus the
-//     pre-pass's visible triangle, VisibilityPass::redrawState), so each pixel is shaded once and
-//     overdraw disappears.
+//     gbuffer/visibility/VisibilityPass.h), then shades with a depth-equal test (closer-or-equal
+//     plus the pre-pass's visible triangle, VisibilityPass::redrawState), so each pixel is shaded
+//     once and overdraw disappears.
 //
 // Shading on the light kernel (FragmentShading.h): the draw queues each fragment with its
 // object's list; 16 consecutive fragments of a raster tile form a packet the kernel shades on
@@ -25,11 +25,11 @@
 // owning its raster tile, in submission order (FragmentShading.h).
 #include "lighting/StageRegistry.h"
 
-#include "lighting/BlendedPass.h"
-#include "lighting/ForwardGeometry.h"
-#include "lighting/FragmentShading.h"
-#include "lighting/LightBounds.h"
-#include "lighting/PassNames.h"
+#include "lighting/culling/LightBounds.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/ForwardGeometry.h"
+#include "lighting/passes/FragmentShading.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

@@ -24,10 +24,10 @@
 // accumulateLights (each pixel written by one task).
 #include "lighting/StageRegistry.h"
 
-#include "lighting/BlendedPass.h"
-#include "lighting/ContributingLights.h"
-#include "lighting/PacketContributingLights.h"
-#include "lighting/PassNames.h"
+#include "lighting/lists/ContributingLights.h"
+#include "lighting/lists/PacketContributingLights.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

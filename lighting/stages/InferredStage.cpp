@@ -13,10 +13,10 @@
 //               low-res G-buffer (whose pixel centres would lie between full-res pixels for even
 //               scales). It stores diffuse RGB (the BRDF's diffuse part without albedo, plus
 //               ambient radiance) and specular RGB (without the specular intensity), both from
-//               the one BRDF (lighting/SplitLighting.h: albedo 1 / intensity 0, then albedo 0 /
-//               intensity 1; metallic-roughness: diffuse, F0 lobe and Fresnel edge). On the
-//               shading kernel: accumulateSplitLights (lighting/LightAccumulation.h) walks the
-//               L-buffer in packets of 4x4 SAMPLES (lanes gathered from the G-buffer pixels the
+//               the one BRDF (lighting/brdf/SplitLighting.h: albedo 1 / intensity 0, then albedo 0
+//               / intensity 1; metallic-roughness: diffuse, F0 lobe and Fresnel edge). On the
+//               shading kernel: accumulateSplitLights (lighting/passes/LightAccumulation.h) walks
+//               the L-buffer in packets of 4x4 SAMPLES (lanes gathered from the G-buffer pixels the
 //               samples read, GBuffer::surfaceAt; stippled samples left out), lanes grouped by
 //               culling tile, kernel::shadePacketSplit on --isa: `--isa scalar` is the per-sample
 //               splitLighting bitwise, a vector ISA differs only in Blinn-Phong specular sums
@@ -26,7 +26,7 @@
 //               Pre-Lighting, Lee 2008, does) so that this stage's error is the resolution alone;
 //               `light-prepass` measures the monochromatic-specular approximation separately. With
 //               scale=1 the image equals brute's up to float summation order.
-//   "material"  the second geometry pass (lighting/MaterialPass.h): the scene is rasterized
+//   "material"  the second geometry pass (lighting/passes/MaterialPass.h): the scene is rasterized
 //               again with the G-buffer pass's visibility draw, and each visible pixel's albedo
 //               and specular intensity come from its triangle's surface. Object IDs (ids=1): a
 //               pixel's ID is the scene instance of its visible triangle
@@ -79,15 +79,15 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/BlendedPass.h"
-#include "lighting/DsfFilter.h"
-#include "lighting/InferredStipple.h"
-#include "lighting/LightAccumulation.h"
-#include "lighting/LightBounds.h"
-#include "lighting/LightListShading.h"
-#include "lighting/MaterialPass.h"
-#include "lighting/PassNames.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/lists/LightListShading.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/DsfFilter.h"
+#include "lighting/passes/InferredStipple.h"
+#include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/MaterialPass.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

@@ -27,12 +27,12 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/BlendedPass.h"
-#include "lighting/LightAccumulation.h"
-#include "lighting/LightBounds.h"
-#include "lighting/PassNames.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/LightVolumes.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/PassNames.h"
 #include "lighting/stages/VolumeStageOptions.h"
 
 namespace lighting {

@@ -10,19 +10,19 @@
 //                 specular     = lum(sum_i radiance_i * att_i * (n.l_i) * blinnPhong_i)
 //               i.e. the BRDF's diffuse part without albedo and ONE monochromatic specular scalar
 //               without the specular intensity, as the technique stores it (RGB + alpha).
-//               Both terms are the one BRDF's (lighting/SplitLighting.h, addSplitLight): albedo 1
-//               and specular intensity 0 for the diffuse part, albedo 0 and intensity 1 for the
-//               specular part (only for lights whose diffuse part is non-zero: a light with zero
-//               diffuse there has zero att * n.l, so zero specular too); metallic-roughness
+//               Both terms are the one BRDF's (lighting/brdf/SplitLighting.h, addSplitLight):
+//               albedo 1 and specular intensity 0 for the diffuse part, albedo 0 and intensity 1
+//               for the specular part (only for lights whose diffuse part is non-zero: a light with
+//               zero diffuse there has zero att * n.l, so zero specular too); metallic-roughness
 //               surfaces split exactly into diffuse, F0 lobe and Fresnel edge sums.
-//               On the shading kernel: accumulateSplitLights (lighting/LightAccumulation.h)
+//               On the shading kernel: accumulateSplitLights (lighting/passes/LightAccumulation.h)
 //               decodes 4x4-pixel packets, groups their lanes by tile and shades each group with
 //               kernel::shadePacketSplit on --isa (one evaluation per light for all the sums).
 //               `--isa scalar` gives the per-pixel splitLighting sums bitwise; a vector ISA the
 //               same diffuse and metallic-roughness sums bitwise and Blinn-Phong specular sums
 //               within pow's error (kernel/SplitLightKernel.h); a layout the packet decoder
 //               refuses takes the per-pixel path (stage_parameters.isa = scalar).
-//   "material"  the second geometry pass (lighting/MaterialPass.h): the scene is rasterized
+//   "material"  the second geometry pass (lighting/passes/MaterialPass.h): the scene is rasterized
 //               again with the G-buffer pass's visibility draw, and each visible pixel's material
 //               comes from its triangle's surface -- albedo and specular intensity are never read
 //               from the G-buffer. Then radiance = albedo * diffuse + intensity * specular *
@@ -49,13 +49,13 @@
 #include <algorithm>
 #include <span>
 
-#include "lighting/BlendedPass.h"
-#include "lighting/LightAccumulation.h"
-#include "lighting/LightBounds.h"
-#include "lighting/LightListShading.h"
-#include "lighting/MaterialPass.h"
-#include "lighting/PassNames.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/lists/LightListShading.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/MaterialPass.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

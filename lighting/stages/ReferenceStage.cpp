@@ -3,8 +3,8 @@
 // image is compared with it. The loop is shadeWithEveryLight (EveryLight.h), shared with `brute`.
 #include "lighting/StageRegistry.h"
 
-#include "lighting/BlendedPass.h"
-#include "lighting/EveryLight.h"
+#include "lighting/lists/EveryLight.h"
+#include "lighting/passes/BlendedPass.h"
 
 namespace lighting {
 

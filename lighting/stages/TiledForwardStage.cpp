@@ -1,6 +1,7 @@
 // `tiled-forward`: tile-based forward shading, "Forward+" (Ishmukhametov 2013, section 2.4.2,
 // after Harada et al. 2012). Three passes over the scene's own geometry, no G-buffer:
-//   1. "prepass": depth-only pre-pass (the visibility draw, gbuffer/VisibilityPass.h), which also
+//   1. "prepass": depth-only pre-pass (the visibility draw, gbuffer/visibility/VisibilityPass.h),
+//   which also
 //      records each pixel's visible triangle;
 //   2. "cull": the screen is split into square tiles; the pre-pass depths bound each tile's
 //      frustum (computeTileDepthBounds in culling/TileFrusta.h: min/max view depth of the
@@ -38,12 +39,12 @@
 #include <memory>
 #include <span>
 
-#include "lighting/BlendedPass.h"
-#include "lighting/ForwardGeometry.h"
-#include "lighting/FragmentShading.h"
-#include "lighting/LightBounds.h"
-#include "lighting/PassNames.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/ForwardGeometry.h"
+#include "lighting/passes/FragmentShading.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

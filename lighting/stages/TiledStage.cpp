@@ -34,11 +34,11 @@
 
 #include <tbb/parallel_for.h>
 
-#include "lighting/BlendedPass.h"
-#include "lighting/LightAccumulation.h"
-#include "lighting/LightBounds.h"
-#include "lighting/PassNames.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/TileFrusta.h"
+#include "lighting/passes/BlendedPass.h"
+#include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

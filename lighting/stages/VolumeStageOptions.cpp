@@ -1,6 +1,6 @@
 #include "lighting/stages/VolumeStageOptions.h"
 
-#include "lighting/PassNames.h"
+#include "lighting/passes/PassNames.h"
 
 namespace lighting {
 

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "gbuffer/GBuffer.h"
-#include "lighting/LightBounds.h"
-#include "lighting/LightList.h"
 #include "lighting/ShadingStage.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/culling/LightBounds.h"
+#include "lighting/culling/LightList.h"
 #include "lighting/culling/LightVolumes.h"
 
 namespace lighting {

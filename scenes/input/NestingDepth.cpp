@@ -1,7 +1,7 @@
 // The two pre-scans of NestingDepth.h. They follow each format's lexical rules only as far as
 // needed to tell brackets and dots that nest from those inside strings and comments; anything
 // they do not understand is left to the real parser, which will report it.
-#include "scenes/NestingDepth.h"
+#include "scenes/input/NestingDepth.h"
 
 #include <algorithm>
 #include <vector>

@@ -25,11 +25,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
-#include "scenes/LightGenerator.h"
-#include "scenes/Limits.h"
-#include "scenes/NestingDepth.h"
-#include "scenes/ProceduralScenes.h"
 #include "scenes/Viewpoints.h"
+#include "scenes/input/Limits.h"
+#include "scenes/input/NestingDepth.h"
+#include "scenes/procedural/LightGenerator.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace scenes {
 

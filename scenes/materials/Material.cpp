@@ -1,4 +1,4 @@
-#include "scenes/Material.h"
+#include "scenes/materials/Material.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "scenes/Texture.h"
+#include "scenes/materials/Texture.h"
 
 #include <array>
 #include <cmath>

@@ -5,7 +5,7 @@
 // Exactness: positions along a shared edge come from the same floats (coordinate tables, an
 // endpoint-exact lerp), so neighbouring patches meet without cracks. Angles are evaluated in
 // double and the points that must be exact (seams, poles, quarter turns) are snapped.
-#include "scenes/MeshBuilder.h"
+#include "scenes/mesh/MeshBuilder.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "scenes/Limits.h"
+#include "scenes/input/Limits.h"
 
 namespace scenes {
 

@@ -1,4 +1,4 @@
-#include "scenes/Tangents.h"
+#include "scenes/mesh/Tangents.h"
 
 #include <array>
 #include <cmath>

@@ -27,7 +27,7 @@
 //   - MikkTSpace also keeps the magnitudes of dP/du and dP/dv (unused by its default output,
 //     which glTF uses) and merges corners whose tangents differ by more than a threshold only
 //     when asked to (the default threshold merges all), so neither changes the result here.
-// tests/scenes/tangents_test.cpp measures the angle to the tangents that BoomBox and Suzanne
+// tests/scenes/mesh/tangents_test.cpp measures the angle to the tangents that BoomBox and Suzanne
 // ship. Cost: linear in vertices and triangles (one hash map for welding). Pure function,
 // thread-safe.
 #pragma once

@@ -5,12 +5,12 @@
 // per light (position x, y, z, range, intensity, hue, saturation), so a light's values depend
 // only on the seed and its index; the first n lights of a larger count are the n lights of the
 // smaller count.
-#include "scenes/LightGenerator.h"
+#include "scenes/procedural/LightGenerator.h"
 
 #include <cmath>
 #include <string>
 
-#include "scenes/Limits.h"
+#include "scenes/input/Limits.h"
 
 namespace scenes {
 

@@ -6,7 +6,7 @@
 // with request.seed, so a request always gives bitwise the same lights. Building is
 // single-threaded and allocates only the scene; the atrium at detail=1 takes a few tens of
 // milliseconds.
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 #include <algorithm>
 #include <charconv>
@@ -18,8 +18,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "scenes/LightGenerator.h"
-#include "scenes/MeshBuilder.h"
+#include "scenes/mesh/MeshBuilder.h"
+#include "scenes/procedural/LightGenerator.h"
 
 namespace scenes {
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "lighting/PreparedScene.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace bench {
 

@@ -1,5 +1,5 @@
-// The stages on accumulateLights (lighting/LightAccumulation.h), with the kernel's scalar path
-// and its widest vector target timed alternately in one benchmark (iteration i: scalar, then
+// The stages on accumulateLights (lighting/passes/LightAccumulation.h), with the kernel's scalar
+// path and its widest vector target timed alternately in one benchmark (iteration i: scalar, then
 // vector, on the same frame), so their ratio comes from the same moments of a shared machine.
 // Each iteration runs the stage's whole shade() under a tbb::task_arena of `threads`, wall clock.
 // Counters: the median of each ISA's times (ms), their ratio (scalar / vector, median and best),

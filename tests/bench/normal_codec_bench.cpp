@@ -1,5 +1,5 @@
-// Encode and decode throughput of every normal codec x bits (gbuffer/NormalCodec.h), one thread,
-// structure-of-arrays loops over 1M normals as a G-buffer pass would see them: front-facing
+// Encode and decode throughput of every normal codec x bits (gbuffer/codecs/NormalCodec.h), one
+// thread, structure-of-arrays loops over 1M normals as a G-buffer pass would see them: front-facing
 // normals for random pixels of a 60 degree FOV 16:9 camera, each with its view ray (only
 // pixel-view reads it). items_per_second = normals per second per core.
 //   build/bin/testbed_bench --benchmark_filter='normal(Encode|Decode)'
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "gbuffer/NormalCodec.h"
+#include "gbuffer/codecs/NormalCodec.h"
 
 namespace {
 

@@ -14,12 +14,12 @@
 #include <string>
 
 #include "gbuffer/GBufferPass.h"
-#include "gbuffer/SceneGeometry.h"
-#include "lighting/LightAccumulation.h"
-#include "lighting/LightList.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 #include "lighting/Oracle.h"
-#include "lighting/PacketContributingLights.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/culling/LightList.h"
+#include "lighting/lists/PacketContributingLights.h"
+#include "lighting/passes/LightAccumulation.h"
 #include "tests/bench/BenchScenes.h"
 
 namespace {

@@ -11,8 +11,8 @@
 #include <memory>
 
 #include "gbuffer/GBufferPass.h"
-#include "lighting/LightList.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/culling/LightList.h"
 #include "tests/bench/BenchScenes.h"
 
 namespace {

@@ -17,9 +17,9 @@
 #include <string>
 
 #include "gbuffer/GBufferPass.h"
-#include "gbuffer/SceneGeometry.h"
-#include "lighting/LightList.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/culling/LightList.h"
 #include "tests/bench/BenchScenes.h"
 
 namespace {

@@ -4,10 +4,10 @@
 // file's name; nothing else may leave.
 //
 // Work per input is bounded: an input whose header declares more than kMaxFuzzPixels pixels (or a
-// depth) is read up to its header only. diff's own limit (scenes/Limits.h, 2^26 pixels) is tested
-// by tests/experiments/diff_test.cpp; here a few bytes declaring an 8192 x 8192 image made one
-// input take 37 s under AddressSanitizer (54 executions in 600 s), and the decoding and diff code
-// are reached as well by small images.
+// depth) is read up to its header only. diff's own limit (scenes/input/Limits.h, 2^26 pixels) is
+// tested by tests/experiments/compare/diff_test.cpp; here a few bytes declaring an 8192 x 8192
+// image made one input take 37 s under AddressSanitizer (54 executions in 600 s), and the decoding
+// and diff code are reached as well by small images.
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
@@ -16,8 +16,8 @@
 #include <OpenImageIO/imageio.h>
 
 #include "FuzzInput.h"
-#include "experiments/DiffCommand.h"
-#include "experiments/ImageOutput.h"
+#include "experiments/compare/DiffCommand.h"
+#include "experiments/output/ImageOutput.h"
 
 namespace {
 

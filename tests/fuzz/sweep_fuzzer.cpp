@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "experiments/SweepFile.h"
+#include "experiments/sweep/SweepFile.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size == 0)

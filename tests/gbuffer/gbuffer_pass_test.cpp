@@ -6,9 +6,9 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "gbuffer/ExactSurface.h"
 #include "gbuffer/GBufferPass.h"
-#include "gbuffer/SceneGeometry.h"
+#include "gbuffer/visibility/ExactSurface.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 
 namespace {
 

@@ -3,16 +3,16 @@
 // that the derived layout is lossless (brute on it gives bitwise the image of brute on reference).
 #include <gtest/gtest.h>
 
-#include "TwoQuads.h"
+#include "tests/gbuffer/TwoQuads.h"
 
 #include <cstring>
 
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
 #include "scenes/SceneRequest.h"
-#include "scenes/Texture.h"
+#include "scenes/materials/Texture.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace {
 

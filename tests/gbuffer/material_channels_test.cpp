@@ -1,22 +1,22 @@
 // The metallic-roughness channels of the G-buffer: how the layout derivation stores roughness,
 // metallic and the material model (gbuffer/LayoutDerivation.h addMaterialModels), their storage
 // round trip, the normal-mapping formula the resolve and the reference share
-// (gbuffer/NormalMapping.h), and that the derived layout stays lossless on a glTF model with
-// metallic-roughness and normal textures (brute on it gives bitwise brute on the reference
+// (gbuffer/visibility/NormalMapping.h), and that the derived layout stays lossless on a glTF model
+// with metallic-roughness and normal textures (brute on it gives bitwise brute on the reference
 // layout, and the derived layout is smaller).
 #include <gtest/gtest.h>
 
-#include "TwoQuads.h"
+#include "tests/gbuffer/TwoQuads.h"
 
 #include <cmath>
 
 #include "gbuffer/LayoutDerivation.h"
-#include "gbuffer/NormalMapping.h"
+#include "gbuffer/visibility/NormalMapping.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/SceneLoader.h"
 #include "scenes/SceneRequest.h"
-#include "scenes/Texture.h"
+#include "scenes/materials/Texture.h"
 
 namespace {
 

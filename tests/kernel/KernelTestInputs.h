@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "lighting/Brdf.h"
+#include "lighting/brdf/Brdf.h"
 #include "lighting/kernel/KernelIsa.h"
 #include "lighting/kernel/KernelLights.h"
 #include "lighting/kernel/ShadingPacket.h"

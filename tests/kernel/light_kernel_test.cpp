@@ -1,5 +1,5 @@
 // The shading kernel's vector paths (every compiled instruction set this CPU runs) against its
-// scalar path (lighting/Brdf.h's evaluateLight lane by lane) and the double-precision formula,
+// scalar path (lighting/brdf/Brdf.h's evaluateLight lane by lane) and the double-precision formula,
 // for both material models (Blinn-Phong, metallic-roughness) and packets that mix them:
 // random packets and lights, hand-built edge cases with known outcomes, lane independence, the
 // early-out rule (a contributing light is never skipped, counters equal to the scalar path's),
@@ -346,7 +346,7 @@ TEST_P(LightKernelTest, HardCases) {
     }
 }
 
-// An analytic value, independent of lighting/Brdf.h: a sun straight above a floor seen along
+// An analytic value, independent of lighting/brdf/Brdf.h: a sun straight above a floor seen along
 // +Z (l = +Y, v = +Z, so h = (0, 1, 1) / sqrt 2 and n.h = 1 / sqrt 2), radiance 2:
 // 2 * (albedo / pi + intensity (power + 8) / (8 pi) * (1 / sqrt 2)^power).
 TEST_P(LightKernelTest, ClosedFormSun) {

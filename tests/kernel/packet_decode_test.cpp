@@ -14,8 +14,8 @@
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/kernel/PacketDecoder.h"
-#include "scenes/ProceduralScenes.h"
 #include "scenes/SceneLoader.h"
+#include "scenes/procedural/ProceduralScenes.h"
 #include "tests/kernel/GBufferPlaneCopy.h"
 #include "tests/kernel/KernelTestInputs.h"
 

@@ -12,7 +12,7 @@
 #include "lighting/Oracle.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
 #include "tests/kernel/GBufferPlaneCopy.h"
 #include "tests/kernel/KernelTestInputs.h"
 #include "tests/kernel/PacketFrame.h"

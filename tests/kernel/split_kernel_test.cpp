@@ -1,5 +1,5 @@
 // The kernel's split form (lighting/kernel/SplitLightKernel.h), what light-prepass and inferred
-// shade with: its scalar path against splitLighting (lighting/SplitLighting.h, the per-pixel
+// shade with: its scalar path against splitLighting (lighting/brdf/SplitLighting.h, the per-pixel
 // code the stages ran before) bitwise, and every compiled vector target against the scalar path
 // on random packets of both material models: diffuse sums and every metallic-roughness sum
 // bitwise, the Blinn-Phong specular sum within the pow bound, counters identical (and equal to
@@ -12,7 +12,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "lighting/SplitLighting.h"
+#include "lighting/brdf/SplitLighting.h"
 #include "lighting/kernel/LightKernel.h"
 #include "lighting/kernel/SplitLightKernel.h"
 #include "tests/kernel/KernelTestInputs.h"

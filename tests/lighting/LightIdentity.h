@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "lighting/BlendedPass.h"
-#include "lighting/ContributingLights.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/lists/ContributingLights.h"
+#include "lighting/passes/BlendedPass.h"
 
 namespace stagecheck {
 
@@ -82,8 +82,8 @@ everyContributingLightEvaluated(const lighting::StageResult& result,
            << " contributing (pixel, light) pairs dropped:" << failures.str();
 }
 
-// Per pixel, the blended fragments a stage composites there (lighting/BlendedPass.h), each with
-// its contributing lights (every light tested on the fragment's surface, ascending), over the
+// Per pixel, the blended fragments a stage composites there (lighting/passes/BlendedPass.h), each
+// with its contributing lights (every light tested on the fragment's surface, ascending), over the
 // opaque depth `inputs.gbuffer` holds: the expectation of the blended identity check.
 using BlendedFragments = std::vector<std::vector<lighting::StageResult::BlendedFragmentTrace>>;
 inline BlendedFragments blendedContributingLights(const lighting::StageInputs& inputs) {

@@ -8,9 +8,9 @@
 
 #include <glm/glm.hpp>
 
-#include "scenes/ProceduralScenes.h"
 #include "scenes/SceneLoader.h"
 #include "scenes/Viewpoints.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace {
 

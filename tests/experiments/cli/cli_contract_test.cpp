@@ -16,7 +16,7 @@
 
 #include <sys/wait.h>
 
-#include "experiments/PlotScript.h"
+#include "experiments/output/PlotScript.h"
 #include "lighting/StageRegistry.h"
 
 namespace {

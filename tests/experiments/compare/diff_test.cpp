@@ -14,9 +14,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "TestFolders.h"
-#include "experiments/DiffCommand.h"
-#include "experiments/ImageOutput.h"
+#include "experiments/compare/DiffCommand.h"
+#include "experiments/output/ImageOutput.h"
+#include "tests/experiments/TestFolders.h"
 
 namespace experiments {
 namespace {

@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "experiments/FlipMetric.h"
-#include "experiments/PlotScript.h"
+#include "experiments/compare/FlipMetric.h"
+#include "experiments/output/PlotScript.h"
 
 namespace experiments {
 namespace {

@@ -18,11 +18,11 @@
 
 #include <gtest/gtest.h>
 
-#include "TestFolders.h"
-#include "experiments/AtomicFile.h"
-#include "experiments/ImageOutput.h"
-#include "experiments/SweepFile.h"
-#include "scenes/Limits.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/sweep/SweepFile.h"
+#include "scenes/input/Limits.h"
+#include "tests/experiments/TestFolders.h"
 
 namespace experiments {
 namespace {

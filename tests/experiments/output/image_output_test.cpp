@@ -21,8 +21,8 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
-#include "experiments/AtomicFile.h"
-#include "experiments/ImageOutput.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/output/ImageOutput.h"
 
 namespace experiments {
 namespace {

@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "experiments/CpuLoad.h"
-#include "experiments/RenderCommand.h"
-#include "experiments/RenderJob.h"
+#include "experiments/render/CpuLoad.h"
+#include "experiments/render/RenderCommand.h"
+#include "experiments/render/RenderJob.h"
 
 namespace experiments {
 namespace {

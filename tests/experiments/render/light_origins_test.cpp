@@ -8,11 +8,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "TestFolders.h"
-#include "experiments/LightOrigins.h"
-#include "experiments/RenderOptions.h"
-#include "experiments/RenderPlan.h"
-#include "experiments/SweepFile.h"
+#include "experiments/render/LightOrigins.h"
+#include "experiments/render/RenderOptions.h"
+#include "experiments/render/RenderPlan.h"
+#include "experiments/sweep/SweepFile.h"
+#include "tests/experiments/TestFolders.h"
 
 namespace experiments {
 namespace {

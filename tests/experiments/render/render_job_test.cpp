@@ -10,8 +10,8 @@
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
-#include "experiments/RenderCommand.h"
-#include "experiments/RenderJob.h"
+#include "experiments/render/RenderCommand.h"
+#include "experiments/render/RenderJob.h"
 
 namespace {
 
@@ -100,7 +100,7 @@ TEST_P(RenderJobIsa, BruteMatchesReferenceOnAtrium) {
 
 // Issue 14's "brute vs reference relative RMSE below 1e-5", stated for what brute can be held to:
 // the shading of the G-buffer's surface. The reference shades the exact surface (double ray
-// against the pixel's own triangle, gbuffer/ExactSurface.h); the G-buffer holds the same
+// against the pixel's own triangle, gbuffer/visibility/ExactSurface.h); the G-buffer holds the same
 // triangle's plane at the pixel centre from float-transformed vertices, and where that plane is
 // nearly edge-on to the view ray the intersection is ill-conditioned, so its depth can be off by
 // far more than rounding (atrium, 320x180, 256 lights: one pixel, (123, 98), 2.25% off, makes the

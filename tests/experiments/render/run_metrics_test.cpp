@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "experiments/RenderJob.h"
-#include "experiments/ResultsTable.h"
-#include "experiments/RunMetrics.h"
+#include "experiments/render/RenderJob.h"
+#include "experiments/render/RunMetrics.h"
+#include "experiments/sweep/ResultsTable.h"
 #include "lighting/StageRegistry.h"
 
 namespace {

@@ -2,7 +2,7 @@
 # Opens the report of a tiny sweep in headless Chromium and fails if the page logs an error, an
 # image fails to load, or a plot (or the page) is blank. Registered with ctest by
 # tests/CMakeLists.txt; by hand:
-#   tests/experiments/report_chromium_test.sh build/bin/testbed /tmp/report-chromium-test
+#   tests/experiments/report/report_chromium_test.sh build/bin/testbed /tmp/report-chromium-test
 #
 # Input: made here by `testbed sweep tests/experiments/fixtures/report-smoke.json` (16 tiny
 # jobs, four stages x two light counts x two views, i.e. four comparable groups, with a
@@ -16,9 +16,9 @@
 # rows); the results table with the flip (ꟻLIP) column among the main columns and the others
 # behind the toggle, and -- when ꟻLIP is unavailable on this machine (no flip-evaluator) -- the
 # visible note saying why; inferred's reduced-resolution light counts are explained in a note.
-# Failed jobs, null metrics and single-valued axes are covered by tests/experiments/report_test.cpp.
+# Failed jobs, null metrics and single-valued axes are covered by tests/experiments/report/report_test.cpp.
 #
-# The page's inline script (experiments/ReportCommand.h, pageCheckScript) writes
+# The page's inline script (experiments/report/ReportCommand.h, pageCheckScript) writes
 # "PAGE-CHECK: OK (N images)" into #page-check after the load event, or "PAGE-CHECK: FAILED" and
 # the images that did not load / script errors; --dump-dom prints the DOM after loading. Any
 # console message or uncaught exception is caught from Chromium's log (--enable-logging=stderr). The plot PNGs
@@ -29,7 +29,7 @@ set -euo pipefail
 
 testbed=${1:?usage: $0 TESTBED_BINARY WORK_DIR}
 work=${2:?usage: $0 TESTBED_BINARY WORK_DIR}
-here=$(cd "$(dirname "$0")" && pwd)
+here=$(cd "$(dirname "$0")/.." && pwd) # tests/experiments
 sweep_file=$here/fixtures/report-smoke.json
 
 fail() { echo "report_chromium_test: FAIL: $*" >&2; exit 1; }

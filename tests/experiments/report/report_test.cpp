@@ -15,9 +15,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "TestFolders.h"
-#include "experiments/ImageOutput.h"
-#include "experiments/ReportCommand.h"
+#include "experiments/output/ImageOutput.h"
+#include "experiments/report/ReportCommand.h"
+#include "tests/experiments/TestFolders.h"
 
 namespace experiments {
 namespace {

@@ -17,10 +17,10 @@
 #include <nlohmann/json.hpp>
 #include <tbb/task_arena.h>
 
-#include "TestFolders.h"
-#include "experiments/PlotScript.h"
+#include "experiments/output/PlotScript.h"
 #include "experiments/studies/DepthStudy.h"
 #include "experiments/studies/DepthStudyOutputs.h"
+#include "tests/experiments/TestFolders.h"
 
 namespace experiments {
 namespace {

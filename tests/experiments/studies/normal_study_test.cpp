@@ -17,9 +17,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/PlotScript.h"
+#include "experiments/output/PlotScript.h"
 #include "experiments/studies/NormalStudy.h"
-#include "gbuffer/NormalCodec.h"
+#include "gbuffer/codecs/NormalCodec.h"
 
 namespace {
 

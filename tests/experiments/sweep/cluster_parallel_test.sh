@@ -4,7 +4,7 @@
 # users to run) and checks that the merged table equals a local unsharded run of the same sweep
 # in every column but the timings (compare_sweep_results.py). Registered with ctest by
 # tests/CMakeLists.txt; by hand:
-#   tests/experiments/cluster_parallel_test.sh build/bin/testbed /tmp/cluster-parallel-test
+#   tests/experiments/sweep/cluster_parallel_test.sh build/bin/testbed /tmp/cluster-parallel-test
 #
 # Skips (exit 77, ctest's SKIP_RETURN_CODE) when GNU parallel is not installed (./run.sh test
 # installs Debian's parallel). The recipe runs under `timeout`, so it cannot hang.
@@ -12,7 +12,7 @@ set -euo pipefail
 
 testbed=${1:?usage: $0 TESTBED_BINARY WORK_DIR}
 work=${2:?usage: $0 TESTBED_BINARY WORK_DIR}
-here=$(cd "$(dirname "$0")" && pwd)
+here=$(cd "$(dirname "$0")/.." && pwd) # tests/experiments
 source_root=$(cd "$here/../.." && pwd)
 sweep_file=$here/fixtures/cluster-smoke.json
 shards=3
@@ -37,6 +37,6 @@ for shard in $(seq 1 "$shards"); do
 done
 timeout 120 "$testbed" sweep "$sweep_file" --out "$work/local" --threads 1 > "$work/local.log" 2>&1 ||
     { tail -n 20 "$work/local.log" >&2; fail "the local sweep failed"; }
-python3 "$here/compare_sweep_results.py" "$work/out/all/results.json" \
+python3 "$here/sweep/compare_sweep_results.py" "$work/out/all/results.json" \
     "$work/local/results.json" "$jobs" || fail "the merged table differs from the local run's"
 echo "cluster_parallel_test: PASS"

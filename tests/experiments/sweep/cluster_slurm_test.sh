@@ -7,7 +7,7 @@
 # users), waits, and checks that the merged table equals a local unsharded run of the same sweep
 # in every column but the timings (compare_sweep_results.py) and that the report was written.
 # Registered with ctest by tests/CMakeLists.txt; by hand:
-#   tests/experiments/cluster_slurm_test.sh build/bin/testbed /tmp/cluster-slurm-test
+#   tests/experiments/sweep/cluster_slurm_test.sh build/bin/testbed /tmp/cluster-slurm-test
 #
 # Skips (exit 77, ctest's SKIP_RETURN_CODE) with the reason when it cannot run a cluster: not
 # root (munged must run as the munge user and slurmd as root), slurm-wlm or munge not installed
@@ -18,7 +18,7 @@ set -euo pipefail
 
 testbed=${1:?usage: $0 TESTBED_BINARY WORK_DIR}
 work=${2:?usage: $0 TESTBED_BINARY WORK_DIR}
-here=$(cd "$(dirname "$0")" && pwd)
+here=$(cd "$(dirname "$0")/.." && pwd) # tests/experiments
 source_root=$(cd "$here/../.." && pwd)
 sweep_file=$here/fixtures/cluster-smoke.json
 shards=3
@@ -169,6 +169,6 @@ done
 # The same sweep on this machine, unsharded, with the tasks' --threads.
 timeout 100 "$testbed" sweep "$sweep_file" --out "$work/local" --threads 1 > "$work/local.log" 2>&1 ||
     { tail -n 20 "$work/local.log" >&2; fail "the local sweep failed"; }
-python3 "$here/compare_sweep_results.py" "$work/out/all/results.json" \
+python3 "$here/sweep/compare_sweep_results.py" "$work/out/all/results.json" \
     "$work/local/results.json" "$jobs" || fail "the merged table differs from the local run's"
 echo "cluster_slurm_test: PASS"

@@ -5,7 +5,7 @@ time_* columns (status, error, settings, light counts, error metrics, bytes per 
 
     compare_sweep_results.py MERGED/results.json LOCAL/results.json EXPECTED_JOB_COUNT
 
-Used by tests/experiments/cluster_slurm_test.sh and cluster_parallel_test.sh. Exit 0 when equal,
+Used by tests/experiments/sweep/cluster_slurm_test.sh and cluster_parallel_test.sh. Exit 0 when equal,
 1 (with every difference listed) otherwise."""
 import json
 import sys

@@ -9,8 +9,8 @@
 #include <set>
 #include <tuple>
 
-#include "experiments/RenderPlan.h"
-#include "experiments/SweepFile.h"
+#include "experiments/render/RenderPlan.h"
+#include "experiments/sweep/SweepFile.h"
 #include "scenes/Viewpoints.h"
 
 namespace {
@@ -477,7 +477,8 @@ TEST(SweepFile, ShardsPartitionTheJobs) {
 // stage, encoding or option breaks this test, not a sweep after an hour.
 TEST(SweepFile, ReproductionSweepsAreValid) {
     const fs::path folder =
-        fs::path(__FILE__).parent_path().parent_path().parent_path() / "experiments" / "sweeps";
+        fs::path(__FILE__).parent_path().parent_path().parent_path().parent_path() / "experiments" /
+        "sweeps";
     ASSERT_TRUE(fs::is_directory(folder)) << folder;
     size_t files = 0;
     for (const auto& entry : fs::directory_iterator(folder)) {

@@ -11,7 +11,7 @@
 // resumed makes no progress, exactly like one stuck in a loop or a wait, until --job-timeout.
 #include <gtest/gtest.h>
 
-#include "SpawnTestbed.h"
+#include "tests/experiments/SpawnTestbed.h"
 
 #include <algorithm>
 #include <chrono>
@@ -32,7 +32,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "experiments/SanitizerBuild.h"
+#include "experiments/sweep/SanitizerBuild.h"
 
 namespace {
 

@@ -3,7 +3,7 @@
 // "skipped" in its progress output), redo the rest, and end with every job exactly once.
 #include <gtest/gtest.h>
 
-#include "SpawnTestbed.h"
+#include "tests/experiments/SpawnTestbed.h"
 
 #include <chrono>
 #include <filesystem>

@@ -6,9 +6,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "experiments/AtomicFile.h"
-#include "experiments/ResultsTable.h"
-#include "experiments/SweepFile.h"
+#include "experiments/output/AtomicFile.h"
+#include "experiments/sweep/ResultsTable.h"
+#include "experiments/sweep/SweepFile.h"
 
 namespace {
 

@@ -9,9 +9,9 @@
 #include <set>
 #include <sstream>
 
-#include "experiments/ResultsTable.h"
-#include "experiments/SweepFile.h"
-#include "experiments/SweepRunner.h"
+#include "experiments/sweep/ResultsTable.h"
+#include "experiments/sweep/SweepFile.h"
+#include "experiments/sweep/SweepRunner.h"
 
 namespace {
 

@@ -21,8 +21,8 @@
 
 #include <Imath/half.h>
 
-#include "gbuffer/CameraView.h"
-#include "gbuffer/DepthFormat.h"
+#include "gbuffer/codecs/DepthFormat.h"
+#include "gbuffer/visibility/CameraView.h"
 #include "scenes/Scene.h"
 
 namespace gbuffer {

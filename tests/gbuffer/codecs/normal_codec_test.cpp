@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "gbuffer/NormalCodec.h"
+#include "gbuffer/codecs/NormalCodec.h"
 
 namespace gbuffer {
 // Test names and messages show "octahedral:24", not the spec's bytes.

@@ -1,5 +1,5 @@
-// Lambert + Blinn-Phong (lighting/Brdf.h) against closed forms computed independently of it, so
-// that a wrong formula cannot hide behind the reference, which shares it: the specular peak and
+// Lambert + Blinn-Phong (lighting/brdf/Brdf.h) against closed forms computed independently of it,
+// so that a wrong formula cannot hide behind the reference, which shares it: the specular peak and
 // the directional albedo of the normalised lobe (its (n + 8) / (8 pi) normalisation integrated by
 // quadrature), the Lambert albedo, the spot smoothstep at chosen angles and the distance window at
 // chosen distances. Also: lightIncidence (LightIncidence.h), which the metallic-roughness model
@@ -11,9 +11,9 @@
 
 #include <glm/glm.hpp>
 
-#include "lighting/Brdf.h"
-#include "lighting/LightIncidence.h"
-#include "lighting/MetallicRoughness.h"
+#include "lighting/brdf/Brdf.h"
+#include "lighting/brdf/LightIncidence.h"
+#include "lighting/brdf/MetallicRoughness.h"
 
 namespace {
 

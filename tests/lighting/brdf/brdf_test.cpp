@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "lighting/Brdf.h"
+#include "lighting/brdf/Brdf.h"
 
 namespace {
 

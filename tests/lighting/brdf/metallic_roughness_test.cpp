@@ -1,4 +1,4 @@
-// The glTF metallic-roughness BRDF (lighting/MetallicRoughness.h) against values computed
+// The glTF metallic-roughness BRDF (lighting/brdf/MetallicRoughness.h) against values computed
 // independently of it: the spec's Appendix B "full code" written out here in double in its own
 // form (D with (N.H)^2 (alpha^2 - 1) + 1, G / (4 |N.L| |N.V|), the mix() of dielectric and metal
 // lobes), closed forms (roughness 1 makes D = 1/pi), white-furnace integrals of the GGX + Smith
@@ -13,7 +13,7 @@
 
 #include <glm/glm.hpp>
 
-#include "lighting/MetallicRoughness.h"
+#include "lighting/brdf/MetallicRoughness.h"
 
 namespace {
 

@@ -16,12 +16,12 @@
 
 #include "gbuffer/GBufferLayout.h"
 #include "gbuffer/GBufferPass.h"
-#include "lighting/LightBounds.h"
 #include "lighting/Oracle.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/culling/LightBounds.h"
 #include "lighting/culling/LightVolumes.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace {
 

@@ -1,5 +1,5 @@
-// accumulateLights (lighting/LightAccumulation.h), through the stages that shade with it, on the
-// kernel's scalar path and its widest vector target: 1, 2 and 7 threads give bitwise the same
+// accumulateLights (lighting/passes/LightAccumulation.h), through the stages that shade with it, on
+// the kernel's scalar path and its widest vector target: 1, 2 and 7 threads give bitwise the same
 // image, counts and SIMT lane slots; the scalar path is the per-pixel loop's image bitwise (a
 // layout the packet decoder refuses is gathered pixel by pixel, then shaded on the kernel); the
 // vector path stays within a few ulps of it (the figure is printed), and on metallic-roughness
@@ -17,8 +17,8 @@
 #include "gbuffer/GBufferLayout.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
 #include "scenes/SceneLoader.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace {
 

@@ -1,7 +1,7 @@
 // The approximate stages `light-prepass` and `inferred` against the double-precision `reference`
 // (256x144, 100 lights): the relative RMSE (RMSE over all pixels and channels divided by the
-// reference's RMS, as experiments/RenderJob.cpp reports it) must lie below a bound and above a
-// floor, which proves the stage really approximates and that the test can fail. Every bound is
+// reference's RMS, as experiments/render/RenderJob.cpp reports it) must lie below a bound and above
+// a floor, which proves the stage really approximates and that the test can fail. Every bound is
 // the measured error times a small factor and lies well below what an all-black image scores
 // (relative RMSE 1.0, computed in the test), so a stage that outputs nothing fails.
 // Frames: `atrium` (textured, lit mostly diffusely: the errors are a few to 20% of the RMS) and
@@ -25,7 +25,7 @@
 
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace {
 

@@ -16,7 +16,7 @@
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/culling/ClusterGrid.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace {
 

@@ -5,17 +5,18 @@
 // emissive texture, under three lights that all reach both quads (a per-light emission would be
 // counted three times). Without any light the image is exactly the emission. A blended (BLEND)
 // pane that emits, over an emitting wall: its emission is composited with its lit colour by
-// "over" in every stage's blended pass and the reference's composite (lighting/BlendedPass.h).
+// "over" in every stage's blended pass and the reference's composite
+// (lighting/passes/BlendedPass.h).
 #include <gtest/gtest.h>
 
-#include "../gbuffer/TwoQuads.h"
+#include "tests/gbuffer/TwoQuads.h"
 
 #include <cmath>
 
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/Texture.h"
+#include "scenes/materials/Texture.h"
 
 namespace {
 

@@ -14,12 +14,12 @@
 #include <tbb/task_arena.h>
 
 #include "gbuffer/GBufferPass.h"
-#include "lighting/ForwardGeometry.h"
-#include "lighting/FragmentShading.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/MeshBuilder.h"
-#include "scenes/ProceduralScenes.h"
+#include "lighting/passes/ForwardGeometry.h"
+#include "lighting/passes/FragmentShading.h"
+#include "scenes/mesh/MeshBuilder.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace {
 
@@ -191,12 +191,13 @@ TEST(Forward, SameResultForAnyThreadCount) {
     }
 }
 
-// The forward stages on the light kernel (lighting/FragmentShading.h): on the widest ISA they
-// report it and stay bitwise brute's there (overdraw included: a later fragment of a pixel, even
-// in the same 16-lane packet, replaces the earlier one); counts and the kernel's packet counters do
-// not depend on the ISA; the SIMT model's warps (32 or 64 consecutive fragments of a raster
-// tile) pay warpLanes lane slots per light of their union, so slots are a multiple of the warp,
-// at least the evaluations, and a 64-lane warp (two 32-lane warps' union) pays at least as much.
+// The forward stages on the light kernel (lighting/passes/FragmentShading.h): on the widest ISA
+// they report it and stay bitwise brute's there (overdraw included: a later fragment of a pixel,
+// even in the same 16-lane packet, replaces the earlier one); counts and the kernel's packet
+// counters do not depend on the ISA; the SIMT model's warps (32 or 64 consecutive fragments of a
+// raster tile) pay warpLanes lane slots per light of their union, so slots are a multiple of the
+// warp, at least the evaluations, and a 64-lane warp (two 32-lane warps' union) pays at least as
+// much.
 TEST(Forward, FragmentPacketsOnTheKernelReportIsaAndSimtLaneSlots) {
     const TestScene& f = atrium();
     const lighting::kernel::KernelIsa best = lighting::kernel::KernelIsa::best();

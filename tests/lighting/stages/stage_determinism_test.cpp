@@ -13,10 +13,10 @@
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
-#include "LightIdentity.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/procedural/ProceduralScenes.h"
+#include "tests/lighting/LightIdentity.h"
 
 namespace {
 

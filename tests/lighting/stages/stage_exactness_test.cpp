@@ -19,15 +19,15 @@
 
 #include <tbb/task_arena.h>
 
-#include "LightIdentity.h"
-#include "lighting/ContributingLights.h"
 #include "lighting/Oracle.h"
-#include "lighting/PassNames.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/kernel/ShadingPacket.h"
-#include "scenes/ProceduralScenes.h"
+#include "lighting/lists/ContributingLights.h"
+#include "lighting/passes/PassNames.h"
 #include "scenes/SceneLoader.h"
+#include "scenes/procedural/ProceduralScenes.h"
+#include "tests/lighting/LightIdentity.h"
 
 namespace {
 
@@ -54,7 +54,7 @@ const SceneCase kScenes[] = {
     {"glass", "glass", 200, {}},
 };
 // The scenes of the IdealStage suite: all but glass, whose blended pass has its own timed pass
-// and its own lists (lighting/BlendedPass.h).
+// and its own lists (lighting/passes/BlendedPass.h).
 constexpr int kIdealSceneCount = int(std::size(kScenes)) - 1;
 
 // Deterministic spot lights from the generated point lights: axes spread over the lower

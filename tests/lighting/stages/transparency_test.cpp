@@ -22,13 +22,13 @@
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
-#include "LightIdentity.h"
-#include "gbuffer/AlphaCoverage.h"
+#include "gbuffer/visibility/AlphaCoverage.h"
 #include "lighting/Oracle.h"
-#include "lighting/PassNames.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
-#include "scenes/ProceduralScenes.h"
+#include "lighting/passes/PassNames.h"
+#include "scenes/procedural/ProceduralScenes.h"
+#include "tests/lighting/LightIdentity.h"
 
 namespace {
 

@@ -17,9 +17,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "scenes/Limits.h"
-#include "scenes/NestingDepth.h"
 #include "scenes/SceneLoader.h"
+#include "scenes/input/Limits.h"
+#include "scenes/input/NestingDepth.h"
 
 namespace {
 

@@ -14,10 +14,10 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
-#include "scenes/LightGenerator.h"
-#include "scenes/ProceduralScenes.h"
 #include "scenes/SceneLoader.h"
 #include "scenes/Viewpoints.h"
+#include "scenes/procedural/LightGenerator.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace {
 

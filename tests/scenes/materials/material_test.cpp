@@ -1,13 +1,13 @@
-// Material helpers (scenes/Material.h): the KHR_texture_transform mapping against the extension's
-// own example, the Blinn-Phong approximation of a metallic-roughness material and its inverse, and
-// which materials read the second uv set.
+// Material helpers (scenes/materials/Material.h): the KHR_texture_transform mapping against the
+// extension's own example, the Blinn-Phong approximation of a metallic-roughness material and its
+// inverse, and which materials read the second uv set.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include <glm/glm.hpp>
 
-#include "scenes/Material.h"
+#include "scenes/materials/Material.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Tangent generation (scenes/Tangents.h): closed-form cases (a quad whose uv axes are known, a
+// Tangent generation (scenes/mesh/Tangents.h): closed-form cases (a quad whose uv axes are known, a
 // mirrored one, welding, degenerate uvs), and the agreement with the tangents BoomBox and Suzanne
 // ship, measured as the angle between generated and shipped tangent directions (the shipped one
 // first projected onto its normal's plane, as a renderer's Gram-Schmidt step does) and the share
@@ -18,7 +18,7 @@
 #include <glm/glm.hpp>
 
 #include "scenes/SceneLoader.h"
-#include "scenes/Tangents.h"
+#include "scenes/mesh/Tangents.h"
 
 namespace {
 

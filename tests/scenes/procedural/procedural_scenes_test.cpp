@@ -18,9 +18,9 @@
 #include <tuple>
 #include <utility>
 
-#include "scenes/LightGenerator.h"
-#include "scenes/MeshBuilder.h"
-#include "scenes/ProceduralScenes.h"
+#include "scenes/mesh/MeshBuilder.h"
+#include "scenes/procedural/LightGenerator.h"
+#include "scenes/procedural/ProceduralScenes.h"
 
 namespace scenes {
 namespace {

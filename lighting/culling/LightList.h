@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "gbuffer/CameraView.h"
-#include "lighting/Brdf.h"
+#include "gbuffer/visibility/CameraView.h"
+#include "lighting/brdf/Brdf.h"
 #include "scenes/Scene.h"
 
 namespace lighting {

@@ -19,18 +19,18 @@
 #include <CLI/CLI.hpp>
 
 #include "experiments/CommandErrors.h"
-#include "experiments/DiffCommand.h"
-#include "experiments/JobProcess.h"
-#include "experiments/ListCommand.h"
-#include "experiments/RenderCommand.h"
-#include "experiments/RenderPlan.h"
-#include "experiments/ReportCommand.h"
-#include "experiments/SweepFile.h"
-#include "experiments/SweepRunner.h"
+#include "experiments/cli/ListCommand.h"
+#include "experiments/compare/DiffCommand.h"
+#include "experiments/render/RenderCommand.h"
+#include "experiments/render/RenderPlan.h"
+#include "experiments/report/ReportCommand.h"
 #include "experiments/studies/DepthStudy.h"
 #include "experiments/studies/NormalStudy.h"
+#include "experiments/sweep/JobProcess.h"
+#include "experiments/sweep/SweepFile.h"
+#include "experiments/sweep/SweepRunner.h"
 #include "gbuffer/LayoutDerivation.h"
-#include "scenes/ClosestName.h"
+#include "scenes/input/ClosestName.h"
 
 namespace {
 
@@ -178,7 +178,7 @@ std::string parseErrorMessage(CLI::App& app, const CLI::ParseError& error, int a
 
 int main(int argc, char** argv) {
     // Before anything of ours starts a thread: sweep jobs fork only while none has
-    // (experiments/JobProcess.h).
+    // (experiments/sweep/JobProcess.h).
     experiments::noteStartupThreads();
     // Named, so that help texts say `testbed`, not the path the binary was started by.
     CLI::App app{"testbed: CPU rasterizer research testbed for deferred shading", "testbed"};
@@ -305,7 +305,8 @@ int main(int argc, char** argv) {
     sweep->add_flag("--wait", sweepOptions.waitForLock,
                     "when another sweep is running the same jobs into --out, wait for it to end "
                     "(default: refuse, naming its process)");
-    // The child process of one sweep job (experiments/JobProcess.h): not for users, not in --help.
+    // The child process of one sweep job (experiments/sweep/JobProcess.h): not for users, not in
+    // --help.
     std::string sweepJobText;
     long sweepJobParent = 0;
     int sweepJobReportFd = -1;
@@ -361,8 +362,8 @@ int main(int argc, char** argv) {
                 return experiments::reportError(error);
             sweepOptions.jobTimeoutSeconds = sweepJobTimeout;
         }
-        // Every job in a child process (experiments/JobProcess.h): forked, or this very binary
-        // (even if the file is rebuilt meanwhile).
+        // Every job in a child process (experiments/sweep/JobProcess.h): forked, or this very
+        // binary (even if the file is rebuilt meanwhile).
         sweepOptions.isolation = experiments::JobIsolation::Fork;
         sweepOptions.jobExecutable = "/proc/self/exe";
         return experiments::runSweepCommand(sweepOptions);

@@ -1,4 +1,4 @@
-#include "lighting/LightList.h"
+#include "lighting/culling/LightList.h"
 
 namespace lighting {
 

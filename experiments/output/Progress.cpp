@@ -1,4 +1,4 @@
-#include "experiments/Progress.h"
+#include "experiments/output/Progress.h"
 
 #include <cmath>
 #include <cstdio>

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "experiments/Progress.h"
+#include "experiments/output/Progress.h"
 
 namespace experiments {
 namespace {

@@ -1,7 +1,7 @@
 #include "lighting/Oracle.h"
 
-#include "lighting/BlendedPass.h"
-#include "lighting/EveryLight.h"
+#include "lighting/lists/EveryLight.h"
+#include "lighting/passes/BlendedPass.h"
 
 namespace lighting {
 

@@ -1,11 +1,11 @@
-#include "lighting/BlendedTileLists.h"
+#include "lighting/culling/BlendedTileLists.h"
 
 #include <algorithm>
 
 #include <tbb/parallel_for.h>
 
 #include "gbuffer/GBufferLayout.h"
-#include "lighting/LightBounds.h"
+#include "lighting/culling/LightBounds.h"
 
 namespace lighting {
 

@@ -1,0 +1,50 @@
+// ImageMetrics: the error of an image against its reference, as every command that compares
+// computes it (render --compare-reference, diff, sweep rows through RunMetrics): RMSE, relative
+// RMSE, PSNR, the largest and the 99th-percentile absolute difference, the relative mean, and the
+// mean HDR-ꟻLIP. Pure functions of two images; never run inside a stage's timed passes.
+// Thread safety: values; compareImages runs ImageBufAlgo on the calling thread's pool.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "lighting/ShadingStage.h"
+
+namespace experiments {
+
+// Output names of the error figures, shared by stats.json, diff.json and the sweep's result
+// columns (RunMetrics.h has the run's other figures in the same namespace).
+namespace metric {
+inline constexpr const char* kRmse = "rmse";
+inline constexpr const char* kRelativeRmse = "relative_rmse";
+inline constexpr const char* kPsnr = "psnr";
+inline constexpr const char* kMaxAbs = "max_abs";
+inline constexpr const char* kRelativeMean = "relative_mean";
+inline constexpr const char* kP99Abs = "p99_abs";
+inline constexpr const char* kFlip = "flip";
+inline constexpr const char* kFlipUnavailable = "flip_unavailable";
+} // namespace metric
+
+// Over all pixels and the three colour channels.
+struct ErrorMetrics {
+    double rmse = 0.0;
+    double relativeRmse = 0.0; // rmse / rms of the reference
+    double maxAbs = 0.0;
+    double psnr = 0.0;           // dB, peak = the reference's maximum channel value
+    double relativeMean = 0.0;   // mean |image - reference| / mean |reference|
+    double p99Abs = 0.0;         // 99th percentile of |image - reference|
+    std::optional<double> flip;  // mean HDR-ꟻLIP (FlipMetric.h); nullopt when not computed
+    std::string flipUnavailable; // why flip is missing ("" when computed)
+};
+
+ErrorMetrics compareImages(const lighting::StageResult& image,
+                           const lighting::StageResult& reference);
+
+// A note when the error is large but sits in under 1% of the samples (relative RMSE above 0.1
+// while the 99th percentile is below 1% of the largest error): a sharp highlight that a
+// reduced-resolution stage (inferred) misplaces dominates the RMSE of a dark frame while 99% of
+// the samples are nearly exact, and a relative RMSE near 1 would read as a broken image. Empty
+// otherwise.
+std::string errorConcentrationNote(const ErrorMetrics& error);
+
+} // namespace experiments
