@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 
 #include "experiments/CommandErrors.h"
+#include "experiments/advise/Advisor.h"
 #include "experiments/cli/ListCommand.h"
 #include "experiments/compare/DiffCommand.h"
 #include "experiments/render/RenderCommand.h"
@@ -219,6 +220,22 @@ int main(int argc, char** argv) {
             "scale of the error maps: linear or log (default: the sweep file's error-scale, else "
             "linear)")
         ->check(CLI::IsMember({"linear", "log"}));
+    experiments::AdviseCommandOptions adviseOptions;
+    std::vector<std::string> adviseGroups;
+    CLI::App* advise = app.add_subcommand(
+        "advise", "which stage and layout for a time and error budget, from a finished sweep");
+    advise->add_option("dir", adviseOptions.dir, "results folder (holds results.json)")->required();
+    advise
+        ->add_option("--budget-ms", adviseOptions.criteria.budgetMs,
+                     "frame-time budget in ms (median total time)")
+        ->required();
+    CLI::Option* maxFlip = advise->add_option("--max-flip", adviseOptions.criteria.maxFlip,
+                                              "error budget: mean HDR-FLIP at most this (0..1)");
+    CLI::Option* maxRmse = advise->add_option("--max-rmse", adviseOptions.criteria.maxRelativeRmse,
+                                              "error budget: relative RMSE at most this");
+    maxFlip->excludes(maxRmse);
+    advise->add_option("--group", adviseGroups,
+                       "only groups with this setting, KEY=VALUE (repeatable), e.g. lights=256");
     experiments::DiffCommandOptions diffOptions;
     CLI::App* diff =
         app.add_subcommand("diff", "image-diff report of two EXRs (B is the reference)");
@@ -342,6 +359,16 @@ int main(int argc, char** argv) {
         return experiments::runListCommand(listViewsScene);
     if (report->parsed())
         return experiments::runReportCommand(reportOptions);
+    if (advise->parsed()) {
+        for (const std::string& filter : adviseGroups) {
+            const size_t equals = filter.find('=');
+            if (equals == std::string::npos || equals == 0)
+                return experiments::reportError("--group " + filter + ": expected KEY=VALUE");
+            adviseOptions.criteria.groupFilters.emplace_back(filter.substr(0, equals),
+                                                             filter.substr(equals + 1));
+        }
+        return experiments::runAdviseCommand(adviseOptions);
+    }
     if (diff->parsed())
         return experiments::runDiffCommand(diffOptions);
     if (depth->parsed())

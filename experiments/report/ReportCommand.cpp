@@ -23,6 +23,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 
 #include "experiments/CommandErrors.h"
+#include "experiments/advise/Advisor.h"
 #include "experiments/compare/FlipMetric.h"
 #include "experiments/output/AtomicFile.h"
 #include "experiments/output/ImageOutput.h"
@@ -661,6 +662,14 @@ int runReportCommand(const ReportCommandOptions& options) {
             html << "<a href=\"#views\">across views</a> &middot; ";
         html << "<a href=\"#across\">across groups</a> &middot; <a href=\"#results\">results "
                 "table</a></p>\n";
+        // The advisor's answer, when `testbed advise DIR` has written one.
+        if (fs::is_regular_file(dir / "advice.json")) {
+            html << adviceHtml(readJsonFile(dir / "advice.json"));
+        } else {
+            html << "<p class=\"note\">No advice yet: <code>testbed advise "
+                 << htmlEscape(dir.string())
+                 << " --budget-ms X [--max-flip Y]</code> writes advice.json, shown here.</p>\n";
+        }
         if (!publishedTables.empty()) {
             html << "<h2 id=\"published\">Published vs measured</h2>\n";
             for (size_t i = 0; i < publishedTables.size(); ++i)
