@@ -12,7 +12,7 @@
 # installed. The one download from elsewhere is NVIDIA's ꟻLIP
 # (the Python package flip-evaluator, from the Python package index) into the project-local
 # virtual environment .venv/; when the index cannot be reached, ꟻLIP is reported unavailable in
-# every output (experiments/FlipMetric.h) and nothing else changes.
+# every output (experiments/compare/FlipMetric.h) and nothing else changes.
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -129,7 +129,7 @@ if [ "$mode" = fuzz ]; then
 fi
 
 # ꟻLIP: a venv that sees Debian's numpy; a failed install (offline machine) is not an error.
-flip_version=1.6.0.1 # experiments/FlipMetric.h kFlipEvaluatorVersion
+flip_version=1.6.0.1 # experiments/compare/FlipMetric.h kFlipEvaluatorVersion
 if ! .venv/bin/python3 -c "import flip_evaluator" 2>/dev/null; then
     python3 -m venv --system-site-packages .venv
     .venv/bin/python3 -m pip install --quiet --timeout 20 --retries 1 \
@@ -139,12 +139,17 @@ if ! .venv/bin/python3 -c "import flip_evaluator" 2>/dev/null; then
 fi
 
 cmake -S . -B build "${launcher[@]}" -DCMAKE_BUILD_TYPE=Release
-cmake --build build -j"$(nproc)"
 
 if [ "$mode" = test ]; then
+    # Every target: the tests, the benchmarks and the testbed the end-to-end tests run.
+    cmake --build build -j"$(nproc)"
     cd build
     exec ctest --output-on-failure -j"$(nproc)"
 fi
+
+# The main job needs only the testbed: the tests and benchmarks are built by ./run.sh test (in
+# the same build/, so either command may run first).
+cmake --build build -j"$(nproc)" --target testbed
 
 out=out/default
 build/bin/testbed render --compare-reference --out "$out"
