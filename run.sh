@@ -9,10 +9,7 @@
 #                   package, because Debian's libtbb is not instrumented: see tests/tsan.supp)
 #   ./run.sh fuzz [SECONDS]  every libFuzzer target for SECONDS each (default 600) in build-asan/
 # Only missing Debian packages (and, for sanitize, Debian's oneTBB source package) are
-# installed. The one download from elsewhere is NVIDIA's ꟻLIP
-# (the Python package flip-evaluator, from the Python package index) into the project-local
-# virtual environment .venv/; when the index cannot be reached, ꟻLIP is reported unavailable in
-# every output (experiments/compare/FlipMetric.h) and nothing else changes.
+# installed; nothing else is downloaded (ꟻLIP is the testbed's own, experiments/compare/Flip.h).
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -27,7 +24,6 @@ packages=(
     libtomlplusplus-dev libstb-dev
     clang-14 libclang-rt-14-dev ccache
     python3-matplotlib chromium
-    python3-venv python3-pip
     slurm-wlm munge parallel # the sweep recipes run for real (tests/experiments/cluster_*_test.sh)
 )
 missing=()
@@ -126,16 +122,6 @@ fi
 if [ "$mode" = fuzz ]; then
     build_asan testbed gltf_fuzzer json_scene_fuzzer sweep_fuzzer exr_fuzzer
     exec tests/fuzz/run_fuzzers.sh build-asan "${2:-600}"
-fi
-
-# ꟻLIP: a venv that sees Debian's numpy; a failed install (offline machine) is not an error.
-flip_version=1.6.0.1 # experiments/compare/FlipMetric.h kFlipEvaluatorVersion
-if ! .venv/bin/python3 -c "import flip_evaluator" 2>/dev/null; then
-    python3 -m venv --system-site-packages .venv
-    .venv/bin/python3 -m pip install --quiet --timeout 20 --retries 1 \
-        "flip-evaluator==$flip_version" \
-        || echo "run.sh: cannot install flip-evaluator==$flip_version (no access to the Python" \
-                "package index?): FLIP will be reported unavailable" >&2
 fi
 
 cmake -S . -B build "${launcher[@]}" -DCMAKE_BUILD_TYPE=Release

@@ -207,7 +207,7 @@ int main(int argc, char** argv) {
         ->add_option("--thumbnail-width", reportOptions.thumbnailWidth, "thumbnail width in pixels")
         ->capture_default_str();
     report
-        ->add_option("--error-metric", reportOptions.errorMetric,
+        ->add_option("--error-metric,--metric", reportOptions.errorMetric,
                      "y axis of the Pareto plots: relative_rmse, rmse, flip, psnr, max_abs, "
                      "relative_mean or p99_abs")
         ->capture_default_str();

@@ -238,8 +238,11 @@ std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
             "PSNR peak = "
             "the largest channel value of B.</p>\n";
     if (m.flip)
-        html << "<p>ꟻLIP: mean HDR-ꟻLIP of A against B, by NVIDIA's flip-evaluator "
-             << htmlEscape(diff.flipParameters.value("version", "?")) << " ("
+        html << "<p>ꟻLIP: mean HDR-ꟻLIP of A against B " << formatNumber(*m.flip)
+             << ", weighted median " << formatNumber(m.flipWeightedMedian.value_or(0.0))
+             << ", 95th percentile " << formatNumber(m.flipP95.value_or(0.0))
+             << ", 99th percentile " << formatNumber(m.flipP99.value_or(0.0))
+             << " (the testbed's HDR-ꟻLIP, experiments/compare/Flip.h; parameters: "
              << htmlEscape(diff.flipParameters.dump()) << ").</p>\n";
     else
         html << "<p class=\"flip-unavailable\"><b>ꟻLIP unavailable:</b> "
@@ -493,8 +496,11 @@ ImageDiff diffImageFiles(const fs::path& aPath, const fs::path& bPath) {
     lighting::StageResult resultA = beautyAsStageResult(rgbA), resultB = beautyAsStageResult(rgbB);
     DiffMetrics& m = diff.metrics;
     static_cast<ErrorMetrics&>(m) = compareImages(resultA, resultB);
-    FlipResult flip = computeFlip(resultA, resultB);
+    FlipComparison flip = computeFlip(resultA, resultB);
     m.flip = flip.mean;
+    m.flipWeightedMedian = flip.weightedMedian;
+    m.flipP95 = flip.p95;
+    m.flipP99 = flip.p99;
     m.flipUnavailable = flip.unavailableReason;
     diff.flipMap = std::move(flip.errorMap);
     diff.flipParameters = std::move(flip.parameters);
@@ -585,6 +591,10 @@ json diffJson(const ImageDiff& diff, const fs::path& a, const fs::path& b) {
               {"relative_mean", m.relativeMean},
               {"p99_abs", m.p99Abs},
               {metric::kFlip, m.flip ? json(*m.flip) : json()},
+              {metric::kFlipWeightedMedian,
+               m.flipWeightedMedian ? json(*m.flipWeightedMedian) : json()},
+              {metric::kFlipP95, m.flipP95 ? json(*m.flipP95) : json()},
+              {metric::kFlipP99, m.flipP99 ? json(*m.flipP99) : json()},
               {metric::kFlipUnavailable, m.flipUnavailable},
               {"flip_parameters", diff.flipParameters}}},
             {"channels", channels},

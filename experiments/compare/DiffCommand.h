@@ -10,9 +10,9 @@
 //   DIR/absdiff.png    max over R,G,B of |A - B|, turbo colour map from 0 to max_abs with a colour
 //                      bar (matplotlib, experiments/plots/report.py diff)
 //   DIR/absdiff.exr    |A - B| per beauty channel as float32 R, G, B, for inspection in a viewer
-//   DIR/flip.png       the HDR-ꟻLIP map of A against B (magma, 0..1, with a legend), when the
-//                      package flip-evaluator is installed (FlipMetric.h); otherwise the page and
-//                      diff.json say why ꟻLIP is unavailable
+//   DIR/flip.png       the HDR-ꟻLIP map of A against B (magma, 0..1, with a legend; FlipMetric.h);
+//                      images that cannot be compared (different sizes) have none, and the page and
+//                      diff.json say why
 //
 // B is the reference of the metrics, which are the sweep's error metrics (experiments::
 // compareImages on the beauty R, G, B, through OpenImageIO's ImageBufAlgo), so a diff of a job's
@@ -22,9 +22,10 @@
 //   p99_abs                              99th percentile of |A - B| over the R, G, B samples
 //                                        (nearest rank)
 //   mean_abs                             mean of |A - B| over the R, G, B samples
-//   flip                                 mean HDR-ꟻLIP of A against B (null when unavailable,
-//                                        with flip_unavailable saying why; flip_parameters
-//                                        say what the package assumed)
+//   flip, flip_weighted_median,          HDR-ꟻLIP of A against B (experiments/compare/Flip.h):
+//   flip_p95, flip_p99                   mean, weighted median and percentiles (null when the
+//                                        images cannot be compared, with flip_unavailable saying
+//                                        why); flip_parameters say what was assumed
 // Per-channel statistics cover every channel present in both files (N.X, Z, albedo.R,
 // lights.evaluated, ...), through ImageBufAlgo::computePixelStats on A, B, A - B and |A - B|;
 // min/max/mean are over the finite values, nan/inf count the others.

@@ -22,6 +22,9 @@ inline constexpr const char* kMaxAbs = "max_abs";
 inline constexpr const char* kRelativeMean = "relative_mean";
 inline constexpr const char* kP99Abs = "p99_abs";
 inline constexpr const char* kFlip = "flip";
+inline constexpr const char* kFlipWeightedMedian = "flip_weighted_median";
+inline constexpr const char* kFlipP95 = "flip_p95";
+inline constexpr const char* kFlipP99 = "flip_p99";
 inline constexpr const char* kFlipUnavailable = "flip_unavailable";
 } // namespace metric
 
@@ -30,10 +33,11 @@ struct ErrorMetrics {
     double rmse = 0.0;
     double relativeRmse = 0.0; // rmse / rms of the reference
     double maxAbs = 0.0;
-    double psnr = 0.0;           // dB, peak = the reference's maximum channel value
-    double relativeMean = 0.0;   // mean |image - reference| / mean |reference|
-    double p99Abs = 0.0;         // 99th percentile of |image - reference|
-    std::optional<double> flip;  // mean HDR-ꟻLIP (FlipMetric.h); nullopt when not computed
+    double psnr = 0.0;          // dB, peak = the reference's maximum channel value
+    double relativeMean = 0.0;  // mean |image - reference| / mean |reference|
+    double p99Abs = 0.0;        // 99th percentile of |image - reference|
+    std::optional<double> flip; // mean HDR-ꟻLIP (FlipMetric.h); nullopt when not computed
+    std::optional<double> flipWeightedMedian, flipP95, flipP99; // its percentiles (Flip.h)
     std::string flipUnavailable; // why flip is missing ("" when computed)
 };
 

@@ -75,6 +75,27 @@ function toggleColumns(button) {
   var compact = table.classList.toggle('compact');
   button.textContent = compact ? 'Show all columns' : 'Show the main columns only';
 }
+// Clicking a results-table header sorts the rows by that column: numbers numerically (missing
+// values last), text alphabetically; a second click reverses the order.
+function sortResults(header) {
+  var table = document.getElementById('results-table');
+  var index = Array.prototype.indexOf.call(header.parentNode.children, header);
+  var rows = Array.prototype.slice.call(table.rows, 1);
+  var descending = header.getAttribute('data-sorted') === 'ascending';
+  var key = function (row) {
+    var text = row.cells[index] ? row.cells[index].textContent : '';
+    var number = parseFloat(text);
+    return isNaN(number) ? text : number;
+  };
+  rows.sort(function (a, b) {
+    var x = key(a), y = key(b);
+    if (typeof x !== typeof y) return typeof x === 'number' ? -1 : 1;
+    var order = x < y ? -1 : x > y ? 1 : 0;
+    return descending ? -order : order;
+  });
+  rows.forEach(function (row) { table.tBodies[0].appendChild(row); });
+  header.setAttribute('data-sorted', descending ? 'descending' : 'ascending');
+}
 </script>
 )";
 

@@ -146,8 +146,10 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
         if (const std::string note = errorConcentrationNote(*error); !note.empty())
             std::cout << "    (" << note << ")\n";
         if (error->flip)
-            std::cout << "  HDR-FLIP (flip-evaluator " << run.flipParameters.value("version", "?")
-                      << "): mean " << std::fixed << std::setprecision(4) << *error->flip << "\n";
+            std::cout << "  HDR-FLIP: mean " << std::fixed << std::setprecision(4) << *error->flip
+                      << ", weighted median " << error->flipWeightedMedian.value_or(0.0) << ", p95 "
+                      << error->flipP95.value_or(0.0) << ", p99 " << error->flipP99.value_or(0.0)
+                      << std::defaultfloat << "\n";
         else
             std::cout << "  HDR-FLIP: unavailable: " << error->flipUnavailable << "\n";
     }
@@ -213,7 +215,7 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         {"testbed:stats", stats.dump()},
         {"testbed:Z", "view-space depth in metres decoded from the G-buffer, 0 = background"},
         {"testbed:error", "error.R,G,B = |R,G,B - reference| (double-precision reference)"},
-        {"testbed:flip", "flip = HDR-FLIP per pixel against the reference, 0..1 (flip-evaluator)"},
+        {"testbed:flip", "flip = HDR-FLIP per pixel against the reference, 0..1"},
         {"testbed:lights.wasted",
          "lights.evaluated - lights.oracle at the pixels the stage lit; 0 at pixels a "
          "reduced-resolution stage only filtered"},
@@ -290,8 +292,8 @@ void addTimings(nlohmann::json& stats, const RenderRun& run) {
 }
 
 // The error figures; psnr is +inf for identical images, written as "inf" (JSON has no infinity);
-// flip is null when unavailable, with flip_unavailable saying why, else flip_parameters say what
-// flip-evaluator assumed.
+// flip (and its percentiles) is null when it could not be computed, with flip_unavailable saying
+// why, else flip_parameters say what was assumed (exposures, pixels per degree, warnings).
 nlohmann::json errorJson(const RenderRun& run) {
     const RunMetrics& metrics = run.metrics;
     nlohmann::json error = {{"reference", "reference"}};

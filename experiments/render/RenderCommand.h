@@ -6,7 +6,7 @@
 //   heatmap.png  lights evaluated per pixel, false colour with a legend
 //   error.png    with a reference: the largest channel |render - reference| per pixel, false
 //                colour with a legend, linear or log scale (RenderOutputScales)
-//   flip.png     with a reference and flip-evaluator: the HDR-ꟻLIP map, magma from 0 to 1
+//   flip.png     with a reference: the HDR-ꟻLIP map, magma from 0 to 1
 //   stats.json   configuration, machine, commit, timings, light counts, error metrics
 // The command plans the render (RenderPlan.h: options validated once, scene loaded, layout
 // derived), checks the output folder for writability, then runs the plan (RenderJob.h). Every

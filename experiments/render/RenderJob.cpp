@@ -166,11 +166,14 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
             fillReference(run, plan.stage->name(), givenReference);
             referenceMs = millisecondsSince(start);
             error = compareImages(run.result, run.reference);
-            step("HDR-FLIP (flip-evaluator)");
+            step("HDR-FLIP");
             start = Clock::now();
-            FlipResult flip = computeFlip(run.result, run.reference);
+            FlipComparison flip = computeFlip(run.result, run.reference);
             flipMs = millisecondsSince(start);
             error->flip = flip.mean;
+            error->flipWeightedMedian = flip.weightedMedian;
+            error->flipP95 = flip.p95;
+            error->flipP99 = flip.p99;
             error->flipUnavailable = flip.unavailableReason;
             run.flipMap = std::move(flip.errorMap);
             run.flipParameters = std::move(flip.parameters);

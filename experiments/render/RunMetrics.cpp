@@ -124,13 +124,17 @@ void RunMetrics::setSimtModel(const std::map<std::string, std::string>& stagePar
 std::vector<NamedFigure> RunMetrics::errorFigures() const {
     if (!error)
         return {};
+    constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
     return {{metric::kRmse, error->rmse},
             {metric::kRelativeRmse, error->relativeRmse},
             {metric::kPsnr, error->psnr},
             {metric::kMaxAbs, error->maxAbs},
             {metric::kRelativeMean, error->relativeMean},
             {metric::kP99Abs, error->p99Abs},
-            {metric::kFlip, error->flip ? *error->flip : std::numeric_limits<double>::quiet_NaN()}};
+            {metric::kFlip, error->flip.value_or(kMissing)},
+            {metric::kFlipWeightedMedian, error->flipWeightedMedian.value_or(kMissing)},
+            {metric::kFlipP95, error->flipP95.value_or(kMissing)},
+            {metric::kFlipP99, error->flipP99.value_or(kMissing)}};
 }
 
 std::vector<std::string> runFigureColumns() {

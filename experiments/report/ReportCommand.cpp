@@ -162,7 +162,8 @@ void appendResultsTable(std::ostringstream& html, const json& jobs,
     auto cellClass = [&](size_t index) { return index < mainCount - 1 ? "" : " extra"; };
     for (size_t i = 0; i < ordered.size(); ++i) {
         html << "<th class=\"col" << cellClass(i) << "\" data-column=\"" << htmlEscape(ordered[i])
-             << "\">" << htmlEscape(ordered[i]) << "</th>";
+             << "\" onclick=\"sortResults(this)\" title=\"sort by this column\">"
+             << htmlEscape(ordered[i]) << "</th>";
         if (ordered[i] == "job_id")
             html << "<th class=\"col\" data-column=\"group\">group</th>";
     }

@@ -121,23 +121,41 @@ TEST(RunMetrics, AnErrorInUnderOnePercentOfTheSamplesIsSaidToBeSo) {
 TEST(RunMetrics, FlipIsAnErrorFigureAndNaNWhenUnavailable) {
     RunMetrics metrics;
     metrics.error = experiments::ErrorMetrics{};
-    metrics.error->flipUnavailable = "not installed";
+    metrics.error->flipUnavailable = "images differ in size";
+    // The mean and its percentiles, in this order, last among the error figures.
+    auto figure = [&](const std::string& name) {
+        for (const experiments::NamedFigure& f : metrics.errorFigures())
+            if (name == f.name)
+                return f.value;
+        ADD_FAILURE() << "no figure " << name;
+        return 0.0;
+    };
     const std::vector<experiments::NamedFigure> figures = metrics.errorFigures();
-    ASSERT_EQ(std::string(figures.back().name), "flip");
-    EXPECT_TRUE(std::isnan(figures.back().value));
+    ASSERT_GE(figures.size(), 4u);
+    EXPECT_EQ(std::string(figures[figures.size() - 4].name), "flip");
+    EXPECT_EQ(std::string(figures.back().name), "flip_p99");
+    for (const char* name : {"flip", "flip_weighted_median", "flip_p95", "flip_p99"})
+        EXPECT_TRUE(std::isnan(figure(name))) << name;
     metrics.error->flip = 0.25;
-    EXPECT_EQ(metrics.errorFigures().back().value, 0.25);
+    metrics.error->flipWeightedMedian = 0.5;
+    metrics.error->flipP95 = 0.75;
+    metrics.error->flipP99 = 0.875;
+    EXPECT_EQ(figure("flip"), 0.25);
+    EXPECT_EQ(figure("flip_weighted_median"), 0.5);
+    EXPECT_EQ(figure("flip_p95"), 0.75);
+    EXPECT_EQ(figure("flip_p99"), 0.875);
 }
 
 TEST(RunMetrics, TheTableColumnsAreTheRecordsFigures) {
     const std::vector<std::string> columns = experiments::metricColumns({});
     const std::vector<std::string> figures = experiments::runFigureColumns();
     EXPECT_EQ(columns, figures);
-    EXPECT_EQ(figures, (std::vector<std::string>{
-                           "light_evaluations", "oracle_light_evaluations", "culling_efficiency",
-                           "counted_pixels", "simt_lane_slots", "simt_efficiency",
-                           "bytes_per_pixel", "rmse", "relative_rmse", "psnr", "max_abs",
-                           "relative_mean", "p99_abs", "flip", "flip_unavailable"}));
+    EXPECT_EQ(figures,
+              (std::vector<std::string>{
+                  "light_evaluations", "oracle_light_evaluations", "culling_efficiency",
+                  "counted_pixels", "simt_lane_slots", "simt_efficiency", "bytes_per_pixel", "rmse",
+                  "relative_rmse", "psnr", "max_abs", "relative_mean", "p99_abs", "flip",
+                  "flip_weighted_median", "flip_p95", "flip_p99", "flip_unavailable"}));
 }
 
 } // namespace

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "experiments/advise/Advisor.h"
 #include "experiments/output/ImageOutput.h"
 #include "experiments/report/ReportCommand.h"
 #include "tests/experiments/TestFolders.h"
@@ -199,8 +200,8 @@ TEST(ReportPublished, MalformedEntriesAreRefusedByName) {
 // so three comparable groups of two) with tiny images, one failed job without a folder; job 0005
 // lacks error.png. Jobs 0000-0003 also have a render.exr whose lights.evaluated peak at
 // 8 * (ordinal + 1) and whose error peaks at 0.01 * (ordinal + 1), so that the report redraws
-// their maps at their group's scale; ꟻLIP is unavailable (null, with a reason) as on a machine
-// without flip-evaluator.
+// their maps at their group's scale; ꟻLIP is unavailable (null, with a reason), as for images
+// that could not be compared (withFlip below gives every ok job a known ꟻLIP).
 fs::path writeResultsFolder(const fs::path& dir, bool singleJob) {
     const int w = 32, h = 18;
     std::vector<float> red(w * h), green(w * h), blue(w * h);
@@ -438,9 +439,9 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
     // The table: the compared columns first, the rest behind the toggle; ꟻLIP among the first,
     // and a visible note saying why it is empty.
     EXPECT_NE(html.find("id=\"toggle-columns\""), std::string::npos);
-    EXPECT_NE(html.find("<th class=\"col\" data-column=\"flip\">"), std::string::npos);
-    EXPECT_NE(html.find("<th class=\"col\" data-column=\"relative_rmse\">"), std::string::npos);
-    EXPECT_NE(html.find("<th class=\"col extra\" data-column=\"psnr\">"), std::string::npos);
+    EXPECT_NE(html.find("<th class=\"col\" data-column=\"flip\""), std::string::npos);
+    EXPECT_NE(html.find("<th class=\"col\" data-column=\"relative_rmse\""), std::string::npos);
+    EXPECT_NE(html.find("<th class=\"col extra\" data-column=\"psnr\""), std::string::npos);
     EXPECT_NE(html.find("id=\"flip-note\""), std::string::npos);
     EXPECT_NE(html.find("flip-evaluator is not installed &lt;here&gt;"), std::string::npos);
     EXPECT_EQ(html.find("id=\"counts-note\""), std::string::npos) << "every job counts every pixel";
@@ -451,7 +452,7 @@ TEST(ReportCommand, WritesThePageWithTablesPlotsAndThumbnails) {
     // among the main columns.
     EXPECT_NEAR(published[0]["rows"][0]["cells"][1]["modelled_ratio"].get<double>(), 0.3, 1e-12);
     EXPECT_NE(html.find("<th>modelled ratio</th>"), std::string::npos);
-    EXPECT_NE(html.find("<th class=\"col\" data-column=\"simt_efficiency\">"), std::string::npos);
+    EXPECT_NE(html.find("<th class=\"col\" data-column=\"simt_efficiency\""), std::string::npos);
 }
 
 TEST(ReportCommand, SingleValuedAxesSayNotEnoughDataInsteadOfEmptyPlots) {
@@ -537,6 +538,63 @@ TEST(ReportCommand, TheErrorMetricIsTheUsersChoiceAndFlipSaysWhyItIsMissing) {
     const std::string error = testing::internal::GetCapturedStderr();
     EXPECT_NE(error.find("--error-metric 'speed' is not an error column"), std::string::npos)
         << error;
+}
+
+// The results of writeResultsFolder with a known ꟻLIP per ok job: tiled 0.02, brute 0.001.
+void withFlip(const fs::path& dir) {
+    json results = json::parse(readText(dir / "results.json"));
+    // What the sweep runner writes and the advisor requires (the report guesses without it).
+    results["axis_columns"] = {"scene", "stage", "lights", "width", "height", "repetitions"};
+    results["sweep_file"] = "hand-made";
+    results["quick"] = false;
+    if (!results.contains("sweep"))
+        results["sweep"] = json::object();
+    for (json& job : results["jobs"]) {
+        if (job["status"] != "ok")
+            continue;
+        job["flip"] = job["stage"] == "tiled" ? 0.02 : 0.001;
+        job["flip_unavailable"] = "";
+    }
+    std::ofstream(dir / "results.json") << results.dump();
+}
+
+// ꟻLIP as a column and a Pareto axis, and the advisor's section once `advise` has run: tiled is
+// 4x faster than brute at every light count (0.5 vs 2 ms per light), and within flip <= 0.05 it
+// is the fastest; within 40 ms the least error is brute at 16 lights (32 ms), tiled above.
+TEST(ReportCommand, FlipIsAColumnAndAParetoAxisAndTheAdviceIsASection) {
+    const fs::path dir = writeResultsFolder(freshTestFolder(), false);
+    withFlip(dir);
+    ReportCommandOptions options;
+    options.dir = dir;
+    options.errorMetric = "flip";
+    ASSERT_EQ(runReportCommand(options), 0);
+    std::string html = readText(dir / "report.html");
+    EXPECT_NE(html.find("<th class=\"col\" data-column=\"flip\""), std::string::npos);
+    EXPECT_EQ(html.find("id=\"flip-note\""), std::string::npos) << "every job has ꟻLIP";
+    EXPECT_NE(html.find("No advice yet"), std::string::npos);
+    const json manifest = json::parse(readText(dir / "report" / "plots.json"));
+    size_t paretoPlots = 0;
+    for (const json& plot : manifest["plots"])
+        paretoPlots += plot["kind"] == "pareto";
+    EXPECT_EQ(paretoPlots, 3u) << manifest.dump();
+
+    AdviseCommandOptions advise;
+    advise.dir = dir;
+    advise.criteria.budgetMs = 40;
+    advise.criteria.maxFlip = 0.05;
+    testing::internal::CaptureStdout();
+    ASSERT_EQ(runAdviseCommand(advise), 0);
+    const std::string text = testing::internal::GetCapturedStdout();
+    EXPECT_NE(text.find("tiled"), std::string::npos) << text;
+    ASSERT_EQ(runReportCommand(options), 0);
+    html = readText(dir / "report.html");
+    EXPECT_NE(html.find("<h2 id=\"advice\">Advice</h2>"), std::string::npos);
+    EXPECT_EQ(html.find("No advice yet"), std::string::npos);
+    // 16 lights: brute 32 ms (28.8-38.4), tiled 11 ms (9.9-13.2): tiled 2.91x faster; the least
+    // ꟻLIP within 40 ms is brute's 0.001.
+    EXPECT_NE(html.find("<b>tiled</b> 11 ms"), std::string::npos);
+    EXPECT_NE(html.find("2.91&times; faster than brute"), std::string::npos);
+    EXPECT_NE(html.find("<b>brute</b> 32 ms"), std::string::npos);
 }
 
 // Views: each view is its own comparable group (no Pareto plot pools views), and the views are

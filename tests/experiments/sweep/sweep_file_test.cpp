@@ -476,9 +476,7 @@ TEST(SweepFile, ShardsPartitionTheJobs) {
 // The reproductions in experiments/sweeps (full and --quick) expand into valid jobs: a renamed
 // stage, encoding or option breaks this test, not a sweep after an hour.
 TEST(SweepFile, ReproductionSweepsAreValid) {
-    const fs::path folder =
-        fs::path(__FILE__).parent_path().parent_path().parent_path().parent_path() / "experiments" /
-        "sweeps";
+    const fs::path folder = fs::path(TESTBED_SOURCE_DIR) / "experiments" / "sweeps";
     ASSERT_TRUE(fs::is_directory(folder)) << folder;
     size_t files = 0;
     for (const auto& entry : fs::directory_iterator(folder)) {
