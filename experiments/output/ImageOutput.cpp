@@ -526,7 +526,12 @@ void writeScalarMapPng(const fs::path& path, int width, int height, const float*
         fillRect(canvas, kLegendTextColour, x, x + 1, barY1, barY1 + kTickLength);
         drawLabel(path, canvas, x, labelTop, label(v));
     };
-    const int labelPitch = topLabelWidth + kLabelGap;
+    // Labels between 0 and the top may be wider than the top's ("0.02" beside "1"): the pitch
+    // takes the widest a 3-digit tick label can be, so labels never overlap.
+    const int tickLabelWidth = std::max(
+        topLabelWidth, style.scale == MapScale::Linear ? textWidth(path, label(double(top) * 0.123))
+                                                       : textWidth(path, "1e-04"));
+    const int labelPitch = tickLabelWidth + kLabelGap;
     const int maxLabelCount = std::max(2, barWidth / labelPitch);
     std::vector<double> ticks;
     if (style.scale == MapScale::Linear) {
