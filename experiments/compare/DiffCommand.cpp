@@ -257,7 +257,9 @@ std::string diffPage(const ImageDiff& diff, const DiffCommandOptions& options) {
          << "<figure><a href=\"absdiff.png\"><img class=\"plot\" src=\"absdiff.png\" "
             "alt=\"|A-B|\"></a>"
             "<figcaption>|A &minus; B|, maximum over R, G, B, linear radiance; the full-precision "
-            "difference is in <a href=\"absdiff.exr\">absdiff.exr</a></figcaption></figure>\n";
+            "difference (and the raw ꟻLIP map, layer flip) is in <a "
+            "href=\"absdiff.exr\">absdiff.exr</a>"
+            "</figcaption></figure>\n";
     if (!diff.flipMap.empty())
         html << "<figure><a href=\"flip.png\"><img class=\"plot\" src=\"flip.png\" "
                 "alt=\"HDR-FLIP map\"></a><figcaption>HDR-ꟻLIP of A against B per pixel "
@@ -613,11 +615,14 @@ int runDiffCommand(const DiffCommandOptions& options) {
                         diff.beautyA[2].data(), options.exposure);
         writePreviewPng(options.out / "b.png", w, h, diff.beautyB[0].data(), diff.beautyB[1].data(),
                         diff.beautyB[2].data(), options.exposure);
+        // |A - B| per channel, and the raw HDR-ꟻLIP map as the layer "flip" when computed.
+        std::vector<ImagePlane> layers = {{"R", diff.absDifference[0].data()},
+                                          {"G", diff.absDifference[1].data()},
+                                          {"B", diff.absDifference[2].data()}};
+        if (!diff.flipMap.empty())
+            layers.push_back({"flip", diff.flipMap.data()});
         writeMultiLayerExr(
-            options.out / "absdiff.exr", w, h,
-            {{"R", diff.absDifference[0].data()},
-             {"G", diff.absDifference[1].data()},
-             {"B", diff.absDifference[2].data()}},
+            options.out / "absdiff.exr", w, h, layers,
             {{"testbed:diff", "|A - B| of " + options.a.string() + " and " + options.b.string()}});
         writeDiffPlot(options, diff, options.out / "absdiff.png");
         const fs::path flipPng = options.out / "flip.png";

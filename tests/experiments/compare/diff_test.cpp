@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -148,6 +149,22 @@ TEST(DiffCommand, WritesPageJsonAndImages) {
     ASSERT_TRUE(result["metrics"]["flip"].is_number()) << result["metrics"].dump();
     for (const char* key : {"flip_weighted_median", "flip_p95", "flip_p99"})
         EXPECT_TRUE(result["metrics"][key].is_number()) << key;
+    // The raw map is the layer "flip" of absdiff.exr, and its mean is the reported mean.
+    {
+        OIIO::ImageBuf exr((options.out / "absdiff.exr").string());
+        ASSERT_TRUE(exr.read(0, 0, true, OIIO::TypeDesc::FLOAT)) << exr.geterror();
+        const int channel = exr.spec().channelindex("flip");
+        ASSERT_GE(channel, 0);
+        double sum = 0.0;
+        std::vector<float> pixel(exr.nchannels());
+        for (int y = 0; y < exr.spec().height; ++y)
+            for (int x = 0; x < exr.spec().width; ++x) {
+                exr.getpixel(x, y, pixel.data());
+                sum += pixel[channel];
+            }
+        EXPECT_NEAR(sum / (double(exr.spec().width) * exr.spec().height),
+                    result["metrics"]["flip"].get<double>(), 1e-6);
+    }
     EXPECT_TRUE(fs::is_regular_file(options.out / "flip.png"));
     EXPECT_NE(html.find("src=\"flip.png\""), std::string::npos);
     EXPECT_NE(html.find("src=\"absdiff.png\""), std::string::npos);
