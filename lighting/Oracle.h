@@ -1,7 +1,15 @@
-// Oracle: how many lights contribute at each pixel, counted by brute force over every light
-// from the G-buffer. Culling stages are checked against it: at every pixel a stage must evaluate
-// at least this many lights. Blended fragments (BlendedPass.h) add their contributing lights at
-// their pixel, as the stages add the lights they evaluate there.
+// Oracle: how many lights contribute at each pixel (a light contributes where its radiance at the
+// pixel's surface from the G-buffer is non-zero: Brdf.h contributes()). Culling stages are
+// checked against it: at every pixel a stage must evaluate at least this many lights. Blended
+// fragments (BlendedPass.h) add their contributing lights at their pixel, as the stages add the
+// lights they evaluate there.
+//
+// countContributingLights is exact and fast: it evaluates only the candidates of a LightGrid
+// (lists/LightGrid.h) over the visible surfaces, a superset of the contributing lights, so its
+// cost grows with the lights near each surface, not with the scene's light count.
+// countContributingLightsBrute evaluates every light at every pixel; the tests hold the two
+// equal pixel by pixel (tests/lighting/stages/stage_exactness_test.cpp).
+// Threads: rows in parallel, each pixel written by one task: no dependence on the thread count.
 #pragma once
 
 #include <cstdint>
@@ -12,5 +20,8 @@
 namespace lighting {
 
 std::vector<uint32_t> countContributingLights(const StageInputs& inputs);
+
+// The same counts by brute force over every light (the grid's check).
+std::vector<uint32_t> countContributingLightsBrute(const StageInputs& inputs);
 
 } // namespace lighting

@@ -275,6 +275,31 @@ INSTANTIATE_TEST_SUITE_P(Scenes, IdealStage,
 
 // The cone bound must cut work: on atrium with spot lights, tiled evaluates markedly fewer lights
 // than it would with the range spheres of point lights at the same places.
+// The oracle's light grid (lighting/lists/LightGrid.h) is exact: its counts equal brute force's
+// at every pixel, on every scene case (points, spots, directional and ambient lights, glTF, blended
+// fragments).
+TEST(Oracle, GridCountsEqualBruteForceOnEveryScene) {
+    for (const SceneCase& c : kScenes) {
+        SCOPED_TRACE(c.name);
+        const PreparedCase& f = prepared(c);
+        EXPECT_EQ(f.oracle, lighting::countContributingLightsBrute(f.prepared->inputs));
+    }
+}
+
+// Many small lights (the count the grid exists for), at a small size so brute force stays quick.
+TEST(Oracle, GridCountsEqualBruteForceWithTwentyThousandLights) {
+    scenes::SceneRequest request;
+    request.lightCount = 20000;
+    request.seed = 5;
+    lighting::PreparedScene frame(scenes::buildProceduralScene("atrium", request), 96, 54);
+    const std::vector<uint32_t> grid = lighting::countContributingLights(frame.inputs);
+    EXPECT_EQ(grid, lighting::countContributingLightsBrute(frame.inputs));
+    uint64_t total = 0;
+    for (uint32_t count : grid)
+        total += count;
+    EXPECT_GT(total, 0u) << "lights reach the surfaces";
+}
+
 TEST(SpotBounds, ConeBoundsCullMoreThanRangeSpheres) {
     const PreparedCase& spots = prepared(kScenes[3]);
     lighting::StageResult withCones;
