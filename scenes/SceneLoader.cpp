@@ -98,7 +98,10 @@ Scene loadScene(const std::string& nameOrPath, const SceneRequest& request) {
         }
         if (lightCount > 0 && !fileHasLights) {
             try {
-                scatterPointLights(scene, defaultScatterFor(scene), lightCount, request.seed);
+                scatterPointLights(
+                    scene,
+                    scatterForDensity(defaultScatterFor(scene), request.lightDensity, lightCount),
+                    lightCount, request.seed);
             } catch (const SceneError& error) {
                 throw SceneError(nameOrPath + ": " + error.what());
             }

@@ -70,6 +70,16 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
     render.add_option("--seed", r.seed, "seed of the light generator")
         ->check(kSeedValidator)
         ->capture_default_str();
+    render
+        .add_option_function<std::string>(
+            "--light-density",
+            [&r](const std::string& text) {
+                experiments::setRenderOption(r, "light-density", text);
+            },
+            "generated lights: fixed (radii from the scene, overlap grows with the count) or "
+            "constant-overlap (radii shrink as the count grows; scenes/SceneRequest.h)")
+        ->default_str("fixed")
+        ->check(CLI::IsMember({"fixed", "constant-overlap"}));
     render.add_option("--width", r.width, "image width in pixels")->capture_default_str();
     render.add_option("--height", r.height, "image height in pixels")->capture_default_str();
     render.add_option("--threads", r.threads, "worker threads, 0 = all hardware threads")

@@ -1,5 +1,7 @@
 #include "experiments/render/RenderCommand.h"
 
+#include "scenes/procedural/LightGenerator.h"
+
 #include "experiments/BuildCommit.h"
 #include "experiments/compare/FlipMetric.h"
 
@@ -358,6 +360,10 @@ nlohmann::json statsJson(const RenderRun& run) {
                                   : "the stage's G-buffer";
     stats[metric::kLightEvaluations] = metrics.lightEvaluations;
     stats[metric::kOracleLightEvaluations] = metrics.oracleLightEvaluations;
+    stats["lights_per_covered_pixel"] = {
+        {"mean", metrics.oracleLightsPerCoveredPixelMean},
+        {"p99", metrics.oracleLightsPerCoveredPixelP99},
+        {"light_density", scenes::lightDensityName(run.options.lightDensity)}};
     stats[metric::kCullingEfficiency] = metrics.cullingEfficiency;
     stats[metric::kCountedPixels] = metrics.countedPixels;
     if (!metrics.lightCountsNote.empty())

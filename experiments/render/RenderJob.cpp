@@ -1,5 +1,6 @@
 #include "experiments/render/RenderJob.h"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -188,6 +189,20 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;
         run.metrics.flipMs = flipMs;
+        std::vector<uint32_t> covered;
+        const gbuffer::GBuffer& gb = run.gbuffer();
+        for (size_t pixel = 0; pixel < run.oracle.size(); ++pixel)
+            if (gb.covered(pixel))
+                covered.push_back(run.oracle[pixel]);
+        if (!covered.empty()) {
+            uint64_t sum = 0;
+            for (uint32_t count : covered)
+                sum += count;
+            run.metrics.oracleLightsPerCoveredPixelMean = double(sum) / double(covered.size());
+            const size_t rank = std::min(covered.size() - 1, size_t(0.99 * covered.size()));
+            std::nth_element(covered.begin(), covered.begin() + rank, covered.end());
+            run.metrics.oracleLightsPerCoveredPixelP99 = covered[rank];
+        }
     });
     return run;
 }

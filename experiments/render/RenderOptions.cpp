@@ -7,6 +7,7 @@
 
 #include "lighting/StageRegistry.h"
 #include "scenes/input/ClosestName.h"
+#include "scenes/procedural/LightGenerator.h"
 #include "scenes/procedural/ProceduralScenes.h"
 
 namespace experiments {
@@ -134,9 +135,25 @@ std::string lightsText(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {"scene",        "stage",   "lights",   "seed",      "width",  "height",
-            "resolution",   "threads", "isa",      "simt-warp", "layout", "normals",
-            "normal-space", "depth",   "position", "view",      "brdf",   "scene-option.<key>"};
+    return {"scene",
+            "stage",
+            "lights",
+            "seed",
+            "light-density",
+            "width",
+            "height",
+            "resolution",
+            "threads",
+            "isa",
+            "simt-warp",
+            "layout",
+            "normals",
+            "normal-space",
+            "depth",
+            "position",
+            "view",
+            "brdf",
+            "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -151,7 +168,13 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.lights = parseNumber<int>(key, value);
     else if (key == "seed")
         options.seed = parseNumber<uint64_t>(key, value);
-    else if (key == "width")
+    else if (key == "light-density") {
+        try {
+            options.lightDensity = scenes::parseLightDensity(value);
+        } catch (const scenes::SceneError& error) {
+            throw UsageError(std::string("option 'light-density': ") + error.what());
+        }
+    } else if (key == "width")
         options.width = parseNumber<int>(key, value);
     else if (key == "height")
         options.height = parseNumber<int>(key, value);

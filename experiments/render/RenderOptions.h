@@ -18,6 +18,7 @@
 
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/ShadingStage.h"
+#include "scenes/SceneRequest.h"
 #include "scenes/input/Limits.h"
 
 namespace experiments {
@@ -39,6 +40,8 @@ struct RenderOptions {
     // JSON scene's generator count and seed (requestedLights).
     std::optional<int> lights;
     uint64_t seed = 1;
+    // --light-density fixed|constant-overlap (scenes/SceneRequest.h LightDensity).
+    scenes::LightDensity lightDensity = scenes::LightDensity::FixedRadius;
     int width = 1280;
     int height = 720;
     int threads = 0; // 0 = every hardware thread

@@ -16,6 +16,7 @@ scenes::Scene loadRequestedScene(const RenderOptions& options) {
     scenes::SceneRequest request;
     request.lightCount = requestedLights(options);
     request.seed = options.seed;
+    request.lightDensity = options.lightDensity;
     request.options = options.sceneOptions;
     scenes::Scene scene = scenes::loadScene(options.scene, request);
     if (!options.view.empty())

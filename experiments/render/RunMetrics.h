@@ -82,6 +82,11 @@ struct RunMetrics {
     double oracleMs = 0.0;          // measurement, not part of the stage
     double referenceMs = 0.0;
     double flipMs = 0.0;
+    // Lights that contribute at a covered (non-background) pixel, from the oracle: the mean and
+    // the 99th percentile (nearest rank); what the light generator's density means
+    // (--light-density). Zero when no pixel is covered.
+    double oracleLightsPerCoveredPixelMean = 0.0;
+    uint32_t oracleLightsPerCoveredPixelP99 = 0;
     // CPU time against wall time over the timed repetitions (CpuLoad.h): in stats.json, not in
     // the sweep's columns (each job's stats.json has it).
     CpuLoad cpuLoad;

@@ -766,7 +766,8 @@ void JsonSceneReader::generateLights(const Json* generator, Scene& scene) const 
     if (!(scatter.minIntensity <= scatter.maxIntensity))
         fail(field, "minIntensity " + std::to_string(scatter.minIntensity) +
                         " exceeds maxIntensity " + std::to_string(scatter.maxIntensity));
-    scatterPointLights(scene, scatter, count, seed);
+    scatterPointLights(scene, scatterForDensity(scatter, mRequest.lightDensity, count), count,
+                       seed);
 }
 
 } // namespace

@@ -88,6 +88,46 @@ void scatterPointLights(Scene& scene, const PointLightScatter& scatter, int coun
     scene.generatedLightCount += count;
 }
 
+double meanFalloffOverBall(double radiusMetres) {
+    if (!(radiusMetres > 0.0))
+        return 1.0;
+    constexpr int kShells = 1024;
+    double weighted = 0.0, volume = 0.0;
+    for (int i = 0; i < kShells; ++i) {
+        const double d = (i + 0.5) / kShells * radiusMetres;
+        const double window = std::max(0.0, 1.0 - std::pow(d / radiusMetres, 4.0));
+        const double shell = d * d; // 4 pi d^2 dd, constant factors cancel
+        weighted += shell * window * window / (d * d + 1.0);
+        volume += shell;
+    }
+    return weighted / volume;
+}
+
+PointLightScatter scatterForDensity(PointLightScatter scatter, LightDensity density, int count) {
+    if (density == LightDensity::FixedRadius || count <= 0)
+        return scatter;
+    const double scale = std::cbrt(double(kOverlapReferenceCount) / double(count));
+    const double typical = 0.5 * (scatter.minRangeMetres + scatter.maxRangeMetres);
+    const double exposure = meanFalloffOverBall(typical) / meanFalloffOverBall(typical * scale);
+    scatter.minRangeMetres = float(scatter.minRangeMetres * scale);
+    scatter.maxRangeMetres = float(scatter.maxRangeMetres * scale);
+    scatter.minIntensity = float(scatter.minIntensity * exposure);
+    scatter.maxIntensity = float(scatter.maxIntensity * exposure);
+    return scatter;
+}
+
+LightDensity parseLightDensity(const std::string& name) {
+    if (name == "fixed")
+        return LightDensity::FixedRadius;
+    if (name == "constant-overlap")
+        return LightDensity::ConstantOverlap;
+    throw SceneError("light density '" + name + "' is not fixed or constant-overlap");
+}
+
+const char* lightDensityName(LightDensity density) {
+    return density == LightDensity::FixedRadius ? "fixed" : "constant-overlap";
+}
+
 PointLightScatter defaultScatterFor(const Scene& scene) {
     const Aabb bounds = geometryBoundsWorld(scene);
     if (bounds.empty())

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "scenes/Scene.h"
+#include "scenes/SceneRequest.h"
 
 namespace scenes {
 
@@ -28,6 +29,25 @@ struct PointLightScatter {
     float minIntensity = 0.5f;
     float maxIntensity = 2.0f;
 };
+
+// The light count at which the constant-overlap mode keeps a scatter's own radii and intensities
+// (the atrium's ranges give about 25 lights reaching a point of its courtyard at this count).
+inline constexpr int kOverlapReferenceCount = 1000;
+
+// The scatter for `count` lights under `density`: unchanged for FixedRadius; for ConstantOverlap
+// radii times (kOverlapReferenceCount / count)^(1/3) (the expected lights whose sphere holds a
+// point: density x mean sphere volume, constant) and intensities times the ratio of the mean
+// windowed falloff over the old and the new ball (Brdf's (1 - (d/r)^4)^2 / (d^2 + 1)), so that
+// the radiance the lights add at a point keeps its expectation. count <= 0 changes nothing.
+PointLightScatter scatterForDensity(PointLightScatter scatter, LightDensity density, int count);
+
+// "fixed" / "constant-overlap" and back; parseLightDensity throws SceneError for other names.
+LightDensity parseLightDensity(const std::string& name);
+const char* lightDensityName(LightDensity density);
+
+// The mean of the windowed inverse-square falloff over a ball of radius r (metres) around the
+// light, by the midpoint rule on 1024 shells.
+double meanFalloffOverBall(double radiusMetres);
 
 // Appends `count` point lights to scene.lights, with random saturated colours.
 void scatterPointLights(Scene& scene, const PointLightScatter& scatter, int count, uint64_t seed);

@@ -369,7 +369,9 @@ Scene buildAtrium(const SceneRequest& request) {
     scatter.maxRangeMetres = 5.0f;
     scatter.minIntensity = 0.3f;
     scatter.maxIntensity = 1.5f;
-    scatterPointLights(scene, scatter, request.lightCount.value_or(0), request.seed);
+    const int lightCount = request.lightCount.value_or(0);
+    scatterPointLights(scene, scatterForDensity(scatter, request.lightDensity, lightCount),
+                       lightCount, request.seed);
     addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
     // More views (Viewpoints.h): back down the nave from the far end,
     // from gallery height above the nave edge across to the far arcade, and from high above the
@@ -485,6 +487,7 @@ Scene buildWall(const SceneRequest& request) {
     front.region.max = {alongMax, kWallHeight - 0.3f, kWallFaceZ + 4.0f};
     front.minRangeMetres = kFrontMinRange;
     front.maxRangeMetres = kFrontMaxRange;
+    front = scatterForDensity(front, request.lightDensity, frontCount);
     scatterAccepted(scene, front, frontCount, request.seed, [&](Light& light) {
         return insideViewAtAspectOne(camera, light.positionWorld);
     });
@@ -496,6 +499,7 @@ Scene buildWall(const SceneRequest& request) {
     behindScatter.region.max = {alongMax, 1.0f, 1.0f};
     behindScatter.minRangeMetres = kBehindMinRange;
     behindScatter.maxRangeMetres = kBehindMaxRange;
+    behindScatter = scatterForDensity(behindScatter, request.lightDensity, behindCount);
     auto placeBehind = [&](Light& light) {
         const float range = light.rangeMetres;
         const float heightVariate = light.positionWorld.y, depthVariate = light.positionWorld.z;
