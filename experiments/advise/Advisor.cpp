@@ -85,52 +85,60 @@ bool timesOverlap(const Candidate& a, const Candidate& b) {
     return a.timeMinMs <= b.timeMaxMs && b.timeMinMs <= a.timeMaxMs;
 }
 
-// The fastest candidate (median time), its ties (overlapping repetition ranges) and its margin.
-json fastestAnswer(std::vector<Candidate> pool, const std::string& whyNone) {
-    json answer = {{"best", nullptr},   {"tied", json::array()},    {"runner_up", nullptr},
+// The best candidate of `pool` in the order `before`, the candidates `tied` with it (listed, not
+// ranked), the first that is not (the runner-up) and margin(best, runner-up).
+template <class Before, class Tied, class Margin>
+json answer(std::vector<Candidate> pool, const std::string& whyNone, Before before, Tied tied,
+            Margin margin) {
+    json result = {{"best", nullptr},   {"tied", json::array()},    {"runner_up", nullptr},
                    {"margin", nullptr}, {"distinguishable", false}, {"why_none", ""}};
     if (pool.empty()) {
-        answer["why_none"] = whyNone;
-        return answer;
+        result["why_none"] = whyNone;
+        return result;
     }
-    std::stable_sort(pool.begin(), pool.end(), [](const Candidate& a, const Candidate& b) {
-        return a.timeMs < b.timeMs || (a.timeMs == b.timeMs && a.error < b.error);
-    });
+    std::stable_sort(pool.begin(), pool.end(), before);
     const Candidate& best = pool.front();
-    answer["best"] = candidateJson(best);
-    for (size_t i = 1; i < pool.size(); ++i)
-        if (timesOverlap(best, pool[i]))
-            answer["tied"].push_back(candidateJson(pool[i]));
-    if (pool.size() > 1) {
-        answer["runner_up"] = candidateJson(pool[1]);
-        answer["margin"] = best.timeMs > 0.0 ? json(pool[1].timeMs / best.timeMs) : json();
+    result["best"] = candidateJson(best);
+    const Candidate* runnerUp = nullptr;
+    for (size_t i = 1; i < pool.size(); ++i) {
+        if (tied(best, pool[i]))
+            result["tied"].push_back(candidateJson(pool[i]));
+        else if (!runnerUp)
+            runnerUp = &pool[i];
     }
-    answer["distinguishable"] = pool.size() == 1 || answer["tied"].empty();
-    return answer;
+    if (runnerUp) {
+        result["runner_up"] = candidateJson(*runnerUp);
+        result["margin"] = margin(best, *runnerUp);
+    }
+    result["distinguishable"] = result["tied"].empty();
+    return result;
 }
 
-// The least-error candidate, exact ties in error, and the margin (runner-up error / best error).
+// The fastest candidate (median time); tied: overlapping repetition ranges; margin: how many
+// times faster than the runner-up.
+json fastestAnswer(std::vector<Candidate> pool, const std::string& whyNone) {
+    return answer(
+        std::move(pool), whyNone,
+        [](const Candidate& a, const Candidate& b) {
+            return a.timeMs < b.timeMs || (a.timeMs == b.timeMs && a.error < b.error);
+        },
+        timesOverlap,
+        [](const Candidate& best, const Candidate& next) {
+            return best.timeMs > 0.0 ? json(next.timeMs / best.timeMs) : json();
+        });
+}
+
+// The least-error candidate; tied: exactly equal error; margin: runner-up error / best error.
 json leastErrorAnswer(std::vector<Candidate> pool, const std::string& whyNone) {
-    json answer = {{"best", nullptr},   {"tied", json::array()},    {"runner_up", nullptr},
-                   {"margin", nullptr}, {"distinguishable", false}, {"why_none", ""}};
-    if (pool.empty()) {
-        answer["why_none"] = whyNone;
-        return answer;
-    }
-    std::stable_sort(pool.begin(), pool.end(), [](const Candidate& a, const Candidate& b) {
-        return a.error < b.error || (a.error == b.error && a.timeMs < b.timeMs);
-    });
-    const Candidate& best = pool.front();
-    answer["best"] = candidateJson(best);
-    size_t next = 1;
-    while (next < pool.size() && pool[next].error == best.error)
-        answer["tied"].push_back(candidateJson(pool[next++]));
-    if (next < pool.size()) {
-        answer["runner_up"] = candidateJson(pool[next]);
-        answer["margin"] = best.error > 0.0 ? json(pool[next].error / best.error) : json();
-    }
-    answer["distinguishable"] = answer["tied"].empty();
-    return answer;
+    return answer(
+        std::move(pool), whyNone,
+        [](const Candidate& a, const Candidate& b) {
+            return a.error < b.error || (a.error == b.error && a.timeMs < b.timeMs);
+        },
+        [](const Candidate& best, const Candidate& c) { return c.error == best.error; },
+        [](const Candidate& best, const Candidate& next) {
+            return best.error > 0.0 ? json(next.error / best.error) : json();
+        });
 }
 
 // Candidates no other beats in both median time and error, fastest first.
