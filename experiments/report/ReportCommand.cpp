@@ -655,6 +655,19 @@ int runReportCommand(const ReportCommandOptions& options) {
         html << "</p>\n";
         appendFlipNote(html, jobs, columns);
         appendCountsNote(html, jobs);
+        html
+            << "<details class=\"metrics-note\"><summary>Relative RMSE and ꟻLIP: why they can "
+               "disagree</summary><p>Relative RMSE weighs every sample by its squared radiance "
+               "difference, so a few samples that are far off (a misplaced highlight, an emissive "
+               "pixel) can dominate it however small they are on screen. HDR-ꟻLIP scores what a "
+               "viewer sees when the two images alternate at 67 pixels per degree: its mean is the "
+               "share of the picture that differs visibly, its percentiles where that error sits. "
+               "Example: DamagedHelmet with <code>inferred</code> has relative RMSE 0.998 (99% of "
+               "the samples within 0.0014 of the reference, a handful off by up to 1453) and ꟻLIP "
+               "0.0043 (the visible error is on the panel outlines). Use relative RMSE for "
+               "exactness and energy, ꟻLIP to rank what a person sees "
+               "(<code>--error-metric flip</code>); experiments/README.md explains.</p>"
+               "</details>\n";
         html << "<p>Contents: ";
         if (!publishedTables.empty())
             html << "<a href=\"#published\">published vs measured</a> &middot; ";

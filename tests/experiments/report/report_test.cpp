@@ -571,6 +571,7 @@ TEST(ReportCommand, FlipIsAColumnAndAParetoAxisAndTheAdviceIsASection) {
     std::string html = readText(dir / "report.html");
     EXPECT_NE(html.find("<th class=\"col\" data-column=\"flip\""), std::string::npos);
     EXPECT_EQ(html.find("id=\"flip-note\""), std::string::npos) << "every job has ꟻLIP";
+    EXPECT_NE(html.find("Relative RMSE and ꟻLIP: why they can disagree"), std::string::npos);
     EXPECT_NE(html.find("No advice yet"), std::string::npos);
     const json manifest = json::parse(readText(dir / "report" / "plots.json"));
     size_t paretoPlots = 0;
