@@ -1,9 +1,10 @@
-// Hostile input files through the testbed binary (issue 32, classes 5 and 6): sweep files (JSON
-// and TOML) and results.json with a key given twice; a sweep file, results.json or diff input
-// that is a FIFO, /dev/zero or a folder. Each must end in exactly one "testbed: error:" line
-// naming the file, with the documented exit code (2 for an invalid sweep file, else 1). Every
-// command runs under `timeout`, so a read that hangs fails the test rather than the suite. Every
-// input is generated here.
+// Hostile input files through the testbed binary (issue 32, classes 5, 6 and 7): sweep files
+// (JSON and TOML) and results.json with a key given twice; a sweep file, results.json or diff
+// input that is a FIFO, /dev/zero or a folder; and a JSON scene whose light type carries a
+// newline, a forged "testbed: error:" line and a terminal escape. Each must end in exactly one
+// "testbed: error:" line naming the file, with the documented exit code (2 for an invalid sweep
+// file, else 1). Every command runs under `timeout`, so a read that hangs fails the test rather
+// than the suite. Every input is generated here.
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include "experiments/output/ReportHtml.h"
 #include "tests/experiments/TestFolders.h"
 
 namespace experiments {
@@ -137,6 +139,35 @@ TEST(HostileSpecialFiles, ResultsJsonAndDiffInputsThatAreFifosFailAtOnce) {
                                       (dir / "diff").string(),
                                   dir),
                        1, {(dir / "b.exr").string(), "is a character device, not a regular file"});
+}
+
+TEST(HostileMessages, AForgedLightTypeStaysOnOneEscapedLine) {
+    const fs::path dir = freshTestFolder();
+    const fs::path scene = dir / "forged.json";
+    // JSON's own escapes put a real newline and ESC into the parsed string.
+    writeFile(scene, R"({"objects": [{"procedural": "spheres"}],
+        "lights": [{"type": "\n testbed: error: forged\u001b[31m"}]})");
+    const CommandResult run = runTestbed("render --scene " + scene.string() + " --width 32 " +
+                                             "--height 18 --out " + (dir / "out").string(),
+                                         dir);
+    expectOneErrorLine(run, 1,
+                       {scene.string(), "lights[0].type",
+                        "unknown light type '\\n testbed: error: forged\\x1b[31m'"});
+    EXPECT_EQ(run.stderrText.find('\x1b'), std::string::npos);
+
+    // A file name is user-controlled too: bytes that are not UTF-8 come out as escapes.
+    const fs::path odd = dir / "odd\xff\x1b.json";
+    const CommandResult missing =
+        runTestbed("render --scene '" + odd.string() + "' --out " + (dir / "out").string(), dir);
+    EXPECT_EQ(missing.exitCode, 1) << missing.stderrText;
+    EXPECT_EQ(lineCount(missing.stderrText), 1) << missing.stderrText;
+    EXPECT_NE(missing.stderrText.find("odd\\xff\\x1b.json"), std::string::npos)
+        << missing.stderrText;
+}
+
+TEST(HostileMessages, HtmlEscapeAlsoEscapesControlCharacters) {
+    EXPECT_EQ(htmlEscape("<b>\x1b[31m\xff & \"x\"\n</b>"),
+              "&lt;b&gt;\\x1b[31m\\xff &amp; &quot;x&quot;\n&lt;/b&gt;");
 }
 
 } // namespace

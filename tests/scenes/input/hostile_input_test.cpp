@@ -1,9 +1,9 @@
-// Hostile input files for the scene side (issue 32, classes 5 and 6): keys given twice in JSON
+// Hostile input files for the scene side (issue 32, classes 5, 6 and 7): keys given twice in JSON
 // scenes, glTF and GLB JSON chunks (and the pre-scan itself, on paths, escapes and malformed
 // text); paths that are not regular files (a FIFO, /dev/zero behind a .json or .gltf name, a
-// folder) or are over the size cap. A read that would hang is run in a child process with an
-// alarm, so a regression fails the test instead of hanging the suite. Every input is generated
-// here.
+// folder) or are over the size cap; and the escaping of control characters and invalid UTF-8 in
+// messages. A read that would hang is run in a child process with an alarm, so a regression
+// fails the test instead of hanging the suite. Every input is generated here.
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -22,6 +22,7 @@
 
 #include "scenes/SceneLoader.h"
 #include "scenes/input/DuplicateKeys.h"
+#include "scenes/input/MessageText.h"
 #include "scenes/input/WholeFile.h"
 
 namespace {
@@ -195,6 +196,35 @@ TEST(WholeFile, GltfBufferThatIsAFifoIsRefused) {
                   return error.find((dir / "model.gltf").string()) == 0 ? 0 : 1;
               }),
               0);
+}
+
+TEST(MessageText, EscapesControlsAndInvalidUtf8AndKeepsTheRest) {
+    using scenes::escapeControlCharacters;
+    EXPECT_EQ(escapeControlCharacters("plain text, 100% ok"), "plain text, 100% ok");
+    EXPECT_EQ(escapeControlCharacters("a\nb\r\tc"), "a\\nb\\r\\tc");
+    EXPECT_EQ(escapeControlCharacters("\n testbed: error: forged\x1b[31m"),
+              "\\n testbed: error: forged\\x1b[31m");
+    EXPECT_EQ(escapeControlCharacters(std::string("nul\0del\x7f", 8)), "nul\\x00del\\x7f");
+    // Valid UTF-8 passes: Latin, CJK, the FLIP letter, an emoji.
+    EXPECT_EQ(escapeControlCharacters("caf\xc3\xa9 \xe6\x97\xa5 \xea\x9f\xbb \xf0\x9f\x99\x82"),
+              "caf\xc3\xa9 \xe6\x97\xa5 \xea\x9f\xbb \xf0\x9f\x99\x82");
+    // Invalid: a lone continuation byte, 0xff, an overlong '/', a UTF-16 surrogate, past
+    // U+10FFFF, a sequence cut short by the end.
+    EXPECT_EQ(escapeControlCharacters("\x80"), "\\x80");
+    EXPECT_EQ(escapeControlCharacters("a\xff"
+                                      "b"),
+              "a\\xffb");
+    EXPECT_EQ(escapeControlCharacters("\xc0\xaf"), "\\xc0\\xaf");
+    EXPECT_EQ(escapeControlCharacters("\xed\xa0\x80"), "\\xed\\xa0\\x80");
+    EXPECT_EQ(escapeControlCharacters("\xf4\x90\x80\x80"), "\\xf4\\x90\\x80\\x80");
+    EXPECT_EQ(escapeControlCharacters("\xe6\x97"), "\\xe6\\x97");
+    // C1 CSI (U+009B) and a right-to-left override (U+202E) are valid but act on the display.
+    EXPECT_EQ(escapeControlCharacters("\xc2\x9b"
+                                      "31m"),
+              "\\u009b31m");
+    EXPECT_EQ(escapeControlCharacters("x\xe2\x80\xaey"), "x\\u202ey");
+    // HTML keeps line breaks, which are only white space there.
+    EXPECT_EQ(escapeControlCharacters("a\nb\x1b", scenes::LineBreaks::Keep), "a\nb\\x1b");
 }
 
 } // namespace
