@@ -14,6 +14,7 @@
 #include <iostream>
 #include <system_error>
 
+#include "scenes/input/MessageText.h"
 #include "scenes/procedural/LightGenerator.h"
 #include "scenes/procedural/ProceduralScenes.h"
 
@@ -110,7 +111,7 @@ Scene loadScene(const std::string& nameOrPath, const SceneRequest& request) {
             const std::string warning = nameOrPath + ": the file has its own lights; the " +
                                         std::to_string(lightCount) +
                                         " requested generated lights were not added";
-            std::cerr << "warning: " << warning << '\n';
+            std::cerr << "warning: " << escapeControlCharacters(warning) << '\n';
             scene.warnings.push_back(warning);
         }
         validate(scene);

@@ -25,6 +25,7 @@
 #include "experiments/output/PlotScript.h"
 #include "experiments/output/ReportHtml.h"
 #include "scenes/input/Limits.h"
+#include "scenes/input/WholeFile.h"
 
 namespace experiments {
 
@@ -91,6 +92,13 @@ void checkLinearExr(const fs::path& path, const OIIO::ImageBuf& image) {
 // file that holds no linear colour before anything is compared (checkLinearExr).
 OIIO::ImageBuf readImage(const fs::path& path) {
     runImageLibraryOnTheCallingThread();
+    // A regular file first (scenes/input/WholeFile.h): OpenEXR would block opening a FIFO and
+    // read /dev/zero as long as it is asked to. Not read whole, so no byte cap: the header
+    // limits below bound what is allocated.
+    if (const std::string problem =
+            scenes::regularFileProblem(path, std::numeric_limits<uint64_t>::max());
+        !problem.empty())
+        throw std::runtime_error("cannot read " + path.string() + ": " + problem);
     checkExrAttributeSizes(path);
     OIIO::ImageBuf image(path.string());
     if (!image.init_spec(path.string(), 0, 0))

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "scenes/input/MessageText.h"
+
 namespace experiments {
 
 using nlohmann::json;
@@ -155,9 +157,12 @@ std::string stringField(const json& object, const char* key) {
 }
 
 std::string htmlEscape(const std::string& text) {
+    // Control characters and invalid UTF-8 from a results file become visible escapes first
+    // (scenes/input/MessageText.h): the page stays valid UTF-8 and shows what the file holds.
+    const std::string visible = scenes::escapeControlCharacters(text, scenes::LineBreaks::Keep);
     std::string out;
-    out.reserve(text.size());
-    for (char c : text) {
+    out.reserve(visible.size());
+    for (char c : visible) {
         switch (c) {
         case '&':
             out += "&amp;";

@@ -456,7 +456,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         delayed.finish();
         printSummary(run, options.out);
         if (run.metrics.cpuLoad.loaded)
-            std::cerr << "testbed: warning: " << run.metrics.cpuLoad.warning << "\n";
+            reportWarning(run.metrics.cpuLoad.warning);
         return 0;
     } catch (const std::exception& e) {
         return reportError(e);

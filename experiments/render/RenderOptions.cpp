@@ -7,6 +7,7 @@
 
 #include "lighting/StageRegistry.h"
 #include "scenes/input/ClosestName.h"
+#include "scenes/input/WholeFile.h"
 #include "scenes/procedural/LightGenerator.h"
 #include "scenes/procedural/ProceduralScenes.h"
 
@@ -55,8 +56,10 @@ void checkScene(const std::string& scene) {
                          scenes::didYouMean(scene, scenes::proceduralSceneNames()) +
                          ": not a built-in scene (" + joined(scenes::proceduralSceneNames()) +
                          ") nor a .gltf/.glb/.json file");
-    if (!std::filesystem::is_regular_file(path))
-        throw UsageError("scene file '" + scene + "' not found");
+    // A FIFO or device would block or never end in the loader: refused here with its kind.
+    if (const std::string problem = scenes::regularFileProblem(path); !problem.empty())
+        throw UsageError("scene file '" + scene + "' " +
+                         (problem == "file not found" ? "not found" : problem));
 }
 
 void checkRepetitions(const RenderOptions& options) {

@@ -29,8 +29,10 @@
 #include "experiments/output/ImageOutput.h"
 #include "experiments/render/RenderCommand.h"
 #include "experiments/render/RunMetrics.h"
+#include "scenes/input/DuplicateKeys.h"
 #include "scenes/input/Limits.h"
 #include "scenes/input/NestingDepth.h"
+#include "scenes/input/WholeFile.h"
 
 namespace experiments {
 
@@ -46,18 +48,20 @@ constexpr const char* kJobImages[] = {"preview", "heatmap", "error", "flip"};
 // are behind the "all columns" toggle.
 constexpr const char* kMainMetricColumns[] = {"time_total_median_ms", "relative_rmse", "flip",
                                               "culling_efficiency", "simt_efficiency"};
-// Results are ours but may have been edited: the nesting is bounded before parsing, as for every
-// JSON input (scenes/input/Limits.h), since the report copies values recursively.
+// Results are ours but may have been edited: read as every input file is
+// (scenes/input/WholeFile.h), the nesting bounded before parsing (scenes/input/Limits.h, since the
+// report copies values recursively) and a key given twice refused, as for every JSON input.
 json readJsonFile(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    if (!file)
-        throw std::runtime_error("cannot read " + path.string() + ": " + std::strerror(errno));
-    const std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+    std::string text;
+    if (const std::string problem = scenes::readWholeFile(path, &text); !problem.empty())
+        throw std::runtime_error("cannot read " + path.string() + ": " + problem);
     scenes::NestingViolation violation;
     if (scenes::jsonNestsDeeperThan(text, scenes::limits::kMaxNestingDepth, &violation))
         throw std::runtime_error("cannot parse " + path.string() + ": line " +
                                  std::to_string(violation.line) + " nests deeper than " +
                                  std::to_string(scenes::limits::kMaxNestingDepth) + " levels");
+    if (const std::string problem = scenes::jsonDuplicateKeyProblem(text); !problem.empty())
+        throw std::runtime_error("cannot parse " + path.string() + ": " + problem);
     try {
         return json::parse(text);
     } catch (const json::exception& e) {

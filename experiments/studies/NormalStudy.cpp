@@ -20,6 +20,7 @@
 #include "experiments/studies/NormalStatistics.h"
 #include "experiments/studies/NormalStudyOutputs.h"
 #include "experiments/studies/StudyPlots.h"
+#include "scenes/input/MessageText.h"
 #include "scenes/procedural/ProceduralScenes.h"
 
 namespace experiments {
@@ -307,7 +308,8 @@ int runNormalStudyCommand(const NormalStudyOptions& options) {
     try {
         const NormalStudyResult result = runNormalStudy(options, progress);
         for (const std::string& warning : result.warnings)
-            std::cerr << "testbed normals: warning: " << warning << "\n";
+            std::cerr << "testbed normals: warning: " << scenes::escapeControlCharacters(warning)
+                      << "\n";
         printSummary(result, std::cout);
         std::cout << "outputs in " << std::filesystem::absolute(options.out).string() << "\n";
         return 0;

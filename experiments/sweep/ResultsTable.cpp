@@ -12,8 +12,10 @@
 #include "experiments/sweep/CsvTable.h"
 #include "experiments/sweep/SweepFile.h"
 #include "lighting/passes/PassNames.h"
+#include "scenes/input/DuplicateKeys.h"
 #include "scenes/input/Limits.h"
 #include "scenes/input/NestingDepth.h"
+#include "scenes/input/WholeFile.h"
 
 namespace experiments {
 
@@ -46,23 +48,26 @@ std::string cellText(const Json& value) {
     return value.is_string() ? value.get<std::string>() : value.dump();
 }
 
+// A regular file within scenes::limits::kMaxFileBytes (scenes/input/WholeFile.h): a FIFO or
+// /dev/zero in an output folder is refused at once instead of hanging or filling memory.
 std::string readText(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw SweepError(path.string() + ": cannot open");
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
+    std::string text;
+    if (const std::string problem = scenes::readWholeFile(path, &text); !problem.empty())
+        throw SweepError(path.string() + ": " + problem);
+    return text;
 }
 
-// Results and markers are ours but may have been edited: nesting past scenes::limits is refused
-// before parsing (values are copied recursively afterwards).
+// Results and markers are ours but may have been edited: nesting past scenes::limits and a key
+// given twice (which the parser would silently resolve) are refused before parsing (values are
+// copied recursively afterwards).
 Json parseBounded(const std::string& text, const fs::path& path) {
     scenes::NestingViolation violation;
     if (scenes::jsonNestsDeeperThan(text, scenes::limits::kMaxNestingDepth, &violation))
         throw SweepError(path.string() + ":" + std::to_string(violation.line) +
                          ": nests deeper than " + std::to_string(scenes::limits::kMaxNestingDepth) +
                          " levels");
+    if (const std::string problem = scenes::jsonDuplicateKeyProblem(text); !problem.empty())
+        throw SweepError(path.string() + ": " + problem);
     return Json::parse(text);
 }
 
@@ -155,7 +160,8 @@ void writeResults(const fs::path& dir, const Json& results) {
 
 Json readResults(const fs::path& dir) {
     const fs::path file = dir / "results.json";
-    if (!fs::is_regular_file(file))
+    std::error_code error;
+    if (!fs::exists(file, error))
         throw SweepError(file.string() + ": not found (is " + dir.string() +
                          " a sweep output folder?)");
     Json results;

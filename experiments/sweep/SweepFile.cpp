@@ -15,8 +15,10 @@
 
 #include "experiments/render/RenderPlan.h"
 #include "scenes/Viewpoints.h"
+#include "scenes/input/DuplicateKeys.h"
 #include "scenes/input/Limits.h"
 #include "scenes/input/NestingDepth.h"
+#include "scenes/input/WholeFile.h"
 
 namespace experiments {
 
@@ -387,17 +389,10 @@ std::string jobTimeoutError(double seconds, const std::string& where) {
 
 SweepSpec readSweepFile(const std::filesystem::path& file) {
     const std::string origin = file.string();
-    std::error_code error;
-    const uintmax_t size = std::filesystem::file_size(file, error);
-    if (!error && size > scenes::limits::kMaxFileBytes)
-        throw SweepError(origin + ": " + std::to_string(size) + " bytes, more than the limit of " +
-                         std::to_string(scenes::limits::kMaxFileBytes));
-    std::ifstream in(file, std::ios::binary);
-    if (!in)
-        throw SweepError(origin + ": cannot open the sweep file");
-    std::stringstream text;
-    text << in.rdbuf();
-    return readSweepText(text.str(), origin, file.extension() == ".toml");
+    std::string text;
+    if (const std::string problem = scenes::readWholeFile(file, &text); !problem.empty())
+        throw SweepError(origin + ": " + problem);
+    return readSweepText(text, origin, file.extension() == ".toml");
 }
 
 SweepSpec readSweepText(const std::string& text, const std::string& origin, bool isToml) {
@@ -420,6 +415,10 @@ SweepSpec readSweepText(const std::string& text, const std::string& origin, bool
                              ": TOML syntax error: " + std::string(e.description()));
         }
     } else {
+        // toml++ refuses a key given twice itself ("cannot redefine existing ..."); nlohmann
+        // keeps the last, so JSON is checked first.
+        if (const std::string problem = scenes::jsonDuplicateKeyProblem(text); !problem.empty())
+            throw SweepError(origin + ": " + problem);
         try {
             object = Json::parse(text);
         } catch (const nlohmann::json::exception& e) {

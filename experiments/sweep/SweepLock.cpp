@@ -8,6 +8,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include "experiments/CommandErrors.h"
+
 namespace experiments {
 
 namespace fs = std::filesystem;
@@ -43,8 +45,10 @@ SweepLock::SweepLock(const fs::path& dir, size_t first, size_t last, bool wait, 
     const int error = errno;
     if (error != EACCES && error != EAGAIN) {
         // ENOLCK and the like: a file system without record locks.
-        log << "testbed: warning: cannot lock " << path.string() << " (" << std::strerror(error)
-            << "): nothing keeps a second sweep from running the same jobs into this folder\n";
+        reportWarning("cannot lock " + path.string() + " (" + std::strerror(error) +
+                          "): nothing keeps a second sweep from running the same jobs into this "
+                          "folder",
+                      log);
         close(mFd);
         mFd = -1;
         return;

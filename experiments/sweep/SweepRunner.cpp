@@ -16,6 +16,7 @@
 #include "experiments/sweep/SweepFile.h"
 #include "experiments/sweep/SweepJobRun.h"
 #include "experiments/sweep/SweepLock.h"
+#include "scenes/input/WholeFile.h"
 
 namespace experiments {
 
@@ -38,25 +39,35 @@ std::string utcNow() {
     return text;
 }
 
+// A marker's JSON, or nullopt when there is no readable marker. Read as every input file is
+// (scenes/input/WholeFile.h): a FIFO or device put in its place is unreadable, never a hang.
+std::optional<Json> readMarker(const fs::path& marker) {
+    std::string text;
+    if (!scenes::readWholeFile(marker, &text).empty())
+        return std::nullopt;
+    try {
+        return Json::parse(text);
+    } catch (const std::exception&) {
+        return std::nullopt; // cannot happen with atomic writes; treat as unfinished
+    }
+}
+
 // The marker's status, or "" when there is no readable marker (then the job is not finished).
 std::string markerStatus(const fs::path& marker) {
-    std::ifstream in(marker, std::ios::binary);
-    if (!in)
-        return "";
+    const std::optional<Json> json = readMarker(marker);
     try {
-        const Json json = Json::parse(in);
-        return json.value("status", "");
+        return json && json->is_object() ? json->value("status", "") : "";
     } catch (const std::exception&) {
-        return ""; // cannot happen with atomic writes; treat as unfinished
+        return ""; // a status that is not a string: not a marker we wrote
     }
 }
 
 std::optional<Json> markerRow(const fs::path& marker) {
-    std::ifstream in(marker, std::ios::binary);
-    if (!in)
+    std::optional<Json> read = readMarker(marker);
+    if (!read)
         return std::nullopt;
     try {
-        Json json = Json::parse(in);
+        Json& json = *read;
         if (json.contains("row") && json["row"].is_object())
             return json["row"];
     } catch (const std::exception&) {

@@ -52,6 +52,7 @@
 
 #include "scenes/Viewpoints.h"
 #include "scenes/input/Limits.h"
+#include "scenes/input/MessageText.h"
 #include "scenes/input/NestingDepth.h"
 #include "scenes/mesh/Tangents.h"
 
@@ -113,7 +114,7 @@ void GltfConverter::warn(const std::string& what) {
     const std::string warning = mPath.string() + ": " + what;
     if (!mWarned.insert(warning).second)
         return;
-    std::cerr << "warning: " << warning << '\n';
+    std::cerr << "warning: " << escapeControlCharacters(warning) << '\n';
     mScene.warnings.push_back(warning);
 }
 

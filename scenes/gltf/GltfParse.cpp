@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -22,8 +21,10 @@
 #include <tiny_gltf.h>
 
 #include "scenes/Viewpoints.h"
+#include "scenes/input/DuplicateKeys.h"
 #include "scenes/input/Limits.h"
 #include "scenes/input/NestingDepth.h"
+#include "scenes/input/WholeFile.h"
 #include "scenes/mesh/Tangents.h"
 
 namespace scenes::gltf {
@@ -31,21 +32,9 @@ namespace scenes::gltf {
 namespace {
 
 std::vector<unsigned char> readFile(const fs::path& path) {
-    std::error_code error;
-    if (!fs::exists(path, error))
-        fail(path, "file not found");
-    if (!fs::is_regular_file(path, error))
-        fail(path, "not a regular file");
-    const uintmax_t size = fs::file_size(path, error);
-    if (error)
-        fail(path, "cannot read the size: " + error.message());
-    if (size > limits::kMaxFileBytes)
-        fail(path, "the file has " + str(size) + " bytes, more than the limit of " +
-                       str(limits::kMaxFileBytes));
-    std::vector<unsigned char> bytes(size);
-    std::ifstream in(path, std::ios::binary);
-    if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
-        fail(path, "cannot be read");
+    std::vector<unsigned char> bytes;
+    if (const std::string problem = readWholeFile(path, &bytes); !problem.empty())
+        fail(path, problem);
     return bytes;
 }
 
@@ -111,36 +100,26 @@ bool fileExistsBesideModel(const std::string& path, void*) {
     return path.rfind("./", 0) != 0 && fs::is_regular_file(path, error);
 }
 
-// tinygltf's ReadWholeFile, with the size checked against limits::kMaxFileBytes before the
-// buffer is allocated.
+// tinygltf's ReadWholeFile (external buffers and images), through the same checked read as the
+// model itself: a regular file within limits::kMaxFileBytes, checked before allocating.
 bool readWholeFileWithinLimit(std::vector<unsigned char>* out, std::string* error,
                               const std::string& path, void*) {
-    std::error_code code;
-    const uintmax_t size = fs::is_regular_file(path, code) ? fs::file_size(path, code) : 0;
-    if (code || !fs::is_regular_file(path, code)) {
-        *error += "'" + path + "' is not a readable regular file\n";
-        return false;
-    }
-    if (size > limits::kMaxFileBytes) {
-        *error += "'" + path + "' has " + str(size) + " bytes, more than the limit of " +
-                  str(limits::kMaxFileBytes) + "\n";
-        return false;
-    }
-    out->resize(size);
-    std::ifstream in(path, std::ios::binary);
-    if (!in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size))) {
-        *error += "'" + path + "' cannot be read\n";
+    if (const std::string problem = readWholeFile(path, out); !problem.empty()) {
+        *error += "'" + path + "' " + problem + "\n";
         return false;
     }
     return true;
 }
 
-// The nesting bound (limits::kMaxNestingDepth) on the JSON text tinygltf is about to parse.
-void checkJsonNesting(const fs::path& path, std::string_view json) {
+// The checks every JSON reader makes on the text tinygltf is about to parse: the nesting bound
+// (limits::kMaxNestingDepth) and no key twice in an object (tinygltf would keep the last).
+void checkJsonText(const fs::path& path, std::string_view json) {
     NestingViolation violation;
     if (jsonNestsDeeperThan(json, limits::kMaxNestingDepth, &violation))
         fail(path, "JSON nests deeper than " + std::to_string(limits::kMaxNestingDepth) +
                        " levels (line " + str(violation.line) + ")");
+    if (const std::string problem = jsonDuplicateKeyProblem(json); !problem.empty())
+        fail(path, problem);
 }
 
 } // namespace
@@ -181,15 +160,15 @@ tinygltf::Model parseModel(const fs::path& path, ImageBudget& imageBudget) {
         checkGlbLayout(path, bytes);
         uint32_t jsonBytes;
         std::memcpy(&jsonBytes, bytes.data() + 12, 4);
-        checkJsonNesting(
+        checkJsonText(
             path, std::string_view(reinterpret_cast<const char*>(bytes.data()) + 20, jsonBytes));
         loaded = parser.LoadBinaryFromMemory(&model, &error, &ignoredWarnings, bytes.data(),
                                              unsigned(bytes.size()), baseDir);
     } else {
         if (path.extension() == ".glb")
             fail(path, "not a GLB file (it does not start with 'glTF')");
-        checkJsonNesting(
-            path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+        checkJsonText(path,
+                      std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
         loaded = parser.LoadASCIIFromString(&model, &error, &ignoredWarnings,
                                             reinterpret_cast<const char*>(bytes.data()),
                                             unsigned(bytes.size()), baseDir);

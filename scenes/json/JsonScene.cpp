@@ -16,7 +16,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <optional>
@@ -26,8 +25,10 @@
 #include <nlohmann/json.hpp>
 
 #include "scenes/Viewpoints.h"
+#include "scenes/input/DuplicateKeys.h"
 #include "scenes/input/Limits.h"
 #include "scenes/input/NestingDepth.h"
+#include "scenes/input/WholeFile.h"
 #include "scenes/procedural/LightGenerator.h"
 #include "scenes/procedural/ProceduralScenes.h"
 
@@ -242,25 +243,17 @@ Scene JsonSceneReader::read() {
                      "' is not valid: a JSON scene takes its options from the file");
     if (mRequest.lightCount.value_or(0) < 0)
         fail("", "light count must be >= 0, got " + std::to_string(*mRequest.lightCount));
-    std::error_code error;
-    if (!fs::exists(mPath, error))
-        fail("", "file not found");
-    const uintmax_t size = fs::file_size(mPath, error);
-    if (error || !fs::is_regular_file(mPath, error))
-        fail("", "not a readable regular file");
-    if (size > limits::kMaxFileBytes)
-        fail("", std::to_string(size) + " bytes, more than the limit of " +
-                     std::to_string(limits::kMaxFileBytes));
-    std::ifstream in(mPath, std::ios::binary);
-    std::string bytes(size, '\0');
-    if (!in || !in.read(bytes.data(), std::streamsize(size)))
-        fail("", "cannot be read");
+    std::string bytes;
+    if (const std::string problem = readWholeFile(mPath, &bytes); !problem.empty())
+        fail("", problem);
     // nlohmann::json parses and destroys iteratively, but the bound keeps every reader of the
     // document (and of the glTF files it names) within one documented limit.
     NestingViolation violation;
     if (jsonNestsDeeperThan(bytes, limits::kMaxNestingDepth, &violation))
         fail("", "JSON nests deeper than " + std::to_string(limits::kMaxNestingDepth) +
                      " levels (line " + std::to_string(violation.line) + ")");
+    if (const std::string problem = jsonDuplicateKeyProblem(bytes); !problem.empty())
+        fail("", problem);
     Json root;
     try {
         root = Json::parse(bytes);
