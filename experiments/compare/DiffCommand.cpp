@@ -524,6 +524,8 @@ ImageDiff diffImageFiles(const fs::path& aPath, const fs::path& bPath) {
         diff.beautyB[c] = std::move(resultB.radiance[c]);
         diff.absDifference[c] = channelPlane(absRgb, c);
     }
+    if (m.nonFinitePixels > 0 || m.referenceNonFinitePixels > 0) // as compareImages' figures
+        m.meanAbs = std::numeric_limits<double>::infinity();
     OIIO::ImageBuf maxAbs;
     if (!OIIO::ImageBufAlgo::maxchan(maxAbs, absRgb))
         throw std::runtime_error("cannot compute max over channels: " + maxAbs.geterror());
@@ -593,13 +595,16 @@ json diffJson(const ImageDiff& diff, const fs::path& a, const fs::path& b) {
             {"width", diff.width},
             {"height", diff.height},
             {"metrics",
-             {{"rmse", m.rmse},
-              {"relative_rmse", m.relativeRmse},
+             {{"rmse", numberOrText(m.rmse)},
+              {"relative_rmse", numberOrText(m.relativeRmse)},
               {"psnr", numberOrText(m.psnr)},
-              {"max_abs", m.maxAbs},
-              {"mean_abs", m.meanAbs},
-              {"relative_mean", m.relativeMean},
-              {"p99_abs", m.p99Abs},
+              {"max_abs", numberOrText(m.maxAbs)},
+              {"mean_abs", numberOrText(m.meanAbs)},
+              {"relative_mean", numberOrText(m.relativeMean)},
+              {"p99_abs", numberOrText(m.p99Abs)},
+              {metric::kNonFinitePixels, m.nonFinitePixels},
+              {metric::kReferenceNonFinitePixels, m.referenceNonFinitePixels},
+              {"unreliable", nonFiniteNote(m)},
               {metric::kFlip, m.flip ? json(*m.flip) : json()},
               {metric::kFlipWeightedMedian,
                m.flipWeightedMedian ? json(*m.flipWeightedMedian) : json()},
@@ -649,6 +654,8 @@ int runDiffCommand(const DiffCommandOptions& options) {
                   << formatNumber(m.p99Abs) << ", HDR-FLIP "
                   << (m.flip ? formatNumber(*m.flip) : "unavailable (" + m.flipUnavailable + ")")
                   << "\n  report: " << (options.out / "index.html").string() << "\n";
+        if (const std::string note = nonFiniteNote(m); !note.empty())
+            std::cout << "  WARNING: " << note << "\n";
         return 0;
     } catch (const std::exception& e) {
         return reportError(e);

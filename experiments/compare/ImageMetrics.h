@@ -2,9 +2,10 @@
 // computes it (render --compare-reference, diff, sweep rows through RunMetrics): RMSE, relative
 // RMSE, PSNR, the largest and the 99th-percentile absolute difference, the relative mean, and the
 // mean HDR-ꟻLIP. Pure functions of two images; never run inside a stage's timed passes.
-// Thread safety: values; compareImages runs ImageBufAlgo on the calling thread's pool.
+// Thread safety: values; compareImages runs on the calling thread.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -26,9 +27,16 @@ inline constexpr const char* kFlipWeightedMedian = "flip_weighted_median";
 inline constexpr const char* kFlipP95 = "flip_p95";
 inline constexpr const char* kFlipP99 = "flip_p99";
 inline constexpr const char* kFlipUnavailable = "flip_unavailable";
+inline constexpr const char* kNonFinitePixels = "non_finite_pixels";
+inline constexpr const char* kReferenceNonFinitePixels = "reference_non_finite_pixels";
 } // namespace metric
 
-// Over all pixels and the three colour channels.
+// Over all pixels and the three colour channels. The figures agree with each other and with the
+// pixels (issue 32, class 3): identical finite images give rmse 0, relative figures 0 and psnr
+// +inf; any difference gives rmse > 0 and a finite psnr (-inf when the reference's peak is not
+// positive); a difference against an all-zero reference gives relative figures of +inf, never 0.
+// When either image holds a non-finite sample (NaN or Inf, counted per pixel below) nothing can be
+// measured: the error figures are +inf and psnr -inf, never a perfect score.
 struct ErrorMetrics {
     double rmse = 0.0;
     double relativeRmse = 0.0; // rmse / rms of the reference
@@ -38,7 +46,9 @@ struct ErrorMetrics {
     double p99Abs = 0.0;        // 99th percentile of |image - reference|
     std::optional<double> flip; // mean HDR-ꟻLIP (FlipMetric.h); nullopt when not computed
     std::optional<double> flipWeightedMedian, flipP95, flipP99; // its percentiles (Flip.h)
-    std::string flipUnavailable; // why flip is missing ("" when computed)
+    std::string flipUnavailable;           // why flip is missing ("" when computed)
+    uint64_t nonFinitePixels = 0;          // pixels of the image with a NaN or Inf channel
+    uint64_t referenceNonFinitePixels = 0; // the same in the reference
 };
 
 ErrorMetrics compareImages(const lighting::StageResult& image,
@@ -50,5 +60,9 @@ ErrorMetrics compareImages(const lighting::StageResult& image,
 // the samples are nearly exact, and a relative RMSE near 1 would read as a broken image. Empty
 // otherwise.
 std::string errorConcentrationNote(const ErrorMetrics& error);
+
+// Why the error figures cannot be trusted ("the image has 3 pixels with NaN or Inf ..."), or ""
+// when both images are finite. Printed in the summary and written beside the figures.
+std::string nonFiniteNote(const ErrorMetrics& error);
 
 } // namespace experiments

@@ -147,6 +147,8 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
                   << error->relativeRmse << "\n";
         if (const std::string note = errorConcentrationNote(*error); !note.empty())
             std::cout << "    (" << note << ")\n";
+        if (const std::string note = nonFiniteNote(*error); !note.empty())
+            std::cout << "  WARNING: " << note << "\n";
         if (error->flip)
             std::cout << "  HDR-FLIP: mean " << std::fixed << std::setprecision(4) << *error->flip
                       << ", weighted median " << error->flipWeightedMedian.value_or(0.0) << ", p95 "
@@ -300,9 +302,14 @@ nlohmann::json errorJson(const RenderRun& run) {
     const RunMetrics& metrics = run.metrics;
     nlohmann::json error = {{"reference", "reference"}};
     for (const NamedFigure& figure : metrics.errorFigures())
-        error[figure.name] = std::isinf(figure.value) && figure.value > 0 ? nlohmann::json("inf")
-                             : std::isnan(figure.value)                   ? nlohmann::json()
+        error[figure.name] = std::isinf(figure.value)
+                                 ? nlohmann::json(figure.value > 0 ? "inf" : "-inf")
+                             : std::isnan(figure.value) ? nlohmann::json()
                                                         : nlohmann::json(figure.value);
+    error[metric::kNonFinitePixels] = metrics.error->nonFinitePixels;
+    error[metric::kReferenceNonFinitePixels] = metrics.error->referenceNonFinitePixels;
+    if (const std::string note = nonFiniteNote(*metrics.error); !note.empty())
+        error["unreliable"] = note;
     error[metric::kFlipUnavailable] = metrics.error->flipUnavailable;
     if (!run.flipParameters.is_null())
         error["flip_parameters"] = run.flipParameters;
