@@ -14,7 +14,7 @@
 # "Across views" section with one family per light count, each aggregating the four stages over
 # the two views (a row per stage) with its per-view rows in a closed toggle (<details>, eight
 # rows); the results table with the flip (ꟻLIP) column among the main columns and the others
-# behind the toggle, and -- when ꟻLIP is unavailable on this machine (no flip-evaluator) -- the
+# behind the toggle, and -- when ꟻLIP is missing for some job (images that could not be compared) -- the
 # visible note saying why; inferred's reduced-resolution light counts are explained in a note.
 # Failed jobs, null metrics and single-valued axes are covered by tests/experiments/report/report_test.cpp.
 #
