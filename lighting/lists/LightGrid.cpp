@@ -59,12 +59,8 @@ void LightGrid::build(const std::vector<LightSphere>& spheres, glm::vec3 boxMin,
     const glm::vec3 widen = mCellSize * kCellSlack;
     for (uint32_t light : inBox) {
         const LightSphere& s = spheres[light];
-        const glm::ivec3 lo =
-            glm::clamp(glm::ivec3(glm::floor((s.centreView - s.radius - mMin) / mCellSize)),
-                       glm::ivec3(0), mCells - 1);
-        const glm::ivec3 hi =
-            glm::clamp(glm::ivec3(glm::floor((s.centreView + s.radius - mMin) / mCellSize)),
-                       glm::ivec3(0), mCells - 1);
+        const glm::ivec3 lo = cellIndex(s.centreView - s.radius);
+        const glm::ivec3 hi = cellIndex(s.centreView + s.radius);
         for (int z = lo.z; z <= hi.z; ++z)
             for (int y = lo.y; y <= hi.y; ++y)
                 for (int x = lo.x; x <= hi.x; ++x) {
@@ -89,9 +85,16 @@ void LightGrid::build(const std::vector<LightSphere>& spheres, glm::vec3 boxMin,
         mCellLights[next[cell]++] = light;
 }
 
+glm::ivec3 LightGrid::cellIndex(glm::vec3 pointView) const {
+    // Clamped while still a float: a sphere far larger than the box gives indices beyond int's
+    // range, whose conversion would be undefined.
+    const glm::vec3 cell = glm::clamp(glm::floor((pointView - mMin) / mCellSize), glm::vec3(0.0f),
+                                      glm::vec3(mCells - 1));
+    return glm::ivec3(cell);
+}
+
 size_t LightGrid::cellOf(glm::vec3 pointView) const {
-    const glm::ivec3 cell = glm::clamp(glm::ivec3(glm::floor((pointView - mMin) / mCellSize)),
-                                       glm::ivec3(0), mCells - 1);
+    const glm::ivec3 cell = cellIndex(pointView);
     return (size_t(cell.z) * mCells.y + cell.y) * mCells.x + cell.x;
 }
 

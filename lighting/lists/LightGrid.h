@@ -48,6 +48,7 @@ public:
     size_t pairCount() const { return mCellLights.size(); }
 
 private:
+    glm::ivec3 cellIndex(glm::vec3 pointView) const; // clamped to the grid
     size_t cellOf(glm::vec3 pointView) const;
 
     glm::vec3 mMin{0.0f};
