@@ -14,6 +14,7 @@
 #include "gbuffer/Surface.h"
 #include "lighting/ShadingStage.h"
 #include "lighting/brdf/Brdf.h"
+#include "lighting/lists/LightGrid.h"
 #include "lighting/passes/PassNames.h"
 
 namespace lighting {
@@ -21,10 +22,14 @@ namespace lighting {
 // Resizes `result` to width x height with the oracle plane, shades, and records the loop as the
 // pass "shading". Per covered pixel: radiance summed over `lights` in order plus the surface's
 // emission (in T: the reference adds it in double), lightsEvaluated =
-// every light, lightsOracle = the lights that contribute.
+// every light, lightsOracle = the lights that contribute. With a grid (LightGrid.h, built over the
+// covered surfaces from the same lights), only its candidates are evaluated: the image and the
+// counts are bitwise those of the full loop (lightsEvaluated still says every light: the others
+// were decided by the grid, exactly).
 template <class T, class SurfaceAt>
 void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>>& lights,
-                         const SurfaceAt& surfaceAt, StageResult& result) {
+                         const SurfaceAt& surfaceAt, StageResult& result,
+                         const LightGrid* grid = nullptr) {
     result.resize(width, height, true);
     PassTimer shading(result, pass::kShading);
     tbb::parallel_for(0, height, [&](int y) {
@@ -36,10 +41,24 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
             const Vec3<T> toViewer = glm::normalize(-point.positionView);
             Vec3<T> sum(T(0));
             uint32_t contributing = 0;
-            for (const LightInView<T>& light : lights) {
+            auto add = [&](const LightInView<T>& light) {
                 const Vec3<T> radiance = evaluateLight(point, toViewer, light);
                 sum += radiance;
                 contributing += contributes(radiance) ? 1u : 0u;
+            };
+            if (!grid) {
+                for (const LightInView<T>& light : lights)
+                    add(light);
+            } else {
+                // The grid's two ascending lists merged: the same lights in the same order as
+                // the loop above, less lights whose radiance here is exactly zero (outside their
+                // range), which leave the sum unchanged bit for bit.
+                const std::span<const uint32_t> a = grid->everywhere();
+                const std::span<const uint32_t> b =
+                    grid->candidatesAt(glm::vec3(point.positionView));
+                size_t i = 0, j = 0;
+                while (i < a.size() || j < b.size())
+                    add(lights[j == b.size() || (i < a.size() && a[i] < b[j]) ? a[i++] : b[j++]]);
             }
             sum += point.emissive; // once per pixel, after the lights; counts unaffected
             result.radiance[0][pixel] = float(sum.x);

@@ -20,8 +20,13 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <span>
+#include <utility>
 #include <vector>
+
+#include <tbb/parallel_for.h>
 
 #include <glm/glm.hpp>
 
@@ -58,5 +63,34 @@ private:
     std::vector<uint32_t> mCellLights; // the lights of each cell, ascending
     std::vector<uint32_t> mUnbounded;
 };
+
+// The view-space box of the covered pixels' surfaces: surfaceAt(x, y, surface) fills a surface
+// with a positionView and returns false for background. nullopt when no pixel is covered. Rows in
+// parallel; min and max do not depend on the order.
+template <class Surface, class SurfaceAt>
+std::optional<std::pair<glm::vec3, glm::vec3>> surfaceBox(int width, int height,
+                                                          const SurfaceAt& surfaceAt) {
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    std::vector<glm::vec3> rowMin(size_t(height), glm::vec3{kInf});
+    std::vector<glm::vec3> rowMax(size_t(height), glm::vec3{-kInf});
+    tbb::parallel_for(0, height, [&](int y) {
+        for (int x = 0; x < width; ++x) {
+            Surface point;
+            if (!surfaceAt(x, y, point))
+                continue;
+            const glm::vec3 p(point.positionView);
+            rowMin[size_t(y)] = glm::min(rowMin[size_t(y)], p);
+            rowMax[size_t(y)] = glm::max(rowMax[size_t(y)], p);
+        }
+    });
+    glm::vec3 boxMin{kInf}, boxMax{-kInf};
+    for (int y = 0; y < height; ++y) {
+        boxMin = glm::min(boxMin, rowMin[size_t(y)]);
+        boxMax = glm::max(boxMax, rowMax[size_t(y)]);
+    }
+    if (!(boxMin.x <= boxMax.x))
+        return std::nullopt;
+    return std::make_pair(boxMin, boxMax);
+}
 
 } // namespace lighting

@@ -16,12 +16,18 @@ public:
     StageRequirements requirements() const override { return {{gbuffer::Channel::Depth}, true}; }
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::ExactSurface& exact = *inputs.exact;
-        shadeWithEveryLight(
-            exact.width, exact.height, inputs.lights->lightsExact,
-            [&exact](int x, int y, gbuffer::BasicSurface<double>& s) {
-                return exact.surfaceAt(x, y, s);
-            },
-            result);
+        auto surfaceAt = [&exact](int x, int y, gbuffer::BasicSurface<double>& s) {
+            return exact.surfaceAt(x, y, s);
+        };
+        // Every light that can reach a surface, found by a light grid over the exact surfaces:
+        // the sum is bitwise the full loop's (EveryLight.h), and 10^6 lights stay tractable.
+        LightGrid grid;
+        const auto box =
+            surfaceBox<gbuffer::BasicSurface<double>>(exact.width, exact.height, surfaceAt);
+        if (box)
+            grid.build(boundingSpheresView(*inputs.lights), box->first, box->second);
+        shadeWithEveryLight(exact.width, exact.height, inputs.lights->lightsExact, surfaceAt,
+                            result, box ? &grid : nullptr);
         if (mBlended.prepare(inputs))
             mBlended.compositeExact(inputs.gbuffer->depth(), result);
     }

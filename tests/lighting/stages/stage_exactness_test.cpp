@@ -24,6 +24,8 @@
 #include "lighting/StageRegistry.h"
 #include "lighting/kernel/ShadingPacket.h"
 #include "lighting/lists/ContributingLights.h"
+#include "lighting/lists/EveryLight.h"
+#include "lighting/passes/BlendedPass.h"
 #include "lighting/passes/PassNames.h"
 #include "scenes/SceneLoader.h"
 #include "scenes/procedural/ProceduralScenes.h"
@@ -283,6 +285,33 @@ TEST(Oracle, GridCountsEqualBruteForceOnEveryScene) {
         SCOPED_TRACE(c.name);
         const PreparedCase& f = prepared(c);
         EXPECT_EQ(f.oracle, lighting::countContributingLightsBrute(f.prepared->inputs));
+    }
+}
+
+// The reference stage evaluates only the light grid's candidates: its image and counts are
+// bitwise those of the loop over every light, on every scene case.
+TEST(ReferenceStage, GridImageIsBitwiseTheEveryLightLoop) {
+    for (const SceneCase& c : kScenes) {
+        SCOPED_TRACE(c.name);
+        const PreparedCase& f = prepared(c);
+        f.prepared->addExactSurface(); // the G-buffer stays bitwise the same
+        const lighting::StageInputs& inputs = f.prepared->inputs;
+        ASSERT_NE(inputs.exact, nullptr);
+        lighting::StageResult withGrid, everyLight;
+        lighting::makeStage("reference")->shade(inputs, withGrid);
+        const gbuffer::ExactSurface& exact = *inputs.exact;
+        lighting::shadeWithEveryLight(
+            exact.width, exact.height, inputs.lights->lightsExact,
+            [&exact](int x, int y, gbuffer::BasicSurface<double>& s) {
+                return exact.surfaceAt(x, y, s);
+            },
+            everyLight);
+        lighting::BlendedPass blended;
+        if (blended.prepare(inputs))
+            blended.compositeExact(inputs.gbuffer->depth(), everyLight);
+        for (int channel = 0; channel < 3; ++channel)
+            EXPECT_EQ(withGrid.radiance[channel], everyLight.radiance[channel]) << channel;
+        EXPECT_EQ(withGrid.lightsOracle, everyLight.lightsOracle);
     }
 }
 
