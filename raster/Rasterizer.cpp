@@ -122,6 +122,40 @@ void setUpPlanes(SetupTriangle& s, SetupBarycentrics* barycentrics, double x[3],
 
 } // namespace
 
+std::span<const SampleOffset> standardSamplePattern(int samples) {
+    // Direct3D's standard multisample patterns (D3D11_STANDARD_MULTISAMPLE_PATTERN), in 1/16
+    // pixel from the centre, y down.
+    static constexpr SampleOffset kOne[] = {{0, 0}};
+    static constexpr SampleOffset kTwo[] = {{4, 4}, {-4, -4}};
+    static constexpr SampleOffset kFour[] = {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}};
+    static constexpr SampleOffset kEight[] = {{1, -3}, {-1, 3},  {5, 1}, {-3, -5},
+                                              {-5, 5}, {-7, -1}, {3, 7}, {7, -7}};
+    static constexpr SampleOffset kSixteen[] = {
+        {1, 1},  {-1, -3}, {-3, 2},  {4, -1}, {-5, -2}, {2, 5},  {5, 3}, {3, -5},
+        {-2, 6}, {0, -7},  {-4, -6}, {-6, 4}, {-8, 0},  {7, -4}, {6, 7}, {-7, -8}};
+    switch (samples) {
+    case 1:
+        return kOne;
+    case 2:
+        return kTwo;
+    case 4:
+        return kFour;
+    case 8:
+        return kEight;
+    case 16:
+        return kSixteen;
+    default:
+        throw std::invalid_argument("no standard sample pattern of " + std::to_string(samples) +
+                                    " samples (1, 2, 4, 8 or 16)");
+    }
+}
+
+void Rasterizer::checkSampleCount(int samples) {
+    if (!isRasterSampleCount(samples))
+        throw std::invalid_argument("Rasterizer: " + std::to_string(samples) +
+                                    " samples per pixel; supported: 1, 2, 4, 8");
+}
+
 Rasterizer::ProjectedVertex Rasterizer::project(const glm::vec4& clip) const {
     // After clipping, w = 0 is only possible at the clip-space origin (the eye of a zero-near
     // projection): a piece touching it is seen edge-on and covers nothing (invW = 0 marks it).
@@ -299,18 +333,27 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
         std::swap(invW[1], invW[2]);
         std::swap(order[1], order[2]);
     }
-    // Pixel bounds: pixel p is sampled at p + 0.5, so the first candidate column is
-    // ceil(minX - 0.5) and the last floor(maxX - 0.5), in fixed point.
+    // Pixel bounds: pixel p is sampled at p + 0.5 (plus a sample's offset when multisampling),
+    // so the first candidate column is ceil(minX - 0.5 - largest offset) and the last
+    // floor(maxX - 0.5 - smallest offset), in fixed point.
     const int32_t minXf = std::min({s.x[0], s.x[1], s.x[2]});
     const int32_t maxXf = std::max({s.x[0], s.x[1], s.x[2]});
     const int32_t minYf = std::min({s.y[0], s.y[1], s.y[2]});
     const int32_t maxYf = std::max({s.y[0], s.y[1], s.y[2]});
+    int32_t offsetMinX = 0, offsetMaxX = 0, offsetMinY = 0, offsetMaxY = 0;
+    for (const SampleOffset& o : standardSamplePattern(state.samples)) {
+        constexpr int32_t kUnit = kSubpixelScale / 16;
+        offsetMinX = std::min(offsetMinX, o.x * kUnit);
+        offsetMaxX = std::max(offsetMaxX, o.x * kUnit);
+        offsetMinY = std::min(offsetMinY, o.y * kUnit);
+        offsetMaxY = std::max(offsetMaxY, o.y * kUnit);
+    }
     constexpr int32_t kHalf = kSubpixelScale / 2;
     auto ceilDiv = [](int32_t a) { return -((-a) >> kSubpixelBits); }; // ceil(a / 256)
-    const int minX = std::max(0, ceilDiv(minXf - kHalf));
-    const int minY = std::max(0, ceilDiv(minYf - kHalf));
-    const int maxX = std::min(mWidth - 1, (maxXf - kHalf) >> kSubpixelBits);
-    const int maxY = std::min(mHeight - 1, (maxYf - kHalf) >> kSubpixelBits);
+    const int minX = std::max(0, ceilDiv(minXf - kHalf - offsetMaxX));
+    const int minY = std::max(0, ceilDiv(minYf - kHalf - offsetMaxY));
+    const int maxX = std::min(mWidth - 1, (maxXf - kHalf - offsetMinX) >> kSubpixelBits);
+    const int maxY = std::min(mHeight - 1, (maxYf - kHalf - offsetMinY) >> kSubpixelBits);
     if (minX > maxX || minY > maxY) {
         ++batch.stats.trianglesCulled; // between sample points or off screen
         return;

@@ -26,16 +26,29 @@
 // its tile, so the result is bitwise identical for any thread count. Use tbb::task_arena to set
 // the thread count.
 //
-// The fragment function is called as fn(const Fragment&) for every covered sample that passes
-// the (early) depth test; it may be called concurrently for different tiles and must only write
-// data belonging to its own pixel. A fragment function that returns bool can discard the
-// fragment (an alpha test): false means no depth write and no count in samplesPassed; one that
-// returns void keeps every fragment (the choice is made at compile time, so draws without a
-// discard pay nothing for it). A Rasterizer object keeps scratch memory between draws: one
-// draw at a time per object.
+// Multisampling (RasterState::samples = 2, 4 or 8): coverage and depth are evaluated at the
+// standard Direct3D sample positions of each pixel (standardSamplePattern), each sample with the
+// same exact fixed-point edge functions and top-left rule as a pixel centre, so shared edges stay
+// watertight per sample. The depth buffer then holds one float per sample (pixel-major:
+// depth[(y * width + x) * samples + s]) and the depth test runs per sample, against the
+// triangle's depth plane at the sample. The fragment function is called ONCE per pixel and
+// triangle, as hardware MSAA shades: Fragment::coverage has a bit per sample that is covered and
+// passed the depth test, and Fragment::depth and the barycentrics are the pixel centre's (also
+// when the centre itself is outside the triangle: attributes are extrapolated, as a GPU does
+// without centroid sampling). The samples it keeps are written to the depth buffer afterwards.
+//
+// The fragment function is called as fn(const Fragment&) for every covered pixel (one sample
+// per pixel without multisampling) that passes the (early) depth test; it may be called
+// concurrently for different tiles and must only write data belonging to its own pixel. A fragment
+// function that returns bool can discard the fragment (an alpha test): false means no depth write
+// and no count in samplesPassed; one that returns void keeps every fragment (the choice is made at
+// compile time, so draws without a discard pay nothing for it). A Rasterizer object keeps scratch
+// memory between draws: one draw at a time per object.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <span>
 #include <type_traits>
@@ -61,6 +74,20 @@ inline constexpr int kTileSize = 128;
 // Input triangles per set-up batch: fixed so that binning order never depends on the threads.
 inline constexpr uint32_t kTrianglesPerBatch = 2048;
 
+// Multisampling: at most 8 samples per pixel (Fragment::coverage is a byte).
+inline constexpr int kMaxSamples = 8;
+// A sample position relative to the pixel centre in 1/16 pixel, screen axes (x right, y down).
+struct SampleOffset {
+    int8_t x, y;
+};
+// The standard Direct3D 10.1+ sample pattern of 1, 2, 4, 8 or 16 samples (16: for supersampled
+// references; the rasterizer takes up to kMaxSamples). Throws std::invalid_argument otherwise.
+std::span<const SampleOffset> standardSamplePattern(int samples);
+// Whether `samples` is a sample count the rasterizer supports (1, 2, 4, 8).
+inline bool isRasterSampleCount(int samples) {
+    return samples == 1 || samples == 2 || samples == 4 || samples == 8;
+}
+
 enum class CullMode { None, Back, Front };
 enum class DepthTest { Always, Less, LessEqual, Greater, GreaterEqual };
 
@@ -71,6 +98,9 @@ struct RasterState {
     // Compute Fragment::barycentric. Passes that find their attributes another way (from the
     // triangle id and the pixel centre) turn it off and save its set-up; it is then zero.
     bool barycentrics = true;
+    // Samples per pixel: 1, 2, 4 or 8 (see the file comment on multisampling); the depth buffer
+    // holds this many floats per pixel.
+    int samples = 1;
 };
 
 // Triangles as indexed clip-space vertices; triangle t uses indices[3t .. 3t+2].
@@ -89,6 +119,9 @@ struct Fragment {
     glm::vec3 barycentric{0.0f};
     uint32_t triangle = 0; // index into the TriangleList
     bool frontFacing = true;
+    // Multisampling: bit s set when sample s (standardSamplePattern) is covered and passed the
+    // depth test; 1 without multisampling.
+    uint8_t coverage = 1;
 };
 
 template <class T>
@@ -101,8 +134,9 @@ struct RasterStats {
     uint64_t trianglesCulled = 0;  // back/front-face or degenerate
     uint64_t trianglesClipped = 0; // needed polygon clipping
     uint64_t trianglesSetUp = 0;   // after clipping (a clipped triangle can become several)
-    uint64_t samplesCovered = 0;
-    uint64_t samplesPassed = 0; // passed the depth test and was not discarded
+    uint64_t samplesCovered = 0;   // samples (pixels without multisampling) inside a triangle
+    uint64_t samplesPassed = 0;    // passed the depth test and was not discarded
+    uint64_t fragments = 0;        // fragment-function calls that kept their fragment
 };
 
 // A triangle after clipping, snapping and orientation fix-up, as the traversal reads it for
@@ -151,8 +185,9 @@ public:
     int width() const { return mWidth; }
     int height() const { return mHeight; }
 
-    // Rasterizes every triangle; depth (width*height floats, row 0 = top) may be null for no
-    // depth test. Cost: set-up O(triangles), traversal O(covered bounding-box pixels).
+    // Rasterizes every triangle; depth (width*height*state.samples floats, row 0 = top) may be
+    // null for no depth test. Throws std::invalid_argument for an unsupported sample count. Cost:
+    // set-up O(triangles), traversal O(covered bounding-box pixels).
     template <class FragmentFn>
     void draw(const TriangleList& triangles, const RasterState& state, float* depth,
               FragmentFn&& fragmentFn);
@@ -182,6 +217,7 @@ private:
         RasterStats stats;
     };
 
+    static void checkSampleCount(int samples);
     // Clip, cull, snap and bin all triangles into mBatches (parallel, deterministic).
     void setUpAndBin(const TriangleList& triangles, const RasterState& state);
     void setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last,
@@ -213,6 +249,11 @@ private:
     template <DepthTest kDepthTest, class FragmentFn>
     void rasterizeTile(int tileIndex, const RasterState& state, float* depth,
                        FragmentFn& fragmentFn, RasterStats& tileStats) const;
+    // The same with state.samples > 1 (a separate loop: the one-sample path keeps its early span
+    // exit and per-pixel tests, which multisampling cannot use).
+    template <DepthTest kDepthTest, class FragmentFn>
+    void rasterizeTileMultisample(int tileIndex, const RasterState& state, float* depth,
+                                  FragmentFn& fragmentFn, RasterStats& tileStats) const;
 
     int mWidth;
     int mHeight;
@@ -260,26 +301,45 @@ inline int64_t fillBias(int32_t ax, int32_t ay, int32_t bx, int32_t by) {
 template <class FragmentFn>
 void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, float* depth,
                       FragmentFn&& fragmentFn) {
+    checkSampleCount(state.samples);
     setUpAndBin(triangles, state);
     const int tileCount = mTilesX * mTilesY;
     mTileStats.assign(size_t(tileCount), TileStats{});
     auto rasterize = [&](int tile) {
         RasterStats& stats = mTileStats[size_t(tile)].stats;
+        const bool multisample = state.samples > 1;
         switch (state.depthTest) {
         case DepthTest::Always:
-            rasterizeTile<DepthTest::Always>(tile, state, depth, fragmentFn, stats);
+            if (multisample)
+                rasterizeTileMultisample<DepthTest::Always>(tile, state, depth, fragmentFn, stats);
+            else
+                rasterizeTile<DepthTest::Always>(tile, state, depth, fragmentFn, stats);
             break;
         case DepthTest::Less:
-            rasterizeTile<DepthTest::Less>(tile, state, depth, fragmentFn, stats);
+            if (multisample)
+                rasterizeTileMultisample<DepthTest::Less>(tile, state, depth, fragmentFn, stats);
+            else
+                rasterizeTile<DepthTest::Less>(tile, state, depth, fragmentFn, stats);
             break;
         case DepthTest::LessEqual:
-            rasterizeTile<DepthTest::LessEqual>(tile, state, depth, fragmentFn, stats);
+            if (multisample)
+                rasterizeTileMultisample<DepthTest::LessEqual>(tile, state, depth, fragmentFn,
+                                                               stats);
+            else
+                rasterizeTile<DepthTest::LessEqual>(tile, state, depth, fragmentFn, stats);
             break;
         case DepthTest::Greater:
-            rasterizeTile<DepthTest::Greater>(tile, state, depth, fragmentFn, stats);
+            if (multisample)
+                rasterizeTileMultisample<DepthTest::Greater>(tile, state, depth, fragmentFn, stats);
+            else
+                rasterizeTile<DepthTest::Greater>(tile, state, depth, fragmentFn, stats);
             break;
         case DepthTest::GreaterEqual:
-            rasterizeTile<DepthTest::GreaterEqual>(tile, state, depth, fragmentFn, stats);
+            if (multisample)
+                rasterizeTileMultisample<DepthTest::GreaterEqual>(tile, state, depth, fragmentFn,
+                                                                  stats);
+            else
+                rasterizeTile<DepthTest::GreaterEqual>(tile, state, depth, fragmentFn, stats);
             break;
         }
     };
@@ -297,6 +357,7 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
     for (const TileStats& tile : mTileStats) {
         mStats.samplesCovered += tile.stats.samplesCovered;
         mStats.samplesPassed += tile.stats.samplesPassed;
+        mStats.fragments += tile.stats.fragments;
     }
 }
 
@@ -418,6 +479,129 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     }
     tileStats.samplesCovered = samplesCovered;
     tileStats.samplesPassed = samplesPassed;
+    tileStats.fragments = samplesPassed;
+}
+
+template <DepthTest kDepthTest, class FragmentFn>
+void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& state, float* depth,
+                                          FragmentFn& fragmentFn, RasterStats& tileStats) const {
+    const int tileMinX = (tileIndex % mTilesX) * kTileSize;
+    const int tileMinY = (tileIndex / mTilesX) * kTileSize;
+    const int tileMaxX = std::min(tileMinX + kTileSize, mWidth) - 1;
+    const int tileMaxY = std::min(tileMinY + kTileSize, mHeight) - 1;
+    constexpr int64_t kHalf = kSubpixelScale / 2;
+    // Sample offsets are in 1/16 pixel: this many fixed-point units each.
+    constexpr int64_t kOffsetUnit = kSubpixelScale / 16;
+    constexpr bool kCanDiscard =
+        std::is_same_v<std::invoke_result_t<FragmentFn&, const Fragment&>, bool>;
+    const int sampleCount = state.samples;
+    const std::span<const SampleOffset> pattern = standardSamplePattern(sampleCount);
+
+    uint64_t samplesCovered = 0, samplesPassed = 0, fragments = 0;
+    for (const Batch& batch : mBatches) {
+        const uint32_t binEnd = batch.binOffsets[size_t(tileIndex) + 1];
+        for (uint32_t item = batch.binOffsets[size_t(tileIndex)]; item < binEnd; ++item) {
+            const uint32_t index = batch.binItems[item];
+            const SetupTriangle& t = batch.triangles[index];
+            const int minX = std::max(int(t.minX), tileMinX),
+                      maxX = std::min(int(t.maxX), tileMaxX);
+            const int minY = std::max(int(t.minY), tileMinY),
+                      maxY = std::min(int(t.maxY), tileMaxY);
+            if (minX > maxX || minY > maxY)
+                continue;
+
+            // Edge i is opposite vertex i, as in rasterizeTile; each edge value is carried at the
+            // pixel centre, and a sample's is the centre's plus the edge's exact change over the
+            // sample's offset (integers: the same value a direct evaluation gives).
+            const int32_t* x = t.x;
+            const int32_t* y = t.y;
+            const int32_t ax[3] = {x[1], x[2], x[0]}, ay[3] = {y[1], y[2], y[0]};
+            const int32_t bx[3] = {x[2], x[0], x[1]}, by[3] = {y[2], y[0], y[1]};
+            int64_t stepX[3], stepY[3], bias[3], row[3], maxOffset[3];
+            int64_t offset[3][kMaxSamples];
+            const int64_t px0 = int64_t(minX) * kSubpixelScale + kHalf;
+            const int64_t py0 = int64_t(minY) * kSubpixelScale + kHalf;
+            for (int e = 0; e < 3; ++e) {
+                const int64_t dx = int64_t(bx[e]) - ax[e], dy = int64_t(by[e]) - ay[e];
+                stepX[e] = -dy * kSubpixelScale;
+                stepY[e] = dx * kSubpixelScale;
+                bias[e] = detail::fillBias(ax[e], ay[e], bx[e], by[e]);
+                row[e] = dx * (py0 - ay[e]) - dy * (px0 - ax[e]);
+                maxOffset[e] = INT64_MIN;
+                for (int s = 0; s < sampleCount; ++s) {
+                    offset[e][s] = (dx * pattern[s].y - dy * pattern[s].x) * kOffsetUnit + bias[e];
+                    maxOffset[e] = std::max(maxOffset[e], offset[e][s]);
+                }
+            }
+            // Depth at a sample: the centre's plane value plus the plane's change over the offset.
+            double depthOffset[kMaxSamples];
+            for (int s = 0; s < sampleCount; ++s)
+                depthOffset[s] = t.z[1] * (pattern[s].x / 16.0) + t.z[2] * (pattern[s].y / 16.0);
+
+            for (int py = minY; py <= maxY; ++py) {
+                int64_t w0 = row[0], w1 = row[1], w2 = row[2];
+                const double zRow = t.z[0] + t.z[2] * py;
+                double pxDouble = minX;
+                for (int px = minX; px <= maxX;
+                     ++px, pxDouble += 1.0, w0 += stepX[0], w1 += stepX[1], w2 += stepX[2]) {
+                    // No sample can be inside when an edge rejects even its most favourable one.
+                    if (((w0 + maxOffset[0]) | (w1 + maxOffset[1]) | (w2 + maxOffset[2])) < 0)
+                        continue;
+                    unsigned covered = 0;
+                    for (int s = 0; s < sampleCount; ++s)
+                        if (((w0 + offset[0][s]) | (w1 + offset[1][s]) | (w2 + offset[2][s])) >= 0)
+                            covered |= 1u << s;
+                    if (covered == 0)
+                        continue;
+                    samplesCovered += unsigned(std::popcount(covered));
+                    const double zCentre = zRow + t.z[1] * pxDouble;
+                    float* depthPixel =
+                        depth ? depth + (size_t(py) * mWidth + size_t(px)) * size_t(sampleCount)
+                              : nullptr;
+                    float sampleDepth[kMaxSamples];
+                    unsigned passed = 0;
+                    for (int s = 0; s < sampleCount; ++s) {
+                        if (!(covered >> s & 1u))
+                            continue;
+                        sampleDepth[s] = float(std::clamp(zCentre + depthOffset[s], 0.0, 1.0));
+                        if (!depthPixel ||
+                            detail::depthPasses<kDepthTest>(sampleDepth[s], depthPixel[s]))
+                            passed |= 1u << s;
+                    }
+                    if (passed == 0)
+                        continue;
+                    Fragment fragment;
+                    fragment.x = px;
+                    fragment.y = py;
+                    fragment.depth = float(std::clamp(zCentre, 0.0, 1.0));
+                    if (state.barycentrics)
+                        fragment.barycentric = barycentricAt(batch, index, t, px, py);
+                    fragment.triangle = t.triangle;
+                    fragment.frontFacing = t.frontFacing;
+                    fragment.coverage = uint8_t(passed);
+                    bool kept = true;
+                    if constexpr (kCanDiscard)
+                        kept = fragmentFn(fragment);
+                    else
+                        fragmentFn(fragment);
+                    if (!kept)
+                        continue;
+                    ++fragments;
+                    samplesPassed += unsigned(std::popcount(passed));
+                    if (depthPixel && state.depthWrite)
+                        for (int s = 0; s < sampleCount; ++s)
+                            if (passed >> s & 1u)
+                                depthPixel[s] = sampleDepth[s];
+                }
+                row[0] += stepY[0];
+                row[1] += stepY[1];
+                row[2] += stepY[2];
+            }
+        }
+    }
+    tileStats.samplesCovered = samplesCovered;
+    tileStats.samplesPassed = samplesPassed;
+    tileStats.fragments = fragments;
 }
 
 } // namespace raster
