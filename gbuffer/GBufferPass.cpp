@@ -18,10 +18,11 @@ GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geomet
     VisibilityPass::checkTriangleCount(scene, geometry);
 }
 
-void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
+void GBufferPass::resolve(std::span<const uint32_t> codeSpan, GBuffer& target,
+                          ExactSurface* exact) const {
     const int width = target.width();
     const GBuffer::Writer sharedWriter = target.writer();
-    const uint32_t* codes = mVisibility.codes().data();
+    const uint32_t* codes = codeSpan.data();
     tbb::parallel_for(0, target.height(), [&](int y) {
         // A copy whose address does not escape, so the plane pointers stay in registers (the
         // encoded planes' out-of-line call could otherwise change the shared one).
@@ -51,7 +52,7 @@ void GBufferPass::resolve(GBuffer& target, ExactSurface* exact) const {
 }
 
 GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& target,
-                                       ExactSurface* exact) {
+                                       ExactSurface* exact, MultisampleTarget* multisample) {
     GBufferPassTimings timings;
     const CameraView& view = target.view();
     auto start = std::chrono::steady_clock::now();
@@ -59,14 +60,43 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     timings.transformMs = millisecondsSince(start);
 
     start = std::chrono::steady_clock::now();
-    mVisibility.draw(rasterizer, target.depthPlane());
+    if (multisample) {
+        multisample->sampleDepth.resize(target.pixelCount() * size_t(multisample->samples));
+        mVisibility.draw(rasterizer, multisample->sampleDepth, multisample->samples);
+    } else {
+        mVisibility.draw(rasterizer, target.depthPlane());
+    }
     timings.rasterMs = millisecondsSince(start);
+
+    std::span<const uint32_t> codes = mVisibility.codes();
+    if (multisample) {
+        start = std::chrono::steady_clock::now();
+        FragmentLayers& layers = multisample->layers;
+        layers.build(mVisibility, multisample->options);
+        timings.layersMs = millisecondsSince(start);
+        codes = layers.codes(0);
+        std::span<const float> depths = layers.depths(0);
+        std::copy(depths.begin(), depths.end(), target.depthPlane().begin());
+    }
 
     start = std::chrono::steady_clock::now();
     target.quantiseDepth();
     if (exact)
         exact->resize(view.width, view.height);
-    resolve(target, exact);
+    resolve(codes, target, exact);
+    if (multisample) {
+        const FragmentLayers& layers = multisample->layers;
+        multisample->upperLayers.resize(size_t(layers.layerCount() - 1));
+        for (int k = 1; k < layers.layerCount(); ++k) {
+            std::unique_ptr<GBuffer>& layer = multisample->upperLayers[size_t(k - 1)];
+            if (!layer)
+                layer = std::make_unique<GBuffer>(target.layout(), view);
+            std::span<const float> depths = layers.depths(k);
+            std::copy(depths.begin(), depths.end(), layer->depthPlane().begin());
+            layer->quantiseDepth();
+            resolve(layers.codes(k), *layer, nullptr);
+        }
+    }
     timings.resolveMs = millisecondsSince(start);
 
     if (exact) {

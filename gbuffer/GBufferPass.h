@@ -7,7 +7,11 @@
 // count (see raster/Rasterizer.h).
 #pragma once
 
+#include <memory>
+#include <vector>
+
 #include "gbuffer/GBuffer.h"
+#include "gbuffer/msaa/FragmentLayers.h"
 #include "gbuffer/visibility/ExactSurface.h"
 #include "gbuffer/visibility/SceneGeometry.h"
 #include "gbuffer/visibility/VisibilityPass.h"
@@ -22,6 +26,23 @@ struct GBufferPassTimings {
     double resolveMs = 0.0; // depth rounded to its format; attributes of the visible
                             // triangles encoded into the G-buffer planes
     double exactMs = 0.0;   // double-precision surface reconstruction (0 when not asked)
+    double layersMs = 0.0;  // multisampled: complex-pixel detection and the fragment layers
+                            // (the layers' resolve counts in resolveMs)
+};
+
+// What a multisampled G-buffer pass fills besides its target (layer 0): the fragment layers
+// (msaa/FragmentLayers.h) and one more G-buffer per layer above 0, in the target's layout and
+// view, each covered only where the layer has a fragment.
+struct MultisampleTarget {
+    int samples = 4; // 2, 4 or 8
+    FragmentLayerOptions options;
+    FragmentLayers layers;
+    std::vector<std::unique_ptr<GBuffer>> upperLayers; // layers 1 .. layerCount - 1
+    std::vector<float> sampleDepth;                    // the per-sample depth buffer
+    // The G-buffer of layer k: `target` for 0.
+    const GBuffer& layer(const GBuffer& target, int k) const {
+        return k == 0 ? target : *upperLayers[size_t(k - 1)];
+    }
 };
 
 class GBufferPass {
@@ -32,11 +53,17 @@ public:
 
     // Clears and fills `target`; fills `exact` too when non-null. Not thread-safe per object
     // (keeps the per-frame visibility pass); parallel inside, under the caller's tbb::task_arena.
+    // With `multisample`, the draw is multisampled and `target` holds layer 0 (every pixel's main
+    // fragment, FragmentLayers.h), multisample->upperLayers the others; `exact` then describes
+    // layer 0 (the reference of a multisampled frame is rendered apart, supersampled).
     GBufferPassTimings render(raster::Rasterizer& rasterizer, GBuffer& target,
-                              ExactSurface* exact = nullptr);
+                              ExactSurface* exact = nullptr,
+                              MultisampleTarget* multisample = nullptr);
 
 private:
-    void resolve(GBuffer& target, ExactSurface* exact) const;
+    // Encodes the surfaces of `codes` (one per pixel) into `target`, whose depth plane holds
+    // their depths already.
+    void resolve(std::span<const uint32_t> codes, GBuffer& target, ExactSurface* exact) const;
 
     const scenes::Scene& mScene;
     const SceneGeometry& mGeometry;

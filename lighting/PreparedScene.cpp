@@ -22,8 +22,14 @@ gbuffer::GBufferLayout withSceneMaterials(gbuffer::GBufferLayout layout,
 } // namespace
 
 PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,
-                             const gbuffer::GBufferLayout& layout)
+                             const gbuffer::GBufferLayout& layout,
+                             const Multisampling& multisampling)
     : scene(std::move(sceneIn)) {
+    if (multisampling.samples > 1) {
+        multisample = std::make_unique<gbuffer::MultisampleTarget>();
+        multisample->samples = multisampling.samples;
+        multisample->options = multisampling.layers;
+    }
     geometry = gbuffer::SceneGeometry::build(scene);
     view = gbuffer::CameraView::fromCamera(scene.cameras.front(), width, height,
                                            layout.depth.convention(), layout.depth.infiniteFar);
@@ -48,7 +54,7 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
                     gbuffer::GBufferLayout::lossless(depth)) {}
 
 void PreparedScene::renderGBuffer() {
-    gbufferTimings = mPass->render(*mRasterizer, *gbuffer, exact.get());
+    gbufferTimings = mPass->render(*mRasterizer, *gbuffer, exact.get(), multisample.get());
     rasterStats = mRasterizer->lastStats();
     exactSurfacePasses += exact ? 1 : 0;
 }
@@ -57,7 +63,7 @@ void PreparedScene::addExactSurface() {
     if (exact)
         return;
     exact = std::make_unique<gbuffer::ExactSurface>();
-    mPass->render(*mRasterizer, *gbuffer, exact.get());
+    mPass->render(*mRasterizer, *gbuffer, exact.get(), multisample.get());
     ++exactSurfacePasses;
     inputs.exact = exact.get();
 }

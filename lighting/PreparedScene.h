@@ -22,6 +22,12 @@
 
 namespace lighting {
 
+// Multisampled G-buffer passes (gbuffer/GBufferPass.h MultisampleTarget): samples 1 = none.
+struct Multisampling {
+    int samples = 1;
+    gbuffer::FragmentLayerOptions layers;
+};
+
 struct PreparedScene {
     scenes::Scene scene;
     gbuffer::SceneGeometry geometry;
@@ -30,6 +36,9 @@ struct PreparedScene {
     std::unique_ptr<gbuffer::ExactSurface> exact; // null unless asked for
     LightList lights;
     StageInputs inputs;
+    // Multisampled frames only (null otherwise): the fragment layers and the G-buffers of the
+    // layers above 0 (`gbuffer` is layer 0). layerInputs(k) are `inputs` with layer k's G-buffer.
+    std::unique_ptr<gbuffer::MultisampleTarget> multisample;
     raster::RasterStats rasterStats;
     gbuffer::GBufferPassTimings gbufferTimings;
     int exactSurfacePasses = 0; // G-buffer passes so far that also computed the exact surface
@@ -39,7 +48,7 @@ struct PreparedScene {
     // table (GBufferLayout::reference(), lossless()) gets the scene's, and the float32 roughness
     // and metallic its metallic-roughness materials need (gbuffer::addMaterialModels).
     PreparedScene(scenes::Scene scene, int width, int height, bool withExactSurface,
-                  const gbuffer::GBufferLayout& layout);
+                  const gbuffer::GBufferLayout& layout, const Multisampling& multisampling = {});
     // The reference layout (float32 everything), with standard or reversed float depth.
     PreparedScene(scenes::Scene scene, int width, int height, bool withExactSurface = false,
                   gbuffer::DepthConvention depth = gbuffer::DepthConvention::Reversed);
@@ -56,6 +65,14 @@ struct PreparedScene {
     // convention): what forward stages shade, for measurements on frames whose layout lacks
     // channels. Costs one more G-buffer pass.
     std::unique_ptr<gbuffer::GBuffer> renderLosslessGBuffer();
+
+    int layerCount() const { return multisample ? multisample->layers.layerCount() : 1; }
+    StageInputs layerInputs(int layer) const {
+        StageInputs layerFrame = inputs;
+        if (layer > 0)
+            layerFrame.gbuffer = multisample->upperLayers[size_t(layer - 1)].get();
+        return layerFrame;
+    }
 
     // Replaces the scene's lights (the G-buffer does not depend on them); for tests that place
     // lights by hand after seeing the geometry.

@@ -58,6 +58,10 @@ struct StageInfo {
     // brute 10, ideal 20, deferred 30, light-indexed 40, clustered 50, tiled 60, tiled-backface
     // 70, forward 80, forward-multipass 90, light-prepass 100, inferred 110, tiled-forward 120.
     int listOrder = 0;
+    // Multisampled frames (--msaa 2|4|8, MultisampleShading.h): empty when the stage shades them
+    // through the fragment layers; otherwise why it refuses them (`testbed list` shows it and the
+    // runner's error quotes it).
+    std::string msaaRefusal;
 };
 
 // Builds a stage from its checked options (defaults filled in). May throw StageError for a rule

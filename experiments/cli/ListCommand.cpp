@@ -51,6 +51,11 @@ void printStages(std::ostream& out) {
         << "), with their options (key=accepted values, type, default: what it does):\n";
     for (const lighting::StageInfo& info : lighting::stageInfos()) {
         out << "  " << info.name << "  - " << info.description << "\n";
+        out << "    msaa: "
+            << (info.msaaRefusal.empty()
+                    ? "yes (per-sample shading at complex pixels only, through the fragment layers)"
+                    : "refused: " + info.msaaRefusal)
+            << "\n";
         for (const lighting::StageOption& option : info.options)
             out << "    " << option.key << "=" << option.range() << "  " << option.typeName()
                 << ", default " << option.defaultText << ": " << option.doc << "\n";

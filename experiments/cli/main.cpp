@@ -92,6 +92,16 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         .add_option("--simt-warp", r.simtWarp,
                     "SIMT cost model warp: 32 (8x4 pixels) or 64 (8x8) lanes")
         ->capture_default_str();
+    render
+        .add_option("--msaa", r.msaa,
+                    "samples per pixel: 1, 2, 4 or 8 (Direct3D positions); complex pixels are "
+                    "shaded per fragment, simple ones once (gbuffer/msaa/FragmentLayers.h)")
+        ->capture_default_str();
+    render
+        .add_option("--complex-detect", r.complexDetect,
+                    "complex pixels by primitive (samples show different triangles) or "
+                    "discontinuity (depth + normal + material differ)")
+        ->capture_default_str();
     render.add_option("--out", options.out, "output folder")->capture_default_str();
     render
         .add_option("--heatmap-max", options.scales.heatmapMax,

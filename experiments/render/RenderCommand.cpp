@@ -327,6 +327,36 @@ nlohmann::json rasterJson(const raster::RasterStats& raster) {
             {"samples_passed", raster.samplesPassed}};
 }
 
+// The anti-aliasing block of stats.json: samples, complex-pixel detection and counts, and the
+// G-buffer's bytes (FragmentLayers.h: stored = as a compressed store holds them; allocated = the
+// full planes of every layer; per_sample_buffers = the multisampled depth and visibility buffers
+// the rasterizer fills before the layers are built).
+nlohmann::json msaaJson(const RenderRun& run) {
+    const RunMetrics& metrics = run.metrics;
+    nlohmann::json msaa = {{"samples", metrics.msaaSamples},
+                           {"complex_detect", run.options.complexDetect},
+                           {metric::kComplexFraction, metrics.complexFraction},
+                           {metric::kSurfacesPerPixel, metrics.surfacesPerCoveredPixel},
+                           {metric::kGBufferBytes, metrics.gbufferBytes},
+                           {metric::kGBufferAllocatedBytes, metrics.gbufferAllocatedBytes}};
+    const gbuffer::MultisampleTarget* target = run.prepared->multisample.get();
+    if (target) {
+        const gbuffer::FragmentLayers& layers = target->layers;
+        msaa["layers"] = layers.layerCount();
+        msaa["covered_pixels"] = layers.counts().coveredPixels;
+        msaa["complex_pixels"] = layers.counts().complexPixels;
+        msaa["partial_pixels"] = layers.counts().partialPixels;
+        msaa["merged_fragments"] = layers.counts().mergedFragments;
+        msaa["shaded_surfaces"] = layers.counts().fragments;
+        msaa["per_sample_buffers_bytes"] =
+            double(layers.pixelCount()) * layers.samples() * (sizeof(float) * 2 + sizeof(uint32_t));
+        msaa["gbuffer_bytes_per_pixel"] = metrics.gbufferBytes / double(layers.pixelCount());
+        msaa["gbuffer_bytes_ratio_to_1x"] =
+            metrics.gbufferBytes / (metrics.bytesPerPixel * double(layers.pixelCount()));
+    }
+    return msaa;
+}
+
 } // namespace
 
 nlohmann::json statsJson(const RenderRun& run) {
@@ -361,6 +391,13 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["seed"] = run.options.seed;
     stats["layout"] = layoutJson(run.gbuffer().layout(), metrics);
     stats[metric::kBytesPerPixel] = metrics.bytesPerPixel;
+    stats["msaa"] = msaaJson(run);
+    // The G-buffer pass's phases in the last timed repetition (GBufferPass.h).
+    const gbuffer::GBufferPassTimings& phases = run.prepared->gbufferTimings;
+    stats["gbuffer_phases_ms"] = {{"transform", phases.transformMs},
+                                  {"raster", phases.rasterMs},
+                                  {"layers", phases.layersMs},
+                                  {"resolve", phases.resolveMs}};
     addTimings(stats, run);
     stats["oracle_surface"] = run.oracleFromLosslessGBuffer
                                   ? "lossless G-buffer (the layout lacks BRDF channels)"

@@ -8,6 +8,7 @@
 
 #include "experiments/compare/FlipMetric.h"
 #include "experiments/render/CpuLoad.h"
+#include "lighting/MultisampleShading.h"
 #include "lighting/Oracle.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/passes/PassNames.h"
@@ -37,6 +38,7 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
     const int runs = options.warmup + options.repetitions;
     std::vector<PassTiming> passes;
     double cpuSeconds = 0.0, wallSeconds = 0.0;
+    lighting::MultisampleShading multisampleShading;
     for (int i = 0; i < runs; ++i) {
         const bool timed = i >= options.warmup;
         step(std::string(timed ? "" : "warm-up ") + "shading: " + options.stage +
@@ -47,13 +49,13 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
             run.prepared->renderGBuffer();
         const gbuffer::GBufferPassTimings& gbufferTimings = run.prepared->gbufferTimings;
         std::vector<std::pair<std::string, double>> repetition;
-        repetition.emplace_back(lighting::pass::kGBuffer, gbufferTimings.transformMs +
-                                                              gbufferTimings.rasterMs +
-                                                              gbufferTimings.resolveMs);
+        repetition.emplace_back(lighting::pass::kGBuffer,
+                                gbufferTimings.transformMs + gbufferTimings.rasterMs +
+                                    gbufferTimings.layersMs + gbufferTimings.resolveMs);
         if (exactSurface)
             repetition.emplace_back(lighting::pass::kExactSurface, gbufferTimings.exactMs);
         lighting::StageResult result;
-        stage.shade(run.prepared->inputs, result);
+        multisampleShading.shade(stage, *run.prepared, result);
         if (timed) {
             cpuSeconds += processCpuSeconds() - cpuStart;
             wallSeconds += std::chrono::duration<double>(Clock::now() - wallStart).count();
@@ -80,6 +82,13 @@ void countOracle(RenderRun& run) {
         run.oracle = run.result.lightsOracle;
         return;
     }
+    if (run.prepared->multisample) {
+        // Summed over the fragment layers, as the stage's evaluations are; on the stored layers
+        // (a lossless copy of every layer is not rendered: the count is then on the lossy
+        // surfaces, like a stage's).
+        run.oracle = lighting::countContributingLightsOverLayers(*run.prepared);
+        return;
+    }
     const lighting::StageInputs& frame = run.prepared->inputs;
     const gbuffer::GBufferLayout& stored = run.prepared->gbuffer->layout();
     const bool complete = stored.provides(gbuffer::Channel::Normal) &&
@@ -103,12 +112,32 @@ void fillReference(RenderRun& run, const std::string& stageName,
                    const lighting::StageResult* givenReference) {
     if (givenReference) {
         run.reference = *givenReference;
+    } else if (run.prepared->multisample) {
+        // Not from this frame's exact surface (layer 0 only): the reference is its own render.
+        run.reference = renderReference(run.options);
     } else if (stageName == kReferenceStage) {
         run.reference = run.result;
     } else {
         run.prepared->addExactSurface();
         lighting::makeStage(kReferenceStage)->shade(run.prepared->inputs, run.reference);
     }
+}
+
+// The anti-aliasing figures (RunMetrics.h), also for one-sample frames (1 surface per pixel).
+void setMultisampleMetrics(RunMetrics& metrics, const lighting::PreparedScene& prepared) {
+    const double pixels = double(prepared.gbuffer->pixelCount());
+    metrics.gbufferBytes = metrics.bytesPerPixel * pixels;
+    metrics.gbufferAllocatedBytes = metrics.allocatedBytesPerPixel * pixels;
+    if (!prepared.multisample)
+        return;
+    const gbuffer::FragmentLayers& layers = prepared.multisample->layers;
+    metrics.msaaSamples = layers.samples();
+    metrics.complexFraction = layers.complexFraction();
+    const auto& counts = layers.counts();
+    metrics.surfacesPerCoveredPixel =
+        counts.coveredPixels ? double(counts.fragments) / double(counts.coveredPixels) : 1.0;
+    metrics.gbufferBytes = layers.storedBytes(metrics.bytesPerPixel);
+    metrics.gbufferAllocatedBytes = layers.allocatedBytes(metrics.allocatedBytesPerPixel);
 }
 
 } // namespace
@@ -146,9 +175,12 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         step("G-buffer pass");
         // The exact surface only when the stage reads it: the reference's (compare) is computed
         // after the timed passes, so its work never inflates the stage's G-buffer time.
+        lighting::Multisampling multisampling;
+        multisampling.samples = options.msaa;
+        gbuffer::parseComplexDetection(options.complexDetect, multisampling.layers.detection);
         run.prepared = std::make_unique<lighting::PreparedScene>(
             std::move(plan.scene), options.width, options.height, plan.requirements.exactSurface,
-            plan.layout);
+            plan.layout, multisampling);
         run.prepared->inputs.isa = plan.isa;
         run.prepared->inputs.simtWarpLanes = options.simtWarp;
         std::vector<PassTiming> passes =
@@ -185,6 +217,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
                                  run.result.lightingSamples, layout.bytesPerPixel(),
                                  layout.allocatedBytesPerPixel(), error);
         run.metrics.setSimtModel(run.result.parameters);
+        setMultisampleMetrics(run.metrics, *run.prepared);
         run.metrics.cpuLoad = cpuLoad;
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;

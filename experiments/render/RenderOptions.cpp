@@ -5,7 +5,9 @@
 #include <charconv>
 #include <filesystem>
 
+#include "gbuffer/msaa/FragmentLayers.h"
 #include "lighting/StageRegistry.h"
+#include "raster/Rasterizer.h"
 #include "scenes/input/ClosestName.h"
 #include "scenes/input/WholeFile.h"
 #include "scenes/procedural/LightGenerator.h"
@@ -108,6 +110,20 @@ CheckedOptions checkOptions(const RenderOptions& options) {
     if (options.simtWarp != 32 && options.simtWarp != 64)
         throw UsageError("--simt-warp " + std::to_string(options.simtWarp) +
                          " refused: must be 32 (8x4 pixels) or 64 (8x8)");
+    if (!raster::isRasterSampleCount(options.msaa))
+        throw UsageError("--msaa " + std::to_string(options.msaa) +
+                         " refused: samples per pixel must be 1, 2, 4 or 8");
+    gbuffer::ComplexDetection detection;
+    if (!gbuffer::parseComplexDetection(options.complexDetect, detection))
+        throw UsageError("--complex-detect '" + options.complexDetect +
+                         "' refused: must be primitive or discontinuity");
+    if (options.msaa > 1) {
+        const std::string stageName = lighting::StageSpec::parse(options.stage).name;
+        for (const lighting::StageInfo& info : lighting::stageInfos())
+            if (info.name == stageName && !info.msaaRefusal.empty())
+                throw UsageError("--msaa " + std::to_string(options.msaa) + " refused for stage " +
+                                 stageName + ": " + info.msaaRefusal);
+    }
     if (options.brdf != "auto")
         usageErrorFrom([&] { return scenes::parseMaterialModel(options.brdf); });
     return checked;
@@ -149,6 +165,8 @@ std::vector<std::string> renderOptionKeys() {
             "threads",
             "isa",
             "simt-warp",
+            "msaa",
+            "complex-detect",
             "layout",
             "normals",
             "normal-space",
@@ -187,6 +205,10 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.isa = value;
     else if (key == "simt-warp")
         options.simtWarp = parseNumber<int>(key, value);
+    else if (key == "msaa")
+        options.msaa = parseNumber<int>(key, value);
+    else if (key == "complex-detect")
+        options.complexDetect = value;
     else if (key == "layout")
         options.layout = value;
     else if (key == "normals")

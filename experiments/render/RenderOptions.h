@@ -49,6 +49,10 @@ struct RenderOptions {
     // CPU runs), "scalar" (evaluateLight per pixel), or a target name (sse4, avx2, avx3...).
     std::string isa = "auto";
     int simtWarp = 32; // lanes of the SIMT cost model's warp: 32 (8x4 pixels) or 64 (8x8)
+    // Anti-aliasing: samples per pixel of the G-buffer pass (1, 2, 4, 8; raster/Rasterizer.h) and
+    // how complex pixels are found (primitive | discontinuity; gbuffer/msaa/FragmentLayers.h).
+    int msaa = 1;
+    std::string complexDetect = "primitive";
     bool compareReference = false;
     // G-buffer: a preset name ("" = derived from the scene and the stage,
     // gbuffer/LayoutDerivation.h), then overrides of its normal encoding ("NAME:BITS"), depth
@@ -78,10 +82,11 @@ std::optional<int> requestedLights(const RenderOptions& options);
 std::string lightsText(const RenderOptions& options);
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
-// seed, width, height, resolution (WxH), threads, isa, simt-warp, layout, normals, normal-space,
-// depth, position, view, brdf, and scene-option.KEY. Values are checked later by validate(); a
-// malformed number or an unknown key throws UsageError naming it. The sweep runner goes through
-// this, so every stage, encoding or scene added later is reachable without touching the runner.
+// seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect, layout,
+// normals, normal-space, depth, position, view, brdf, and scene-option.KEY. Values are checked
+// later by validate(); a malformed number or an unknown key throws UsageError naming it. The sweep
+// runner goes through this, so every stage, encoding or scene added later is reachable without
+// touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();

@@ -53,6 +53,14 @@ inline constexpr const char* kSimtLaneSlots = "simt_lane_slots";
 inline constexpr const char* kSimtEfficiency = "simt_efficiency";
 inline constexpr const char* kBytesPerPixel = "bytes_per_pixel";
 inline constexpr const char* kAllocatedBytesPerPixel = "allocated_bytes_per_pixel";
+// Anti-aliasing (--msaa, gbuffer/msaa/FragmentLayers.h): the fraction of covered pixels that are
+// complex, the surfaces shaded per covered pixel (1 without MSAA), and the G-buffer's bytes in
+// total: as a compressed store holds them (main surface per pixel, extra surfaces at complex
+// pixels) and as the testbed allocates them (full planes per layer).
+inline constexpr const char* kComplexFraction = "complex_fraction";
+inline constexpr const char* kSurfacesPerPixel = "surfaces_per_covered_pixel";
+inline constexpr const char* kGBufferBytes = "gbuffer_bytes";
+inline constexpr const char* kGBufferAllocatedBytes = "gbuffer_allocated_bytes";
 } // namespace metric
 
 // Passes the runner adds around the stage's (lighting/passes/PassNames.h has the frame's passes).
@@ -102,6 +110,12 @@ struct RunMetrics {
     void setSimtModel(const std::map<std::string, std::string>& stageParameters);
     double bytesPerPixel = 0.0;
     double allocatedBytesPerPixel = 0.0;
+    // Anti-aliasing figures (see metric::kComplexFraction); samples 1 without MSAA.
+    int msaaSamples = 1;
+    double complexFraction = 0.0;
+    double surfacesPerCoveredPixel = 1.0;
+    double gbufferBytes = 0.0;
+    double gbufferAllocatedBytes = 0.0;
     std::optional<ErrorMetrics> error;
 
     // rmse, relative_rmse, psnr, max_abs, relative_mean, p99_abs, flip (empty without a

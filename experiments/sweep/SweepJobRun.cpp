@@ -125,6 +125,10 @@ Json metricColumnsOf(const RunMetrics& metrics) {
     row[metric::kSimtEfficiency] =
         metrics.simtEfficiency ? number(*metrics.simtEfficiency) : Json(nullptr);
     row[metric::kBytesPerPixel] = metrics.bytesPerPixel;
+    row[metric::kComplexFraction] = metrics.complexFraction;
+    row[metric::kSurfacesPerPixel] = metrics.surfacesPerCoveredPixel;
+    row[metric::kGBufferBytes] = metrics.gbufferBytes;
+    row[metric::kGBufferAllocatedBytes] = metrics.gbufferAllocatedBytes;
     for (const NamedFigure& figure : metrics.errorFigures())
         row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
     if (metrics.error)

@@ -61,28 +61,57 @@ raster::RasterState VisibilityPass::redrawState() const {
     return state;
 }
 
-void VisibilityPass::draw(raster::Rasterizer& rasterizer, std::span<float> depth) {
+void VisibilityPass::draw(raster::Rasterizer& rasterizer, std::span<float> depth, int samples) {
     const size_t pixelCount = size_t(mView.width) * size_t(mView.height);
-    if (depth.size() != pixelCount)
+    const size_t sampleCount = pixelCount * size_t(std::max(samples, 1));
+    if (depth.size() != sampleCount)
         throw std::invalid_argument("visibility draw: the depth plane has " +
-                                    std::to_string(depth.size()) + " pixels, the view " +
-                                    std::to_string(pixelCount));
+                                    std::to_string(depth.size()) + " samples, the view " +
+                                    std::to_string(sampleCount));
     std::fill(depth.begin(), depth.end(), mView.clearDepth());
-    mCodes.assign(pixelCount, kNoTriangle);
+    mSamples = samples;
+    mCodes.assign(sampleCount, kNoTriangle);
+    raster::RasterState state = drawState();
+    state.samples = samples;
     const size_t width = size_t(mView.width);
     uint32_t* codes = mCodes.data();
-    if (mAlpha.active()) {
-        rasterizer.draw(triangles(), drawState(), depth.data(),
-                        [&](const raster::Fragment& fragment) {
-                            if (!keeps(fragment))
-                                return false;
-                            codes[size_t(fragment.y) * width + size_t(fragment.x)] =
-                                code(fragment.triangle, fragment.frontFacing);
-                            return true;
-                        });
+    if (samples > 1) {
+        // Read only where a code was written: resized, not cleared.
+        mCentreDepths.resize(sampleCount);
+        float* centreDepths = mCentreDepths.data();
+        const size_t stride = size_t(samples);
+        auto record = [&](const raster::Fragment& fragment) {
+            const size_t first = (size_t(fragment.y) * width + size_t(fragment.x)) * stride;
+            const uint32_t value = code(fragment.triangle, fragment.frontFacing);
+            for (size_t s = 0; s < stride; ++s)
+                if (fragment.coverage >> s & 1u) {
+                    codes[first + s] = value;
+                    centreDepths[first + s] = fragment.depth;
+                }
+        };
+        if (mAlpha.active())
+            rasterizer.draw(triangles(), state, depth.data(), [&](const raster::Fragment& f) {
+                if (!keeps(f))
+                    return false;
+                record(f);
+                return true;
+            });
+        else
+            rasterizer.draw(triangles(), state, depth.data(), record);
         return;
     }
-    rasterizer.draw(triangles(), drawState(), depth.data(), [&](const raster::Fragment& fragment) {
+    mCentreDepths.clear();
+    if (mAlpha.active()) {
+        rasterizer.draw(triangles(), state, depth.data(), [&](const raster::Fragment& fragment) {
+            if (!keeps(fragment))
+                return false;
+            codes[size_t(fragment.y) * width + size_t(fragment.x)] =
+                code(fragment.triangle, fragment.frontFacing);
+            return true;
+        });
+        return;
+    }
+    rasterizer.draw(triangles(), state, depth.data(), [&](const raster::Fragment& fragment) {
         codes[size_t(fragment.y) * width + size_t(fragment.x)] =
             code(fragment.triangle, fragment.frontFacing);
     });

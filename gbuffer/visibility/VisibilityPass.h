@@ -85,12 +85,19 @@ public:
     }
     const scenes::Scene& scene() const { return *mScene; }
 
-    // Clears `depth` (view width x height floats) to the view's far value and the visibility
-    // buffer to kNoTriangle, then draws the scene with drawState(), recording codes; with an
-    // active alpha test, discarded fragments write neither depth nor code.
-    void draw(raster::Rasterizer& rasterizer, std::span<float> depth);
-    // The visibility buffer of the last draw(): one code per pixel, row-major.
+    // Clears `depth` (view width x height x `samples` floats) to the view's far value and the
+    // visibility buffer to kNoTriangle, then draws the scene with drawState() at `samples` samples
+    // per pixel (raster/Rasterizer.h: 1, 2, 4 or 8), recording codes; with an active alpha test,
+    // discarded fragments write neither depth nor code (the whole fragment: no alpha-to-coverage).
+    void draw(raster::Rasterizer& rasterizer, std::span<float> depth, int samples = 1);
+    // The visibility buffer of the last draw(): one code per sample, pixel-major
+    // (codes()[pixel * sampleCount() + s]), row-major pixels.
     std::span<const uint32_t> codes() const { return mCodes; }
+    int sampleCount() const { return mSamples; }
+    // Multisampled draws only (else empty): per sample, the depth of its triangle's plane at the
+    // PIXEL CENTRE (raster::Fragment::depth), the depth its surface is reconstructed at (shading
+    // once per pixel and triangle), as the sample's code.
+    std::span<const float> centreDepths() const { return mCentreDepths; }
     bool isVisible(const raster::Fragment& fragment, uint32_t triangle) const {
         return mCodes[size_t(fragment.y) * size_t(mView.width) + size_t(fragment.x)] ==
                code(triangle, fragment.frontFacing);
@@ -114,6 +121,8 @@ private:
     std::vector<MaterialSampling> mMaterials; // what the resolve reads of each material
     std::vector<float> mNdcXOfColumn; // view.ndcOfPixel(x, y).x per column: no division per pixel
     Plane<uint32_t> mCodes;
+    std::vector<float> mCentreDepths; // multisampled draws: per sample (centreDepths())
+    int mSamples = 1;
     AlphaCoverage mAlpha;
 };
 

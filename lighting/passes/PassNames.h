@@ -24,10 +24,12 @@ inline constexpr const char* kShading = "shading";     // evaluating the lights
 inline constexpr const char* kLighting = "lighting";   // light buffer accumulation (pre-pass)
 inline constexpr const char* kMaterial = "material";   // second geometry pass (pre-pass)
 inline constexpr const char* kBlend = "blend"; // blended surfaces, after the opaque (BlendedPass.h)
+// Multisampled frames: the layers' images weighted into the pixel (MultisampleShading.h).
+inline constexpr const char* kResolve = "resolve";
 
 // The order passes run in within a frame; tables list passes this way, others after by name.
-inline constexpr std::array<std::string_view, 11> kPipelineOrder = {
-    kGBuffer, kExactSurface, kTransform, kPrepass,  kCull, kAssign,
-    kIndex,   kShading,      kLighting,  kMaterial, kBlend};
+inline constexpr std::array<std::string_view, 12> kPipelineOrder = {
+    kGBuffer, kExactSurface, kTransform, kPrepass,  kCull,  kAssign,
+    kIndex,   kShading,      kLighting,  kMaterial, kBlend, kResolve};
 
 } // namespace lighting::pass

@@ -116,13 +116,15 @@ private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-const StageRegistrar
-    kRegistrar({.name = "forward-multipass",
-                .description = "one additive pass per light over its illumination set",
-                .kind = StageKind::Exact,
-                .options = {}, // none
-                .listOrder = 90},
-               [](const StageOptions&) { return std::make_unique<ForwardMultipassStage>(); });
+const StageRegistrar kRegistrar(
+    {.name = "forward-multipass",
+     .description = "one additive pass per light over its illumination set",
+     .kind = StageKind::Exact,
+     .options = {}, // none
+     .listOrder = 90,
+     .msaaRefusal = "shades while rasterizing; hardware-style MSAA (per-sample colour with "
+                    "coverage, shaded once per pixel and triangle) is not implemented yet"},
+    [](const StageOptions&) { return std::make_unique<ForwardMultipassStage>(); });
 
 } // namespace
 

@@ -87,7 +87,9 @@ const StageRegistrar kRegistrar(
      .kind = StageKind::Exact,
      .options = {StageOption::boolean(
          "prepass", false, "depth-only pre-pass first, then shade each pixel once (no overdraw)")},
-     .listOrder = 80},
+     .listOrder = 80,
+     .msaaRefusal = "shades while rasterizing; hardware-style MSAA (per-sample colour with "
+                    "coverage, shaded once per pixel and triangle) is not implemented yet"},
     [](const StageOptions& options) {
         return std::make_unique<ForwardStage>(options.boolean("prepass"));
     });

@@ -323,7 +323,9 @@ const StageRegistrar kRegistrar(
                                      "DSF: minimum cosine between sample and pixel normals"),
                  StageOption::integer("tile", 16, 4, 128, "culling tile size in low-res samples"),
                  StageOption::boolean("ids", true, "DSF object-ID test")},
-     .listOrder = 110},
+     .listOrder = 110,
+     .msaaRefusal = "its DSF resolve already filters edges from the reduced-resolution light "
+                    "buffer; combining it with per-sample layers is not implemented yet"},
     [](const StageOptions& table) {
         InferredOptions options;
         options.scale = table.integer("scale");

@@ -166,7 +166,10 @@ const StageRegistrar kRegistrar(
                                      "colour of the monochrome specular: white, or the "
                                      "chromaticity of the diffuse light (Engel)"),
                  StageOption::integer("tile", 16, 4, 128, "culling tile size in pixels")},
-     .listOrder = 100},
+     .listOrder = 100,
+     .msaaRefusal =
+         "its material pass rasterizes the scene again and reads the light buffer per pixel; the "
+         "per-sample light buffer at edges that the seeds describe is not implemented yet"},
     [](const StageOptions& options) {
         return std::make_unique<LightPrepassStage>(options.text("spec") == "chroma",
                                                    options.integer("tile"));

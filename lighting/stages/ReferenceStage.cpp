@@ -36,13 +36,15 @@ private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-const StageRegistrar
-    kRegistrar({.name = "reference",
-                .description = "every light at every pixel, double precision, exact surface",
-                .kind = StageKind::Reference,
-                .options = {}, // none
-                .listOrder = 0},
-               [](const StageOptions&) { return std::make_unique<ReferenceStage>(); });
+const StageRegistrar kRegistrar(
+    {.name = "reference",
+     .description = "every light at every pixel, double precision, exact surface",
+     .kind = StageKind::Reference,
+     .options = {}, // none
+     .listOrder = 0,
+     .msaaRefusal =
+         "the reference of an anti-aliased frame is supersampled instead (--reference-spp)"},
+    [](const StageOptions&) { return std::make_unique<ReferenceStage>(); });
 
 } // namespace
 

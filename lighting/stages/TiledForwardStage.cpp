@@ -125,7 +125,9 @@ const StageRegistrar kRegistrar(
                                       "cull lights against the camera frustum first (speed only)"),
                  StageOption::boolean("mask", false,
                                       "Harada's 2.5D culling: a 32-bin depth mask per tile")},
-     .listOrder = 120},
+     .listOrder = 120,
+     .msaaRefusal = "shades while rasterizing; hardware-style MSAA (per-sample colour with "
+                    "coverage, shaded once per pixel and triangle) is not implemented yet"},
     [](const StageOptions& table) {
         TiledForwardOptions options;
         options.tileSizePixels = table.integer("tile");

@@ -1,0 +1,118 @@
+#include "lighting/MultisampleShading.h"
+
+#include <algorithm>
+#include <string>
+
+#include <tbb/parallel_for.h>
+
+#include "lighting/Oracle.h"
+#include "lighting/passes/PassNames.h"
+
+namespace lighting {
+
+namespace {
+
+bool hasBlendedMaterial(const scenes::Scene& scene) {
+    return std::any_of(scene.materials.begin(), scene.materials.end(), [](const auto& material) {
+        return material.alphaMode == scenes::AlphaMode::Blend;
+    });
+}
+
+// Adds `run`'s passes to `total`'s of the same name (appended when new), in order.
+void addTimings(std::vector<std::pair<std::string, double>>& total,
+                const std::vector<std::pair<std::string, double>>& run) {
+    for (const auto& [name, ms] : run) {
+        auto it = std::find_if(total.begin(), total.end(),
+                               [&](const auto& entry) { return entry.first == name; });
+        if (it == total.end())
+            total.emplace_back(name, ms);
+        else
+            it->second += ms;
+    }
+}
+
+} // namespace
+
+void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepared,
+                               StageResult& result) {
+    stage.shade(prepared.inputs, result);
+    if (!prepared.multisample)
+        return;
+    const gbuffer::FragmentLayers& layers = prepared.multisample->layers;
+    const int width = layers.width();
+    std::vector<StageResult>& upper = mUpper;
+    upper.resize(size_t(layers.layerCount() - 1));
+    for (int k = 1; k < layers.layerCount(); ++k) {
+        upper[size_t(k - 1)].traceLights = result.traceLights;
+        stage.shade(prepared.layerInputs(k), upper[size_t(k - 1)]);
+        addTimings(result.timingsMs, upper[size_t(k - 1)].timingsMs);
+    }
+    // Blended surfaces over the background samples of partially covered pixels.
+    StageResult& background = mBackground;
+    const bool blended = hasBlendedMaterial(prepared.scene) && layers.counts().partialPixels > 0;
+    if (blended) {
+        if (!mEmpty || mEmpty->width() != prepared.view.width ||
+            mEmpty->height() != prepared.view.height)
+            mEmpty = std::make_unique<gbuffer::GBuffer>(prepared.gbuffer->layout(), prepared.view);
+        StageInputs frame = prepared.inputs;
+        frame.gbuffer = mEmpty.get();
+        stage.shade(frame, background);
+        addTimings(result.timingsMs, background.timingsMs);
+    }
+
+    PassTimer resolve(result, pass::kResolve);
+    const bool oracle = !result.lightsOracle.empty();
+    tbb::parallel_for(0, layers.height(), [&](int y) {
+        for (size_t pixel = size_t(y) * size_t(width); pixel < size_t(y + 1) * size_t(width);
+             ++pixel) {
+            const float w0 = layers.weight(0, pixel);
+            float rgb[3];
+            for (int c = 0; c < 3; ++c)
+                rgb[c] = w0 * result.radiance[c][pixel];
+            for (int k = 1; k < layers.layerCount(); ++k) {
+                const StageResult& layer = upper[size_t(k - 1)];
+                result.lightsEvaluated[pixel] += layer.lightsEvaluated[pixel];
+                if (layers.codes(k)[pixel] == gbuffer::VisibilityPass::kNoTriangle)
+                    continue;
+                const float w = layers.weight(k, pixel);
+                for (int c = 0; c < 3; ++c)
+                    rgb[c] += w * layer.radiance[c][pixel];
+                if (oracle)
+                    result.lightsOracle[pixel] += layer.lightsOracle[pixel];
+            }
+            if (blended) {
+                result.lightsEvaluated[pixel] += background.lightsEvaluated[pixel];
+                const bool partial =
+                    layers.codes(0)[pixel] != gbuffer::VisibilityPass::kNoTriangle &&
+                    layers.backgroundWeight(pixel) > 0.0f;
+                if (partial)
+                    for (int c = 0; c < 3; ++c)
+                        rgb[c] += layers.backgroundWeight(pixel) * background.radiance[c][pixel];
+            }
+            for (int c = 0; c < 3; ++c)
+                result.radiance[c][pixel] = rgb[c];
+        }
+    });
+    resolve.stop();
+    const gbuffer::FragmentLayers::Counts& counts = layers.counts();
+    result.parameters["msaa"] = std::to_string(layers.samples());
+    result.parameters["msaa_layers"] = std::to_string(layers.layerCount());
+    result.parameters["msaa_complex_pixels"] = std::to_string(counts.complexPixels);
+    result.parameters["msaa_shaded_fragments"] = std::to_string(counts.fragments);
+    result.parameters["msaa_background_run"] = blended ? "1" : "0";
+}
+
+std::vector<uint32_t> countContributingLightsOverLayers(const PreparedScene& prepared) {
+    std::vector<uint32_t> total = countContributingLights(prepared.inputs);
+    if (!prepared.multisample)
+        return total;
+    const gbuffer::FragmentLayers& layers = prepared.multisample->layers;
+    for (int k = 1; k < layers.layerCount(); ++k) {
+        const std::vector<uint32_t> layer = countContributingLights(prepared.layerInputs(k));
+        for (size_t pixel = 0; pixel < total.size(); ++pixel)
+            total[pixel] += layer[pixel];
+    }
+    return total;
+}
+
+} // namespace lighting

@@ -1,0 +1,56 @@
+// MultisampleShading: how a stage shades a multisampled frame (PreparedScene with Multisampling)
+// and how its samples are resolved, for every stage that shades from the G-buffer.
+//
+// The stage runs once per fragment layer (gbuffer/msaa/FragmentLayers.h): on layer 0, the
+// full-screen G-buffer of every pixel's main fragment, then on each layer above, whose G-buffer is
+// covered only at complex pixels. Nothing in the stage changes: a tiled or clustered stage finds no
+// covered pixel in most tiles of an upper layer and skips them (the survey's per-tile MSAA choice,
+// made by the data), a light-volume stage tests its volumes against the layer's depth, and the
+// shading kernel runs full packets over the complex pixels' fragments. Scenes with blended
+// surfaces get one more run over an empty G-buffer: the blended surfaces over the background, for
+// the background samples of partially covered pixels.
+// Resolve ("resolve" pass): radiance = sum over layers of weight x the layer's radiance
+// (FragmentLayers::weight: the fraction of the pixel's samples the fragment covers), plus the
+// background run weighted by the background samples. lightsEvaluated adds every run's evaluations
+// (all of them were done); a stage-filled lightsOracle adds the layers' at the pixels where the
+// layer has a fragment. Passes of the same name are summed over the runs, in first-run order, and
+// "resolve" is appended. Parameters are the first run's, plus msaa_* counters.
+//
+// Which stages: those whose StageInfo says MsaaSupport::Layers (StageRegistry.h). Stages that
+// rasterize the scene themselves (forward family, the light pre-pass and inferred material
+// passes) would shade the whole scene again per layer: they are refused (RenderPlan.h).
+//
+// Exactness: a layer's image is the stage's own on that layer's G-buffer, so the exactness of each
+// stage per layer (tested against brute per layer) carries over, and the resolve is the same
+// weighted sum for every stage: bitwise brute's resolve for a stage that is bitwise brute per
+// layer. Deterministic: per-pixel sums in layer order.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "lighting/PreparedScene.h"
+#include "lighting/ShadingStage.h"
+
+namespace lighting {
+
+// Shades `prepared` (multisampled or not: without layers this is stage.shade) into `result`.
+// Keeps the upper layers' results and the background run's empty G-buffer between calls (one
+// object per run and stage, like the stage's own scratch), so that timed repetitions do not pay
+// for fresh allocations. Not reentrant.
+class MultisampleShading {
+public:
+    void shade(ShadingStage& stage, const PreparedScene& prepared, StageResult& result);
+
+private:
+    std::vector<StageResult> mUpper;
+    StageResult mBackground;
+    std::unique_ptr<gbuffer::GBuffer> mEmpty;
+};
+
+// The contributing lights per pixel summed over the layers' fragments (layer 0 alone when not
+// multisampled): the oracle that matches shadeMultisampled's lightsEvaluated.
+std::vector<uint32_t> countContributingLightsOverLayers(const PreparedScene& prepared);
+
+} // namespace lighting

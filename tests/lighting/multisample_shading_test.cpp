@@ -1,0 +1,234 @@
+// Multisampled frames (lighting/MultisampleShading.h) through every stage that takes them: per
+// fragment layer, the stage's image and its evaluated lights against brute on the same layer
+// (the exactness tests' identity check and bitwise image, per layer: "per-sample exactness", since
+// a layer's fragment stands for its samples, shaded once); the resolved image against brute's
+// resolve (bitwise for ascending-order stages); the resolve's arithmetic; determinism across
+// thread counts; and the refusal of the stages that cannot take a multisampled frame.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <tbb/task_arena.h>
+
+#include "lighting/MultisampleShading.h"
+#include "lighting/PreparedScene.h"
+#include "lighting/StageRegistry.h"
+#include "lighting/lists/ContributingLights.h"
+#include "scenes/SceneLoader.h"
+#include "scenes/procedural/ProceduralScenes.h"
+#include "tests/lighting/LightIdentity.h"
+
+namespace {
+
+constexpr int kWidth = 192;
+constexpr int kHeight = 108;
+
+struct SceneCase {
+    const char* name;
+    const char* scene;
+    int lights;
+};
+
+const SceneCase kScenes[] = {
+    {"atrium", "atrium", 300},
+    {"glass", "glass", 200}, // alpha-masked fence and blended panes
+    {"helmet", TESTBED_GLTF_DIR "/DamagedHelmet/DamagedHelmet.gltf", 64},
+};
+
+scenes::Scene loadCase(const SceneCase& c) {
+    scenes::SceneRequest request;
+    request.lightCount = c.lights;
+    request.seed = 5;
+    const std::string source = c.scene;
+    return source.ends_with(".gltf") ? scenes::loadScene(source, request)
+                                     : scenes::buildProceduralScene(c.scene, request);
+}
+
+std::unique_ptr<lighting::PreparedScene> prepareMultisampled(const SceneCase& c, int samples,
+                                                             gbuffer::ComplexDetection detection) {
+    lighting::Multisampling multisampling;
+    multisampling.samples = samples;
+    multisampling.layers.detection = detection;
+    return std::make_unique<lighting::PreparedScene>(
+        loadCase(c), kWidth, kHeight, false,
+        gbuffer::GBufferLayout::lossless(gbuffer::DepthConvention::Reversed), multisampling);
+}
+
+const lighting::PreparedScene& cachedFrame(int sceneIndex) {
+    static std::unique_ptr<lighting::PreparedScene> frames[std::size(kScenes)];
+    auto& frame = frames[sceneIndex];
+    if (!frame)
+        frame = prepareMultisampled(kScenes[sceneIndex], 4, gbuffer::ComplexDetection::Primitive);
+    return *frame;
+}
+
+std::vector<std::string> multisampledExactStages() {
+    std::vector<std::string> names;
+    for (const lighting::StageInfo& info : lighting::stageInfos())
+        if (info.kind == lighting::StageKind::Exact && info.msaaRefusal.empty())
+            names.push_back(info.name);
+    return names;
+}
+
+const lighting::StageInfo& stageInfo(const std::string& name) {
+    static const std::vector<lighting::StageInfo> infos = lighting::stageInfos();
+    for (const lighting::StageInfo& info : infos)
+        if (info.name == name)
+            return info;
+    throw std::runtime_error("no stage " + name);
+}
+
+float peakOf(const lighting::StageResult& image) {
+    float peak = 0.0f;
+    for (int ch = 0; ch < 3; ++ch)
+        for (float v : image.radiance[ch])
+            peak = std::max(peak, v);
+    return peak;
+}
+
+::testing::AssertionResult closeImages(const lighting::StageResult& a,
+                                       const lighting::StageResult& b, float relative) {
+    const float peak = std::max(peakOf(b), 1e-20f);
+    for (int ch = 0; ch < 3; ++ch)
+        for (size_t pixel = 0; pixel < a.radiance[ch].size(); ++pixel)
+            if (!(std::abs(a.radiance[ch][pixel] - b.radiance[ch][pixel]) <= relative * peak))
+                return ::testing::AssertionFailure()
+                       << "pixel " << pixel % a.width << "," << pixel / a.width << " channel " << ch
+                       << ": " << a.radiance[ch][pixel] << " vs " << b.radiance[ch][pixel];
+    return ::testing::AssertionSuccess();
+}
+
+class MultisampledStage : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+
+TEST_P(MultisampledStage, EachLayerMatchesBruteAndTheResolveMatchesBrutesResolve) {
+    const auto& [stageName, sceneIndex] = GetParam();
+    const lighting::PreparedScene& frame = cachedFrame(sceneIndex);
+    ASSERT_TRUE(frame.multisample);
+    ASSERT_GE(frame.layerCount(), 2) << "the scene must have complex pixels";
+    const bool ascending = stageInfo(stageName).ascendingLightOrder;
+    const auto stage = lighting::makeStage(stageName);
+    const auto brute = lighting::makeStage("brute");
+    for (int k = 0; k < frame.layerCount(); ++k) {
+        const lighting::StageInputs inputs = frame.layerInputs(k);
+        lighting::ContributingLights contributing;
+        contributing.build(*inputs.gbuffer, inputs.lights->lights);
+        const lighting::StageResult result = stagecheck::shadeTraced(*stage, inputs);
+        lighting::StageResult bruteResult;
+        brute->shade(inputs, bruteResult);
+        EXPECT_TRUE(stagecheck::everyContributingLightEvaluated(result, contributing, ascending))
+            << stageName << " on " << kScenes[sceneIndex].name << ", layer " << k;
+        if (ascending)
+            EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, bruteResult))
+                << stageName << ", layer " << k;
+        else
+            EXPECT_TRUE(closeImages(result, bruteResult, 1e-5f)) << stageName << ", layer " << k;
+    }
+    lighting::MultisampleShading stageShading, bruteShading;
+    lighting::StageResult resolved, bruteResolved;
+    stageShading.shade(*stage, frame, resolved);
+    bruteShading.shade(*brute, frame, bruteResolved);
+    if (ascending)
+        EXPECT_TRUE(stagecheck::bitwiseEqualImages(resolved, bruteResolved)) << stageName;
+    else
+        EXPECT_TRUE(closeImages(resolved, bruteResolved, 1e-5f)) << stageName;
+    EXPECT_EQ(resolved.parameters.at("msaa"), "4");
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryStage, MultisampledStage,
+                         ::testing::Combine(::testing::ValuesIn(multisampledExactStages()),
+                                            ::testing::Range(0, int(std::size(kScenes)))),
+                         [](const auto& info) {
+                             std::string name = std::get<0>(info.param) + "_" +
+                                                kScenes[std::get<1>(info.param)].name;
+                             for (char& ch : name)
+                                 if (!std::isalnum(static_cast<unsigned char>(ch)))
+                                     ch = '_';
+                             return name;
+                         });
+
+TEST(MultisampleResolve, IsTheCoverageWeightedSumOfTheLayers) {
+    const lighting::PreparedScene& frame = cachedFrame(0);
+    const gbuffer::FragmentLayers& layers = frame.multisample->layers;
+    const auto brute = lighting::makeStage("brute");
+    std::vector<lighting::StageResult> perLayer(size_t(frame.layerCount()));
+    for (int k = 0; k < frame.layerCount(); ++k)
+        brute->shade(frame.layerInputs(k), perLayer[size_t(k)]);
+    lighting::MultisampleShading shading;
+    lighting::StageResult resolved;
+    shading.shade(*brute, frame, resolved);
+    size_t partial = 0, complex = 0;
+    for (size_t pixel = 0; pixel < layers.pixelCount(); ++pixel) {
+        float coverage = layers.backgroundWeight(pixel);
+        double expected[3] = {0, 0, 0};
+        for (int k = 0; k < frame.layerCount(); ++k) {
+            if (layers.codes(k)[pixel] == gbuffer::VisibilityPass::kNoTriangle)
+                continue;
+            coverage += layers.weight(k, pixel);
+            for (int ch = 0; ch < 3; ++ch)
+                expected[ch] += double(layers.weight(k, pixel)) *
+                                double(perLayer[size_t(k)].radiance[ch][pixel]);
+        }
+        if (layers.codes(0)[pixel] != gbuffer::VisibilityPass::kNoTriangle)
+            ASSERT_FLOAT_EQ(coverage, 1.0f) << "samples of pixel " << pixel << " not partitioned";
+        partial += layers.backgroundWeight(pixel) > 0.0f &&
+                   layers.codes(0)[pixel] != gbuffer::VisibilityPass::kNoTriangle;
+        complex += layers.complex(pixel);
+        for (int ch = 0; ch < 3; ++ch)
+            ASSERT_NEAR(resolved.radiance[ch][pixel], expected[ch], 1e-5 * (1.0 + expected[ch]))
+                << "pixel " << pixel;
+    }
+    EXPECT_GT(complex, 100u);
+    // Every light evaluation of every layer is counted.
+    uint64_t sum = 0, layered = 0;
+    for (size_t pixel = 0; pixel < layers.pixelCount(); ++pixel) {
+        sum += resolved.lightsEvaluated[pixel];
+        for (const auto& layer : perLayer)
+            layered += layer.lightsEvaluated[pixel];
+    }
+    EXPECT_EQ(sum, layered);
+    (void)partial;
+}
+
+TEST(MultisampleResolve, SameImageForAnyThreadCount) {
+    for (const char* stageName : {"tiled", "clustered", "deferred"}) {
+        lighting::StageResult images[2];
+        for (int t = 0; t < 2; ++t)
+            tbb::task_arena(t + 1).execute([&] {
+                auto frame =
+                    prepareMultisampled(kScenes[1], 8, gbuffer::ComplexDetection::Primitive);
+                lighting::MultisampleShading shading;
+                shading.shade(*lighting::makeStage(stageName), *frame, images[t]);
+            });
+        EXPECT_TRUE(stagecheck::bitwiseEqualImages(images[0], images[1])) << stageName;
+        EXPECT_EQ(images[0].lightsEvaluated, images[1].lightsEvaluated) << stageName;
+    }
+}
+
+TEST(MultisampleResolve, TwoAndEightSamplesResolveLikeBrute) {
+    for (int samples : {2, 8}) {
+        auto frame = prepareMultisampled(kScenes[0], samples, gbuffer::ComplexDetection::Primitive);
+        lighting::MultisampleShading a, b;
+        lighting::StageResult tiled, brute;
+        a.shade(*lighting::makeStage("tiled-backface"), *frame, tiled);
+        b.shade(*lighting::makeStage("brute"), *frame, brute);
+        EXPECT_TRUE(stagecheck::bitwiseEqualImages(tiled, brute)) << samples;
+        EXPECT_EQ(tiled.parameters.at("msaa"), std::to_string(samples));
+    }
+}
+
+TEST(MultisampleStages, EveryStageSaysWhetherItTakesMultisampledFrames) {
+    // The stages that rasterize the scene themselves or are the reference refuse, with a reason;
+    // the G-buffer stages take them.
+    for (const lighting::StageInfo& info : lighting::stageInfos()) {
+        const bool rasterizes = info.name.starts_with("forward") || info.name == "tiled-forward" ||
+                                info.name == "light-prepass" || info.name == "inferred" ||
+                                info.name == "reference";
+        EXPECT_EQ(!info.msaaRefusal.empty(), rasterizes) << info.name;
+    }
+}
+
+} // namespace
