@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 #include <OpenImageIO/imagebuf.h>
@@ -160,10 +161,27 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     if (!run.metrics.lightCountsNote.empty())
         std::cout << "  light counts: " << run.metrics.lightCountsNote << "\n";
     std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
-    for (const char* file :
-         {"render.exr", "preview.png", "heatmap.png", "error.png", "flip.png", "stats.json"})
+    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "flip.png",
+                             "complex.png", "stats.json"})
         if (std::filesystem::exists(out / file))
             std::cout << "  " << (out / file).string() << "\n";
+}
+
+// Per pixel of a multisampled frame, the surfaces shaded there when the pixel is complex (a
+// background sample counts as none), 0 at simple and background pixels; empty without MSAA.
+std::vector<float> complexMap(const RenderRun& run) {
+    const gbuffer::MultisampleTarget* target = run.prepared->multisample.get();
+    if (!target)
+        return {};
+    const gbuffer::FragmentLayers& layers = target->layers;
+    std::vector<float> map(layers.pixelCount(), 0.0f);
+    for (size_t pixel = 0; pixel < map.size(); ++pixel) {
+        if (!layers.complex(pixel))
+            continue;
+        for (int k = 0; k < layers.layerCount(); ++k)
+            map[pixel] += layers.codes(k)[pixel] != gbuffer::VisibilityPass::kNoTriangle;
+    }
+    return map;
 }
 
 } // namespace
@@ -211,6 +229,9 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
     }
     if (!run.flipMap.empty())
         planes.push_back({"flip", run.flipMap.data()});
+    const std::vector<float> complex = complexMap(run);
+    if (!complex.empty())
+        planes.push_back({"msaa.complex", complex.data()});
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"testbed:scene", run.options.scene},
         {"testbed:stage", run.options.stage},
@@ -234,6 +255,14 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
                           errorMapStyle(scales));
     if (!run.flipMap.empty())
         writeScalarMapPng(dir / "flip.png", w, h, run.flipMap.data(), flipMapStyle());
+    if (!complex.empty()) {
+        ScalarMapStyle style;
+        style.max = float(run.prepared->multisample->layers.samples());
+        style.colourMap = "magma";
+        style.title = "surfaces shaded at complex pixels (black: simple or background), " +
+                      std::to_string(run.prepared->multisample->layers.samples()) + "x MSAA";
+        writeScalarMapPng(dir / "complex.png", w, h, complex.data(), style);
+    }
     writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
 }
 
@@ -474,6 +503,30 @@ int renderEveryView(const RenderCommandOptions& options) {
 
 } // namespace
 
+// What --explain-layout adds for anti-aliasing: the G-buffer's bytes at each sample count, as
+// the fragment layers store them (gbuffer/msaa/FragmentLayers.h), bounds before rendering.
+std::string explainMultisampleBytes(const RenderPlan& plan) {
+    const double surface = plan.layout.bytesPerPixel();
+    std::ostringstream out;
+    out << "anti-aliasing (--msaa N, --complex-detect " << plan.options.complexDetect
+        << "): one surface per pixel (" << surface
+        << " bytes) at simple pixels, one per distinct surface at complex ones; per pixel:\n";
+    for (int samples : {1, 2, 4, 8}) {
+        out << "  " << samples << "x: ";
+        if (samples == 1) {
+            out << surface << " bytes\n";
+            continue;
+        }
+        out << "stored " << surface + 1 << " bytes + " << surface + 1
+            << " per extra surface at a complex pixel (at most " << samples - 1 << ": "
+            << samples * (surface + 1) << " bytes); allocated " << surface
+            << " per layer; during the pass " << samples * 12
+            << " bytes of per-sample depth, centre depth and visibility"
+            << (samples == plan.options.msaa ? "  <- this render" : "") << "\n";
+    }
+    return out.str();
+}
+
 int runRenderCommand(const RenderCommandOptions& options) {
     if (options.render.view == kEveryView && !options.explainLayout) {
         try {
@@ -490,7 +543,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         RenderPlan plan = planRender(options.render); // every input error stops here
         if (options.explainLayout) {
             std::cout << "stage " << options.render.stage << " on " << options.render.scene << ":\n"
-                      << plan.layout.explain();
+                      << plan.layout.explain() << explainMultisampleBytes(plan);
             return 0;
         }
         ensureWritableDirectory(options.out); // before the G-buffer pass and the stage
