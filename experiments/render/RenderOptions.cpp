@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "lighting/StageRegistry.h"
+#include "lighting/SupersampledReference.h"
 #include "scenes/input/ClosestName.h"
 #include "scenes/input/WholeFile.h"
 #include "scenes/procedural/LightGenerator.h"
@@ -108,6 +109,10 @@ CheckedOptions checkOptions(const RenderOptions& options) {
     if (options.simtWarp != 32 && options.simtWarp != 64)
         throw UsageError("--simt-warp " + std::to_string(options.simtWarp) +
                          " refused: must be 32 (8x4 pixels) or 64 (8x8)");
+    if (const std::string problem = lighting::referenceSppProblem(options.referenceSpp);
+        !problem.empty())
+        throw UsageError("--reference-spp " + std::to_string(options.referenceSpp) +
+                         " refused: " + problem);
     if (options.brdf != "auto")
         usageErrorFrom([&] { return scenes::parseMaterialModel(options.brdf); });
     return checked;
@@ -138,25 +143,10 @@ std::string lightsText(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {"scene",
-            "stage",
-            "lights",
-            "seed",
-            "light-density",
-            "width",
-            "height",
-            "resolution",
-            "threads",
-            "isa",
-            "simt-warp",
-            "layout",
-            "normals",
-            "normal-space",
-            "depth",
-            "position",
-            "view",
-            "brdf",
-            "scene-option.<key>"};
+    return {"scene",     "stage",         "lights",     "seed",    "light-density",
+            "width",     "height",        "resolution", "threads", "isa",
+            "simt-warp", "reference-spp", "layout",     "normals", "normal-space",
+            "depth",     "position",      "view",       "brdf",    "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -187,6 +177,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.isa = value;
     else if (key == "simt-warp")
         options.simtWarp = parseNumber<int>(key, value);
+    else if (key == "reference-spp")
+        options.referenceSpp = parseNumber<int>(key, value);
     else if (key == "layout")
         options.layout = value;
     else if (key == "normals")
