@@ -77,6 +77,15 @@ std::unique_ptr<gbuffer::GBuffer> PreparedScene::renderLosslessGBuffer() {
     return lossless;
 }
 
+void PreparedScene::setPixelOffset(glm::dvec2 pixelOffset) {
+    view = gbuffer::CameraView::fromCamera(scene.cameras.front(), view.width, view.height,
+                                           view.depthConvention, view.infiniteFar, pixelOffset);
+    gbuffer = std::make_unique<gbuffer::GBuffer>(gbuffer->layout(), view);
+    inputs.gbuffer = gbuffer.get();
+    renderGBuffer();
+    setLights(scene.lights);
+}
+
 void PreparedScene::setLights(const std::vector<scenes::Light>& sceneLights) {
     if (&sceneLights != &scene.lights)
         scene.lights = sceneLights;

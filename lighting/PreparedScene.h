@@ -74,6 +74,14 @@ struct PreparedScene {
         return layerFrame;
     }
 
+    // Renders the G-buffer (and the exact surface, if any) again from the same camera with every
+    // pixel's sample moved by `pixelOffset` pixels from its centre (y down;
+    // gbuffer::CameraView::pixelOffset): the supersampled reference's sub-frames
+    // (SupersampledReference.h). The view, the G-buffer (same layout) and the lights are
+    // replaced; `inputs` follows. A zero offset gives bitwise the unjittered frame. Only the
+    // reference may shade a jittered frame: the culling tests assume a symmetric frustum.
+    void setPixelOffset(glm::dvec2 pixelOffset);
+
     // Replaces the scene's lights (the G-buffer does not depend on them); for tests that place
     // lights by hand after seeing the geometry.
     void setLights(const std::vector<scenes::Light>& sceneLights);

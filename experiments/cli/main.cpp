@@ -123,6 +123,12 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
     render.add_flag("--compare-reference", r.compareReference,
                     "also render the double-precision reference and record the error");
+    render
+        .add_option("--reference-spp", r.referenceSpp,
+                    "samples per pixel of the reference compared with: a square 1..256 (1 = "
+                    "the pixel centre, 16 = the D3D 16x pattern, other squares a stratified "
+                    "grid), box filtered")
+        ->capture_default_str();
     std::string presets; // from the presets themselves, so a new one is listed (ue4 was not)
     for (const std::string& name : gbuffer::layoutPresetNames())
         presets += (presets.empty() ? "" : ", ") + name;

@@ -25,6 +25,7 @@
 #include "experiments/output/Progress.h"
 #include "experiments/render/LightOrigins.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/SupersampledReference.h"
 #include "lighting/passes/PassNames.h"
 #include "scenes/Scene.h"
 #include "scenes/Viewpoints.h"
@@ -329,7 +330,10 @@ void addTimings(nlohmann::json& stats, const RenderRun& run) {
 // why, else flip_parameters say what was assumed (exposures, pixels per degree, warnings).
 nlohmann::json errorJson(const RenderRun& run) {
     const RunMetrics& metrics = run.metrics;
-    nlohmann::json error = {{"reference", "reference"}};
+    nlohmann::json error = {
+        {"reference", "reference"},
+        {"reference_spp", run.options.referenceSpp},
+        {"reference_pattern", lighting::referenceSamplePattern(run.options.referenceSpp)}};
     for (const NamedFigure& figure : metrics.errorFigures())
         error[figure.name] = std::isinf(figure.value)
                                  ? nlohmann::json(figure.value > 0 ? "inf" : "-inf")
@@ -410,6 +414,7 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["isa_requested"] = run.options.isa;
     const auto dispatched = run.result.parameters.find("isa");
     stats["isa"] = dispatched != run.result.parameters.end() ? dispatched->second : "scalar";
+    stats["reference_spp"] = run.options.referenceSpp;
     stats["hardware_threads"] = std::thread::hardware_concurrency();
     stats["commit"] = kBuildCommit;
     stats["triangles"] = run.scene().triangleCount();

@@ -11,6 +11,7 @@
 #include "lighting/MultisampleShading.h"
 #include "lighting/Oracle.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/SupersampledReference.h"
 #include "lighting/passes/PassNames.h"
 
 namespace experiments {
@@ -105,13 +106,19 @@ void countOracle(RenderRun& run) {
     run.oracle = lighting::countContributingLights(losslessFrame);
 }
 
-// The reference image of the run: the given one, the stage's own image when the stage is the
-// reference, else rendered from the run's exact surface, computed now (after the timed passes)
-// when the stage did not need it itself.
+// The reference image of the run: the given one; at 1 sample per pixel the stage's own image
+// when the stage is the reference, else rendered from the run's exact surface, computed now
+// (after the timed passes) when the stage did not need it itself; at more samples the
+// supersampled reference of the run's scene (lighting/SupersampledReference.h), even when the
+// stage is `reference` itself (its image is then the 1-sample reference, measured against the
+// same anti-aliased truth as every other stage).
 void fillReference(RenderRun& run, const std::string& stageName,
                    const lighting::StageResult* givenReference) {
     if (givenReference) {
         run.reference = *givenReference;
+    } else if (run.options.referenceSpp > 1) {
+        run.reference = lighting::renderSupersampledReference(
+            run.prepared->scene, run.options.width, run.options.height, run.options.referenceSpp);
     } else if (run.prepared->multisample) {
         // Not from this frame's exact surface (layer 0 only): the reference is its own render.
         run.reference = renderReference(run.options);
@@ -147,9 +154,8 @@ lighting::StageResult renderReference(const RenderOptions& options) {
     lighting::StageResult reference;
     tbb::task_arena arena(effectiveThreads(options.threads));
     arena.execute([&] {
-        lighting::PreparedScene frame(loadRequestedScene(options), options.width, options.height,
-                                      true);
-        lighting::makeStage(kReferenceStage)->shade(frame.inputs, reference);
+        reference = lighting::renderSupersampledReference(
+            loadRequestedScene(options), options.width, options.height, options.referenceSpp);
     });
     return reference;
 }
@@ -194,7 +200,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         std::optional<ErrorMetrics> error;
         double referenceMs = 0.0, flipMs = 0.0;
         if (compare) {
-            step("reference (double precision)");
+            step("reference (double precision, " + std::to_string(options.referenceSpp) + " spp)");
             start = Clock::now();
             fillReference(run, plan.stage->name(), givenReference);
             referenceMs = millisecondsSince(start);

@@ -48,8 +48,10 @@ struct RenderRun {
 RenderRun runRender(RenderPlan plan, const std::function<void(const std::string&)>& progress = {},
                     const lighting::StageResult* reference = nullptr);
 
-// The double-precision reference image of (scene, scene options, lights, seed, width, height).
-// It does not depend on the stage or the G-buffer layout. Runs under options.threads.
+// The double-precision reference image of (scene, scene options, lights, seed, width, height,
+// reference samples per pixel): lighting::renderSupersampledReference at options.referenceSpp,
+// bitwise the `reference` stage's image at 1. It does not depend on the stage or the G-buffer
+// layout. Runs under options.threads.
 lighting::StageResult renderReference(const RenderOptions& options);
 
 } // namespace experiments

@@ -7,6 +7,7 @@
 
 #include "gbuffer/msaa/FragmentLayers.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/SupersampledReference.h"
 #include "raster/Rasterizer.h"
 #include "scenes/input/ClosestName.h"
 #include "scenes/input/WholeFile.h"
@@ -124,6 +125,10 @@ CheckedOptions checkOptions(const RenderOptions& options) {
                 throw UsageError("--msaa " + std::to_string(options.msaa) + " refused for stage " +
                                  stageName + ": " + info.msaaRefusal);
     }
+    if (const std::string problem = lighting::referenceSppProblem(options.referenceSpp);
+        !problem.empty())
+        throw UsageError("--reference-spp " + std::to_string(options.referenceSpp) +
+                         " refused: " + problem);
     if (options.brdf != "auto")
         usageErrorFrom([&] { return scenes::parseMaterialModel(options.brdf); });
     return checked;
@@ -154,27 +159,17 @@ std::string lightsText(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {"scene",
-            "stage",
-            "lights",
-            "seed",
-            "light-density",
-            "width",
-            "height",
-            "resolution",
-            "threads",
-            "isa",
-            "simt-warp",
-            "msaa",
-            "complex-detect",
-            "layout",
-            "normals",
-            "normal-space",
-            "depth",
-            "position",
-            "view",
-            "brdf",
-            "scene-option.<key>"};
+    return {"scene",         "stage",
+            "lights",        "seed",
+            "light-density", "width",
+            "height",        "resolution",
+            "threads",       "isa",
+            "simt-warp",     "reference-spp",
+            "msaa",          "complex-detect",
+            "layout",        "normals",
+            "normal-space",  "depth",
+            "position",      "view",
+            "brdf",          "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -209,6 +204,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.msaa = parseNumber<int>(key, value);
     else if (key == "complex-detect")
         options.complexDetect = value;
+    else if (key == "reference-spp")
+        options.referenceSpp = parseNumber<int>(key, value);
     else if (key == "layout")
         options.layout = value;
     else if (key == "normals")

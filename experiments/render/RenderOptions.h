@@ -54,6 +54,10 @@ struct RenderOptions {
     int msaa = 1;
     std::string complexDetect = "primitive";
     bool compareReference = false;
+    // Samples per pixel of the reference compared with (lighting/SupersampledReference.h): a
+    // square 1..256; 1 is the pixel-centre reference, 16 the D3D 16x pattern, other squares a
+    // stratified grid. Every stage is measured against the same anti-aliased truth.
+    int referenceSpp = 16;
     // G-buffer: a preset name ("" = derived from the scene and the stage,
     // gbuffer/LayoutDerivation.h), then overrides of its normal encoding ("NAME:BITS"), depth
     // format and position method.
@@ -82,11 +86,11 @@ std::optional<int> requestedLights(const RenderOptions& options);
 std::string lightsText(const RenderOptions& options);
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
-// seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect, layout,
-// normals, normal-space, depth, position, view, brdf, and scene-option.KEY. Values are checked
-// later by validate(); a malformed number or an unknown key throws UsageError naming it. The sweep
-// runner goes through this, so every stage, encoding or scene added later is reachable without
-// touching the runner.
+// seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
+// reference-spp, layout, normals, normal-space, depth, position, view, brdf, and scene-option.KEY.
+// Values are checked later by validate(); a malformed number or an unknown key throws UsageError
+// naming it. The sweep runner goes through this, so every stage, encoding or scene added later is
+// reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();
@@ -113,8 +117,9 @@ struct CheckedOptions {
 };
 
 // Checks every option in a fixed order (size, lights, threads, stage, scene, repetitions, G-buffer
-// names) and throws UsageError (lighting::StageError for a bad stage spec, listing the valid
-// names) for the first bad one. Cheap: loads nothing.
+// names, isa, simt warp, reference samples per pixel, brdf) and throws UsageError
+// (lighting::StageError for a bad stage spec, listing the valid names) for the first bad one.
+// Cheap: loads nothing.
 CheckedOptions checkOptions(const RenderOptions& options);
 // checkOptions for its verdict alone (the sweep checks every job this way before running any).
 void validate(const RenderOptions& options);

@@ -87,17 +87,25 @@ std::string referenceKeyOf(const RenderOptions& o) {
         canonical += "view=" + o.view + "\n";
         stem += "-" + safeName(o.view);
     }
+    // So do the reference's samples per pixel; 1 (the only reference before supersampling)
+    // keeps the older keys, so their cached 1-sample references stay valid for 1-sample jobs.
+    std::string samples;
+    if (o.referenceSpp != 1) {
+        canonical += "reference-spp=" + std::to_string(o.referenceSpp) + "\n";
+        samples = "-spp" + std::to_string(o.referenceSpp);
+    }
     return stem + "-" + std::to_string(o.width) + "x" + std::to_string(o.height) + "-" +
            (requestedLights(o) ? lightsText(o) + "l" : "file-lights") + "-s" +
-           std::to_string(o.seed) + "-" + hex8(fnv1a(canonical));
+           std::to_string(o.seed) + samples + "-" + hex8(fnv1a(canonical));
 }
 
 } // namespace
 
 std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys) {
     static const std::vector<std::string> kOrder = {
-        "scene", "stage",     "lights", "seed",    "resolution",   "width", "height",  "threads",
-        "isa",   "simt-warp", "layout", "normals", "normal-space", "depth", "position"};
+        "scene",        "stage",   "lights",   "seed",         "resolution", "width",
+        "height",       "threads", "isa",      "simt-warp",    "layout",     "normals",
+        "normal-space", "depth",   "position", "reference-spp"};
     std::vector<std::string> columns;
     for (const std::string& key : kOrder)
         if (key == "width" || key == "height" ||

@@ -233,8 +233,11 @@ glm::vec3 positionByInverseProjection(const CameraView& view, glm::vec2 ndc, flo
 }
 
 glm::vec3 viewRayOfNdc(const CameraView& view, glm::vec2 ndc) {
-    // clipFromView[0][0] = 1 / (aspect tan(fov/2)), [1][1] = 1 / tan(fov/2) (symmetric frustum).
-    return {ndc.x / view.clipFromView[0][0], ndc.y / view.clipFromView[1][1], -1.0f};
+    // clipFromView[0][0] = 1 / (aspect tan(fov/2)), [1][1] = 1 / tan(fov/2); [2][0] and [2][1]
+    // are minus the jitter's NDC shift (CameraView::pixelOffset), exactly 0 without one, so the
+    // unjittered ray is bitwise what it was (ndc + 0 = ndc: no NDC is -0).
+    return {(ndc.x + view.clipFromView[2][0]) / view.clipFromView[0][0],
+            (ndc.y + view.clipFromView[2][1]) / view.clipFromView[1][1], -1.0f};
 }
 
 glm::vec3 positionByViewRay(const CameraView& view, glm::vec2 ndc, float viewDepthMetres) {

@@ -5,8 +5,10 @@
 namespace gbuffer {
 
 CameraView CameraView::fromCamera(const scenes::Camera& camera, int width, int height,
-                                  DepthConvention convention, bool infiniteFar) {
+                                  DepthConvention convention, bool infiniteFar,
+                                  glm::dvec2 pixelOffset) {
     CameraView view;
+    view.pixelOffset = pixelOffset;
     view.infiniteFar = infiniteFar;
     view.depthConvention = convention;
     view.width = width;
@@ -32,6 +34,14 @@ CameraView CameraView::fromCamera(const scenes::Camera& camera, int width, int h
         reverse[2][2] = -1.0;
         reverse[3][2] = 1.0;
         clipFromViewExact = reverse * clipFromViewExact;
+    }
+    if (pixelOffset != glm::dvec2(0.0)) {
+        // The point that lands on a pixel's centre is the one that was (dx, dy) pixels away
+        // from it: translate NDC by minus the offset, in clip space (times w).
+        glm::dmat4 shift(1.0);
+        shift[3][0] = -2.0 * pixelOffset.x / double(width);
+        shift[3][1] = 2.0 * pixelOffset.y / double(height);
+        clipFromViewExact = shift * clipFromViewExact;
     }
     view.viewFromClipExact = glm::inverse(clipFromViewExact);
     view.viewFromWorld = glm::mat4(view.viewFromWorldExact);

@@ -5,6 +5,16 @@
 // precision evenly over distance (standard float depth loses ~1e-4 relative position accuracy
 // at tens of metres; reversed Z keeps it near float epsilon). View space is right-handed, camera
 // looking down -Z. Double-precision copies serve the reference.
+//
+// Sub-pixel jitter (the supersampled reference, lighting/SupersampledReference.h): `pixelOffset`
+// moves every pixel's sample from its centre by (dx, dy) pixels (x right, y down) as a
+// translation of the projection in clip space (x' = x - 2 dx / width * w, y' = y + 2 dy / height
+// * w), so the rasterizer (clipFromView), the exact surface and position from depth
+// (viewFromClip, viewFromClipExact) and ndcOfPixel, which stays the pixel centre in the jittered
+// NDC, all see the same sample point. A zero offset leaves the matrices bitwise as they were.
+// With an offset the frustum is no longer symmetric: viewRayOfNdc (DepthFormat.h) accounts for
+// it; the culling tests (lighting/culling), the kernel's view-ray decode and the light volumes
+// assume a symmetric frustum and are only ever given an unjittered view.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -21,7 +31,8 @@ struct CameraView {
     float nearMetres = 0.1f;
     float farMetres = 100.0f;
     DepthConvention depthConvention = DepthConvention::Reversed;
-    bool infiniteFar = false; // far plane at infinity: farMetres is then only the scene's extent
+    bool infiniteFar = false;    // far plane at infinity: farMetres is then only the scene's extent
+    glm::dvec2 pixelOffset{0.0}; // sample position - pixel centre, pixels, y down (above)
     glm::mat4 viewFromWorld{1.0f};
     glm::mat4 clipFromView{1.0f};
     glm::mat4 viewFromClip{1.0f};        // inverse projection, for position reconstruction
@@ -31,7 +42,8 @@ struct CameraView {
 
     static CameraView fromCamera(const scenes::Camera& camera, int width, int height,
                                  DepthConvention convention = DepthConvention::Reversed,
-                                 bool infiniteFar = false);
+                                 bool infiniteFar = false,
+                                 glm::dvec2 pixelOffset = glm::dvec2(0.0));
 
     bool reversedZ() const { return depthConvention == DepthConvention::Reversed; }
     // Depth of "nothing here": the far plane's value.

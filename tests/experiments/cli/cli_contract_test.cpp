@@ -83,6 +83,20 @@ TEST(CliContract, TyposGetTheClosestName) {
     EXPECT_EQ(far.output.find("did you mean"), std::string::npos) << far.output;
 }
 
+TEST(CliContract, ReferenceSamplesOutsideTheSquaresAreRefused) {
+    ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
+    const fs::path out = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / "cli-spp";
+    for (const char* spp : {"15", "0", "-4", "512"})
+        expectOneErrorLine("render --reference-spp " + std::string(spp) + " --out " + out.string(),
+                           "--reference-spp " + std::string(spp) +
+                               " refused: must be a square from 1 to 256");
+    expectOneErrorLine("render --reference-spp many --out " + out.string(), "many");
+    const CliRun help = run("render --help");
+    EXPECT_NE(help.output.find("--reference-spp"), std::string::npos) << help.output;
+    EXPECT_NE(help.output.find("--reference-spp INT=16"), std::string::npos)
+        << "the default is stated";
+}
+
 TEST(CliContract, CodecWithOneBitDepthAcceptsItsBareName) {
     ASSERT_TRUE(fs::is_regular_file(kTestbed)) << kTestbed << " not built";
     const fs::path out = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / "cli-bare";

@@ -32,6 +32,9 @@ RenderOptions smallAtrium(int threads, const char* isa = "auto") {
     options.width = 320;
     options.height = 180;
     options.threads = threads;
+    // These tests hold stages to the pixel-centre reference (exactness, conservative culling);
+    // the supersampled one has its own test below.
+    options.referenceSpp = 1;
     return options;
 }
 
@@ -317,6 +320,31 @@ TEST(RenderJob, TheReferenceWorkStaysOutOfTheTimedPasses) {
     EXPECT_EQ(reference.prepared->exactSurfacePasses, 4);
 }
 
+// --reference-spp above 1: every stage, `reference` itself included, is compared with the same
+// supersampled image, the one renderReference gives (as a sweep's cached reference).
+TEST(RenderJob, EveryStageIsMeasuredAgainstTheSameSupersampledReference) {
+    RenderOptions options = smallAtrium(0);
+    options.width = 96;
+    options.height = 54;
+    options.referenceSpp = 4;
+    options.compareReference = true;
+    const lighting::StageResult truth = renderReference(options);
+    for (const char* stage : {"tiled", "reference"}) {
+        SCOPED_TRACE(stage);
+        options.stage = stage;
+        const RenderRun run = runRender(planRender(options));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_TRUE(bitwiseEqual(run.reference.radiance[c], truth.radiance[c]));
+        ASSERT_TRUE(run.metrics.error.has_value());
+        // Aliased edges against the anti-aliased truth: no longer the float rounding alone.
+        EXPECT_GT(run.metrics.error->relativeRmse, 1e-3);
+    }
+    options.referenceSpp = 1;
+    options.stage = "tiled";
+    const lighting::StageResult centre = renderReference(options);
+    EXPECT_FALSE(bitwiseEqual(centre.radiance[1], truth.radiance[1]));
+}
+
 struct BadCase {
     const char* name;
     RenderOptions options;
@@ -361,7 +389,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"negative_height", with([](RenderOptions& o) { o.height = -5; })},
         BadCase{"absurd_size", with([](RenderOptions& o) { o.width = o.height = 100000; })},
         BadCase{"negative_lights", with([](RenderOptions& o) { o.lights = -1; })},
-        BadCase{"scene_option", with([](RenderOptions& o) { o.sceneOptions["nosuch"] = "1"; })}),
+        BadCase{"scene_option", with([](RenderOptions& o) { o.sceneOptions["nosuch"] = "1"; })},
+        BadCase{"reference_spp_not_square", with([](RenderOptions& o) { o.referenceSpp = 8; })},
+        BadCase{"reference_spp_too_many", with([](RenderOptions& o) { o.referenceSpp = 1024; })},
+        BadCase{"reference_spp_zero", with([](RenderOptions& o) { o.referenceSpp = 0; })}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(RenderCommand, UnwritableOutputFolderIsRefused) {

@@ -120,6 +120,32 @@ TEST(SweepFile, JobsSharingAReferenceAreAdjacent) {
     }
 }
 
+// The reference's samples per pixel are part of its key (a sweep option and axis like any render
+// option); 1 keeps the key references had before supersampling.
+TEST(SweepFile, TheReferenceSamplesArePartOfTheReferenceKey) {
+    std::map<int, std::string> keyOfSpp;
+    for (const int spp : {1, 4, 16}) {
+        Json sweep = baseSweep();
+        sweep["fixed"]["reference-spp"] = spp;
+        const auto expansion =
+            experiments::expandSweep(experiments::parseSweep(sweep, "unit.json"));
+        const SweepJob job = expansion.jobs().front(); // jobs() makes them: a copy
+        EXPECT_EQ(job.options.referenceSpp, spp);
+        keyOfSpp[spp] = job.referenceKey;
+    }
+    const auto plain = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
+    EXPECT_EQ(plain.jobs().front().referenceKey, keyOfSpp[16]) << "16 is the default";
+    EXPECT_NE(keyOfSpp[1], keyOfSpp[4]);
+    EXPECT_NE(keyOfSpp[4], keyOfSpp[16]);
+    EXPECT_EQ(keyOfSpp[1].find("spp"), std::string::npos) << keyOfSpp[1];
+    EXPECT_NE(keyOfSpp[16].find("-spp16-"), std::string::npos) << keyOfSpp[16];
+    Json bad = baseSweep();
+    bad["fixed"]["reference-spp"] = 15;
+    const std::string error =
+        errorOf([&] { experiments::expandSweep(experiments::parseSweep(bad, "unit.json")); });
+    EXPECT_NE(error.find("--reference-spp 15 refused"), std::string::npos) << error;
+}
+
 // Each view has its own reference image; the default view keeps the key it had before views.
 TEST(SweepFile, EveryViewHasItsOwnReference) {
     const auto plain = experiments::expandSweep(experiments::parseSweep(baseSweep(), "unit.json"));
