@@ -25,9 +25,12 @@ inline constexpr const char* kLighting = "lighting";   // light buffer accumulat
 inline constexpr const char* kMaterial = "material";   // second geometry pass (pre-pass)
 inline constexpr const char* kBlend = "blend"; // blended surfaces, after the opaque (BlendedPass.h)
 
+// Timed by the runner after the stage, when `--post-aa` is not none (lighting/postaa/PostAa.h):
+inline constexpr const char* kPostAa = "post_aa";
+
 // The order passes run in within a frame; tables list passes this way, others after by name.
-inline constexpr std::array<std::string_view, 11> kPipelineOrder = {
-    kGBuffer, kExactSurface, kTransform, kPrepass,  kCull, kAssign,
-    kIndex,   kShading,      kLighting,  kMaterial, kBlend};
+inline constexpr std::array<std::string_view, 12> kPipelineOrder = {
+    kGBuffer, kExactSurface, kTransform, kPrepass,  kCull,  kAssign,
+    kIndex,   kShading,      kLighting,  kMaterial, kBlend, kPostAa};
 
 } // namespace lighting::pass
