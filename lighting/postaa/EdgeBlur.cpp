@@ -10,21 +10,19 @@ namespace lighting::postaa {
 
 namespace {
 
-// 0 at `start`, 1 at `end`, linear between, clamped (start > end allowed: a falling ramp).
-float ramp(float value, float start, float end) {
-    return std::clamp((value - start) / (end - start), 0.0f, 1.0f);
-}
+// 0 at `start`, 1 at `end`, linear between, clamped (start > end allowed: a falling ramp). The
+// scale is computed once: the per-pixel work is a subtraction and a multiplication.
+struct Ramp {
+    float start;
+    float scale;
+    Ramp(float rampStart, float rampEnd) : start(rampStart), scale(1.0f / (rampEnd - rampStart)) {}
+    float operator()(float value) const { return std::clamp((value - start) * scale, 0.0f, 1.0f); }
+};
 
 std::string text(float value) {
     std::ostringstream stream;
     stream << value;
     return stream.str();
-}
-
-// The depth term along one axis: neighbours a and b on either side of c (reciprocal depths, all
-// covered). Zero on a plane, where 1/depth is affine in screen space.
-float depthTerm(float a, float c, float b, const EdgeBlurParameters& p) {
-    return ramp(std::abs(a + b - 2.0f * c) / c, p.depthRampStart, p.depthRampEnd);
 }
 
 } // namespace
@@ -78,6 +76,8 @@ void edgeWeights(const SurfacePlanes& surface, const EdgeBlurParameters& p, floa
     const int w = surface.width, h = surface.height;
     const std::vector<float>& inv = surface.inverseDepth;
     const bool normals = !surface.normal[0].empty();
+    const Ramp depthRamp(p.depthRampStart, p.depthRampEnd);
+    const Ramp normalRamp(p.normalCosineStart, p.normalCosineEnd);
     tbb::parallel_for(0, h, [&](int y) {
         for (int x = 0; x < w; ++x) {
             const size_t c = size_t(y) * size_t(w) + size_t(x);
@@ -93,25 +93,31 @@ void edgeWeights(const SurfacePlanes& surface, const EdgeBlurParameters& p, floa
                 edges[c] = silhouette ? 1.0f : 0.0f;
                 continue;
             }
-            float depthEdge = 0.0f;
+            // Depth: the larger second difference of 1/depth over the two axes (zero on a
+            // plane, where 1/depth is affine in screen space), relative to the pixel's; the ramps
+            // are monotonic, so the ramp of the largest is the largest of the ramps.
+            float kink = 0.0f;
             if (neighbour[0] >= 0 && neighbour[1] >= 0)
-                depthEdge =
-                    depthTerm(inv[size_t(neighbour[0])], inv[c], inv[size_t(neighbour[1])], p);
+                kink =
+                    std::abs(inv[size_t(neighbour[0])] + inv[size_t(neighbour[1])] - 2.0f * inv[c]);
             if (neighbour[2] >= 0 && neighbour[3] >= 0)
-                depthEdge = std::max(depthEdge, depthTerm(inv[size_t(neighbour[2])], inv[c],
-                                                          inv[size_t(neighbour[3])], p));
+                kink = std::max(kink, std::abs(inv[size_t(neighbour[2])] +
+                                               inv[size_t(neighbour[3])] - 2.0f * inv[c]));
+            const float depthEdge = depthRamp(kink / inv[c]);
+            // Normals: the smallest cosine with a neighbour (the falling ramp's largest value).
             float normalEdge = 0.0f;
             if (normals) {
                 const std::vector<float>(&nv)[3] = surface.normal;
+                float smallestCosine = 1.0f;
                 for (long long n : neighbour) {
                     if (n < 0)
                         continue;
                     const size_t m = size_t(n);
-                    const float cosine =
-                        nv[0][c] * nv[0][m] + nv[1][c] * nv[1][m] + nv[2][c] * nv[2][m];
-                    normalEdge =
-                        std::max(normalEdge, ramp(cosine, p.normalCosineStart, p.normalCosineEnd));
+                    smallestCosine =
+                        std::min(smallestCosine,
+                                 nv[0][c] * nv[0][m] + nv[1][c] * nv[1][m] + nv[2][c] * nv[2][m]);
                 }
+                normalEdge = normalRamp(smallestCosine);
             }
             edges[c] = 1.0f - (1.0f - depthEdge) * (1.0f - normalEdge);
         }

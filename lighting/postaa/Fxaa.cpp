@@ -26,17 +26,12 @@ std::string text(float value) {
     return stream.str();
 }
 
-// A luma plane read with clamp-to-edge, point and bilinear.
+// A luma plane read with clamp-to-edge.
 struct LumaPlane {
     const float* luma;
     int width;
     int height;
 
-    float at(int x, int y) const {
-        x = std::clamp(x, 0, width - 1);
-        y = std::clamp(y, 0, height - 1);
-        return luma[size_t(y) * size_t(width) + size_t(x)];
-    }
     float bilinear(float x, float y) const {
         return BilinearTap::at(width, height, x, y).apply(luma);
     }
@@ -51,19 +46,25 @@ struct FxaaOffset {
 };
 
 FxaaOffset fxaaOffset(const LumaPlane& l, int x, int y, const FxaaParameters& p) {
-    const float lumaM = l.at(x, y);
-    float lumaN = l.at(x, y - 1);
-    float lumaS = l.at(x, y + 1);
-    const float lumaW = l.at(x - 1, y);
-    const float lumaE = l.at(x + 1, y);
+    // The 3x3 neighbourhood, clamped to the border once.
+    const size_t xW = size_t(std::max(x - 1, 0)), xM = size_t(x);
+    const size_t xE = size_t(std::min(x + 1, l.width - 1));
+    const float* rowN = l.luma + size_t(std::max(y - 1, 0)) * size_t(l.width);
+    const float* rowM = l.luma + size_t(y) * size_t(l.width);
+    const float* rowS = l.luma + size_t(std::min(y + 1, l.height - 1)) * size_t(l.width);
+    const float lumaM = rowM[xM];
+    float lumaN = rowN[xM];
+    float lumaS = rowS[xM];
+    const float lumaW = rowM[xW];
+    const float lumaE = rowM[xE];
     const float rangeMax = std::max({lumaM, lumaN, lumaS, lumaW, lumaE});
     const float rangeMin = std::min({lumaM, lumaN, lumaS, lumaW, lumaE});
     const float range = rangeMax - rangeMin;
     if (range < std::max(p.edgeThresholdMin, rangeMax * p.edgeThreshold))
         return {};
 
-    const float lumaNW = l.at(x - 1, y - 1), lumaNE = l.at(x + 1, y - 1);
-    const float lumaSW = l.at(x - 1, y + 1), lumaSE = l.at(x + 1, y + 1);
+    const float lumaNW = rowN[xW], lumaNE = rowN[xE];
+    const float lumaSW = rowS[xW], lumaSE = rowS[xE];
     // Edge direction from the second differences, the centre row and column weighted twice.
     const float lumaNS = lumaN + lumaS, lumaWE = lumaW + lumaE;
     const float edgeHorz1 = -2.0f * lumaM + lumaNS, edgeVert1 = -2.0f * lumaM + lumaWE;
