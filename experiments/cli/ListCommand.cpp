@@ -11,6 +11,7 @@
 #include "gbuffer/codecs/DepthFormat.h"
 #include "gbuffer/codecs/NormalCodec.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/postaa/PostAa.h"
 #include "scenes/Viewpoints.h"
 #include "scenes/procedural/ProceduralScenes.h"
 
@@ -89,6 +90,8 @@ void printLayoutChoices(std::ostream& out) {
         << gbuffer::normalSpaceName(gbuffer::GBufferLayout{}.normalSpace) << "):\n  "
         << gbuffer::normalSpaceName(gbuffer::NormalSpace::View) << ", "
         << gbuffer::normalSpaceName(gbuffer::NormalSpace::World) << "\n";
+    out << "post-process anti-aliasing (--post-aa; default " << experiments::RenderOptions{}.postAa
+        << "):\n  " << joined(lighting::postaa::postAaNames()) << "\n";
 }
 
 } // namespace

@@ -147,6 +147,12 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
                     "material model: auto (each material's own), blinn-phong or "
                     "metallic-roughness (every material forced to it, for studies)")
         ->capture_default_str();
+    render
+        .add_option("--post-aa", r.postAa,
+                    "post-process anti-aliasing after the stage: none, edge-blur (G-buffer depth "
+                    "and normal edges blurred, S.T.A.L.K.E.R./Tabula Rasa; adds depth and "
+                    "normals to the layout) or fxaa (luminance edges, FXAA 3.11)")
+        ->capture_default_str();
     render.add_option("--normal-space", r.normalSpace,
                       "space normals are encoded in: view (default) or world");
     render.add_flag(

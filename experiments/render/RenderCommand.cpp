@@ -27,6 +27,7 @@
 #include "lighting/StageRegistry.h"
 #include "lighting/SupersampledReference.h"
 #include "lighting/passes/PassNames.h"
+#include "lighting/postaa/PostAa.h"
 #include "scenes/Scene.h"
 #include "scenes/Viewpoints.h"
 
@@ -233,6 +234,8 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
     const std::vector<float> complex = complexMap(run);
     if (!complex.empty())
         planes.push_back({"msaa.complex", complex.data()});
+    if (!run.postAaEdges.empty())
+        planes.push_back({"post_aa.edges", run.postAaEdges.data()});
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"testbed:scene", run.options.scene},
         {"testbed:stage", run.options.stage},
@@ -242,6 +245,9 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         {"testbed:Z", "view-space depth in metres decoded from the G-buffer, 0 = background"},
         {"testbed:error", "error.R,G,B = |R,G,B - reference| (double-precision reference)"},
         {"testbed:flip", "flip = HDR-FLIP per pixel against the reference, 0..1"},
+        {"testbed:post_aa.edges",
+         "post_aa.edges = the post-process anti-aliasing's edge plane, 0..1: edge weight "
+         "(edge-blur) or the neighbour's blend weight (fxaa); absent for --post-aa none"},
         {"testbed:lights.wasted",
          "lights.evaluated - lights.oracle at the pixels the stage lit; 0 at pixels a "
          "reduced-resolution stage only filtered"},
@@ -415,6 +421,14 @@ nlohmann::json statsJson(const RenderRun& run) {
     const auto dispatched = run.result.parameters.find("isa");
     stats["isa"] = dispatched != run.result.parameters.end() ? dispatched->second : "scalar";
     stats["reference_spp"] = run.options.referenceSpp;
+    // The post-process anti-aliasing applied to the image after the stage (before the error was
+    // measured), with every parameter of the filter.
+    lighting::postaa::PostAaPass postAa(lighting::postaa::parsePostAa(run.options.postAa));
+    const size_t filtered = size_t(std::count_if(run.postAaEdges.begin(), run.postAaEdges.end(),
+                                                 [](float edge) { return edge > 0.0f; }));
+    stats["post_aa"] = {{"mode", run.options.postAa},
+                        {"parameters", postAa.describe()},
+                        {"filtered_pixels", filtered}};
     stats["hardware_threads"] = std::thread::hardware_concurrency();
     stats["commit"] = kBuildCommit;
     stats["triangles"] = run.scene().triangleCount();

@@ -13,6 +13,7 @@
 #include "lighting/StageRegistry.h"
 #include "lighting/SupersampledReference.h"
 #include "lighting/passes/PassNames.h"
+#include "lighting/postaa/PostAa.h"
 
 namespace experiments {
 
@@ -34,12 +35,14 @@ double millisecondsSince(Clock::time_point start) {
 // constructor, among the serial preparation of the scene, so without warm-up the first timed
 // repetition counts its stage only).
 std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage& stage,
-                                         bool exactSurface, const Progress& step) {
+                                         bool exactSurface, lighting::postaa::PostAa postAa,
+                                         const Progress& step) {
     const RenderOptions& options = run.options;
     const int runs = options.warmup + options.repetitions;
     std::vector<PassTiming> passes;
     double cpuSeconds = 0.0, wallSeconds = 0.0;
     lighting::MultisampleShading multisampleShading;
+    lighting::postaa::PostAaPass postAaPass(postAa); // scratch planes reused across repetitions
     for (int i = 0; i < runs; ++i) {
         const bool timed = i >= options.warmup;
         step(std::string(timed ? "" : "warm-up ") + "shading: " + options.stage +
@@ -57,6 +60,10 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
             repetition.emplace_back(lighting::pass::kExactSurface, gbufferTimings.exactMs);
         lighting::StageResult result;
         multisampleShading.shade(stage, *run.prepared, result);
+        if (postAa != lighting::postaa::PostAa::None) {
+            lighting::PassTimer timer(result, lighting::pass::kPostAa);
+            postAaPass.apply(*run.prepared->gbuffer, result.radiance, run.postAaEdges);
+        }
         if (timed) {
             cpuSeconds += processCpuSeconds() - cpuStart;
             wallSeconds += std::chrono::duration<double>(Clock::now() - wallStart).count();
@@ -190,7 +197,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         run.prepared->inputs.isa = plan.isa;
         run.prepared->inputs.simtWarpLanes = options.simtWarp;
         std::vector<PassTiming> passes =
-            shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, step);
+            shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, plan.postAa, step);
 
         // The oracle and the reference are measurement, not part of the stage: timed apart.
         step("counting contributing lights (oracle)");

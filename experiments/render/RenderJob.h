@@ -25,7 +25,10 @@ struct RenderRun {
     RenderOptions options;
     int threads = 0;                                   // effective
     std::unique_ptr<lighting::PreparedScene> prepared; // scene, G-buffer, exact surface, lights
-    lighting::StageResult result;                      // of the last repetition
+    lighting::StageResult result;                      // of the last repetition, post-AA'd
+    // The post-process anti-aliasing's edge plane of the last repetition (lighting/postaa/PostAa.h:
+    // edge weight for edge-blur, blend weight for fxaa), empty for --post-aa none.
+    std::vector<float> postAaEdges;
     std::vector<uint32_t> oracle;           // per pixel, from the stage or counted by brute force
     bool oracleFromLosslessGBuffer = false; // the layout lacked channels the oracle needs
     lighting::StageResult reference;        // filled when compared with the reference
@@ -39,12 +42,16 @@ struct RenderRun {
     const gbuffer::GBuffer& gbuffer() const { return *prepared->gbuffer; }
 };
 
-// Runs the plan under a tbb::task_arena of plan.threads. When compared with a reference, the
-// error figures include HDR-ꟻLIP (FlipMetric.h; unavailable without the package, saying why).
-// `progress`, when set, is told the name of each step as it starts (for a terminal display). When
-// `reference` is given it is the image the error is measured against (compareReference is implied)
-// and no reference is rendered: a sweep renders it once per scene, lights and size. Throws
-// UsageError when the given reference has another size than the render.
+// Runs the plan under a tbb::task_arena of plan.threads. The post-process anti-aliasing
+// (plan.postAa) filters each repetition's image right after the stage, timed as the pass post_aa
+// (in the total, not in the stage's time); the error and the outputs see the filtered image (the
+// light counts are the stage's). The reference is not filtered: it is the exact image at the
+// pixel centres. When compared with a reference, the error figures include HDR-ꟻLIP
+// (FlipMetric.h; unavailable without the package, saying why). `progress`, when set, is told the
+// name of each step as it starts (for a terminal display). When `reference` is given it is the
+// image the error is measured against (compareReference is implied) and no reference is rendered:
+// a sweep renders it once per scene, lights and size. Throws UsageError when the given reference
+// has another size than the render.
 RenderRun runRender(RenderPlan plan, const std::function<void(const std::string&)>& progress = {},
                     const lighting::StageResult* reference = nullptr);
 

@@ -131,6 +131,11 @@ CheckedOptions checkOptions(const RenderOptions& options) {
                          " refused: " + problem);
     if (options.brdf != "auto")
         usageErrorFrom([&] { return scenes::parseMaterialModel(options.brdf); });
+    try {
+        checked.postAa = lighting::postaa::parsePostAa(options.postAa);
+    } catch (const std::invalid_argument& error) {
+        throw UsageError(std::string("option 'post-aa': ") + error.what());
+    }
     return checked;
 }
 
@@ -159,17 +164,11 @@ std::string lightsText(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {"scene",         "stage",
-            "lights",        "seed",
-            "light-density", "width",
-            "height",        "resolution",
-            "threads",       "isa",
-            "simt-warp",     "reference-spp",
-            "msaa",          "complex-detect",
-            "layout",        "normals",
-            "normal-space",  "depth",
-            "position",      "view",
-            "brdf",          "scene-option.<key>"};
+    return {
+        "scene",    "stage",          "lights",  "seed",    "light-density",     "width",
+        "height",   "resolution",     "threads", "isa",     "simt-warp",         "reference-spp",
+        "msaa",     "complex-detect", "layout",  "normals", "normal-space",      "depth",
+        "position", "view",           "brdf",    "post-aa", "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -218,6 +217,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.position = value;
     else if (key == "brdf")
         options.brdf = value;
+    else if (key == "post-aa")
+        options.postAa = value;
     else if (key == "resolution") {
         const size_t x = value.find('x');
         if (x == std::string::npos)

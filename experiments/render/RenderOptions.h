@@ -18,6 +18,7 @@
 
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/postaa/PostAa.h"
 #include "scenes/SceneRequest.h"
 #include "scenes/input/Limits.h"
 
@@ -69,6 +70,11 @@ struct RenderOptions {
     // Material model every material is shaded with: "auto" (what each material says),
     // "blinn-phong" or "metallic-roughness" (forced, for studies; scenes::forceMaterialModel).
     std::string brdf = "auto";
+    // Post-process anti-aliasing of the stage's image (lighting/postaa/PostAa.h): "none",
+    // "edge-blur" (G-buffer depth and normal edges, blurred; adds depth and normals to the derived
+    // layout) or "fxaa" (luminance edges, FXAA 3.11). Timed as the pass post_aa, applied before
+    // the error is measured.
+    std::string postAa = "none";
     int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
     int repetitions = 1; // timed runs; timings are reported as median, min and max over them
 };
@@ -87,10 +93,10 @@ std::string lightsText(const RenderOptions& options);
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
-// reference-spp, layout, normals, normal-space, depth, position, view, brdf, and scene-option.KEY.
-// Values are checked later by validate(); a malformed number or an unknown key throws UsageError
-// naming it. The sweep runner goes through this, so every stage, encoding or scene added later is
-// reachable without touching the runner.
+// reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, and
+// scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
+// throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or
+// scene added later is reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();
@@ -114,10 +120,11 @@ struct CheckedOptions {
     std::unique_ptr<lighting::ShadingStage> stage;
     gbuffer::LayoutRequest layoutRequest;
     lighting::kernel::KernelIsa isa = lighting::kernel::KernelIsa::scalar(); // options.isa resolved
+    lighting::postaa::PostAa postAa = lighting::postaa::PostAa::None;        // options.postAa
 };
 
 // Checks every option in a fixed order (size, lights, threads, stage, scene, repetitions, G-buffer
-// names, isa, simt warp, reference samples per pixel, brdf) and throws UsageError
+// names, isa, simt warp, reference samples per pixel, brdf, post-aa) and throws UsageError
 // (lighting::StageError for a bad stage spec, listing the valid names) for the first bad one.
 // Cheap: loads nothing.
 CheckedOptions checkOptions(const RenderOptions& options);

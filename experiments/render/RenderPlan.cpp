@@ -1,7 +1,9 @@
 #include "experiments/render/RenderPlan.h"
 
 #include <algorithm>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "scenes/SceneLoader.h"
 #include "scenes/Viewpoints.h"
@@ -37,11 +39,30 @@ RenderPlan planRender(const RenderOptions& options) {
     plan.scene = loadRequestedScene(options);
     plan.stage = std::move(checked.stage);
     plan.isa = checked.isa;
+    plan.postAa = checked.postAa;
     plan.requirements = plan.stage->requirements();
-    plan.layout = usageErrorFrom([&] {
-        return gbuffer::makeLayout(plan.scene, plan.requirements.channels, plan.stage->name(),
-                                   checked.layoutRequest);
-    });
+    std::vector<gbuffer::Channel> reads = plan.requirements.channels;
+    std::vector<gbuffer::Channel> addedByPostAa;
+    for (gbuffer::Channel channel : lighting::postaa::requiredChannels(plan.postAa))
+        if (std::find(reads.begin(), reads.end(), channel) == reads.end()) {
+            reads.push_back(channel);
+            addedByPostAa.push_back(channel);
+        }
+    const std::string postAaName = lighting::postaa::postAaName(plan.postAa);
+    const std::string reader = addedByPostAa.empty()
+                                   ? plan.stage->name()
+                                   : plan.stage->name() + " with --post-aa " + postAaName;
+    plan.layout = usageErrorFrom(
+        [&] { return gbuffer::makeLayout(plan.scene, reads, reader, checked.layoutRequest); });
+    // The derivation says "the stage reads ...": here the filter does, not the stage.
+    static const std::string kStageReads = "the stage reads ";
+    for (gbuffer::Channel channel : addedByPostAa) {
+        std::string& reason = plan.layout.reasons[channel];
+        const std::string filterReads = "--post-aa " + postAaName + " (not the stage) reads ";
+        reason = reason.rfind(kStageReads, 0) == 0
+                     ? filterReads + reason.substr(kStageReads.size())
+                     : filterReads + gbuffer::channelName(channel) + ": " + reason;
+    }
     return plan;
 }
 

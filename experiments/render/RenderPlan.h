@@ -4,6 +4,11 @@
 // exactly that. `testbed render` (also for --explain-layout, which stops at the plan) and every
 // job of a sweep go through this pair, so the CLI and the sweep cannot plan a render differently.
 //
+// The layout is derived from the stage's requirements plus what the post-process anti-aliasing
+// reads (edge-blur: depth and normals, lighting/postaa/PostAa.h), so that it runs after any stage;
+// a channel only the filter reads says so in the layout's reasons (--explain-layout, stats.json).
+// plan.requirements stays the stage's own.
+//
 // Cost: planning loads the scene (a glTF file with its textures) but rasterizes nothing and
 // allocates no image. Errors: UsageError for bad options and a layout lacking a channel the stage
 // reads, lighting::StageError for a bad stage spec, scenes::SceneError for a bad scene file.
@@ -26,6 +31,7 @@ struct RenderPlan {
     lighting::StageRequirements requirements; // stage->requirements()
     gbuffer::GBufferLayout layout;            // derived, or the requested preset with overrides
     lighting::kernel::KernelIsa isa = lighting::kernel::KernelIsa::scalar(); // options.isa
+    lighting::postaa::PostAa postAa = lighting::postaa::PostAa::None;        // options.postAa
 };
 
 RenderPlan planRender(const RenderOptions& options);

@@ -22,14 +22,15 @@ uint64_t sum(const std::vector<uint32_t>& counts, const std::vector<uint8_t>& ma
     return total;
 }
 
-// The stage's own time per repetition: every pass but the G-buffer's, the exact surface's and
-// the total.
+// The stage's own time per repetition: every pass but the G-buffer's, the exact surface's, the
+// post-process anti-aliasing's (the runner's, after the stage) and the total.
 PassTiming stageTiming(const std::vector<PassTiming>& passes) {
     PassTiming stage;
     stage.pass = pass::kStage;
     for (const PassTiming& timing : passes) {
         if (timing.pass == lighting::pass::kGBuffer ||
-            timing.pass == lighting::pass::kExactSurface || timing.pass == pass::kTotal)
+            timing.pass == lighting::pass::kExactSurface ||
+            timing.pass == lighting::pass::kPostAa || timing.pass == pass::kTotal)
             continue;
         if (stage.samplesMs.size() < timing.samplesMs.size())
             stage.samplesMs.resize(timing.samplesMs.size(), 0.0);

@@ -66,7 +66,7 @@ inline constexpr const char* kGBufferAllocatedBytes = "gbuffer_allocated_bytes";
 // Passes the runner adds around the stage's (lighting/passes/PassNames.h has the frame's passes).
 namespace pass {
 inline constexpr const char* kStage = "stage"; // the stage's own passes summed
-inline constexpr const char* kTotal = "total"; // G-buffer plus the stage's passes
+inline constexpr const char* kTotal = "total"; // G-buffer, the stage's passes and post_aa
 } // namespace pass
 
 // One pass's times over the timed repetitions.

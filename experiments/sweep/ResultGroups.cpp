@@ -22,17 +22,17 @@ using nlohmann::json;
 namespace {
 
 // Method columns: what a group compares (everything else makes the group).
-constexpr const char* kMethodColumns[] = {"stage",        "layout", "normals",
-                                          "normal-space", "depth",  "position"};
+constexpr const char* kMethodColumns[] = {"stage", "layout",   "normals", "normal-space",
+                                          "depth", "position", "post-aa"};
 // The columns of the results table a reader compares first, after the method columns; the rest
 // are behind the "all columns" toggle.
 constexpr const char* kMainMetricColumns[] = {"time_total_median_ms", "relative_rmse", "flip",
                                               "culling_efficiency", "simt_efficiency"};
 // Settings known to be axis columns, for results that do not list theirs.
 constexpr const char* kKnownAxisColumns[] = {
-    "scene",    "stage",   "lights", "seed",        "resolution",   "width",
-    "height",   "threads", "layout", "normals",     "normal-space", "depth",
-    "position", "view",    "views",  "repetitions", "warmup"};
+    "scene",    "stage",   "lights", "seed",    "resolution",   "width",
+    "height",   "threads", "layout", "normals", "normal-space", "depth",
+    "position", "post-aa", "view",   "views",   "repetitions",  "warmup"};
 
 } // namespace
 

@@ -14,9 +14,9 @@
 //                                 default): the runner's, not part of a job's id
 // Keys are the names experiments::setRenderOption accepts (scene, stage, lights, seed, width,
 // height, resolution, threads, isa, simt-warp, layout, normals, normal-space, depth, position,
-// scene-option.KEY: whatever renderOptionKeys() lists) plus warmup and repetitions. Values are
-// strings or numbers and reach setRenderOption as text, so this file knows no stage, encoding or
-// scene: anything registered later works unchanged.
+// post-aa, scene-option.KEY: whatever renderOptionKeys() lists) plus warmup and repetitions. Values
+// are strings or numbers and reach setRenderOption as text, so this file knows no stage, encoding
+// or scene: anything registered later works unchanged.
 // Reading and checking a file is SweepFile.cpp; expanding a spec into jobs, their ids and shards is
 // SweepExpansion.cpp.
 //
@@ -209,8 +209,8 @@ nlohmann::ordered_json sweepJobJson(const SweepJob& job);
 SweepJob sweepJobFromJson(const nlohmann::ordered_json& json);
 
 // The result columns for settings: every key the sweep sets, in the canonical order scene,
-// stage, lights, seed, resolution, width, height, threads, layout, normals, normal-space, depth,
-// position,
+// stage, lights, seed, resolution, width, height, threads, isa, simt-warp, layout, normals,
+// normal-space, depth, position, post-aa,
 // then scene-option.* and any other key in name order; width and height are always present
 // (the effective size), and repetitions and warmup close the list.
 std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys);

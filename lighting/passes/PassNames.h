@@ -27,9 +27,12 @@ inline constexpr const char* kBlend = "blend"; // blended surfaces, after the op
 // Multisampled frames: the layers' images weighted into the pixel (MultisampleShading.h).
 inline constexpr const char* kResolve = "resolve";
 
+// Timed by the runner after the stage, when `--post-aa` is not none (lighting/postaa/PostAa.h):
+inline constexpr const char* kPostAa = "post_aa";
+
 // The order passes run in within a frame; tables list passes this way, others after by name.
-inline constexpr std::array<std::string_view, 12> kPipelineOrder = {
-    kGBuffer, kExactSurface, kTransform, kPrepass,  kCull,  kAssign,
-    kIndex,   kShading,      kLighting,  kMaterial, kBlend, kResolve};
+inline constexpr std::array<std::string_view, 13> kPipelineOrder = {
+    kGBuffer, kExactSurface, kTransform, kPrepass, kCull,    kAssign, kIndex,
+    kShading, kLighting,     kMaterial,  kBlend,   kResolve, kPostAa};
 
 } // namespace lighting::pass
