@@ -51,6 +51,27 @@ void GBufferPass::resolve(std::span<const uint32_t> codeSpan, GBuffer& target,
     });
 }
 
+void GBufferPass::resolveSparse(std::span<const uint32_t> codes, GBuffer& target,
+                                std::vector<uint8_t>& written) const {
+    const int width = target.width();
+    const GBuffer::Writer sharedWriter = target.writer();
+    tbb::parallel_for(0, target.height(), [&](int y) {
+        const GBuffer::Writer writer = sharedWriter;
+        VisibilityPass::RowSurfaces row(mVisibility, y);
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = size_t(y) * width + x;
+            const uint32_t code = codes[pixel];
+            if (code != VisibilityPass::kNoTriangle) {
+                writer.write(pixel, row.at(code, x));
+                written[pixel] = 1;
+            } else if (written[pixel]) {
+                writer.writeBackground(pixel);
+                written[pixel] = 0;
+            }
+        }
+    });
+}
+
 GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& target,
                                        ExactSurface* exact, MultisampleTarget* multisample) {
     GBufferPassTimings timings;
@@ -87,14 +108,19 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     if (multisample) {
         const FragmentLayers& layers = multisample->layers;
         multisample->upperLayers.resize(size_t(layers.layerCount() - 1));
+        multisample->upperWritten.resize(size_t(layers.layerCount() - 1));
         for (int k = 1; k < layers.layerCount(); ++k) {
             std::unique_ptr<GBuffer>& layer = multisample->upperLayers[size_t(k - 1)];
-            if (!layer)
+            std::vector<uint8_t>& written = multisample->upperWritten[size_t(k - 1)];
+            if (!layer || layer->width() != view.width || layer->height() != view.height) {
+                // A new layer: every pixel gets the background value once.
                 layer = std::make_unique<GBuffer>(target.layout(), view);
+                written.assign(target.pixelCount(), 1);
+            }
             std::span<const float> depths = layers.depths(k);
             std::copy(depths.begin(), depths.end(), layer->depthPlane().begin());
             layer->quantiseDepth();
-            resolve(layers.codes(k), *layer, nullptr);
+            resolveSparse(layers.codes(k), *layer, written);
         }
     }
     timings.resolveMs = millisecondsSince(start);

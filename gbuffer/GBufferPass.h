@@ -38,7 +38,11 @@ struct MultisampleTarget {
     FragmentLayerOptions options;
     FragmentLayers layers;
     std::vector<std::unique_ptr<GBuffer>> upperLayers; // layers 1 .. layerCount - 1
-    std::vector<float> sampleDepth;                    // the per-sample depth buffer
+    // Per upper layer and pixel: whether the last frame wrote a surface there (the upper layers'
+    // resolve writes only their fragments and clears only what the last frame left: their cost
+    // follows the complex pixels, not the screen).
+    std::vector<std::vector<uint8_t>> upperWritten;
+    std::vector<float> sampleDepth; // the per-sample depth buffer
     // The G-buffer of layer k: `target` for 0.
     const GBuffer& layer(const GBuffer& target, int k) const {
         return k == 0 ? target : *upperLayers[size_t(k - 1)];
@@ -64,6 +68,10 @@ private:
     // Encodes the surfaces of `codes` (one per pixel) into `target`, whose depth plane holds
     // their depths already.
     void resolve(std::span<const uint32_t> codes, GBuffer& target, ExactSurface* exact) const;
+    // The same for an upper fragment layer (mostly background): surfaces where `codes` has one,
+    // the background value where `written` says the last frame left a surface; `written` updated.
+    void resolveSparse(std::span<const uint32_t> codes, GBuffer& target,
+                       std::vector<uint8_t>& written) const;
 
     const scenes::Scene& mScene;
     const SceneGeometry& mGeometry;
