@@ -39,6 +39,12 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
     if (!prepared.multisample)
         return;
     const gbuffer::FragmentLayers& layers = prepared.multisample->layers;
+    if (stage.multisamplesNatively()) {
+        // Shaded and resolved by the stage itself, once, at inputs.samples.
+        result.parameters["msaa"] = std::to_string(prepared.inputs.samples);
+        result.parameters["msaa_shading"] = "native";
+        return;
+    }
     const int width = layers.width();
     std::vector<StageResult>& upper = mUpper;
     upper.resize(size_t(layers.layerCount() - 1));
@@ -96,6 +102,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
     resolve.stop();
     const gbuffer::FragmentLayers::Counts& counts = layers.counts();
     result.parameters["msaa"] = std::to_string(layers.samples());
+    result.parameters["msaa_shading"] = "layers";
     result.parameters["msaa_layers"] = std::to_string(layers.layerCount());
     result.parameters["msaa_complex_pixels"] = std::to_string(counts.complexPixels);
     result.parameters["msaa_shaded_fragments"] = std::to_string(counts.fragments);

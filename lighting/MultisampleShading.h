@@ -16,9 +16,13 @@
 // layer has a fragment. Passes of the same name are summed over the runs, in first-run order, and
 // "resolve" is appended. Parameters are the first run's, plus msaa_* counters.
 //
-// Which stages: those whose StageInfo says MsaaSupport::Layers (StageRegistry.h). Stages that
-// rasterize the scene themselves (forward family, the light pre-pass and inferred material
-// passes) would shade the whole scene again per layer: they are refused (RenderPlan.h).
+// Which stages: every stage without a StageInfo::msaaRefusal (StageRegistry.h). A stage that
+// multisamples natively (ShadingStage::multisamplesNatively: the forward stages, which rasterize
+// the scene themselves at inputs.samples with per-sample colour, ForwardGeometry.h) is shaded
+// ONCE on the full frame and resolves itself: no layers, no background run, parameters "msaa"
+// and msaa_shading=native (the layered path records msaa_shading=layers). The other stages that
+// rasterize the scene (the light pre-pass and inferred material passes) would shade the whole
+// scene again per layer: they are refused (experiments/render/RenderOptions.cpp).
 //
 // Exactness: a layer's image is the stage's own on that layer's G-buffer, so the exactness of each
 // stage per layer (tested against brute per layer) carries over, and the resolve is the same

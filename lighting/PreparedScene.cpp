@@ -46,6 +46,7 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
     inputs.gbuffer = gbuffer.get();
     inputs.exact = exact.get();
     inputs.lights = &lights;
+    inputs.samples = multisample ? multisampling.samples : 1;
 }
 
 PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,

@@ -37,7 +37,8 @@ struct PreparedScene {
     LightList lights;
     StageInputs inputs;
     // Multisampled frames only (null otherwise): the fragment layers and the G-buffers of the
-    // layers above 0 (`gbuffer` is layer 0). layerInputs(k) are `inputs` with layer k's G-buffer.
+    // layers above 0 (`gbuffer` is layer 0). layerInputs(k) are `inputs` with layer k's G-buffer;
+    // inputs.samples is the sample count (1 without multisampling).
     std::unique_ptr<gbuffer::MultisampleTarget> multisample;
     raster::RasterStats rasterStats;
     gbuffer::GBufferPassTimings gbufferTimings;

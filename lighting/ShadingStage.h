@@ -101,6 +101,11 @@ struct StageInputs {
     // size in lanes (32 = 8x4 pixels, 64 = 8x8).
     kernel::KernelIsa isa = kernel::KernelIsa::best();
     int simtWarpLanes = 32;
+    // The frame's samples per pixel (1, or 2, 4, 8 with --msaa: PreparedScene sets it from its
+    // Multisampling). A stage that multisamples natively (multisamplesNatively()) rasterizes at
+    // this count and resolves itself; the G-buffer stages ignore it (their G-buffer is one
+    // fragment layer, MultisampleShading.h).
+    int samples = 1;
 };
 
 // What shade() fills (see the file comment for each field's contract).
@@ -248,6 +253,12 @@ public:
     virtual std::string name() const = 0;
     virtual StageRequirements requirements() const = 0;
     virtual void shade(const StageInputs& inputs, StageResult& result) = 0;
+    // True for a stage that rasterizes the scene itself at inputs.samples samples per pixel and
+    // resolves its own per-sample colour (the forward stages: hardware-style MSAA): a
+    // multisampled frame is then shaded by ONE shade() call on the full frame
+    // (MultisampleShading.h), not once per fragment layer. Pure, cheap; matches the stage's
+    // StageInfo::msaaNative.
+    virtual bool multisamplesNatively() const { return false; }
 };
 
 } // namespace lighting

@@ -59,9 +59,13 @@ struct StageInfo {
     // 70, forward 80, forward-multipass 90, light-prepass 100, inferred 110, tiled-forward 120.
     int listOrder = 0;
     // Multisampled frames (--msaa 2|4|8, MultisampleShading.h): empty when the stage shades them
-    // through the fragment layers; otherwise why it refuses them (`testbed list` shows it and the
-    // runner's error quotes it).
+    // through the fragment layers or natively; otherwise why it refuses them (`testbed list` shows
+    // it and the runner's error quotes it).
     std::string msaaRefusal;
+    // True when the stage multisamples natively (ShadingStage::multisamplesNatively: rasterized
+    // at the frame's sample count, shaded once per pixel and triangle, per-sample colour resolved
+    // by the stage), so MultisampleShading runs it once on the full frame, not per layer.
+    bool msaaNative = false;
 };
 
 // Builds a stage from its checked options (defaults filled in). May throw StageError for a rule

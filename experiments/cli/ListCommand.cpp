@@ -53,9 +53,12 @@ void printStages(std::ostream& out) {
     for (const lighting::StageInfo& info : lighting::stageInfos()) {
         out << "  " << info.name << "  - " << info.description << "\n";
         out << "    msaa: "
-            << (info.msaaRefusal.empty()
-                    ? "yes (per-sample shading at complex pixels only, through the fragment layers)"
-                    : "refused: " + info.msaaRefusal)
+            << (!info.msaaRefusal.empty() ? "refused: " + info.msaaRefusal
+                : info.msaaNative
+                    ? std::string("yes, natively (rasterized at the sample count, shaded once per "
+                                  "pixel and triangle, per-sample colour resolved)")
+                    : std::string("yes (per-sample shading at complex pixels only, through the "
+                                  "fragment layers)"))
             << "\n";
         for (const lighting::StageOption& option : info.options)
             out << "    " << option.key << "=" << option.range() << "  " << option.typeName()

@@ -90,18 +90,32 @@ void countOracle(RenderRun& run) {
         run.oracle = run.result.lightsOracle;
         return;
     }
-    if (run.prepared->multisample) {
-        // Summed over the fragment layers, as the stage's evaluations are; on the stored layers
-        // (a lossless copy of every layer is not rendered: the count is then on the lossy
-        // surfaces, like a stage's).
-        run.oracle = lighting::countContributingLightsOverLayers(*run.prepared);
-        return;
-    }
     const lighting::StageInputs& frame = run.prepared->inputs;
     const gbuffer::GBufferLayout& stored = run.prepared->gbuffer->layout();
     const bool complete = stored.provides(gbuffer::Channel::Normal) &&
                           stored.provides(gbuffer::Channel::Albedo) &&
                           stored.provides(gbuffer::Channel::Specular);
+    if (run.prepared->multisample) {
+        // Summed over the fragment layers, as the stage's evaluations are; on the stored layers
+        // (the count is then on the lossy surfaces, like a stage's) when they hold what the BRDF
+        // reads, else (the forward stages, which read no channel) on the layers of a lossless
+        // multisampled frame of the same view: one more multisampled G-buffer pass.
+        if (complete) {
+            run.oracle = lighting::countContributingLightsOverLayers(*run.prepared);
+            return;
+        }
+        run.oracleFromLosslessGBuffer = true;
+        lighting::Multisampling multisampling;
+        multisampling.samples = run.prepared->multisample->samples;
+        multisampling.layers = run.prepared->multisample->options;
+        const gbuffer::CameraView& view = run.prepared->view;
+        const lighting::PreparedScene lossless(
+            run.prepared->scene, view.width, view.height, false,
+            gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar),
+            multisampling);
+        run.oracle = lighting::countContributingLightsOverLayers(lossless);
+        return;
+    }
     if (complete) {
         run.oracle = lighting::countContributingLights(frame);
         return;

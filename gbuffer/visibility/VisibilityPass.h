@@ -98,9 +98,29 @@ public:
     // PIXEL CENTRE (raster::Fragment::depth), the depth its surface is reconstructed at (shading
     // once per pixel and triangle), as the sample's code.
     std::span<const float> centreDepths() const { return mCentreDepths; }
+    // Whether the fragment (of scene triangle `triangle`) is what the last draw() left visible at
+    // its pixel: without multisampling, the pixel's code is its triangle's; multisampled, some
+    // sample of its coverage shows its triangle (visibleCoverage() != 0).
     bool isVisible(const raster::Fragment& fragment, uint32_t triangle) const {
-        return mCodes[size_t(fragment.y) * size_t(mView.width) + size_t(fragment.x)] ==
-               code(triangle, fragment.frontFacing);
+        if (mSamples == 1)
+            return mCodes[size_t(fragment.y) * size_t(mView.width) + size_t(fragment.x)] ==
+                   code(triangle, fragment.frontFacing);
+        return visibleCoverage(fragment, triangle) != 0;
+    }
+    // The samples of fragment.coverage at which the last draw() left the fragment's triangle
+    // visible (1 or 0 without multisampling): the samples a redraw over draw()'s depth
+    // (redrawState) writes, so that each sample is written by exactly its visible fragment.
+    uint8_t visibleCoverage(const raster::Fragment& fragment, uint32_t triangle) const {
+        const size_t pixel = size_t(fragment.y) * size_t(mView.width) + size_t(fragment.x);
+        const uint32_t value = code(triangle, fragment.frontFacing);
+        if (mSamples == 1)
+            return mCodes[pixel] == value ? 1 : 0;
+        const uint32_t* samples = mCodes.data() + pixel * size_t(mSamples);
+        unsigned visible = 0;
+        for (int s = 0; s < mSamples; ++s)
+            if ((fragment.coverage >> s & 1u) && samples[s] == value)
+                visible |= 1u << s;
+        return uint8_t(visible);
     }
 
     // The surface of the code's triangle (code != kNoTriangle) at pixel (x, y)'s centre:

@@ -23,20 +23,23 @@ std::vector<std::vector<uint32_t>> blendedTileLightLists(const StageInputs& inpu
     const gbuffer::DepthDecoder decoder =
         gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar).depthDecoder(view);
     const float clear = view.clearDepth();
+    const size_t samples = opaqueDepth.size() / (size_t(view.width) * size_t(view.height));
     std::vector<std::vector<uint32_t>> lists(size_t(grid.tileCount()));
     tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
         const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
         float farthest = 0.0f;
         bool background = false;
         for (int y = grid.y0(ty); y < grid.y1(ty) && !background; ++y)
-            for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
-                const float depth = opaqueDepth[size_t(y) * size_t(view.width) + size_t(x)];
-                if (depth == clear) {
-                    background = true;
-                    break;
+            for (int x = grid.x0(tx); x < grid.x1(tx) && !background; ++x)
+                for (size_t s = 0; s < samples; ++s) {
+                    const float depth =
+                        opaqueDepth[(size_t(y) * size_t(view.width) + size_t(x)) * samples + s];
+                    if (depth == clear) {
+                        background = true;
+                        break;
+                    }
+                    farthest = std::max(farthest, decoder.viewDepthMetres(x, y, depth));
                 }
-                farthest = std::max(farthest, decoder.viewDepthMetres(x, y, depth));
-            }
         TileSurfaceBounds bounds;
         bounds.covered = true;
         bounds.minDepthMetres = view.nearMetres;

@@ -19,8 +19,8 @@
 namespace lighting {
 
 // Lists of every tile of `grid` (indexed ty * tileCountX + tx) for the frame of `inputs`, with
-// opaqueDepth the frame's opaque depth plane (the view's convention) and viewFrustumCulling as
-// the stage's `vfc` option.
+// opaqueDepth the frame's opaque depth plane (the view's convention; one or several samples per
+// pixel, pixel-major, every sample bounded) and viewFrustumCulling as the stage's `vfc` option.
 std::vector<std::vector<uint32_t>> blendedTileLightLists(const StageInputs& inputs,
                                                          std::span<const float> opaqueDepth,
                                                          const TileGrid& grid,

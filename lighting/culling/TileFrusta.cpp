@@ -23,11 +23,14 @@ namespace {
 // The bounds of every tile from its samples. sampleAt(x, y, depthMetres, normalView) returns
 // false for an uncovered pixel, else sets the sample's positive view depth and (read only when
 // options.normalCone) its normal. Templated so the per-pixel call is inlined, not virtual.
+// samplesPerPixel: sampleAt(x, y, s, ...) is called for s in [0, samplesPerPixel).
 template <typename SampleAt>
-std::vector<TileSurfaceBounds>
-boundsOfSamples(const TileGrid& grid, const TileBoundsOptions& options, const SampleAt& sampleAt) {
+std::vector<TileSurfaceBounds> boundsOfSamples(const TileGrid& grid,
+                                               const TileBoundsOptions& options,
+                                               const SampleAt& sampleAt, int samplesPerPixel = 1) {
     std::vector<TileSurfaceBounds> bounds(size_t(grid.tileCount()));
-    const size_t maxSamples = size_t(grid.tileSizePixels) * grid.tileSizePixels;
+    const size_t maxSamples =
+        size_t(grid.tileSizePixels) * grid.tileSizePixels * size_t(samplesPerPixel);
     tbb::parallel_for(
         tbb::blocked_range<int>(0, grid.tileCount()), [&](const tbb::blocked_range<int>& range) {
             // Per-task scratch: the second passes (mask, cone half-angle) need the bounds first.
@@ -43,25 +46,27 @@ boundsOfSamples(const TileGrid& grid, const TileBoundsOptions& options, const Sa
                 float minDepth = INFINITY, maxDepth = -INFINITY;
                 glm::vec3 normalSum(0.0f);
                 for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
-                    for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
-                        float depth = 0.0f;
-                        glm::vec3 normalView(0.0f);
-                        if (!sampleAt(x, y, depth, normalView))
-                            continue;
-                        minDepth = std::min(minDepth, depth);
-                        maxDepth = std::max(maxDepth, depth);
-                        if (options.depthMask)
-                            depths.push_back(depth);
-                        if (options.normalCone) {
-                            const float length = glm::length(normalView);
-                            // A zero normal has no facing: the BRDF's sign test then never passes,
-                            // but keep the tile's cone open rather than reason about it.
-                            const glm::vec3 n =
-                                length > 0.0f ? normalView / length : glm::vec3(0.0f);
-                            normals.push_back(n);
-                            normalSum += n;
+                    for (int x = grid.x0(tx); x < grid.x1(tx); ++x)
+                        for (int s = 0; s < samplesPerPixel; ++s) {
+                            float depth = 0.0f;
+                            glm::vec3 normalView(0.0f);
+                            if (!sampleAt(x, y, s, depth, normalView))
+                                continue;
+                            minDepth = std::min(minDepth, depth);
+                            maxDepth = std::max(maxDepth, depth);
+                            if (options.depthMask)
+                                depths.push_back(depth);
+                            if (options.normalCone) {
+                                const float length = glm::length(normalView);
+                                // A zero normal has no facing: the BRDF's sign test then never
+                                // passes, but keep the tile's cone open rather than reason about
+                                // it.
+                                const glm::vec3 n =
+                                    length > 0.0f ? normalView / length : glm::vec3(0.0f);
+                                normals.push_back(n);
+                                normalSum += n;
+                            }
                         }
-                    }
                 if (!(minDepth <= maxDepth))
                     continue; // no covered pixel
                 b.covered = true;
@@ -100,7 +105,7 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
                                                         const TileGrid& grid,
                                                         const TileBoundsOptions& options) {
     return boundsOfSamples(grid, options,
-                           [&gb](int x, int y, float& depthMetres, glm::vec3& normalView) {
+                           [&gb](int x, int y, int, float& depthMetres, glm::vec3& normalView) {
                                if (!gb.covered(size_t(y) * gb.width() + x))
                                    return false;
                                const gbuffer::Surface s = gb.decode(x, y);
@@ -114,14 +119,18 @@ std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::DepthDecode
                                                       std::span<const float> depth,
                                                       const TileGrid& grid, bool depthMask) {
     const float clearDepth = decoder.view().clearDepth();
-    return boundsOfSamples(grid, {depthMask, false},
-                           [&](int x, int y, float& depthMetres, glm::vec3&) {
-                               const float d = depth[size_t(y) * grid.widthPixels + x];
-                               if (d == clearDepth)
-                                   return false;
-                               depthMetres = decoder.viewDepthMetres(x, y, d);
-                               return true;
-                           });
+    const int samples = int(depth.size() / (size_t(grid.widthPixels) * size_t(grid.heightPixels)));
+    return boundsOfSamples(
+        grid, {depthMask, false},
+        [&](int x, int y, int s, float& depthMetres, glm::vec3&) {
+            const float d =
+                depth[(size_t(y) * grid.widthPixels + size_t(x)) * size_t(samples) + size_t(s)];
+            if (d == clearDepth)
+                return false;
+            depthMetres = decoder.viewDepthMetres(x, y, d);
+            return true;
+        },
+        samples);
 }
 
 TileEdgePlanes TileEdgePlanes::make(const gbuffer::CameraView& view, const TileGrid& grid) {

@@ -70,7 +70,9 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
 // convention, for stages without a G-buffer (tiled forward's depth pre-pass). A pixel is covered
 // when its depth differs from the view's clear depth, as GBuffer::covered; positions come from
 // `decoder` (the decoder of the layout the plane is in), so the same depth plane in a G-buffer
-// of that layout gives bitwise computeTileSurfaceBounds' depth bounds.
+// of that layout gives bitwise computeTileSurfaceBounds' depth bounds. A plane of several
+// samples per pixel (pixel-major, size a multiple of the grid's pixels: multisampled forward
+// shading) bounds every covered sample, each at its pixel's centre ray.
 std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::DepthDecoder& decoder,
                                                       std::span<const float> depth,
                                                       const TileGrid& grid, bool depthMask);

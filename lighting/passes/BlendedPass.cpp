@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <stdexcept>
 
 #include <tbb/parallel_for.h>
 
@@ -13,7 +14,8 @@
 
 namespace lighting {
 
-bool BlendedPass::prepare(const StageInputs& inputs) {
+bool BlendedPass::prepare(const StageInputs& inputs, SampleRadiance* samples) {
+    mTarget = samples;
     const scenes::Scene& scene = *inputs.scene;
     mActive = std::any_of(scene.materials.begin(), scene.materials.end(),
                           [](const auto& m) { return m.alphaMode == scenes::AlphaMode::Blend; });
@@ -81,7 +83,7 @@ std::span<const uint32_t> BlendedPass::contributingLights(const gbuffer::Surface
 void BlendedPass::shadeWithContributingLights(std::span<const float> opaqueDepth,
                                               StageResult& result) {
     PassTimer blendPass(result, pass::kBlend);
-    mShading.begin(*mInputs, FragmentApply::Over, result);
+    mShading.begin(*mInputs, FragmentApply::Over, result, mTarget);
     draw(opaqueDepth, [&](const raster::Fragment& fragment) {
         const uint32_t triangle = mSceneTriangle[fragment.triangle];
         float alpha = 0.0f;
@@ -109,6 +111,8 @@ void BlendedPass::shadeWithTileLists(std::span<const float> opaqueDepth, int til
 }
 
 void BlendedPass::compositeExact(std::span<const float> opaqueDepth, StageResult& result) {
+    if (opaqueDepth.size() != size_t(result.width) * size_t(result.height))
+        throw std::invalid_argument("BlendedPass::compositeExact: one depth sample per pixel");
     PassTimer blendPass(result, pass::kBlend);
     const size_t width = size_t(result.width);
     // Every blended fragment of each pixel (scene triangle, back face), in any order: sorted per

@@ -41,6 +41,14 @@
 // output of a surface is its lit colour plus its emission (Appendix B adds the emissive term to
 // the BRDF's result), so the emission is weighted by alpha like the lit colour; a pane of
 // alpha 0 neither reflects nor emits. KHR_materials_emissive_strength only scales the factor.
+// Multisampling (the forward stages' hardware-style MSAA: prepare() with a SampleRadiance): the
+// opaque depth plane then holds samples per pixel (the SHADING depth of each sample's opaque
+// fragment, ForwardGeometry::shadedDepth), blended triangles are rasterized at one sample per
+// pixel, and a fragment composites over each sample whose opaque depth its centre depth is
+// closer than (the draw's depth test, per sample), in the sample colour buffer. That is exactly
+// what the G-buffer stages do per fragment layer (this pass at one sample over the layer's
+// centre depths, MultisampleShading.h), so every exact stage keeps one image; coverage of a
+// blended triangle's own edges at the samples (what a GPU does) would differ from it there.
 // Thread safety: one frame at a time per object; parallel inside (the rasterizer's
 // tiles), each pixel composited by the thread owning its tile, in submission order, so the
 // result does not depend on the thread count.
@@ -58,6 +66,7 @@
 #include "lighting/brdf/Brdf.h"
 #include "lighting/passes/FragmentShading.h"
 #include "lighting/passes/PassNames.h"
+#include "lighting/passes/SampleRadiance.h"
 #include "raster/Rasterizer.h"
 
 namespace lighting {
@@ -67,8 +76,9 @@ public:
     // Per frame: false (and nothing else done, O(materials)) when no material of inputs.scene is
     // BLEND; else transforms the scene (its own gbuffer::VisibilityPass, so the clip positions
     // are bitwise the opaque pass's) and sorts the blended triangles. Requires inputs.scene,
-    // .geometry, .view, .lights.
-    bool prepare(const StageInputs& inputs);
+    // .geometry, .view, .lights. With `samples`, the frame is multisampled and shade()
+    // composites per sample into it (see the file comment); it must outlive the frame's shade.
+    bool prepare(const StageInputs& inputs, SampleRadiance* samples = nullptr);
     bool active() const { return mActive; }
     // Number of blended triangles this frame.
     size_t triangleCount() const { return mSceneTriangle.size(); }
@@ -136,7 +146,9 @@ private:
     // position from the fragment's depth (the lossless decoder, as ForwardGeometry), its alpha.
     gbuffer::Surface surfaceOf(const raster::Fragment& fragment, uint32_t triangle,
                                float& alpha) const;
-    // Draws the sorted blended triangles over a copy of opaqueDepth.
+    // Draws the sorted blended triangles over a copy of opaqueDepth. Multisampled (opaqueDepth
+    // with several samples per pixel), over each pixel's farthest sample, and each fragment's
+    // coverage is set to the samples it is closer than; fragments closer than none are dropped.
     template <class FragmentFn>
     void draw(std::span<const float> opaqueDepth, FragmentFn&& fragmentFn);
 
@@ -149,22 +161,53 @@ private:
     std::vector<uint32_t> mSortedIndices; // vertex indices of the sorted triangles
     std::vector<uint32_t> mSceneTriangle; // drawn triangle -> scene triangle
     std::vector<uint32_t> mEveryLight;
-    FragmentShading mShading; // the blended fragments on the light kernel
+    FragmentShading mShading;          // the blended fragments on the light kernel
+    SampleRadiance* mTarget = nullptr; // multisampled frames: the per-sample colour
 };
 
 template <class FragmentFn>
 void BlendedPass::draw(std::span<const float> opaqueDepth, FragmentFn&& fragmentFn) {
-    mDepth.assign(opaqueDepth.begin(), opaqueDepth.end());
     raster::RasterState state = mVisibility.drawState();
     state.depthWrite = false;
-    mRasterizer->draw(raster::TriangleList{mVisibility.clipPositions(), mSortedIndices}, state,
-                      mDepth.data(), fragmentFn);
+    const raster::TriangleList triangles{mVisibility.clipPositions(), mSortedIndices};
+    const size_t width = size_t(mVisibility.view().width);
+    const size_t pixelCount = width * size_t(mVisibility.view().height);
+    const size_t samples = opaqueDepth.size() / pixelCount;
+    if (samples <= 1) {
+        mDepth.assign(opaqueDepth.begin(), opaqueDepth.end());
+        mRasterizer->draw(triangles, state, mDepth.data(), fragmentFn);
+        return;
+    }
+    // The farthest sample of each pixel: a fragment closer than some sample is closer than it.
+    mDepth.resize(pixelCount);
+    const bool reversed = mVisibility.view().reversedZ();
+    for (size_t pixel = 0; pixel < pixelCount; ++pixel) {
+        const float* sample = opaqueDepth.data() + pixel * samples;
+        float farthest = sample[0];
+        for (size_t s = 1; s < samples; ++s)
+            farthest = reversed ? std::min(farthest, sample[s]) : std::max(farthest, sample[s]);
+        mDepth[pixel] = farthest;
+    }
+    auto perSample = [&](const raster::Fragment& fragment) {
+        const float* sample =
+            opaqueDepth.data() + (size_t(fragment.y) * width + size_t(fragment.x)) * samples;
+        unsigned coverage = 0;
+        for (size_t s = 0; s < samples; ++s)
+            if (reversed ? fragment.depth > sample[s] : fragment.depth < sample[s])
+                coverage |= 1u << s;
+        if (coverage == 0)
+            return;
+        raster::Fragment covered = fragment;
+        covered.coverage = uint8_t(coverage);
+        fragmentFn(covered);
+    };
+    mRasterizer->draw(triangles, state, mDepth.data(), perSample);
 }
 
 template <class LightsAt>
 void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
                         StageResult& result, PassTimer& blendPass) {
-    mShading.begin(*mInputs, FragmentApply::Over, result);
+    mShading.begin(*mInputs, FragmentApply::Over, result, mTarget);
     draw(opaqueDepth, [&](const raster::Fragment& fragment) {
         const uint32_t triangle = mSceneTriangle[fragment.triangle];
         float alpha = 0.0f;

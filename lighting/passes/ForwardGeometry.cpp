@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -13,25 +14,38 @@
 namespace lighting {
 
 void ForwardGeometry::shadeBlended(const StageInputs& inputs, BlendedPass& blended,
-                                   const LightIndexLists& objectLights, StageResult& result) const {
-    if (blended.prepare(inputs))
+                                   const LightIndexLists& objectLights, StageResult& result) {
+    if (blended.prepare(inputs, sampleTarget()))
         blended.shade(
-            depth(),
+            shadedDepth(),
             [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
                 return objectLights[objectOfTriangle(triangle)];
             },
             result);
 }
 
-void ForwardGeometry::addEmission(StageResult& result) const {
+void ForwardGeometry::addEmission(StageResult& result) {
     if (!mEmits)
         return;
     const uint32_t* codes = mVisibility.codes().data();
     const int width = mVisibility.view().width;
+    const int samples = mSamples;
+    SampleRadiance& target = mSampleRadiance;
     tbb::parallel_for(0, mVisibility.view().height, [&](int y) {
         gbuffer::VisibilityPass::RowSurfaces row(mVisibility, y);
         for (int x = 0; x < width; ++x) {
             const size_t pixel = size_t(y) * width + x;
+            if (samples > 1) {
+                for (int s = 0; s < samples; ++s) {
+                    const uint32_t code = codes[pixel * size_t(samples) + size_t(s)];
+                    if (code == gbuffer::VisibilityPass::kNoTriangle)
+                        continue;
+                    const glm::vec3 emitted = row.at(code, x).emissive;
+                    for (int c = 0; c < 3; ++c)
+                        target.pixel(c, pixel)[s] += emitted[c];
+                }
+                continue;
+            }
             if (codes[pixel] == gbuffer::VisibilityPass::kNoTriangle)
                 continue;
             const glm::vec3 emitted = row.at(codes[pixel], x).emissive;
@@ -39,6 +53,62 @@ void ForwardGeometry::addEmission(StageResult& result) const {
                 result.radiance[c][pixel] += emitted[c];
         }
     });
+}
+
+void ForwardGeometry::drawDepthPrepass() {
+    mVisibility.draw(*mRasterizer, mDepth, mSamples);
+    if (mSamples == 1)
+        return;
+    // Each sample's shading depth: its fragment's centre depth, as FragmentLayers stores it.
+    const std::span<const uint32_t> codes = mVisibility.codes();
+    const std::span<const float> centre = mVisibility.centreDepths();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, codes.size(), 16384), [&](const auto& range) {
+        for (size_t s = range.begin(); s != range.end(); ++s)
+            mCentreDepth[s] = codes[s] == gbuffer::VisibilityPass::kNoTriangle
+                                  ? mClearDepth
+                                  : shadingDepth(centre[s]);
+    });
+}
+
+void ForwardGeometry::boundShadedSamples() {
+    if (mSamples == 1)
+        return;
+    const int width = mVisibility.view().width, height = mVisibility.view().height;
+    const std::span<const uint32_t> codes = mVisibility.codes();
+    const size_t stride = size_t(mSamples);
+    struct Outside {
+        uint32_t object;
+        glm::vec3 positionView;
+    };
+    std::vector<std::vector<Outside>> rows(static_cast<size_t>(height));
+    tbb::parallel_for(0, height, [&](int y) {
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+            for (size_t s = 0; s < stride; ++s) {
+                const uint32_t code = codes[pixel * stride + s];
+                if (code == gbuffer::VisibilityPass::kNoTriangle)
+                    continue;
+                const uint32_t object =
+                    mObjectOfTriangle[gbuffer::VisibilityPass::triangleOf(code)];
+                const glm::vec3 p =
+                    mDepthDecoder->positionView(x, y, mCentreDepth[pixel * stride + s]);
+                if (!insideBounds(object, p))
+                    rows[size_t(y)].push_back({object, p});
+            }
+        }
+    });
+    std::vector<uint8_t> grown(mObjects.size(), 0);
+    for (const std::vector<Outside>& row : rows)
+        for (const Outside& outside : row) {
+            ViewBox& box = mObjects[outside.object].boundsView;
+            box.lo = glm::min(box.lo, outside.positionView);
+            box.hi = glm::max(box.hi, outside.positionView);
+            grown[outside.object] = 1;
+        }
+    for (size_t o = 0; o < mObjects.size(); ++o)
+        if (grown[o])
+            mObjects[o].boundsView =
+                widenedBox(mObjects[o].boundsView.lo, mObjects[o].boundsView.hi);
 }
 
 void ForwardGeometry::prepare(const StageInputs& inputs) {
@@ -52,7 +122,14 @@ void ForwardGeometry::prepare(const StageInputs& inputs) {
     mDepthDecoder =
         gbuffer::GBufferLayout::lossless(view.depthConvention, view.infiniteFar).depthDecoder(view);
     fitRasterizer(mRasterizer, view);
-    mDepth.resize(size_t(view.width) * view.height);
+    if (!raster::isRasterSampleCount(inputs.samples))
+        throw std::invalid_argument("forward shading: " + std::to_string(inputs.samples) +
+                                    " samples per pixel (expected 1, 2, 4 or 8)");
+    mSamples = inputs.samples;
+    mClearDepth = view.clearDepth();
+    mNearerThanClear = std::nextafter(mClearDepth, view.reversedZ() ? 1.0f : 0.0f);
+    mDepth.resize(size_t(view.width) * view.height * size_t(mSamples));
+    mCentreDepth.resize(mSamples > 1 ? mDepth.size() : 0);
 
     // Objects: maximal runs of one instance (SceneGeometry appends instances one after another,
     // so this is one object per instance).

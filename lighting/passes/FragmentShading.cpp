@@ -28,6 +28,7 @@ struct QueuedFragment {
     int y = 0;
     uint32_t triangle = 0; // scene triangle
     bool frontFacing = true;
+    uint8_t coverage = 1; // multisampled: the samples the fragment is applied to
     float alpha = 1.0f;
     uint64_t listKey = 0;
     std::span<const uint32_t> lights; // when copied: empty, see copiedFirst
@@ -44,6 +45,7 @@ QueuedFragment& queued(QueuedFragment& q, const raster::Fragment& fragment, uint
     q.y = fragment.y;
     q.triangle = triangle;
     q.frontFacing = fragment.frontFacing;
+    q.coverage = fragment.coverage;
     q.alpha = alpha;
     q.listKey = listKey;
     q.lights = lights;
@@ -80,6 +82,7 @@ constexpr uint64_t kCopiedListKey = uint64_t(1) << 63;
 struct alignas(64) FragmentShading::TileBatch {
     std::array<QueuedFragment, kMaxWarpLanes> fragments;
     int count = 0;
+    uint64_t queuedTotal = 0;           // fragments queued since begin()
     KernelWork work;                    // SIMT lane slots and kernel counters
     std::vector<uint32_t> copiedLights; // the lists of addCopyingList, until the batch is shaded
     std::vector<uint32_t> unionScratch; // the union of the batch's lists, for the SIMT model
@@ -90,11 +93,13 @@ struct alignas(64) FragmentShading::TileBatch {
 FragmentShading::FragmentShading() = default;
 FragmentShading::~FragmentShading() = default;
 
-void FragmentShading::begin(const StageInputs& inputs, FragmentApply apply, StageResult& result) {
+void FragmentShading::begin(const StageInputs& inputs, FragmentApply apply, StageResult& result,
+                            SampleRadiance* samples) {
     if (inputs.simtWarpLanes != 32 && inputs.simtWarpLanes != 64)
         throw std::invalid_argument("FragmentShading: simtWarpLanes must be 32 or 64, not " +
                                     std::to_string(inputs.simtWarpLanes));
     mResult = &result;
+    mSamples = samples;
     mApply = apply;
     mCountOracle = apply == FragmentApply::Over && !result.lightsOracle.empty();
     mIsa = inputs.isa;
@@ -106,6 +111,7 @@ void FragmentShading::begin(const StageInputs& inputs, FragmentApply apply, Stag
     mTiles.resize(size_t(mTilesX) * size_t(tilesY));
     for (TileBatch& tile : mTiles) {
         tile.count = 0;
+        tile.queuedTotal = 0;
         tile.work = {};
         tile.copiedLights.clear();
     }
@@ -172,8 +178,67 @@ void FragmentShading::flush() {
     });
 }
 
+namespace {
+
+// Multisampled frames: lane `lane`'s result applied to the fragment's covered samples of
+// `target` with `apply`'s semantics (the file comment of FragmentShading.h).
+void applyToSamples(FragmentApply apply, bool countOracle, SampleRadiance& target,
+                    StageResult& result, const QueuedFragment& q,
+                    const kernel::PacketAccumulator& accumulator, int lane, size_t pixel) {
+    const int samples = target.samples();
+    float lit[3];
+    for (int c = 0; c < 3; ++c)
+        lit[c] = accumulator.radiance[c][lane] +
+                 (apply == FragmentApply::Add ? 0.0f : q.surface.emissive[c]);
+    for (int c = 0; c < 3; ++c) {
+        float* sample = target.pixel(c, pixel);
+        for (int s = 0; s < samples; ++s) {
+            if (!(q.coverage >> s & 1u))
+                continue;
+            switch (apply) {
+            case FragmentApply::Replace:
+                sample[s] = lit[c];
+                break;
+            case FragmentApply::Add:
+                sample[s] += lit[c];
+                break;
+            case FragmentApply::Over:
+                sample[s] = q.alpha * lit[c] + (1.0f - q.alpha) * sample[s];
+                break;
+            }
+        }
+    }
+    if (apply == FragmentApply::Over) {
+        if (countOracle)
+            result.lightsOracle[pixel] += accumulator.lightsContributing[lane];
+        result.traceBlendedFragment(pixel, q.triangle, q.frontFacing, q.lights);
+        return;
+    }
+    if (!target.tracing())
+        return;
+    for (int s = 0; s < samples; ++s) {
+        if (!(q.coverage >> s & 1u))
+            continue;
+        std::vector<uint32_t>& trace = target.traceOf(pixel, s);
+        if (apply == FragmentApply::Replace)
+            trace.assign(q.lights.begin(), q.lights.end());
+        else
+            trace.insert(trace.end(), q.lights.begin(), q.lights.end());
+    }
+}
+
+} // namespace
+
+uint64_t FragmentShading::fragmentCount() const {
+    uint64_t count = 0;
+    for (const TileBatch& tile : mTiles)
+        count += tile.queuedTotal;
+    return count;
+}
+
 void FragmentShading::shadeBatch(TileBatch& batch) {
     StageResult& result = *mResult;
+    batch.queuedTotal += uint64_t(batch.count);
     // Copied lists live in the batch's storage, which stops growing once the batch is full.
     for (int i = 0; i < batch.count; ++i) {
         QueuedFragment& q = batch.fragments[size_t(i)];
@@ -243,6 +308,13 @@ void FragmentShading::shadeBatch(TileBatch& batch) {
         for (int lane = 0; lane < laneCount; ++lane) {
             const QueuedFragment& q = lanes[lane];
             const size_t pixel = size_t(q.y) * size_t(mWidth) + size_t(q.x);
+            if (mSamples) {
+                applyToSamples(mApply, mCountOracle, *mSamples, result, q, accumulator, lane,
+                               pixel);
+                result.lightsEvaluated[pixel] +=
+                    q.beyondRange ? uint32_t(q.lights.size()) : accumulator.lightsEvaluated[lane];
+                continue;
+            }
             switch (mApply) {
             case FragmentApply::Replace:
                 for (int c = 0; c < 3; ++c)

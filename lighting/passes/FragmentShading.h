@@ -33,6 +33,12 @@
 // The light trace follows: Replace assigns the lane's list, Add appends its lights, Over appends
 // a blended fragment (StageResult::traceBlendedFragment).
 //
+// Multisampling (the forward stages' hardware-style MSAA, begin() with a SampleRadiance): the
+// fragment is still shaded once, and its result is applied as above to each sample of its
+// coverage mask (raster::Fragment::coverage, queued with it) in the per-sample colour buffer
+// instead of the pixel; lightsEvaluated still adds once per fragment, the opaque trace goes to
+// the buffer's per-sample lists (SampleRadiance.h), blended fragments are traced per pixel.
+//
 // Exactness: a lane's sum is the kernel's sum over its own list in list order from 0, the same
 // sequence of float operations `brute` runs on the same ISA at the same surface (bitwise the
 // G-buffer's, ForwardGeometry.h); `--isa scalar` is evaluateLight lane by lane, bitwise the
@@ -65,6 +71,7 @@
 
 #include "gbuffer/Surface.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/passes/SampleRadiance.h"
 #include "raster/Rasterizer.h"
 
 namespace lighting {
@@ -88,8 +95,11 @@ public:
 
     // Starts a pass: the kernel's lights from inputs.lights, inputs.isa, the warp size
     // (inputs.simtWarpLanes, 32 or 64), one batch per raster tile of the view. `result` (resized
-    // already) receives the fragments and must outlive end().
-    void begin(const StageInputs& inputs, FragmentApply apply, StageResult& result);
+    // already) receives the fragments and must outlive end(). With `samples` (multisampled
+    // frames: reset to the view and inputs.samples) fragments are applied to their covered
+    // samples there instead of to result.radiance (see the file comment).
+    void begin(const StageInputs& inputs, FragmentApply apply, StageResult& result,
+               SampleRadiance* samples = nullptr);
     // Queues a fragment of scene triangle `triangle` with surface `surface` (and, for Over, its
     // alpha) to be shaded with `lights` (ascending for exactness; must stay valid until the next
     // flush()), a list `listKey` identifies within the draw (equal keys = the same list: an
@@ -119,6 +129,8 @@ public:
     // packet_lights_* counters (LightAccumulation.h) in result.parameters, added to those an
     // earlier kernel pass of the frame recorded (KernelWork::record).
     void end();
+    // Fragments queued since begin() (add, addCopyingList and addBeyondRange), all flushed.
+    uint64_t fragmentCount() const;
 
 private:
     struct TileBatch;
@@ -126,6 +138,7 @@ private:
     void shadeBatch(TileBatch& batch);
 
     StageResult* mResult = nullptr;
+    SampleRadiance* mSamples = nullptr; // multisampled: the per-sample colour, else null
     FragmentApply mApply = FragmentApply::Replace;
     bool mCountOracle = false;
     kernel::KernelIsa mIsa = kernel::KernelIsa::scalar();

@@ -18,6 +18,13 @@
 // Records "isa" (what ran) and the SIMT counters (one warp = 32 or 64 consecutive visible
 // fragments of one pass, paying its one light).
 //
+// Multisampling (inputs.samples > 1, hardware-style MSAA, ForwardGeometry.h): the pre-pass and
+// the light passes run at the frame's sample count; a light pass shades each visible fragment
+// once and adds its light to the samples whose pre-pass code is its triangle; the emission is
+// added per sample; the samples are averaged at the end ("resolve"). The object boxes the
+// illumination sets come from are grown to the samples' shading positions first
+// (ForwardGeometry::boundShadedSamples: extrapolated pixel centres), timed in "cull".
+//
 // Exactness: the fragment's surface and position are the G-buffer's own (ForwardGeometry.h), and
 // per pixel the lights are added in ascending order starting from zero, the same sequence of
 // float additions as `brute` on the same ISA minus lights that add exactly zero, so the image is
@@ -45,13 +52,15 @@ public:
         mForward.beginFrame(inputs, result, true);
 
         PassTimer cull(result, pass::kCull);
+        mForward.boundShadedSamples();
         mForward.objectLightLists(boundingSpheresView(*inputs.lights), mObjectLights);
         mSets = mObjectLights.transposed(inputs.lights->size());
         cull.stop();
 
         PassTimer shading(result, pass::kShading);
         const size_t lightCount = inputs.lights->size();
-        mShading.begin(inputs, FragmentApply::Add, result);
+        mShading.begin(inputs, FragmentApply::Add, result, mForward.sampleTarget());
+        const bool multisampled = mForward.samples() > 1;
         const std::vector<ForwardObject>& objects = mForward.objects();
         const std::vector<uint32_t>& allIndices = inputs.geometry->indices;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
@@ -79,10 +88,13 @@ public:
                 globalTriangle = mSetTriangles.data();
             }
             const uint32_t light[1] = {l}; // the pass's list, alive until its flush
-            auto addLight = [&](const raster::Fragment& fragment) {
+            auto addLight = [&](const raster::Fragment& drawn) {
                 const uint32_t triangle =
-                    globalTriangle ? globalTriangle[fragment.triangle] : fragment.triangle;
-                if (!visibility.isVisible(fragment, triangle))
+                    globalTriangle ? globalTriangle[drawn.triangle] : drawn.triangle;
+                raster::Fragment fragment = drawn;
+                if (multisampled)
+                    fragment.coverage = visibility.visibleCoverage(drawn, triangle);
+                if (multisampled ? fragment.coverage == 0 : !visibility.isVisible(drawn, triangle))
                     return;
                 // Outside the light's range it adds exactly zero: queued for its lane and its
                 // count, without decoding its surface (FragmentShading::addBeyondRange).
@@ -104,7 +116,9 @@ public:
         // illumination sets were transposed from: ascending per object). "Over" does not
         // distribute over one additive pass per light, so the blended layers are shaded whole.
         mForward.shadeBlended(inputs, mBlended, mObjectLights, result);
+        mForward.endFrame(result);
     }
+    bool multisamplesNatively() const override { return true; }
 
 private:
     ForwardGeometry mForward;
@@ -116,15 +130,14 @@ private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
-const StageRegistrar kRegistrar(
-    {.name = "forward-multipass",
-     .description = "one additive pass per light over its illumination set",
-     .kind = StageKind::Exact,
-     .options = {}, // none
-     .listOrder = 90,
-     .msaaRefusal = "shades while rasterizing; hardware-style MSAA (per-sample colour with "
-                    "coverage, shaded once per pixel and triangle) is not implemented yet"},
-    [](const StageOptions&) { return std::make_unique<ForwardMultipassStage>(); });
+const StageRegistrar
+    kRegistrar({.name = "forward-multipass",
+                .description = "one additive pass per light over its illumination set",
+                .kind = StageKind::Exact,
+                .options = {}, // none
+                .listOrder = 90,
+                .msaaNative = true},
+               [](const StageOptions&) { return std::make_unique<ForwardMultipassStage>(); });
 
 } // namespace
 

@@ -25,6 +25,12 @@
 // in fragment order (FragmentApply::Replace). Records "isa" (what ran) and the SIMT counters (one
 // warp = 32 or 64 consecutive visible fragments).
 //
+// Multisampling (inputs.samples > 1, hardware-style MSAA, ForwardGeometry.h): pre-pass and
+// shading draw run at the frame's sample count; the tiles are bounded by every covered sample's
+// shading depth (its fragment's centre depth: the surfaces actually shaded); each visible
+// (pixel, triangle) is shaded once and replaces the samples whose pre-pass code is its triangle;
+// the samples are averaged at the end ("resolve"). Records "shaded_fragments".
+//
 // Exactness: the visible fragment's surface and position are computed by the G-buffer's own
 // functions (ForwardGeometry::surfaceAt) and each pixel sums its tile's lights in ascending order
 // with the kernel's arithmetic, so the image is bitwise `brute`'s on the same ISA. Per pixel,
@@ -71,7 +77,7 @@ public:
         PassTimer cull(result, pass::kCull);
         const TileGrid grid = TileGrid::make(view.width, view.height, mOptions.tileSizePixels);
         const std::vector<TileSurfaceBounds> bounds = computeTileDepthBounds(
-            mForward.depthDecoder(), mForward.depth(), grid, mOptions.depthMask);
+            mForward.depthDecoder(), mForward.shadedDepth(), grid, mOptions.depthMask);
         const size_t lightsAfterVfc =
             buildTileLightLists(view, grid, bounds, boundingSpheresView(*inputs.lights),
                                 {mOptions.viewFrustumCulling, mOptions.depthMask, false},
@@ -82,9 +88,14 @@ public:
         PassTimer shading(result, pass::kShading);
         const int tileSize = grid.tileSizePixels, tileCountX = grid.tileCountX;
         const gbuffer::VisibilityPass& visibility = mForward.visibility();
-        mShading.begin(inputs, FragmentApply::Replace, result);
-        auto shadeFragment = [&](const raster::Fragment& fragment) {
-            if (!visibility.isVisible(fragment, fragment.triangle))
+        mShading.begin(inputs, FragmentApply::Replace, result, mForward.sampleTarget());
+        const bool multisampled = mForward.samples() > 1;
+        auto shadeFragment = [&](const raster::Fragment& drawn) {
+            raster::Fragment fragment = drawn;
+            if (multisampled)
+                fragment.coverage = visibility.visibleCoverage(drawn, drawn.triangle);
+            if (multisampled ? fragment.coverage == 0
+                             : !visibility.isVisible(drawn, drawn.triangle))
                 return;
             const uint32_t tile =
                 uint32_t(fragment.y / tileSize) * uint32_t(tileCountX) + fragment.x / tileSize;
@@ -95,9 +106,11 @@ public:
         mShading.flush();
         mShading.end();
         shading.stop();
-        if (mBlended.prepare(inputs))
-            mBlended.shadeWithTileLists(mForward.depth(), mOptions.tileSizePixels,
+        result.parameters["shaded_fragments"] = std::to_string(mShading.fragmentCount());
+        if (mBlended.prepare(inputs, mForward.sampleTarget()))
+            mBlended.shadeWithTileLists(mForward.shadedDepth(), mOptions.tileSizePixels,
                                         mOptions.viewFrustumCulling, result);
+        mForward.endFrame(result);
 
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
@@ -107,6 +120,8 @@ public:
             std::to_string(inputs.lights->lights.size() - lightsAfterVfc);
         result.parameters["tile_light_pairs"] = std::to_string(mTileLights.pairCount());
     }
+
+    bool multisamplesNatively() const override { return true; }
 
 private:
     BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
@@ -126,8 +141,7 @@ const StageRegistrar kRegistrar(
                  StageOption::boolean("mask", false,
                                       "Harada's 2.5D culling: a 32-bin depth mask per tile")},
      .listOrder = 120,
-     .msaaRefusal = "shades while rasterizing; hardware-style MSAA (per-sample colour with "
-                    "coverage, shaded once per pixel and triangle) is not implemented yet"},
+     .msaaNative = true},
     [](const StageOptions& table) {
         TiledForwardOptions options;
         options.tileSizePixels = table.integer("tile");

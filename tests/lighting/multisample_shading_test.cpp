@@ -69,7 +69,7 @@ const lighting::PreparedScene& cachedFrame(int sceneIndex) {
 std::vector<std::string> multisampledExactStages() {
     std::vector<std::string> names;
     for (const lighting::StageInfo& info : lighting::stageInfos())
-        if (info.kind == lighting::StageKind::Exact && info.msaaRefusal.empty())
+        if (info.kind == lighting::StageKind::Exact && info.msaaRefusal.empty() && !info.msaaNative)
             names.push_back(info.name);
     return names;
 }
@@ -221,13 +221,16 @@ TEST(MultisampleResolve, TwoAndEightSamplesResolveLikeBrute) {
 }
 
 TEST(MultisampleStages, EveryStageSaysWhetherItTakesMultisampledFrames) {
-    // The stages that rasterize the scene themselves or are the reference refuse, with a reason;
-    // the G-buffer stages take them.
+    // The forward stages multisample natively (tests/lighting/forward_msaa_test.cpp); the other
+    // stages that rasterize the scene themselves and the reference refuse, with a reason; the
+    // G-buffer stages take them through the layers. StageInfo and the stage object agree.
     for (const lighting::StageInfo& info : lighting::stageInfos()) {
-        const bool rasterizes = info.name.starts_with("forward") || info.name == "tiled-forward" ||
-                                info.name == "light-prepass" || info.name == "inferred" ||
-                                info.name == "reference";
-        EXPECT_EQ(!info.msaaRefusal.empty(), rasterizes) << info.name;
+        const bool native = info.name.starts_with("forward") || info.name == "tiled-forward";
+        const bool refused =
+            info.name == "light-prepass" || info.name == "inferred" || info.name == "reference";
+        EXPECT_EQ(!info.msaaRefusal.empty(), refused) << info.name;
+        EXPECT_EQ(info.msaaNative, native) << info.name;
+        EXPECT_EQ(lighting::makeStage(info.name)->multisamplesNatively(), native) << info.name;
     }
 }
 
