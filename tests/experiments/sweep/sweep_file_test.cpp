@@ -504,6 +504,13 @@ TEST(SweepFile, ShardsPartitionTheJobs) {
 TEST(SweepFile, ReproductionSweepsAreValid) {
     const fs::path folder = fs::path(TESTBED_SOURCE_DIR) / "experiments" / "sweeps";
     ASSERT_TRUE(fs::is_directory(folder)) << folder;
+    // The sweeps are run from the repository root (their glTF scenes are ../shared/... paths).
+    const fs::path previous = fs::current_path();
+    fs::current_path(TESTBED_SOURCE_DIR);
+    struct Restore {
+        fs::path path;
+        ~Restore() { fs::current_path(path); }
+    } restore{previous};
     size_t files = 0;
     for (const auto& entry : fs::directory_iterator(folder)) {
         if (entry.path().extension() != ".json" && entry.path().extension() != ".toml")
