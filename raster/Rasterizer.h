@@ -517,7 +517,7 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
             const int32_t* y = t.y;
             const int32_t ax[3] = {x[1], x[2], x[0]}, ay[3] = {y[1], y[2], y[0]};
             const int32_t bx[3] = {x[2], x[0], x[1]}, by[3] = {y[2], y[0], y[1]};
-            int64_t stepX[3], stepY[3], bias[3], row[3], maxOffset[3];
+            int64_t stepX[3], stepY[3], bias[3], row[3], maxOffset[3], minOffset[3];
             int64_t offset[3][kMaxSamples];
             const int64_t px0 = int64_t(minX) * kSubpixelScale + kHalf;
             const int64_t py0 = int64_t(minY) * kSubpixelScale + kHalf;
@@ -528,9 +528,11 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
                 bias[e] = detail::fillBias(ax[e], ay[e], bx[e], by[e]);
                 row[e] = dx * (py0 - ay[e]) - dy * (px0 - ax[e]);
                 maxOffset[e] = INT64_MIN;
+                minOffset[e] = INT64_MAX;
                 for (int s = 0; s < sampleCount; ++s) {
                     offset[e][s] = (dx * pattern[s].y - dy * pattern[s].x) * kOffsetUnit + bias[e];
                     maxOffset[e] = std::max(maxOffset[e], offset[e][s]);
+                    minOffset[e] = std::min(minOffset[e], offset[e][s]);
                 }
             }
             // Depth at a sample: the centre's plane value plus the plane's change over the offset.
@@ -547,10 +549,16 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
                     // No sample can be inside when an edge rejects even its most favourable one.
                     if (((w0 + maxOffset[0]) | (w1 + maxOffset[1]) | (w2 + maxOffset[2])) < 0)
                         continue;
+                    // Every sample is inside when each edge accepts even its least favourable one
+                    // (most pixels of a triangle): no per-sample test.
                     unsigned covered = 0;
-                    for (int s = 0; s < sampleCount; ++s)
-                        if (((w0 + offset[0][s]) | (w1 + offset[1][s]) | (w2 + offset[2][s])) >= 0)
-                            covered |= 1u << s;
+                    if (((w0 + minOffset[0]) | (w1 + minOffset[1]) | (w2 + minOffset[2])) >= 0)
+                        covered = (1u << sampleCount) - 1u;
+                    else
+                        for (int s = 0; s < sampleCount; ++s)
+                            if (((w0 + offset[0][s]) | (w1 + offset[1][s]) | (w2 + offset[2][s])) >=
+                                0)
+                                covered |= 1u << s;
                     if (covered == 0)
                         continue;
                     samplesCovered += unsigned(std::popcount(covered));
