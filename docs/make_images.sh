@@ -32,4 +32,43 @@ render glass preview.png --scene glass
 render atrium-tiled-heatmap heatmap.png --scene atrium --stage tiled --lights 1000
 render atrium-inferred-error error.png --scene atrium --stage inferred --lights 256 \
     --compare-reference --error-scale log
+# Anti-aliasing side by side (issue 28): glass with tiled at 1 sample, 4x MSAA and 1 sample +
+# edge-blur, and the 16-spp reference they are measured against; top row the images, bottom row
+# each one's HDR-FLIP map against the reference (the reference's own: black). A 160x100 crop
+# around the fence posts and pane edges, enlarged 2x without filtering.
+aa() { # NAME ARGS...
+    name=$1
+    shift
+    echo "testbed render --scene glass --stage tiled $* --compare-reference --width 640 --height 360"
+    "$testbed" render --scene glass --stage tiled "$@" --compare-reference --width 640 \
+        --height 360 --threads 2 --out "$work/$name" >/dev/null
+}
+aa aa-1x
+aa aa-4x --msaa 4
+aa aa-edge-blur --post-aa edge-blur
+crop="160x100+160+90"
+tile() { # IN OUT LABEL
+    oiiotool "$1" --cut "$crop" --resample 320x200 --text:x=6:y=22:size=18:color=1,1,1:font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf "$3" \
+        -o "$2"
+}
+flipTile() { # FLIP_EXR_DIR OUT: the flip layer of render.exr, as a grey map (white = 1)
+    oiiotool "$1/render.exr" --ch flip --chnames Y --ch Y,Y,Y --cut "$crop" --resample 320x200 \
+        -o "$2"
+}
+tile "$work/aa-1x/preview.png" "$work/t1.png" "1 sample"
+tile "$work/aa-4x/preview.png" "$work/t2.png" "4x MSAA"
+tile "$work/aa-edge-blur/preview.png" "$work/t3.png" "1 sample + edge-blur"
+tile "$work/aa-1x/reference.png" "$work/t4.png" "reference, 16 spp"
+flipTile "$work/aa-1x" "$work/f1.png"
+flipTile "$work/aa-4x" "$work/f2.png"
+flipTile "$work/aa-edge-blur" "$work/f3.png"
+oiiotool --create 320x200 3 -o "$work/f4.png"
+oiiotool "$work/t1.png" "$work/t2.png" "$work/t3.png" "$work/t4.png" "$work/f1.png" \
+    "$work/f2.png" "$work/f3.png" "$work/f4.png" --mosaic:pad=4 4x2 --ch R,G,B \
+    -o "$images/glass-aa.png"
+for name in aa-1x aa-4x aa-edge-blur; do
+    python3 -c "import json,sys; e=json.load(open(sys.argv[1]))['error']; print(sys.argv[2], 'FLIP', e['flip'], 'relative RMSE', e['relative_rmse'])" \
+        "$work/$name/stats.json" "$name"
+done
+
 ls -l "$images"

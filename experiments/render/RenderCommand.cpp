@@ -257,9 +257,14 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
                     run.result.radiance[1].data(), run.result.radiance[2].data());
     writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(),
                     scales.heatmapMax);
-    if (run.metrics.error)
+    if (run.metrics.error) {
         writeScalarMapPng(dir / "error.png", w, h, largestChannelError(error).data(),
                           errorMapStyle(scales));
+        // What the image is measured against (the supersampled reference by default), with the
+        // preview's tone map: the two side by side show what the error maps quantify.
+        writePreviewPng(dir / "reference.png", w, h, run.reference.radiance[0].data(),
+                        run.reference.radiance[1].data(), run.reference.radiance[2].data());
+    }
     if (!run.flipMap.empty())
         writeScalarMapPng(dir / "flip.png", w, h, run.flipMap.data(), flipMapStyle());
     if (!complex.empty()) {
