@@ -21,13 +21,13 @@ bool hasBlendedMaterial(const scenes::Scene& scene) {
 // Adds `run`'s passes to `total`'s of the same name (appended when new), in order.
 void addTimings(std::vector<std::pair<std::string, double>>& total,
                 const std::vector<std::pair<std::string, double>>& run) {
-    for (const auto& [name, ms] : run) {
+    for (const auto& pass : run) {
         auto it = std::find_if(total.begin(), total.end(),
-                               [&](const auto& entry) { return entry.first == name; });
+                               [&](const auto& entry) { return entry.first == pass.first; });
         if (it == total.end())
-            total.emplace_back(name, ms);
+            total.push_back(pass);
         else
-            it->second += ms;
+            it->second += pass.second;
     }
 }
 
