@@ -71,6 +71,57 @@ TEST(FragmentLayers, SamplesArePartitionedAndTheMainFragmentHasTheMost) {
     }
 }
 
+TEST(FragmentLayers, SilhouettesAgainstTheFarPlaneStayCovered) {
+    // A floor running past the far plane (clipped there) and a thin slanted wall whose far end
+    // touches it: at the clip line pixels have covered samples while the triangle's depth plane,
+    // extrapolated to the pixel centre, lies beyond the far plane (clamped to the clear value).
+    // Layer 0 must still count them as covered, with a depth strictly nearer than the clear one.
+    scenes::Scene scene;
+    scene.name = "far-silhouette";
+    scene.materials.push_back({});
+    scene.meshes.emplace_back();
+    scenes::Mesh& mesh = scene.meshes[0];
+    auto quad = [&](glm::vec3 corner, glm::vec3 u, glm::vec3 v) {
+        const uint32_t base = uint32_t(mesh.positions.size());
+        const glm::vec3 normal = glm::normalize(glm::cross(u, v));
+        for (const glm::vec3& p : {corner, corner + u, corner + u + v, corner + v}) {
+            mesh.positions.push_back(p);
+            mesh.normals.push_back(normal);
+        }
+        for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u})
+            mesh.indices.push_back(base + i);
+    };
+    quad({-200, -2, 0}, {400, 0, 0}, {0, 0, -400});   // floor, far beyond 100 m
+    quad({-30, -2, -60}, {0.3f, 0, -60}, {0, 30, 0}); // wall reaching 120 m
+    scene.instances.push_back({});
+    scenes::Camera camera;
+    camera.name = "low";
+    camera.forwardWorld = glm::normalize(glm::vec3(0, -0.02f, -1));
+    camera.farMetres = 100.0f;
+    scene.cameras.push_back(camera);
+    const SceneGeometry geometry = SceneGeometry::build(scene);
+    for (const DepthConvention convention :
+         {DepthConvention::Reversed, DepthConvention::Standard}) {
+        const CameraView view = CameraView::fromCamera(camera, 200, 120, convention);
+        GBufferLayout layout = GBufferLayout::lossless(convention);
+        layout.materials = materialTable(scene);
+        GBuffer target(layout, view);
+        MultisampleTarget multisample;
+        multisample.samples = 8;
+        raster::Rasterizer rasterizer(200, 120);
+        GBufferPass pass(scene, geometry);
+        pass.render(rasterizer, target, nullptr, &multisample);
+        const FragmentLayers& layers = multisample.layers;
+        size_t partial = 0;
+        for (size_t pixel = 0; pixel < layers.pixelCount(); ++pixel) {
+            const bool anySample = layers.coverage(0)[pixel] != 0;
+            ASSERT_EQ(target.covered(pixel), anySample) << "pixel " << pixel;
+            partial += anySample && layers.backgroundWeight(pixel) > 0.0f;
+        }
+        EXPECT_GT(partial, 100u) << "the far clip line crosses the image";
+    }
+}
+
 TEST(FragmentLayers, UpperLayerGBuffersAreCoveredOnlyAtTheirFragments) {
     const auto frame = render("atrium", 4, ComplexDetection::Primitive);
     const FragmentLayers& layers = frame->multisample.layers;
