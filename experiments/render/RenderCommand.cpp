@@ -163,8 +163,8 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     if (!run.metrics.lightCountsNote.empty())
         std::cout << "  light counts: " << run.metrics.lightCountsNote << "\n";
     std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
-    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png", "flip.png",
-                             "complex.png", "stats.json"})
+    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png",
+                             "reference.png", "flip.png", "complex.png", "stats.json"})
         if (std::filesystem::exists(out / file))
             std::cout << "  " << (out / file).string() << "\n";
 }
