@@ -16,29 +16,15 @@
 
 #include "lighting/StageRegistry.h"
 
+#include "tests/experiments/cli/CliRun.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kTestbed = fs::path(TESTBED_BINARY_DIR) / "bin" / "testbed";
-
-struct CliRun {
-    int exitCode = -1;
-    std::string output;
-};
-
-CliRun run(const std::string& arguments) {
-    CliRun result;
-    FILE* pipe = popen((kTestbed.string() + " " + arguments + " 2>&1").c_str(), "r");
-    if (!pipe)
-        return result;
-    std::array<char, 4096> buffer{};
-    for (size_t n; (n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0;)
-        result.output.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return result;
-}
+using clitest::CliRun;
+using clitest::kTestbed;
+using clitest::run;
 
 fs::path outDir(const std::string& name) {
     const fs::path dir = fs::path(TESTBED_BINARY_DIR) / "test-output" / "experiments" / name;
