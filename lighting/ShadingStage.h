@@ -70,6 +70,7 @@
 #include "gbuffer/visibility/SceneGeometry.h"
 #include "lighting/culling/LightList.h"
 #include "lighting/kernel/KernelIsa.h"
+#include "lighting/shadows/ShadowLookup.h"
 #include "scenes/Scene.h"
 
 namespace lighting {
@@ -106,6 +107,11 @@ struct StageInputs {
     // this count and resolves itself; the G-buffer stages ignore it (their G-buffer is one
     // fragment layer, MultisampleShading.h).
     int samples = 1;
+    // The frame's shadows (lighting/shadows/ShadowLookup.h; `--shadows`), or null: no light casts
+    // one. Every stage that shades through the kernel applies them there (KernelLights).
+    const shadows::ShadowLookup* shadows = nullptr;
+    // The reference's shadows for the same lights (ray-traced), or null.
+    const shadows::ExactShadowLookup* exactShadows = nullptr;
 };
 
 // What shade() fills (see the file comment for each field's contract).

@@ -47,23 +47,26 @@ struct SplitPoints {
     }
 };
 
-// Adds one light's split lighting at `point` (whose Blinn-Phong evaluations are `points`) to `sum`.
+// Adds one light's split lighting at `point` (whose Blinn-Phong evaluations are `points`) to `sum`,
+// each term times `shadow` (the light's shadow factor there, lighting/shadows; 1 = unshadowed,
+// and x 1 is exact). Whether Blinn-Phong's specular is evaluated is decided by the unshadowed
+// diffuse term.
 inline void addSplitLight(const gbuffer::Surface& point, const SplitPoints& points,
                           const glm::vec3& toViewer, const LightInView<float>& light,
-                          SplitLighting& sum) {
+                          SplitLighting& sum, float shadow = 1.0f) {
     if (point.model == scenes::MaterialModel::MetallicRoughness) {
         const MetallicRoughnessSplit<float> split =
             splitLightMetallicRoughness(point.positionView, point.normalView, point.roughness,
                                         point.occlusion, toViewer, light);
-        sum.diffuse += split.diffuse;
-        sum.specular += split.specularF0;
-        sum.specularEdge += split.specularEdge;
+        sum.diffuse += split.diffuse * shadow;
+        sum.specular += split.specularF0 * shadow;
+        sum.specularEdge += split.specularEdge * shadow;
         return;
     }
     const glm::vec3 d = evaluateLight(points.diffuse, toViewer, light);
-    sum.diffuse += d;
+    sum.diffuse += d * shadow;
     if (contributes(d) && light.type != scenes::LightType::Ambient)
-        sum.specular += evaluateLight(points.specular, toViewer, light);
+        sum.specular += evaluateLight(points.specular, toViewer, light) * shadow;
 }
 
 // The split lighting of `point` summed over `lightIndices`, in list order.

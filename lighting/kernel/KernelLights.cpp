@@ -2,7 +2,9 @@
 
 namespace lighting::kernel {
 
-KernelLights::KernelLights(std::vector<LightInView<float>> lights) : mSource(std::move(lights)) {
+KernelLights::KernelLights(std::vector<LightInView<float>> lights,
+                           const shadows::ShadowLookup* shadows)
+    : mSource(std::move(lights)), mShadows(shadows) {
     mRecords.resize(mSource.size());
     for (size_t i = 0; i < mSource.size(); ++i) {
         const LightInView<float>& light = mSource[i];
@@ -17,6 +19,9 @@ KernelLights::KernelLights(std::vector<LightInView<float>> lights) : mSource(std
         record.spotOuterCos = light.spotOuterCos;
         record.spotWidth = light.spotInnerCos - light.spotOuterCos;
         record.type = uint32_t(light.type);
+        // Ambient light comes from everywhere: nothing shadows it (occlusion is the material's).
+        record.shadow = shadows && light.type != scenes::LightType::Ambient ? shadows->shadowOf(i)
+                                                                            : shadows::kNoShadow;
     }
 }
 

@@ -40,6 +40,7 @@
 // Ordinary headers outside the per-target region, so they are compiled for the baseline only.
 #include "lighting/brdf/MetallicRoughness.h"
 #include "lighting/kernel/VectorTargets.h"
+#include "lighting/shadows/ShadowLookup.h"
 #include "scenes/Scene.h"
 
 #include <type_traits>
@@ -137,8 +138,12 @@ struct ChunkSums {
     IntVec contributing;
 };
 
+// Adds one light's radiance; counts the lanes where it is non-zero. `counted` is what the count
+// reads: the radiance itself, or for a shadowed light its radiance before the shadow (the oracle's
+// definition of contributes ignores occlusion, so shadows change the image, never the counts).
 template <bool kCountContributing>
-HWY_INLINE void accumulate(const FloatVec radiance[3], ChunkSums& sums) {
+HWY_INLINE void accumulate(const FloatVec radiance[3], ChunkSums& sums,
+                           const FloatVec* counted = nullptr) {
     const FloatTag d;
     const IntTag di;
     const FloatVec zero = hn::Zero(d);
@@ -146,6 +151,8 @@ HWY_INLINE void accumulate(const FloatVec radiance[3], ChunkSums& sums) {
         sums.radiance[k] = hn::Add(sums.radiance[k], radiance[k]);
     if (!kCountContributing)
         return;
+    if (counted)
+        radiance = counted;
     const LaneMask contributes = hn::Or(
         hn::Or(hn::Ne(radiance[0], zero), hn::Ne(radiance[1], zero)), hn::Ne(radiance[2], zero));
     // An all-ones lane is -1: subtracting it counts one.
@@ -298,12 +305,53 @@ HWY_INLINE void ambientRadiance(const KernelLight& light, const ShadingPacket& p
     }
 }
 
+// The shadow factor of a shadowed light for one chunk: the lookup's visibility at the lanes of
+// `pass` (those whose radiance may be non-zero), 1 at the others (their radiance is +0 already).
+// The lookup is scalar, lane by lane, with the packet's float position and normal: the very calls
+// the scalar path makes, so the factor is bitwise the same on every path.
+HWY_INLINE FloatVec chunkVisibility(const shadows::ShadowLookup& lookup, uint32_t shadow,
+                                    const ShadingPacket& packet, size_t chunk, LaneMask pass) {
+    const FloatTag d;
+    uint8_t bits[8] = {};
+    hn::StoreMaskBits(d, pass, bits);
+    const uint32_t lanes = uint32_t(bits[0]) | uint32_t(bits[1]) << 8;
+    HWY_ALIGN float visibility[kLanesPerVector];
+    for (size_t i = 0; i < kLanesPerVector; ++i) {
+        const size_t lane = chunk * kLanesPerVector + i;
+        visibility[i] = lanes >> i & 1u ? lookup.visibility(shadow,
+                                                            glm::vec3(packet.positionView[0][lane],
+                                                                      packet.positionView[1][lane],
+                                                                      packet.positionView[2][lane]),
+                                                            glm::vec3(packet.normalView[0][lane],
+                                                                      packet.normalView[1][lane],
+                                                                      packet.normalView[2][lane]))
+                                        : 1.0f;
+    }
+    return hn::Load(d, visibility);
+}
+
+// Adds a shaded light's radiance for one chunk, times its shadow factor when it casts a shadow.
+template <bool kCountContributing>
+HWY_INLINE void addShaded(const ShadeArgs& args, const KernelLight& light, size_t chunk,
+                          const ChunkLight& l, const FloatVec radiance[3], ChunkSums& sums) {
+    if (light.shadow == shadows::kNoShadow || !args.shadows) {
+        accumulate<kCountContributing>(radiance, sums);
+        return;
+    }
+    const FloatVec visibility =
+        chunkVisibility(*args.shadows, light.shadow, *args.packet, chunk, l.pass);
+    FloatVec shadowed[3];
+    for (int k = 0; k < 3; ++k)
+        shadowed[k] = hn::Mul(radiance[k], visibility);
+    accumulate<kCountContributing>(shadowed, sums, radiance);
+}
+
 template <bool kCountContributing, Models kModels>
-HWY_INLINE void shadeAndAdd(const KernelLight& light, const ChunkSurface& s, const ChunkLight& l,
-                            ChunkSums& sums) {
+HWY_INLINE void shadeAndAdd(const ShadeArgs& args, const KernelLight& light, size_t chunk,
+                            const ChunkSurface& s, const ChunkLight& l, ChunkSums& sums) {
     FloatVec radiance[3];
     shadedRadiance<kModels>(light, s, l, radiance);
-    accumulate<kCountContributing>(radiance, sums);
+    addShaded<kCountContributing>(args, light, chunk, l, radiance, sums);
 }
 
 // Phase 1 for one chunk; returns whether any lane is in range.
@@ -487,8 +535,8 @@ void shadeLights(const ShadeArgs& args) {
         if (type == scenes::LightType::Ambient) {
             if (pending) {
                 for (size_t c = 0; c < kChunks; ++c)
-                    shadeAndAdd<kCountContributing, kModels>(*pending, surface[c], pendingLight[c],
-                                                             sums[c]);
+                    shadeAndAdd<kCountContributing, kModels>(args, *pending, c, surface[c],
+                                                             pendingLight[c], sums[c]);
                 pending = nullptr;
             }
             for (size_t c = 0; c < kChunks; ++c) {
@@ -525,7 +573,8 @@ void shadeLights(const ShadeArgs& args) {
         ++accumulator.lightsShaded;
         if (!kPairLights) {
             for (size_t c = 0; c < kChunks; ++c)
-                shadeAndAdd<kCountContributing, kModels>(light, surface[c], chunkLight[c], sums[c]);
+                shadeAndAdd<kCountContributing, kModels>(args, light, c, surface[c], chunkLight[c],
+                                                         sums[c]);
         } else if (!pending) {
             pending = &light;
             for (size_t c = 0; c < kChunks; ++c)
@@ -535,15 +584,15 @@ void shadeLights(const ShadeArgs& args) {
                 FloatVec first[3], second[3];
                 shadedRadiance<kModels>(*pending, surface[c], pendingLight[c], first);
                 shadedRadiance<kModels>(light, surface[c], chunkLight[c], second);
-                accumulate<kCountContributing>(first, sums[c]);
-                accumulate<kCountContributing>(second, sums[c]);
+                addShaded<kCountContributing>(args, *pending, c, pendingLight[c], first, sums[c]);
+                addShaded<kCountContributing>(args, light, c, chunkLight[c], second, sums[c]);
             }
             pending = nullptr;
         }
     }
     if (pending)
         for (size_t c = 0; c < kChunks; ++c)
-            shadeAndAdd<kCountContributing, kModels>(*pending, surface[c], pendingLight[c],
+            shadeAndAdd<kCountContributing, kModels>(args, *pending, c, surface[c], pendingLight[c],
                                                      sums[c]);
 
     for (size_t c = 0; c < kChunks; ++c) {

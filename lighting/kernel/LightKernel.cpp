@@ -14,7 +14,8 @@ void shadePacket(const KernelIsa& isa, const ShadingPacket& packet, uint32_t lan
         return;
     }
     isa.vector()->shade(ShadeArgs{&packet, laneMask, lights.records(), lightIndices.data(),
-                                  lightIndices.size(), &accumulator, countContributing});
+                                  lightIndices.size(), &accumulator, countContributing, nullptr,
+                                  lights.shadows()});
 }
 
 } // namespace lighting::kernel
@@ -34,7 +35,7 @@ void shadePacket(const KernelIsa& isa, const ShadingPacket& packet, uint32_t lan
     }
     isa.vector()->shade(ShadeArgs{&packet, laneMask, lights.records(), lightIndices.data(),
                                   lightIndices.size(), &accumulator, countContributing,
-                                  lightLaneMasks.data()});
+                                  lightLaneMasks.data(), lights.shadows()});
 }
 
 } // namespace lighting::kernel

@@ -42,6 +42,17 @@ EarlyExit earlyExit(const gbuffer::Surface& s, const LightInView<float>& light) 
     return glm::dot(s.normalView, toLight) > 0.0f ? EarlyExit::None : EarlyExit::ConeOrFacing;
 }
 
+// The shadow factor of light `index` at a lane: the lookup's visibility where the light passes the
+// range, cone and facing tests (the lanes the vector path looks up), 1 elsewhere (the light adds
+// +0 there, and +0 x 1 is +0 on both paths).
+float shadowFactor(const KernelLights& lights, uint32_t index, const gbuffer::Surface& s,
+                   EarlyExit exit) {
+    const uint32_t shadow = lights.shadowOf(index);
+    if (shadow == shadows::kNoShadow || !lights.shadows() || exit != EarlyExit::None)
+        return 1.0f;
+    return lights.shadows()->visibility(shadow, s.positionView, s.normalView);
+}
+
 // Lane `lane` of the packet as the per-pixel code's surface.
 gbuffer::Surface surfaceOfLane(const ShadingPacket& packet, int lane) {
     gbuffer::Surface p;
@@ -105,8 +116,9 @@ void shadePacketScalar(const ShadingPacket& packet, uint32_t laneMask, const Ker
             anyShaded |= exit == EarlyExit::None;
             anyPastRange |= exit != EarlyExit::Range;
             const glm::vec3 radiance = evaluateLight(points[lane], toViewer[lane], light);
+            const float shadow = shadowFactor(lights, lightIndices[i], points[lane], exit);
             for (int c = 0; c < 3; ++c)
-                accumulator.radiance[c][lane] += radiance[c];
+                accumulator.radiance[c][lane] += radiance[c] * shadow;
             if (countContributing)
                 accumulator.lightsContributing[lane] += contributes(radiance) ? 1u : 0u;
         }
@@ -153,7 +165,8 @@ void shadePacketSplitScalar(const ShadingPacket& packet, uint32_t laneMask,
             const EarlyExit exit = earlyExit(l.point, light);
             anyShaded |= exit == EarlyExit::None;
             anyPastRange |= exit != EarlyExit::Range;
-            addSplitLight(l.point, l.points, l.toViewer, light, l.sum);
+            addSplitLight(l.point, l.points, l.toViewer, light, l.sum,
+                          shadowFactor(lights, index, l.point, exit));
         }
         countLight(anyShaded, anyPastRange, accumulator);
     }

@@ -59,8 +59,9 @@ HWY_INLINE void addSplit(const FloatVec diffuse[3], const FloatVec specular[3],
 // Phase 3 of a point, spot or directional light for one chunk: the lane's own model's terms.
 // unitSpecularScale: (power + 8) / (8 pi), the Blinn-Phong normalisation with intensity 1.
 template <Models kModels>
-HWY_INLINE void splitShaded(const KernelLight& light, const ChunkSurface& s,
-                            FloatVec unitSpecularScale, const ChunkLight& l, ChunkSplitSums& sums) {
+HWY_INLINE void splitShaded(const ShadeSplitArgs& args, const KernelLight& light, size_t chunk,
+                            const ChunkSurface& s, FloatVec unitSpecularScale, const ChunkLight& l,
+                            ChunkSplitSums& sums) {
     const FloatTag d;
     const FloatVec zero = hn::Zero(d);
     const FloatVec scale = hn::Mul(l.attenuation, l.nDotL);
@@ -100,6 +101,17 @@ HWY_INLINE void splitShaded(const KernelLight& light, const ChunkSurface& s,
                 specular[k] = mrSpecular;
                 specularEdge[k] = mrEdge;
             }
+        }
+    }
+    // A shadowed light: all three terms times the shadow factor (addSplitLight's order: the
+    // Blinn-Phong specular was decided by the unshadowed diffuse above).
+    if (light.shadow != shadows::kNoShadow && args.shadows) {
+        const FloatVec visibility =
+            chunkVisibility(*args.shadows, light.shadow, *args.packet, chunk, l.pass);
+        for (int k = 0; k < 3; ++k) {
+            diffuse[k] = hn::Mul(diffuse[k], visibility);
+            specular[k] = hn::Mul(specular[k], visibility);
+            specularEdge[k] = hn::Mul(specularEdge[k], visibility);
         }
     }
     addSplit(diffuse, specular, specularEdge, sums);
@@ -198,7 +210,8 @@ template <Models kModels> void shadeSplitLights(const ShadeSplitArgs& args) {
         }
         ++accumulator.lightsShaded;
         for (size_t c = 0; c < kChunks; ++c)
-            splitShaded<kModels>(light, surface[c], unitSpecularScale[c], chunkLight[c], sums[c]);
+            splitShaded<kModels>(args, light, c, surface[c], unitSpecularScale[c], chunkLight[c],
+                                 sums[c]);
     }
 
     for (size_t c = 0; c < kChunks; ++c) {

@@ -25,8 +25,8 @@ void shadePacketSplit(const KernelIsa& isa, const ShadingPacket& packet, uint32_
         return;
     }
     isa.vector()->shadeSplit(ShadeSplitArgs{&packet, laneMask, lights.records(),
-                                            lightIndices.data(), lightIndices.size(),
-                                            &accumulator});
+                                            lightIndices.data(), lightIndices.size(), &accumulator,
+                                            lights.shadows()});
 }
 
 } // namespace lighting::kernel

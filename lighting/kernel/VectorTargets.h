@@ -33,6 +33,8 @@ struct ShadeArgs {
     // Optional (nullptr: every light on every lane of laneMask): per light of `indices`, the
     // lanes that evaluate it (LightKernel.h, shadePacket with per-light lane masks).
     const uint16_t* lightLaneMasks = nullptr;
+    // The lights' shadows (KernelLights::shadows()); null when no light casts one.
+    const shadows::ShadowLookup* shadows = nullptr;
 };
 
 // shadePacketSplit's arguments (SplitLightKernel.h).
@@ -43,6 +45,7 @@ struct ShadeSplitArgs {
     const uint32_t* indices;
     size_t count;
     SplitPacketAccumulator* accumulator;
+    const shadows::ShadowLookup* shadows = nullptr; // as ShadeArgs::shadows
 };
 
 struct DecodeArgs {

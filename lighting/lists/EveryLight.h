@@ -26,10 +26,13 @@ namespace lighting {
 // covered surfaces from the same lights), only its candidates are evaluated: the image and the
 // counts are bitwise those of the full loop (lightsEvaluated still says every light: the others
 // were decided by the grid, exactly).
+// With `shadows` (the reference: ray-traced, double), a casting light's radiance is multiplied by
+// its visibility where it contributes; the counts stay the unshadowed ones, as in the kernel.
 template <class T, class SurfaceAt>
 void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>>& lights,
                          const SurfaceAt& surfaceAt, StageResult& result,
-                         const LightGrid* grid = nullptr) {
+                         const LightGrid* grid = nullptr,
+                         const shadows::ExactShadowLookup* shadows = nullptr) {
     result.resize(width, height, true);
     PassTimer shading(result, pass::kShading);
     tbb::parallel_for(0, height, [&](int y) {
@@ -41,14 +44,19 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
             const Vec3<T> toViewer = glm::normalize(-point.positionView);
             Vec3<T> sum(T(0));
             uint32_t contributing = 0;
-            auto add = [&](const LightInView<T>& light) {
-                const Vec3<T> radiance = evaluateLight(point, toViewer, light);
-                sum += radiance;
-                contributing += contributes(radiance) ? 1u : 0u;
+            auto add = [&](size_t index) {
+                const Vec3<T> radiance = evaluateLight(point, toViewer, lights[index]);
+                const bool contributesHere = contributes(radiance);
+                if (shadows && contributesHere && shadows->casts(index))
+                    sum += radiance * T(shadows->visibility(index, glm::dvec3(point.positionView),
+                                                            glm::dvec3(point.normalView)));
+                else
+                    sum += radiance;
+                contributing += contributesHere ? 1u : 0u;
             };
             if (!grid) {
-                for (const LightInView<T>& light : lights)
-                    add(light);
+                for (size_t index = 0; index < lights.size(); ++index)
+                    add(index);
             } else {
                 // The grid's two ascending lists merged: the same lights in the same order as
                 // the loop above, less lights whose radiance here is exactly zero (outside their
@@ -58,7 +66,7 @@ void shadeWithEveryLight(int width, int height, const std::vector<LightInView<T>
                     grid->candidatesAt(glm::vec3(point.positionView));
                 size_t i = 0, j = 0;
                 while (i < a.size() || j < b.size())
-                    add(lights[j == b.size() || (i < a.size() && a[i] < b[j]) ? a[i++] : b[j++]]);
+                    add(j == b.size() || (i < a.size() && a[i] < b[j]) ? a[i++] : b[j++]);
             }
             sum += point.emissive; // once per pixel, after the lights; counts unaffected
             result.radiance[0][pixel] = float(sum.x);

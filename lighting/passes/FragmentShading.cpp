@@ -107,7 +107,7 @@ void FragmentShading::begin(const StageInputs& inputs, FragmentApply apply, Stag
     mWidth = inputs.view->width;
     mTilesX = (inputs.view->width + raster::kTileSize - 1) / raster::kTileSize;
     const int tilesY = (inputs.view->height + raster::kTileSize - 1) / raster::kTileSize;
-    mLights = std::make_unique<kernel::KernelLights>(inputs.lights->lights);
+    mLights = std::make_unique<kernel::KernelLights>(inputs.lights->lights, inputs.shadows);
     mTiles.resize(size_t(mTilesX) * size_t(tilesY));
     for (TileBatch& tile : mTiles) {
         tile.count = 0;

@@ -56,7 +56,7 @@ kernel::GBufferPlanes planesOf(const gbuffer::GBuffer& gb) {
 }
 
 PacketPath::PacketPath(const StageInputs& inputs, bool decodePixels)
-    : gbuffer(*inputs.gbuffer), isa(inputs.isa), lights(inputs.lights->lights) {
+    : gbuffer(*inputs.gbuffer), isa(inputs.isa), lights(inputs.lights->lights, inputs.shadows) {
     if (decodePixels && packetPathFits(inputs))
         decoder.emplace(gbuffer.layout(), gbuffer.view(), planesOf(gbuffer));
 }

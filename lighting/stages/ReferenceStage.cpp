@@ -27,7 +27,7 @@ public:
         if (box)
             grid.build(boundingSpheresView(*inputs.lights), box->first, box->second);
         shadeWithEveryLight(exact.width, exact.height, inputs.lights->lightsExact, surfaceAt,
-                            result, box ? &grid : nullptr);
+                            result, box ? &grid : nullptr, inputs.exactShadows);
         if (mBlended.prepare(inputs))
             mBlended.compositeExact(inputs.gbuffer->depth(), result);
     }
