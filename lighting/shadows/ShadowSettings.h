@@ -25,9 +25,10 @@ enum class ShadowFilter { None, Pcf3, Pcf5, Poisson };
 // How render() schedules the faces. FacesInParallel (default): one face per task, each task
 // rendering with its thread's own Rasterizer; FacesInSequence: one face after another, each with
 // the rasterizer's own tile parallelism. Both give bitwise the same maps. Measured on atrium
-// with 16 casting point lights at 512^2 (tests/bench/shadow_bench.cpp, lighting/shadows/README):
-// a 512^2 face has only 16 tiles and most faces hold fewer triangles than one set-up batch
-// (2048), so in sequence the set-up is serial: faces in parallel are faster on 2 threads.
+// with 16 casting point lights at 512^2 (tests/bench/shadow_bench.cpp, README.md here): faces in
+// parallel 316 ms vs 373 ms in sequence on 1 thread (a 512^2 face has 16 tiles and most faces
+// hold fewer triangles than one set-up batch, 2048, so in sequence the set-up is serial); the
+// 2-thread run was taken on an overloaded machine and decides nothing yet.
 enum class ShadowSchedule { FacesInParallel, FacesInSequence };
 
 struct ShadowSettings {
