@@ -89,6 +89,9 @@ struct Light {
     float rangeMetres = 1.0f;
     float spotInnerCos = 0.9f; // spot: full intensity inside this cosine
     float spotOuterCos = 0.8f; // spot: zero outside this cosine
+    // Whether the light gets a shadow map (lighting/shadows): a JSON scene's "castsShadows", true
+    // for every glTF punctual light. Ambient lights never cast, whatever this says.
+    bool castsShadows = false;
 };
 
 struct Scene {

@@ -468,6 +468,8 @@ void GltfConverter::addLights() {
             source.range > 0.0 ? float(source.range) : 1.01f * glm::length(farthestCorner);
         light.spotInnerCos = float(std::cos(source.spot.innerConeAngle));
         light.spotOuterCos = float(std::cos(source.spot.outerConeAngle));
+        // Every punctual light of a glTF file casts shadows (issue 29: the file has no flag).
+        light.castsShadows = true;
         mScene.lights.push_back(light);
     }
 }

@@ -500,7 +500,8 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
         fail(field, "missing key 'type'");
     const std::string type = text(value["type"], fieldOf(field, "type"));
 
-    // Keys each type requires; color and intensity are optional for every type.
+    // Keys each type requires; color and intensity are optional for every type, castsShadows for
+    // every type but ambient.
     Light light;
     std::vector<std::string> required;
     if (type == "point") {
@@ -520,6 +521,8 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
     }
     std::vector<std::string> valid = required;
     valid.insert(valid.end(), {"type", "color", "intensity"});
+    if (light.type != LightType::Ambient)
+        valid.push_back("castsShadows");
     expectKeys(value, field, valid);
     for (const std::string& key : required)
         if (!member(value, key.c_str()))
@@ -541,6 +544,11 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
         light.directionWorld = direction(*directionValue, fieldOf(field, "direction"));
     if (const Json* range = member(value, "range"))
         light.rangeMetres = positive(*range, fieldOf(field, "range"));
+    if (const Json* casts = member(value, "castsShadows")) {
+        if (!casts->is_boolean())
+            fail(fieldOf(field, "castsShadows"), "expected true or false");
+        light.castsShadows = casts->get<bool>();
+    }
     if (light.type == LightType::Spot) {
         const float inner = number(value["innerConeDegrees"], fieldOf(field, "innerConeDegrees"));
         const float outer = number(value["outerConeDegrees"], fieldOf(field, "outerConeDegrees"));

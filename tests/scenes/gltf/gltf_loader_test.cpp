@@ -494,6 +494,7 @@ TEST(GltfLoader, PunctualLightIsPlacedByItsNode) {
     expectNear(scene.lights[0].color, {1, 0.5f, 0.25f});
     EXPECT_FLOAT_EQ(scene.lights[0].intensity, 3.0f);
     EXPECT_FLOAT_EQ(scene.lights[0].rangeMetres, 2.0f);
+    EXPECT_TRUE(scene.lights[0].castsShadows); // every glTF punctual light casts (issue 29)
 
     // The file's lights define the scene: requested generated lights are not added, and a
     // warning says so.

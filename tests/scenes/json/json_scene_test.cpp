@@ -161,6 +161,29 @@ TEST(JsonScene, PlacesSuzanneAndSpheresWithCameraAndLights) {
     EXPECT_FLOAT_EQ(scene.lights[3].intensity, 0.1f);
 }
 
+// "castsShadows" (issue 29): read per light, false when absent, an error on an ambient light
+// (which never casts) and when not a boolean.
+TEST(JsonScene, CastsShadowsIsReadPerLight) {
+    json document = spheresOnly();
+    document["lights"] = {
+        {{"type", "point"}, {"position", {0, 1, 0}}, {"range", 2}, {"castsShadows", true}},
+        {{"type", "directional"}, {"direction", {0, -1, 0}}},
+        {{"type", "directional"}, {"direction", {0, -1, 0}}, {"castsShadows", false}}};
+    const Scene scene = loadJson(document);
+    ASSERT_EQ(scene.lights.size(), 3u);
+    EXPECT_TRUE(scene.lights[0].castsShadows);
+    EXPECT_FALSE(scene.lights[1].castsShadows);
+    EXPECT_FALSE(scene.lights[2].castsShadows);
+
+    json ambient = spheresOnly();
+    ambient["lights"] = {{{"type", "ambient"}, {"castsShadows", true}}};
+    expectJsonError(ambient, {"lights[0]", "unknown key 'castsShadows'"});
+    json notBoolean = spheresOnly();
+    notBoolean["lights"] = {
+        {{"type", "point"}, {"position", {0, 1, 0}}, {"range", 2}, {"castsShadows", 1}}};
+    expectJsonError(notBoolean, {"lights[0].castsShadows", "true or false"});
+}
+
 TEST(JsonScene, RelativeGltfPathAndDefaultCamera) {
     const fs::path directory = testDirectory();
     const json document = {

@@ -1,0 +1,613 @@
+// ShadowMaps: face set-up (matrices, cascade fitting), the per-light caster cull, the depth-only
+// renders and the lookup. Conventions in ShadowMaps.h.
+#include "lighting/shadows/ShadowMaps.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numeric>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include "lighting/culling/CullingTests.h"
+#include "lighting/culling/LightBounds.h"
+#include "lighting/culling/LightList.h"
+#include "raster/Rasterizer.h"
+
+namespace lighting {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Triangles per chunk of the caster cull: a chunk's box is tested against a light's sphere
+// before its triangles are (consecutive triangles of one mesh are close together).
+constexpr uint32_t kTrianglesPerChunk = 64;
+
+double milliseconds(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+bool sphereTouchesAabb(const glm::dvec3& centre, double radius, const scenes::Aabb& box) {
+    const glm::dvec3 d = glm::max(
+        glm::max(glm::dvec3(box.min) - centre, centre - glm::dvec3(box.max)), glm::dvec3(0.0));
+    return glm::dot(d, d) <= radius * radius;
+}
+
+// A unit vector not parallel to `direction`: the world axis least aligned with it.
+glm::dvec3 upFor(const glm::dvec3& direction) {
+    const glm::dvec3 a = glm::abs(direction);
+    if (a.x <= a.y && a.x <= a.z)
+        return {1.0, 0.0, 0.0};
+    if (a.y <= a.z)
+        return {0.0, 1.0, 0.0};
+    return {0.0, 0.0, 1.0};
+}
+
+// Reversed-Z perspective: z_ndc = a + b / d for light-space depth d = -z, 1 at near, 0 at far.
+glm::dmat4 perspectiveReversed(double tanHalfFov, double nearMetres, double farMetres) {
+    const double a = -nearMetres / (farMetres - nearMetres);
+    const double b = nearMetres * farMetres / (farMetres - nearMetres);
+    glm::dmat4 m(0.0);
+    m[0][0] = 1.0 / tanHalfFov;
+    m[1][1] = 1.0 / tanHalfFov;
+    m[2][2] = -a;
+    m[3][2] = b;
+    m[2][3] = -1.0;
+    return m;
+}
+
+// Reversed-Z orthographic box: x in [x0, x1], y in [y0, y1], depth d = -z in [near, far] maps
+// to z_ndc = (far - d) / (far - near).
+glm::dmat4 orthographicReversed(double x0, double x1, double y0, double y1, double nearMetres,
+                                double farMetres) {
+    glm::dmat4 m(1.0);
+    m[0][0] = 2.0 / (x1 - x0);
+    m[3][0] = -(x0 + x1) / (x1 - x0);
+    m[1][1] = 2.0 / (y1 - y0);
+    m[3][1] = -(y0 + y1) / (y1 - y0);
+    m[2][2] = 1.0 / (farMetres - nearMetres);
+    m[3][2] = farMetres / (farMetres - nearMetres);
+    return m;
+}
+
+// The 16-tap Poisson disk of radius 1 (a common fixed set), scaled by kPoissonRadiusTexels.
+constexpr double kPoissonRadiusTexels = 2.5;
+constexpr std::array<glm::dvec2, 16> kPoissonDisk = {{
+    {-0.94201624, -0.39906216},
+    {0.94558609, -0.76890725},
+    {-0.094184101, -0.92938870},
+    {0.34495938, 0.29387760},
+    {-0.91588581, 0.45771432},
+    {-0.81544232, -0.87912464},
+    {-0.38277543, 0.27676845},
+    {0.97484398, 0.75648379},
+    {0.44323325, -0.97511554},
+    {0.53742981, -0.47373420},
+    {-0.26496911, -0.41893023},
+    {0.79197514, 0.19090188},
+    {-0.24188840, 0.99706507},
+    {-0.81409955, 0.91437590},
+    {0.19984126, 0.78641367},
+    {0.14383161, -0.14100790},
+}};
+
+// Triangles a light's faces draw: either the scene's own buffers (directional lights) or the
+// corners of the triangles within a point or spot light's range, three per triangle.
+struct Casters {
+    std::vector<glm::vec3> ownPositions;
+    bool whole = false;
+    std::span<const glm::vec3> positions(const gbuffer::SceneGeometry& geometry) const {
+        return whole ? std::span<const glm::vec3>(geometry.positionWorld)
+                     : std::span<const glm::vec3>(ownPositions);
+    }
+    uint32_t triangleCount(const gbuffer::SceneGeometry& geometry) const {
+        return whole ? geometry.triangleCount() : uint32_t(ownPositions.size() / 3);
+    }
+};
+
+// What a face task needs beyond the ShadowFace it fills.
+struct FaceJob {
+    size_t shadow = 0;
+    glm::mat4 clipFromWorld{1.0f};
+};
+
+} // namespace
+
+std::vector<uint32_t> ShadowMaps::chooseLights(const std::vector<scenes::Light>& lights,
+                                               const gbuffer::CameraView& view,
+                                               int maxShadowLights) {
+    std::vector<uint32_t> casting;
+    for (size_t i = 0; i < lights.size(); ++i)
+        if (lights[i].castsShadows && lights[i].type != scenes::LightType::Ambient)
+            casting.push_back(uint32_t(i));
+    if (maxShadowLights < 0 || casting.size() <= size_t(maxShadowLights))
+        return casting;
+
+    const LightList list = LightList::build(lights, view);
+    const std::vector<LightSphere> spheres = boundingSpheresView(list);
+    const ViewFrustum frustum(view);
+    struct Rank {
+        bool misses;
+        double score;
+        uint32_t index;
+    };
+    std::vector<Rank> ranks;
+    const double nearMetres = std::max(double(view.nearMetres), 1e-6);
+    for (uint32_t i : casting) {
+        const LightSphere& sphere = spheres[i];
+        const double distance =
+            sphere.unbounded
+                ? 0.0
+                : std::max(0.0, glm::length(glm::dvec3(sphere.centreView)) - sphere.radius);
+        const double clamped = std::max(distance, nearMetres);
+        const glm::vec3& colour = lights[i].color;
+        const double power =
+            double(lights[i].intensity) * std::max({colour.r, colour.g, colour.b, 0.0f});
+        ranks.push_back({!frustum.mayTouch(sphere), power / (clamped * clamped), i});
+    }
+    std::sort(ranks.begin(), ranks.end(), [](const Rank& a, const Rank& b) {
+        if (a.misses != b.misses)
+            return !a.misses;
+        if (a.score != b.score)
+            return a.score > b.score;
+        return a.index < b.index;
+    });
+    std::vector<uint32_t> chosen;
+    for (int k = 0; k < maxShadowLights; ++k)
+        chosen.push_back(ranks[size_t(k)].index);
+    std::sort(chosen.begin(), chosen.end());
+    return chosen;
+}
+
+ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
+                              const gbuffer::CameraView& view, const ShadowSettings& settings) {
+    const auto start = Clock::now();
+    if (!(settings.mapSize >= 1 && settings.mapSize <= raster::kMaxViewportSize))
+        throw std::invalid_argument("shadow map size must be in [1, " +
+                                    std::to_string(raster::kMaxViewportSize) + "], got " +
+                                    std::to_string(settings.mapSize));
+    if (!(settings.cascades >= 1 && settings.cascades <= 8))
+        throw std::invalid_argument("shadow cascades must be in [1, 8], got " +
+                                    std::to_string(settings.cascades));
+
+    ShadowMaps maps;
+    maps.mSettings = settings;
+    maps.mShadowOfLight.assign(scene.lights.size(), kNoShadow);
+    const glm::dmat4 worldFromView = glm::inverse(view.viewFromWorldExact);
+    const glm::dmat4& viewFromWorld = view.viewFromWorldExact;
+    maps.mWorldFromViewRotation = glm::dmat3(worldFromView);
+    const int size = settings.mapSize;
+    // Spot and cascade faces are widened so that their outer kFaceMarginTexels texels lie
+    // beyond the region they must cover (when the map is large enough to afford it).
+    const double marginScale =
+        size > 4 * kFaceMarginTexels ? double(size) / double(size - 2 * kFaceMarginTexels) : 1.0;
+
+    // Chunk boxes and the geometry's bounds (the receivers and casters of the scene).
+    const uint32_t triangleCount = geometry.triangleCount();
+    const uint32_t chunkCount = (triangleCount + kTrianglesPerChunk - 1) / kTrianglesPerChunk;
+    std::vector<scenes::Aabb> chunkBounds(chunkCount);
+    tbb::parallel_for(
+        tbb::blocked_range<uint32_t>(0, chunkCount),
+        [&](const tbb::blocked_range<uint32_t>& range) {
+            for (uint32_t c = range.begin(); c != range.end(); ++c) {
+                const uint32_t end = std::min(triangleCount, (c + 1) * kTrianglesPerChunk);
+                for (uint32_t t = c * kTrianglesPerChunk; t < end; ++t)
+                    for (int k = 0; k < 3; ++k)
+                        chunkBounds[c].extend(geometry.positionWorld[geometry.indices[3 * t + k]]);
+            }
+        });
+    scenes::Aabb sceneBounds;
+    for (const scenes::Aabb& box : chunkBounds)
+        sceneBounds.extend(box);
+
+    const std::vector<uint32_t> chosen = chooseLights(scene.lights, view, settings.maxShadowLights);
+    maps.mStats.castingLightCount = chooseLights(scene.lights, view, -1).size();
+
+    // Faces: matrices and planes, per light in index order.
+    std::vector<FaceJob> jobs;
+    auto addFace = [&](size_t shadow, const glm::dmat4& clipFromLight,
+                       const glm::dmat4& lightFromWorld, bool orthographic, double nearMetres,
+                       double farMetres, double tanHalfFov, double extentMetres) {
+        ShadowFace face;
+        const glm::dmat4 clipFromWorld = clipFromLight * lightFromWorld;
+        face.lightClipFromViewExact = clipFromWorld * worldFromView;
+        face.lightClipFromView = glm::mat4(face.lightClipFromViewExact);
+        face.orthographic = orthographic;
+        face.nearMetres = nearMetres;
+        face.farMetres = farMetres;
+        face.tanHalfFov = tanHalfFov;
+        face.extentMetres = extentMetres;
+        maps.mFaces.push_back(std::move(face));
+        jobs.push_back({shadow, glm::mat4(clipFromWorld)});
+    };
+    auto addEmptyFace = [&](size_t shadow) {
+        ShadowFace face;
+        face.empty = true;
+        maps.mFaces.push_back(std::move(face));
+        jobs.push_back({shadow, glm::mat4(1.0f)});
+    };
+
+    // View depth range of the receivers (the camera's, clipped to the scene's bounds) and the
+    // frustum's side slopes (symmetric pinhole, CameraView.h).
+    double depthMin = std::numeric_limits<double>::max(), depthMax = -depthMin;
+    std::array<glm::dvec3, 8> sceneCornersWorld;
+    for (int k = 0; k < 8; ++k) {
+        sceneCornersWorld[size_t(k)] = glm::dvec3(k & 1 ? sceneBounds.max.x : sceneBounds.min.x,
+                                                  k & 2 ? sceneBounds.max.y : sceneBounds.min.y,
+                                                  k & 4 ? sceneBounds.max.z : sceneBounds.min.z);
+        const double depth = -(viewFromWorld * glm::dvec4(sceneCornersWorld[size_t(k)], 1.0)).z;
+        depthMin = std::min(depthMin, depth);
+        depthMax = std::max(depthMax, depth);
+    }
+    const double receiverNear = std::max(double(view.nearMetres), depthMin);
+    const double receiverFar = std::min(double(view.farMetres), depthMax);
+    const double tanHalfX = 1.0 / double(view.clipFromView[0][0]);
+    const double tanHalfY = 1.0 / double(view.clipFromView[1][1]);
+
+    for (uint32_t lightIndex : chosen) {
+        const scenes::Light& light = scene.lights[lightIndex];
+        Shadow shadow;
+        shadow.lightIndex = lightIndex;
+        shadow.type = light.type;
+        shadow.firstFace = maps.mFaces.size();
+        const size_t shadowIndex = maps.mShadows.size();
+        const glm::dvec3 position(light.positionWorld);
+        const double nearMetres = kNearFraction * light.rangeMetres;
+        const double farMetres = light.rangeMetres;
+        if (light.type == scenes::LightType::Point) {
+            // World axes: +X, -X, +Y, -Y, +Z, -Z (faceFor's order), each with an up vector
+            // perpendicular to it.
+            static constexpr std::array<std::array<double, 6>, 6> kCube = {{
+                {1, 0, 0, 0, -1, 0},
+                {-1, 0, 0, 0, -1, 0},
+                {0, 1, 0, 0, 0, 1},
+                {0, -1, 0, 0, 0, -1},
+                {0, 0, 1, 0, -1, 0},
+                {0, 0, -1, 0, -1, 0},
+            }};
+            const glm::dmat4 clipFromLight = perspectiveReversed(1.0, nearMetres, farMetres);
+            for (const auto& axes : kCube) {
+                const glm::dvec3 forward(axes[0], axes[1], axes[2]), up(axes[3], axes[4], axes[5]);
+                addFace(shadowIndex, clipFromLight, glm::lookAtRH(position, position + forward, up),
+                        false, nearMetres, farMetres, 1.0, 0.0);
+            }
+            shadow.positionView = glm::dvec3(viewFromWorld * glm::dvec4(position, 1.0));
+        } else if (light.type == scenes::LightType::Spot) {
+            const double halfAngle =
+                std::min(std::acos(std::clamp(double(light.spotOuterCos), -1.0, 1.0)),
+                         glm::radians(kMaxSpotHalfAngleDegrees));
+            const double tanHalf = std::tan(halfAngle) * marginScale;
+            const glm::dvec3 forward = glm::normalize(glm::dvec3(light.directionWorld));
+            addFace(shadowIndex, perspectiveReversed(tanHalf, nearMetres, farMetres),
+                    glm::lookAtRH(position, position + forward, upFor(forward)), false, nearMetres,
+                    farMetres, tanHalf, 0.0);
+        } else { // directional
+            const glm::dvec3 forward = glm::normalize(glm::dvec3(light.directionWorld));
+            const glm::dvec3 centre(sceneBounds.centre());
+            const glm::dmat4 lightFromWorld =
+                glm::lookAtRH(centre, centre + forward, upFor(forward));
+            const glm::dmat4 lightFromView = lightFromWorld * worldFromView;
+            glm::dvec3 sceneLo(std::numeric_limits<double>::max()), sceneHi(-sceneLo);
+            for (const glm::dvec3& corner : sceneCornersWorld) {
+                const glm::dvec3 p(lightFromWorld * glm::dvec4(corner, 1.0));
+                sceneLo = glm::min(sceneLo, p);
+                sceneHi = glm::max(sceneHi, p);
+            }
+            const int cascades = settings.cascades;
+            for (int c = 0; c < cascades; ++c) {
+                auto split = [&](int i) {
+                    if (i == 0)
+                        return receiverNear;
+                    if (i == cascades)
+                        return receiverFar;
+                    const double f = double(i) / cascades;
+                    return kCascadeLambda * receiverNear * std::pow(receiverFar / receiverNear, f) +
+                           (1.0 - kCascadeLambda) *
+                               (receiverNear + (receiverFar - receiverNear) * f);
+                };
+                const double d0 = split(c), d1 = split(c + 1);
+                shadow.cascadeFarDepthView.push_back(d1);
+                if (!(receiverFar > receiverNear) || sceneBounds.empty()) {
+                    addEmptyFace(shadowIndex);
+                    continue;
+                }
+                glm::dvec3 sliceLo(std::numeric_limits<double>::max()), sliceHi(-sliceLo);
+                for (int k = 0; k < 8; ++k) {
+                    const double d = k & 4 ? d1 : d0;
+                    const glm::dvec3 cornerView((k & 1 ? 1.0 : -1.0) * tanHalfX * d,
+                                                (k & 2 ? 1.0 : -1.0) * tanHalfY * d, -d);
+                    const glm::dvec3 p(lightFromView * glm::dvec4(cornerView, 1.0));
+                    sliceLo = glm::min(sliceLo, p);
+                    sliceHi = glm::max(sliceHi, p);
+                }
+                double x0 = std::max(sliceLo.x, sceneLo.x), x1 = std::min(sliceHi.x, sceneHi.x);
+                double y0 = std::max(sliceLo.y, sceneLo.y), y1 = std::min(sliceHi.y, sceneHi.y);
+                // Light-space depth d = -z: the near plane at the scene's bound nearest the light
+                // (every caster in), the far plane at the farther receiver bound.
+                double dNear = -sceneHi.z, dFar = std::min(-sliceLo.z, -sceneLo.z);
+                if (!(x1 >= x0 && y1 >= y0 && dFar >= dNear)) {
+                    addEmptyFace(shadowIndex);
+                    continue;
+                }
+                // Margins: kFaceMarginTexels on each side; depth by 1% and 1 mm so that casters
+                // on the bounds are not clipped; a minimum size for flat receivers.
+                const double halfX = 0.5 * std::max(x1 - x0, 1e-3) * marginScale;
+                const double halfY = 0.5 * std::max(y1 - y0, 1e-3) * marginScale;
+                const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+                x0 = cx - halfX, x1 = cx + halfX, y0 = cy - halfY, y1 = cy + halfY;
+                const double depthMargin = 0.01 * (dFar - dNear) + 1e-3;
+                dNear -= depthMargin;
+                dFar += depthMargin;
+                addFace(shadowIndex, orthographicReversed(x0, x1, y0, y1, dNear, dFar),
+                        lightFromWorld, true, dNear, dFar, 0.0, 2.0 * std::max(halfX, halfY));
+            }
+        }
+        shadow.faceCount = maps.mFaces.size() - shadow.firstFace;
+        maps.mShadowOfLight[lightIndex] = uint32_t(shadowIndex);
+        maps.mShadows.push_back(std::move(shadow));
+    }
+
+    // Casters per light: point and spot lights draw the triangles whose box touches their range
+    // sphere (chunk boxes first), in triangle order; directional lights draw everything.
+    std::vector<Casters> casters(maps.mShadows.size());
+    tbb::parallel_for(size_t(0), maps.mShadows.size(), [&](size_t s) {
+        const scenes::Light& light = scene.lights[maps.mShadows[s].lightIndex];
+        Casters& set = casters[s];
+        if (light.type == scenes::LightType::Directional) {
+            set.whole = true;
+            return;
+        }
+        const glm::dvec3 centre(light.positionWorld);
+        const double radius = light.rangeMetres;
+        for (uint32_t c = 0; c < chunkCount; ++c) {
+            if (!sphereTouchesAabb(centre, radius, chunkBounds[c]))
+                continue;
+            const uint32_t end = std::min(triangleCount, (c + 1) * kTrianglesPerChunk);
+            for (uint32_t t = c * kTrianglesPerChunk; t < end; ++t) {
+                scenes::Aabb box;
+                for (int k = 0; k < 3; ++k)
+                    box.extend(geometry.positionWorld[geometry.indices[3 * t + k]]);
+                if (!sphereTouchesAabb(centre, radius, box))
+                    continue;
+                for (int k = 0; k < 3; ++k)
+                    set.ownPositions.push_back(geometry.positionWorld[geometry.indices[3 * t + k]]);
+            }
+        }
+    });
+    size_t maxCorners = 0;
+    for (const Casters& set : casters)
+        if (!set.whole)
+            maxCorners = std::max(maxCorners, set.ownPositions.size());
+    std::vector<uint32_t> sequentialIndices(maxCorners);
+    std::iota(sequentialIndices.begin(), sequentialIndices.end(), 0u);
+
+    // The depth-only renders. Per face: clip positions, then a draw with a no-op fragment
+    // function (reversed Z: Greater, cleared to 0).
+    raster::RasterState state;
+    state.cullMode = raster::CullMode::None;
+    state.depthTest = raster::DepthTest::Greater;
+    state.barycentrics = false;
+    struct Scratch {
+        std::unique_ptr<raster::Rasterizer> rasterizer;
+        std::vector<glm::vec4> clip;
+    };
+    tbb::enumerable_thread_specific<Scratch> scratches;
+    std::vector<double> faceMs(maps.mFaces.size(), 0.0);
+    auto renderFace = [&](size_t f) {
+        ShadowFace& face = maps.mFaces[f];
+        if (face.empty)
+            return;
+        const auto faceStart = Clock::now();
+        Scratch& scratch = scratches.local();
+        if (!scratch.rasterizer)
+            scratch.rasterizer = std::make_unique<raster::Rasterizer>(size, size);
+        const Casters& set = casters[jobs[f].shadow];
+        const std::span<const glm::vec3> positions = set.positions(geometry);
+        const std::span<const uint32_t> indices =
+            set.whole ? std::span<const uint32_t>(geometry.indices)
+                      : std::span<const uint32_t>(sequentialIndices.data(), positions.size());
+        scratch.clip.resize(positions.size());
+        const glm::mat4& clipFromWorld = jobs[f].clipFromWorld;
+        for (size_t i = 0; i < positions.size(); ++i)
+            scratch.clip[i] = clipFromWorld * glm::vec4(positions[i], 1.0f);
+        face.depth.assign(size_t(size) * size_t(size), 0.0f);
+        scratch.rasterizer->draw(raster::TriangleList{scratch.clip, indices}, state,
+                                 face.depth.data(), [](const raster::Fragment&) {});
+        faceMs[f] = milliseconds(faceStart);
+    };
+    if (settings.schedule == ShadowSchedule::FacesInParallel) {
+        // Isolation: while a face's draw waits for its own tile tasks, its thread must not start
+        // another face, which would reuse the thread's rasterizer in the middle of a draw.
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, maps.mFaces.size(), 1),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t f = range.begin(); f != range.end(); ++f)
+                    tbb::this_task_arena::isolate([&] { renderFace(f); });
+            },
+            tbb::simple_partitioner());
+    } else {
+        for (size_t f = 0; f < maps.mFaces.size(); ++f)
+            renderFace(f);
+    }
+
+    for (size_t s = 0; s < maps.mShadows.size(); ++s) {
+        const Shadow& shadow = maps.mShadows[s];
+        ShadowLightStats lightStats;
+        lightStats.lightIndex = shadow.lightIndex;
+        lightStats.type = shadow.type;
+        lightStats.faceCount = shadow.faceCount;
+        for (size_t f = shadow.firstFace; f < shadow.firstFace + shadow.faceCount; ++f) {
+            lightStats.bytes += maps.mFaces[f].depth.size() * kBytesPerTexel;
+            lightStats.renderMs += faceMs[f];
+            if (!maps.mFaces[f].empty)
+                lightStats.trianglesDrawn += casters[s].triangleCount(geometry);
+        }
+        maps.mStats.totalBytes += lightStats.bytes;
+        maps.mStats.lights.push_back(lightStats);
+    }
+    maps.mStats.faceCount = maps.mFaces.size();
+    maps.mStats.renderMs = milliseconds(start);
+    return maps;
+}
+
+size_t ShadowMaps::faceFor(const Shadow& shadow, const glm::dvec3& positionView) const {
+    if (shadow.type == scenes::LightType::Point) {
+        const glm::dvec3 d = mWorldFromViewRotation * (positionView - shadow.positionView);
+        const glm::dvec3 a = glm::abs(d);
+        int axis = 0;
+        if (a.y > a.x && a.y >= a.z)
+            axis = 1;
+        else if (a.z > a.x && a.z > a.y)
+            axis = 2;
+        return shadow.firstFace + size_t(2 * axis + (d[axis] < 0.0 ? 1 : 0));
+    }
+    if (shadow.type == scenes::LightType::Directional) {
+        const double depth = -positionView.z;
+        for (size_t c = 0; c < shadow.faceCount; ++c)
+            if (depth <= shadow.cascadeFarDepthView[c] || c + 1 == shadow.faceCount)
+                return shadow.firstFace + c;
+        return SIZE_MAX;
+    }
+    return shadow.firstFace;
+}
+
+float ShadowMaps::visibility(uint32_t shadow, const glm::vec3& positionView,
+                             const glm::vec3& normalView) const {
+    if (shadow >= mShadows.size())
+        return 1.0f;
+    const glm::dvec3 p(positionView), n(normalView);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(n.x) ||
+        !std::isfinite(n.y) || !std::isfinite(n.z))
+        return 1.0f;
+    const size_t f = faceFor(mShadows[shadow], p);
+    if (f == SIZE_MAX)
+        return 1.0f;
+    const float v = faceVisibility(mFaces[f], p, n);
+    return std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 1.0f;
+}
+
+float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
+                                 const glm::dvec3& normalView) const {
+    if (face.empty)
+        return 1.0f;
+    const int size = mSettings.mapSize;
+    const double sizeD = size;
+    const glm::dmat4& m = face.lightClipFromViewExact;
+    // Texel coordinates (u right, v down, texel i covers [i, i+1)) and light-space depth.
+    struct Projected {
+        double u, v, depth;
+        bool valid;
+    };
+    auto project = [&](const glm::dvec3& q) {
+        const glm::dvec4 c = m * glm::dvec4(q, 1.0);
+        Projected r{0.0, 0.0, 0.0, false};
+        if (face.orthographic) {
+            r.depth = face.farMetres - c.z * (face.farMetres - face.nearMetres);
+            r.u = (c.x * 0.5 + 0.5) * sizeD;
+            r.v = (0.5 - 0.5 * c.y) * sizeD;
+            r.valid = true;
+        } else if (c.w > 0.0) {
+            r.depth = c.w;
+            r.u = (c.x / c.w * 0.5 + 0.5) * sizeD;
+            r.v = (0.5 - 0.5 * c.y / c.w) * sizeD;
+            r.valid = true;
+        }
+        return r;
+    };
+    // Side of one texel at light-space depth d, metres.
+    auto texelWorld = [&](double d) {
+        return face.orthographic ? face.extentMetres / sizeD : 2.0 * d * face.tanHalfFov / sizeD;
+    };
+
+    const double normalLength = glm::length(normalView);
+    const bool hasNormal = normalLength > 0.0 && std::isfinite(normalLength);
+    const glm::dvec3 n = hasNormal ? normalView / normalLength : glm::dvec3(0.0);
+    Projected r = project(p);
+    if (!r.valid)
+        return 1.0f;
+    if (hasNormal && mSettings.normalOffset != 0.0f) {
+        p += n * (double(mSettings.normalOffset) * texelWorld(r.depth));
+        r = project(p);
+        if (!r.valid)
+            return 1.0f;
+    }
+    // Outside the face's coverage: lit (a tolerance of 1e-9 of the face for points on a cube
+    // face's edge, which the major axis assigns to this face).
+    const double tolerance = 1e-9 * sizeD;
+    if (!(r.u >= -tolerance && r.u <= sizeD + tolerance && r.v >= -tolerance &&
+          r.v <= sizeD + tolerance && r.depth >= face.nearMetres && r.depth <= face.farMetres))
+        return 1.0f;
+
+    // Receiver plane: depth change per texel along u and v, from two tangent directions.
+    const double texel = texelWorld(r.depth);
+    glm::dvec2 gradient(0.0);
+    double tanTheta = 0.0;
+    if (hasNormal && texel > 0.0) {
+        const glm::dvec3 t1 = glm::normalize(glm::cross(n, upFor(n)));
+        const glm::dvec3 t2 = glm::cross(n, t1);
+        const Projected a = project(p + texel * t1), b = project(p + texel * t2);
+        const double du1 = a.u - r.u, dv1 = a.v - r.v, dd1 = a.depth - r.depth;
+        const double du2 = b.u - r.u, dv2 = b.v - r.v, dd2 = b.depth - r.depth;
+        const double det = du1 * dv2 - dv1 * du2;
+        if (a.valid && b.valid && std::abs(det) > 1e-12) {
+            gradient = glm::dvec2(dd1 * dv2 - dv1 * dd2, du1 * dd2 - dd1 * du2) / det;
+            tanTheta = glm::length(gradient) / texel;
+        } else {
+            tanTheta = kMaxBiasTan; // the plane contains the light's direction
+        }
+        if (tanTheta > kMaxBiasTan) {
+            gradient *= kMaxBiasTan / tanTheta;
+            tanTheta = kMaxBiasTan;
+        }
+    }
+    const double bias =
+        double(mSettings.biasConstant) + double(mSettings.biasSlope) * texel * tanTheta;
+
+    // Stored depth -> light-space depth (reversed Z; 0 = nothing = the far plane).
+    const double n0 = face.nearMetres, f0 = face.farMetres;
+    const double a = -n0 / (f0 - n0), b = n0 * f0 / (f0 - n0);
+    auto lit = [&](int ti, int tj) {
+        ti = std::clamp(ti, 0, size - 1);
+        tj = std::clamp(tj, 0, size - 1);
+        const double stored = face.depth[size_t(tj) * size_t(size) + size_t(ti)];
+        const double occluder = face.orthographic ? f0 - stored * (f0 - n0) : b / (stored - a);
+        const double receiver =
+            r.depth + gradient.x * (ti + 0.5 - r.u) + gradient.y * (tj + 0.5 - r.v);
+        return receiver - bias <= occluder ? 1 : 0;
+    };
+    const int i = int(std::floor(r.u)), j = int(std::floor(r.v));
+    int litCount = 0, tapCount = 0;
+    switch (mSettings.filter) {
+    case ShadowFilter::None:
+        return float(lit(i, j));
+    case ShadowFilter::Pcf3:
+    case ShadowFilter::Pcf5: {
+        const int radius = mSettings.filter == ShadowFilter::Pcf3 ? 1 : 2;
+        for (int dj = -radius; dj <= radius; ++dj)
+            for (int di = -radius; di <= radius; ++di, ++tapCount)
+                litCount += lit(i + di, j + dj);
+        break;
+    }
+    case ShadowFilter::Poisson:
+        for (const glm::dvec2& offset : kPoissonDisk) {
+            litCount += lit(int(std::floor(r.u + kPoissonRadiusTexels * offset.x)),
+                            int(std::floor(r.v + kPoissonRadiusTexels * offset.y)));
+            ++tapCount;
+        }
+        break;
+    }
+    return float(litCount) / float(tapCount);
+}
+
+} // namespace lighting

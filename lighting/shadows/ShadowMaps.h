@@ -1,0 +1,165 @@
+// ShadowMaps: the shadow maps of one frame (issue 29 item 1), rendered by raster::Rasterizer's
+// depth-only path (a no-op fragment function), and their scalar lookup.
+//
+// Which lights: every scene light with castsShadows that is not ambient; with a budget
+// (ShadowSettings::maxShadowLights = N >= 0) the N of them that matter most in view
+// (chooseLights). Per light, faces:
+//   spot         one perspective face along the axis, half-angle acos(spotOuterCos) plus a
+//                margin of kFaceMarginTexels (clamped at kMaxSpotHalfAngleDegrees), near =
+//                kNearFraction * range, far = range;
+//   point        a cube map: six 90-degree perspective faces along world +X, -X, +Y, -Y, +Z, -Z,
+//                near and far as for spot lights; a lookup takes the face of the major axis of
+//                the world-space direction from the light;
+//   directional  `cascades` orthographic faces, each fitted to its slice of the camera frustum
+//                clipped to the scene's geometry bounds (the visible receivers), in light space:
+//                x and y the intersection of the slice's and the scene's light-space boxes (plus
+//                kFaceMarginTexels), the near plane pushed back to the scene's bound nearest the
+//                light (so every caster of the scene between receivers and light is in). The
+//                slices split the view depth range [max(near, scene), min(far, scene)] by the
+//                practical scheme (log/uniform, lambda kCascadeLambda); the lookup takes the first
+//                cascade whose far split is at or beyond the receiver's view depth.
+//
+// Conventions: each face is a right-handed light view (looking down its -Z) with a zero-to-one
+// reversed-Z projection (1 = near plane, 0 = far plane / nothing; orthographic depth is linear,
+// perspective float depth keeps ~1e-7 relative precision); the depth texture is mapSize^2 floats,
+// row 0 at the top (the rasterizer's screen convention, y down). No face culling (CullMode::None):
+// both sides of a caster write, so open meshes (a single quad, a leaf) cast and the bias model
+// does not depend on which side faces the light. lightClipFromView maps CAMERA VIEW space (the
+// space the shading kernel works in) to the face's clip space.
+//
+// Threading: render() runs in parallel under the caller's tbb::task_arena (per ShadowSchedule);
+// every face is written by one task only, so the maps are bitwise the same for any thread count.
+// A built ShadowMaps is immutable; visibility() and the accessors are thread-safe.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/SceneGeometry.h"
+#include "lighting/shadows/ShadowSettings.h"
+#include "scenes/Scene.h"
+
+namespace lighting {
+
+// Near plane of spot and point faces as a fraction of the range: casters closer than 1% of the
+// range to the light cast no shadow (a light inside a caster would be black anyway).
+inline constexpr double kNearFraction = 0.01;
+// Spot cones wider than this are clamped (a perspective face cannot reach 90 degrees); points
+// outside the clamped cone are lit.
+inline constexpr double kMaxSpotHalfAngleDegrees = 80.0;
+// Every face except the cube's is widened by this many texels on each side, so that filter taps
+// (at most 2.5 texels away) at the edge of a spot cone or a cascade stay inside the map.
+inline constexpr int kFaceMarginTexels = 3;
+// The practical split scheme's weight of the logarithmic split (1 - lambda: uniform).
+inline constexpr double kCascadeLambda = 0.5;
+// tan(theta) of the slope bias and of the receiver plane is clamped here (84 degrees): beyond it
+// the tangent plane says nothing reliable about the depth a texel away.
+inline constexpr double kMaxBiasTan = 10.0;
+// A face's cost: mapSize^2 floats.
+inline constexpr size_t kBytesPerTexel = sizeof(float);
+
+struct ShadowFace {
+    glm::mat4 lightClipFromView{1.0f};      // camera view -> face clip (reversed Z, 0 <= z <= w)
+    glm::dmat4 lightClipFromViewExact{1.0}; // the same in double, what visibility() uses
+    bool orthographic = false;
+    double nearMetres = 0.0; // light-space depth of the near and far planes
+    double farMetres = 0.0;
+    // Perspective: tan of the half field of view; orthographic: the box's larger side, metres.
+    double tanHalfFov = 0.0;
+    double extentMetres = 0.0;
+    bool empty = false;       // nothing to receive (a cascade outside the scene): lookups lit
+    std::vector<float> depth; // mapSize^2, row 0 at the top; empty when `empty`
+};
+
+// Per shadow (one casting light).
+struct ShadowLightStats {
+    size_t lightIndex = 0;
+    scenes::LightType type = scenes::LightType::Point;
+    size_t faceCount = 0;
+    size_t bytes = 0;
+    uint64_t trianglesDrawn = 0; // triangles submitted over all faces, after the range cull
+    // Sum of the wall time of its faces' render tasks (with faces in parallel, CPU time).
+    double renderMs = 0.0;
+};
+
+struct ShadowStats {
+    size_t faceCount = 0;
+    size_t totalBytes = 0;
+    double renderMs = 0.0;                // wall time of render(), all lights
+    size_t castingLightCount = 0;         // lights that would cast without the budget
+    std::vector<ShadowLightStats> lights; // one per shadow, in shadow index order
+};
+
+class ShadowMaps {
+public:
+    static constexpr uint32_t kNoShadow = std::numeric_limits<uint32_t>::max();
+
+    // Renders every face of every chosen light. Parallel under the caller's task_arena; the
+    // result is bitwise independent of the thread count. Cost: per light the triangles within
+    // its range (spot, point) or all (directional), set up once per face; memory: mapSize^2
+    // floats per face. Throws std::invalid_argument for a mapSize outside [1, 16384] or
+    // cascades outside [1, 8].
+    static ShadowMaps render(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
+                             const gbuffer::CameraView& view, const ShadowSettings& settings);
+
+    // The casting lights (indices into scene.lights, ascending) that get maps under the budget:
+    // all of them when maxShadowLights < 0, else the maxShadowLights with the highest
+    // intensity * max(colour) / max(distance from the camera to the light's support, near)^2
+    // (support: the light's bounding sphere, LightBounds.h; directional: distance 0), those
+    // whose support misses the view frustum after all others, ties by index. Pure.
+    static std::vector<uint32_t> chooseLights(const std::vector<scenes::Light>& lights,
+                                              const gbuffer::CameraView& view, int maxShadowLights);
+
+    // Shadow index of scene light `lightIndex` (the scene's `lights` order, which LightList
+    // keeps), or kNoShadow. O(1).
+    uint32_t shadowOf(size_t lightIndex) const {
+        return lightIndex < mShadowOfLight.size() ? mShadowOfLight[lightIndex] : kNoShadow;
+    }
+    // Fraction of the light reaching a receiver at positionView with normal normalView (camera
+    // view space; the normal need not be unit, a zero normal disables the receiver plane and the
+    // slope bias) in [0, 1], 0 = fully shadowed, with the configured filter and bias
+    // (ShadowSettings.h). Points outside every face's coverage (beyond the range, outside a
+    // spot's cone or a cascade's box, closer than the near plane) are lit: the light's own
+    // falloff and cone decide there. Never NaN for finite input (non-finite input: 1). Cost: a
+    // few matrix products and 1 / 9 / 25 / 16 taps. Thread-safe.
+    float visibility(uint32_t shadow, const glm::vec3& positionView,
+                     const glm::vec3& normalView) const;
+
+    size_t shadowCount() const { return mShadows.size(); }
+    const ShadowFace& face(size_t index) const { return mFaces[index]; }
+    size_t faceCount() const { return mFaces.size(); }
+    // Faces of a shadow: [firstFace, firstFace + faceCount).
+    size_t firstFace(uint32_t shadow) const { return mShadows[shadow].firstFace; }
+    size_t faceCountOf(uint32_t shadow) const { return mShadows[shadow].faceCount; }
+    const ShadowStats& stats() const { return mStats; }
+    const ShadowSettings& settings() const { return mSettings; }
+
+private:
+    struct Shadow {
+        size_t lightIndex = 0;
+        scenes::LightType type = scenes::LightType::Point;
+        size_t firstFace = 0;
+        size_t faceCount = 0;
+        glm::dvec3 positionView{0.0};            // point lights: the cube's centre
+        std::vector<double> cascadeFarDepthView; // directional: far split of each cascade
+    };
+
+    // The face of `shadow` that covers positionView (cube face, cascade), or SIZE_MAX.
+    size_t faceFor(const Shadow& shadow, const glm::dvec3& positionView) const;
+    float faceVisibility(const ShadowFace& face, glm::dvec3 positionView,
+                         const glm::dvec3& normalView) const;
+
+    ShadowSettings mSettings;
+    std::vector<Shadow> mShadows;
+    std::vector<ShadowFace> mFaces;
+    std::vector<uint32_t> mShadowOfLight; // per scene light
+    glm::dmat3 mWorldFromViewRotation{1.0};
+    ShadowStats mStats;
+};
+
+} // namespace lighting
