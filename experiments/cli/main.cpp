@@ -153,6 +153,25 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
                     "and normal edges blurred, S.T.A.L.K.E.R./Tabula Rasa; adds depth and "
                     "normals to the layout) or fxaa (luminance edges, FXAA 3.11)")
         ->capture_default_str();
+    render
+        .add_option("--shadows", r.shadows,
+                    "off, or maps: shadow maps (spot: perspective, point: cube, directional: "
+                    "cascades) looked up in the shading kernel by every stage; the reference "
+                    "ray-traces the same lights (Embree). Casters: the scene's castsShadows "
+                    "lights, or every light when it marks none")
+        ->capture_default_str();
+    render.add_option("--shadow-map-size", r.shadowMapSize, "texels per shadow map face side")
+        ->capture_default_str();
+    render.add_option("--shadow-bias", r.shadowBias,
+                      "CONSTANT,SLOPE depth bias (metres, texels); default 0.005,1.5");
+    render.add_option("--shadow-filter", r.shadowFilter, "none, pcf3, pcf5 or poisson")
+        ->capture_default_str();
+    render
+        .add_option("--shadow-lights", r.shadowLights,
+                    "N or all: the casting lights that get maps (the N that matter most in view)")
+        ->capture_default_str();
+    render.add_option("--shadow-cascades", r.shadowCascades, "directional lights' cascades, 1..8")
+        ->capture_default_str();
     render.add_option("--normal-space", r.normalSpace,
                       "space normals are encoded in: view (default) or world");
     render.add_flag(

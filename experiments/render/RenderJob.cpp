@@ -36,6 +36,7 @@ double millisecondsSince(Clock::time_point start) {
 // repetition counts its stage only).
 std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage& stage,
                                          bool exactSurface, lighting::postaa::PostAa postAa,
+                                         const std::optional<lighting::ShadowSettings>& shadows,
                                          const Progress& step) {
     const RenderOptions& options = run.options;
     const int runs = options.warmup + options.repetitions;
@@ -58,6 +59,16 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
                                     gbufferTimings.layersMs + gbufferTimings.resolveMs);
         if (exactSurface)
             repetition.emplace_back(lighting::pass::kExactSurface, gbufferTimings.exactMs);
+        if (shadows) {
+            // Every frame renders its maps (a moving light or camera would need it): timed with
+            // the frame, read by the stage through inputs.shadows.
+            const Clock::time_point start = Clock::now();
+            run.prepared->inputs.shadows = nullptr;
+            run.shadowMaps = std::make_unique<lighting::ShadowMaps>(lighting::ShadowMaps::render(
+                run.prepared->scene, run.prepared->geometry, run.prepared->view, *shadows));
+            run.prepared->inputs.shadows = run.shadowMaps.get();
+            repetition.emplace_back(lighting::pass::kShadowMaps, millisecondsSince(start));
+        }
         lighting::StageResult result;
         multisampleShading.shade(stage, *run.prepared, result);
         if (postAa != lighting::postaa::PostAa::None) {
@@ -211,7 +222,8 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         run.prepared->inputs.isa = plan.isa;
         run.prepared->inputs.simtWarpLanes = options.simtWarp;
         std::vector<PassTiming> passes =
-            shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, plan.postAa, step);
+            shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, plan.postAa,
+                             plan.shadows, step);
 
         // The oracle and the reference are measurement, not part of the stage: timed apart.
         step("counting contributing lights (oracle)");

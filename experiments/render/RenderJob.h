@@ -16,6 +16,7 @@
 #include "experiments/render/RenderPlan.h"
 #include "experiments/render/RunMetrics.h"
 #include "lighting/PreparedScene.h"
+#include "lighting/shadows/ShadowMaps.h"
 #include "lighting/ShadingStage.h"
 #include "scenes/Scene.h"
 
@@ -37,6 +38,9 @@ struct RenderRun {
     std::vector<float> flipMap;
     nlohmann::json flipParameters;
     RunMetrics metrics;
+    // `--shadows maps`: the last repetition's shadow maps (inputs.shadows points here), and the
+    // reference's ray-traced visibility of the same lights (null until the reference is made).
+    std::unique_ptr<lighting::ShadowMaps> shadowMaps;
 
     const scenes::Scene& scene() const { return prepared->scene; }
     const gbuffer::GBuffer& gbuffer() const { return *prepared->gbuffer; }

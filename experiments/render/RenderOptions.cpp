@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <filesystem>
 
 #include "gbuffer/msaa/FragmentLayers.h"
@@ -136,7 +137,60 @@ CheckedOptions checkOptions(const RenderOptions& options) {
     } catch (const std::invalid_argument& error) {
         throw UsageError(std::string("option 'post-aa': ") + error.what());
     }
+    checked.shadows = shadowSettings(options);
     return checked;
+}
+
+std::optional<lighting::ShadowSettings> shadowSettings(const RenderOptions& options) {
+    if (options.shadows == "off")
+        return std::nullopt;
+    if (options.shadows != "maps")
+        throw UsageError("--shadows '" + options.shadows + "' refused: must be off or maps");
+    lighting::ShadowSettings settings;
+    if (options.shadowMapSize < 16 || options.shadowMapSize > 8192)
+        throw UsageError("--shadow-map-size " + std::to_string(options.shadowMapSize) +
+                         " refused: must be 16..8192 texels (a cube map of 8192^2 faces is "
+                         "1.5 GB)");
+    settings.mapSize = options.shadowMapSize;
+    if (!options.shadowBias.empty()) {
+        const size_t comma = options.shadowBias.find(',');
+        const std::string constant = options.shadowBias.substr(0, comma);
+        const std::string slope =
+            comma == std::string::npos ? std::string() : options.shadowBias.substr(comma + 1);
+        try {
+            size_t used = 0, usedSlope = 0;
+            settings.biasConstant = std::stof(constant, &used);
+            settings.biasSlope = std::stof(slope, &usedSlope);
+            if (used != constant.size() || usedSlope != slope.size())
+                throw std::invalid_argument("trailing text");
+        } catch (const std::exception&) {
+            throw UsageError("--shadow-bias '" + options.shadowBias +
+                             "' refused: must be CONSTANT,SLOPE (metres, texels), e.g. 0.005,1.5");
+        }
+        if (!std::isfinite(settings.biasConstant) || !std::isfinite(settings.biasSlope) ||
+            settings.biasConstant < 0.0f || settings.biasSlope < 0.0f ||
+            settings.biasConstant > 100.0f || settings.biasSlope > 100.0f)
+            throw UsageError("--shadow-bias '" + options.shadowBias +
+                             "' refused: both parts must be finite, 0..100");
+    }
+    const std::optional<lighting::ShadowFilter> filter =
+        lighting::parseShadowFilter(options.shadowFilter);
+    if (!filter)
+        throw UsageError("--shadow-filter '" + options.shadowFilter + "' refused: must be " +
+                         lighting::kShadowFilterNames);
+    settings.filter = *filter;
+    if (options.shadowLights != "all") {
+        const int count = parseNumber<int>("shadow-lights", options.shadowLights);
+        if (count < 0)
+            throw UsageError("--shadow-lights " + options.shadowLights +
+                             " refused: must be all or a count >= 0");
+        settings.maxShadowLights = count;
+    }
+    if (options.shadowCascades < 1 || options.shadowCascades > 8)
+        throw UsageError("--shadow-cascades " + std::to_string(options.shadowCascades) +
+                         " refused: must be 1..8");
+    settings.cascades = options.shadowCascades;
+    return settings;
 }
 
 void validate(const RenderOptions& options) {
@@ -168,7 +222,8 @@ std::vector<std::string> renderOptionKeys() {
         "scene",    "stage",          "lights",  "seed",    "light-density",     "width",
         "height",   "resolution",     "threads", "isa",     "simt-warp",         "reference-spp",
         "msaa",     "complex-detect", "layout",  "normals", "normal-space",      "depth",
-        "position", "view",           "brdf",    "post-aa", "scene-option.<key>"};
+        "position", "view",           "brdf",    "post-aa", "shadows",           "shadow-map-size",
+        "shadow-bias", "shadow-filter", "shadow-lights", "shadow-cascades", "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {
@@ -219,6 +274,18 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.brdf = value;
     else if (key == "post-aa")
         options.postAa = value;
+    else if (key == "shadows")
+        options.shadows = value;
+    else if (key == "shadow-map-size")
+        options.shadowMapSize = parseNumber<int>(key, value);
+    else if (key == "shadow-bias")
+        options.shadowBias = value;
+    else if (key == "shadow-filter")
+        options.shadowFilter = value;
+    else if (key == "shadow-lights")
+        options.shadowLights = value;
+    else if (key == "shadow-cascades")
+        options.shadowCascades = parseNumber<int>(key, value);
     else if (key == "resolution") {
         const size_t x = value.find('x');
         if (x == std::string::npos)

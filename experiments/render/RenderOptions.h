@@ -19,6 +19,7 @@
 #include "gbuffer/LayoutDerivation.h"
 #include "lighting/ShadingStage.h"
 #include "lighting/postaa/PostAa.h"
+#include "lighting/shadows/ShadowSettings.h"
 #include "scenes/SceneRequest.h"
 #include "scenes/input/Limits.h"
 
@@ -75,6 +76,17 @@ struct RenderOptions {
     // layout) or "fxaa" (luminance edges, FXAA 3.11). Timed as the pass post_aa, applied before
     // the error is measured.
     std::string postAa = "none";
+    // Shadows (lighting/shadows, issue 29): "off", or "maps": shadow maps rendered by the
+    // rasterizer's depth-only path and looked up in the shading kernel by every stage, the
+    // reference then ray-tracing the same lights' visibility (Embree) as the truth. Casting
+    // lights: those the scene marks (JSON castsShadows, every glTF punctual light), or every
+    // non-ambient light when it marks none; shadowLights keeps the N that matter most in view.
+    std::string shadows = "off";
+    int shadowMapSize = 1024;          // texels per face side (ShadowSettings::mapSize)
+    std::string shadowBias;            // "CONSTANT,SLOPE" (metres, texels); "" = the defaults
+    std::string shadowFilter = "pcf3"; // none | pcf3 | pcf5 | poisson
+    std::string shadowLights = "all";  // N or all
+    int shadowCascades = 1;            // directional lights' cascades, 1..8
     int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
     int repetitions = 1; // timed runs; timings are reported as median, min and max over them
 };
@@ -93,7 +105,8 @@ std::string lightsText(const RenderOptions& options);
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
-// reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, and
+// reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, shadows,
+// shadow-map-size, shadow-bias, shadow-filter, shadow-lights, shadow-cascades, and
 // scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
 // throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or
 // scene added later is reachable without touching the runner.
@@ -121,6 +134,7 @@ struct CheckedOptions {
     gbuffer::LayoutRequest layoutRequest;
     lighting::kernel::KernelIsa isa = lighting::kernel::KernelIsa::scalar(); // options.isa resolved
     lighting::postaa::PostAa postAa = lighting::postaa::PostAa::None;        // options.postAa
+    std::optional<lighting::ShadowSettings> shadows; // options.shadow*; empty: shadows off
 };
 
 // Checks every option in a fixed order (size, lights, threads, stage, scene, repetitions, G-buffer
@@ -128,6 +142,9 @@ struct CheckedOptions {
 // (lighting::StageError for a bad stage spec, listing the valid names) for the first bad one.
 // Cheap: loads nothing.
 CheckedOptions checkOptions(const RenderOptions& options);
+// The shadow settings the options ask for (empty: --shadows off); UsageError naming the first bad
+// shadow option.
+std::optional<lighting::ShadowSettings> shadowSettings(const RenderOptions& options);
 // checkOptions for its verdict alone (the sweep checks every job this way before running any).
 void validate(const RenderOptions& options);
 

@@ -40,6 +40,7 @@ RenderPlan planRender(const RenderOptions& options) {
     plan.stage = std::move(checked.stage);
     plan.isa = checked.isa;
     plan.postAa = checked.postAa;
+    plan.shadows = checked.shadows;
     plan.requirements = plan.stage->requirements();
     std::vector<gbuffer::Channel> reads = plan.requirements.channels;
     std::vector<gbuffer::Channel> addedByPostAa;

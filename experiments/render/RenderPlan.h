@@ -32,6 +32,7 @@ struct RenderPlan {
     gbuffer::GBufferLayout layout;            // derived, or the requested preset with overrides
     lighting::kernel::KernelIsa isa = lighting::kernel::KernelIsa::scalar(); // options.isa
     lighting::postaa::PostAa postAa = lighting::postaa::PostAa::None;        // options.postAa
+    std::optional<lighting::ShadowSettings> shadows; // options.shadow*; empty: --shadows off
 };
 
 RenderPlan planRender(const RenderOptions& options);

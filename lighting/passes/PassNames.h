@@ -13,6 +13,8 @@ namespace lighting::pass {
 // Timed by the runner around the stage (not reported by stages):
 inline constexpr const char* kGBuffer = "gbuffer";            // transform + raster + resolve
 inline constexpr const char* kExactSurface = "exact_surface"; // reference surface (reference only)
+// `--shadows maps`: every casting light's maps, depth-only (lighting/shadows/ShadowMaps.h).
+inline constexpr const char* kShadowMaps = "shadow_maps";
 
 // Reported by stages in StageResult::timingsMs:
 inline constexpr const char* kTransform = "transform"; // vertices to clip/view space (forward)
@@ -31,8 +33,8 @@ inline constexpr const char* kResolve = "resolve";
 inline constexpr const char* kPostAa = "post_aa";
 
 // The order passes run in within a frame; tables list passes this way, others after by name.
-inline constexpr std::array<std::string_view, 13> kPipelineOrder = {
-    kGBuffer, kExactSurface, kTransform, kPrepass, kCull,    kAssign, kIndex,
-    kShading, kLighting,     kMaterial,  kBlend,   kResolve, kPostAa};
+inline constexpr std::array<std::string_view, 14> kPipelineOrder = {
+    kGBuffer,  kExactSurface, kShadowMaps, kTransform, kPrepass, kCull,    kAssign,
+    kIndex,    kShading,      kLighting,   kMaterial,  kBlend,   kResolve, kPostAa};
 
 } // namespace lighting::pass

@@ -127,9 +127,13 @@ struct FaceJob {
 std::vector<uint32_t> ShadowMaps::chooseLights(const std::vector<scenes::Light>& lights,
                                                const gbuffer::CameraView& view,
                                                int maxShadowLights) {
+    // A scene that marks no caster (the built-in scenes' generated lights): every light casts.
+    const bool anyMarked = std::any_of(lights.begin(), lights.end(), [](const scenes::Light& l) {
+        return l.castsShadows && l.type != scenes::LightType::Ambient;
+    });
     std::vector<uint32_t> casting;
     for (size_t i = 0; i < lights.size(); ++i)
-        if (lights[i].castsShadows && lights[i].type != scenes::LightType::Ambient)
+        if ((lights[i].castsShadows || !anyMarked) && lights[i].type != scenes::LightType::Ambient)
             casting.push_back(uint32_t(i));
     if (maxShadowLights < 0 || casting.size() <= size_t(maxShadowLights))
         return casting;

@@ -41,6 +41,7 @@
 
 #include "gbuffer/visibility/CameraView.h"
 #include "gbuffer/visibility/SceneGeometry.h"
+#include "lighting/shadows/ShadowLookup.h"
 #include "lighting/shadows/ShadowSettings.h"
 #include "scenes/Scene.h"
 
@@ -95,9 +96,10 @@ struct ShadowStats {
     std::vector<ShadowLightStats> lights; // one per shadow, in shadow index order
 };
 
-class ShadowMaps {
+// The kernel's ShadowLookup (ShadowLookup.h): the stages shade with it through KernelLights.
+class ShadowMaps final : public shadows::ShadowLookup {
 public:
-    static constexpr uint32_t kNoShadow = std::numeric_limits<uint32_t>::max();
+    static constexpr uint32_t kNoShadow = shadows::kNoShadow;
 
     // Renders every face of every chosen light. Parallel under the caller's task_arena; the
     // result is bitwise independent of the thread count. Cost: per light the triangles within
@@ -107,7 +109,9 @@ public:
     static ShadowMaps render(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
                              const gbuffer::CameraView& view, const ShadowSettings& settings);
 
-    // The casting lights (indices into scene.lights, ascending) that get maps under the budget:
+    // The casting lights (indices into scene.lights, ascending) that get maps under the budget
+    // (casting: castsShadows and not ambient; when no light of the scene is marked, every
+    // non-ambient light):
     // all of them when maxShadowLights < 0, else the maxShadowLights with the highest
     // intensity * max(colour) / max(distance from the camera to the light's support, near)^2
     // (support: the light's bounding sphere, LightBounds.h; directional: distance 0), those
@@ -117,7 +121,7 @@ public:
 
     // Shadow index of scene light `lightIndex` (the scene's `lights` order, which LightList
     // keeps), or kNoShadow. O(1).
-    uint32_t shadowOf(size_t lightIndex) const {
+    uint32_t shadowOf(size_t lightIndex) const override {
         return lightIndex < mShadowOfLight.size() ? mShadowOfLight[lightIndex] : kNoShadow;
     }
     // Fraction of the light reaching a receiver at positionView with normal normalView (camera
@@ -128,7 +132,7 @@ public:
     // falloff and cone decide there. Never NaN for finite input (non-finite input: 1). Cost: a
     // few matrix products and 1 / 9 / 25 / 16 taps. Thread-safe.
     float visibility(uint32_t shadow, const glm::vec3& positionView,
-                     const glm::vec3& normalView) const;
+                     const glm::vec3& normalView) const override;
 
     size_t shadowCount() const { return mShadows.size(); }
     const ShadowFace& face(size_t index) const { return mFaces[index]; }
