@@ -112,8 +112,9 @@ TEST(RayVisibility, PlaneIsNotSelfShadowedAtGrazingOneDegree) {
         int checked = 0;
         for (int k = 0; k < 400; ++k) {
             const double scale = k % 2 ? 1.0 : 100.0; // near the centre, far from it
-            const glm::dvec3 surface = centre + tangent * ((unit(random) - 0.5) * 2.0 * scale) +
-                                       bitangent * ((unit(random) - 0.5) * 2.0 * scale);
+            const double along = (unit(random) - 0.5) * 2.0 * scale;
+            const double across = (unit(random) - 0.5) * 2.0 * scale;
+            const glm::dvec3 surface = centre + tangent * along + bitangent * across;
             const double azimuth = 2.0 * std::numbers::pi * unit(random);
             const glm::dvec3 toLight =
                 (tangent * std::cos(azimuth) + bitangent * std::sin(azimuth)) *
@@ -258,6 +259,15 @@ TEST(RayVisibility, DegenerateTrianglesAreDroppedWithoutHarm) {
     }
 }
 
+// Three draws in a fixed order: the order in which a function's arguments are evaluated is
+// unspecified (gcc and clang would build different scenes from the same seed).
+template <class Distribution> glm::dvec3 draw3(Distribution& distribution, std::mt19937& random) {
+    const double x = distribution(random);
+    const double y = distribution(random);
+    const double z = distribution(random);
+    return {x, y, z};
+}
+
 // A random scene: `triangleCount` triangles of 0.1 to 2 m around `centre` in a 10 m box, a few
 // of them degenerate (a repeated vertex: dropped) or nearly so (collinear in double, slivers once
 // rounded to float: kept).
@@ -266,16 +276,16 @@ SceneGeometry randomScene(std::mt19937& random, int triangleCount, const glm::dv
     std::uniform_real_distribution<double> size(0.1, 2.0);
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     SceneGeometry geometry;
-    const auto randomVector = [&] { return glm::dvec3(unit(random), unit(random), unit(random)); };
+    const auto randomVector = [&] { return draw3(unit, random); };
     for (int t = 0; t < triangleCount; ++t) {
-        const glm::dvec3 c = centre + glm::dvec3(box(random), box(random), box(random));
+        const glm::dvec3 c = centre + draw3(box, random);
         const double s = size(random);
         const glm::dvec3 a = c + randomVector() * s;
         const glm::dvec3 b = c + randomVector() * s;
         if (t % 50 == 7)
             addTriangle(geometry, a, b, b); // repeated vertex
         else if (t % 50 == 19)
-            addTriangle(geometry, a, b, a + (b - a) * 0.375); // collinear (exactly, in binary)
+            addTriangle(geometry, a, b, a + (b - a) * 0.375); // collinear but for rounding
         else
             addTriangle(geometry, a, b, c + randomVector() * s);
     }
@@ -298,11 +308,8 @@ std::vector<ShadowRay> randomRays(std::mt19937& random, const SceneGeometry& geo
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     std::uniform_int_distribution<uint32_t> triangle(0, geometry.triangleCount() - 1);
     std::vector<ShadowRay> rays;
-    const auto inBox = [&] { return centre + glm::dvec3(box(random), box(random), box(random)); };
-    const auto direction = [&] {
-        return glm::normalize(
-            glm::dvec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
-    };
+    const auto inBox = [&] { return centre + draw3(box, random); };
+    const auto direction = [&] { return glm::normalize(draw3(unit, random) - 0.5); };
     while (int(rays.size()) < rayCount) {
         const double kind = unit(random);
         if (kind < 0.6) {
@@ -325,7 +332,9 @@ std::vector<ShadowRay> randomRays(std::mt19937& random, const SceneGeometry& geo
             else
                 rays.push_back(ShadowRay::directional(surface, normal, direction()));
         } else {
-            rays.push_back(ShadowRay::toPoint(inBox(), direction(), inBox()));
+            const glm::dvec3 surface = inBox();
+            const glm::dvec3 normal = direction();
+            rays.push_back(ShadowRay::toPoint(surface, normal, inBox()));
         }
     }
     return rays;
