@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -43,6 +44,14 @@ void throwOnError(RTCDevice device, const ErrorLog& log, const char* step) {
     throw std::runtime_error(std::string("RayVisibility: Embree failed at ") + step + " (error " +
                              std::to_string(int(log.code != RTC_ERROR_NONE ? log.code : code)) +
                              (log.message.empty() ? "" : ": " + log.message) + ")");
+}
+
+// Embree's memory monitor: the bytes it holds (allocations add, frees subtract), from every
+// thread of its parallel build. Returning true lets every allocation proceed.
+bool countBytes(void* userPointer, ssize_t bytes, bool post) {
+    static_cast<std::atomic<int64_t>*>(userPointer)
+        ->fetch_add(int64_t(bytes), std::memory_order_relaxed);
+    return true;
 }
 
 // Kept iff Embree can intersect it: finite float vertices spanning a non-zero area. The cross
@@ -88,6 +97,8 @@ RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry) {
     RTCDevice device = mDevice.get();
     ErrorLog log;
     rtcSetDeviceErrorFunction(device, logError, &log);
+    std::atomic<int64_t> embreeBytes{0};
+    rtcSetDeviceMemoryMonitorFunction(device, countBytes, &embreeBytes);
 
     // The triangles Embree can use, as float vertex indices (vertices are shared, unfiltered:
     // Embree reads only the ones the kept triangles name).
@@ -148,6 +159,8 @@ RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry) {
     // The log dies with the constructor; later errors (none are expected from queries on a
     // committed scene) stay readable through rtcGetDeviceError.
     rtcSetDeviceErrorFunction(device, nullptr, nullptr);
+    rtcSetDeviceMemoryMonitorFunction(device, nullptr, nullptr);
+    mEmbreeBytes = size_t(std::max<int64_t>(embreeBytes.load(), 0));
     mBuildMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

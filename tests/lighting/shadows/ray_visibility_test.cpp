@@ -71,6 +71,7 @@ TEST(RayVisibility, QuadBetweenPointAndLightBlocksIt) {
     const RayVisibility visibility(geometry);
     EXPECT_EQ(visibility.triangleCount(), 2u);
     EXPECT_EQ(visibility.droppedTriangleCount(), 0u);
+    EXPECT_GT(visibility.embreeBytes(), 0u); // at least the buffers
     const glm::dvec3 up(0, 1, 0);
     EXPECT_TRUE(visibility.occluded(glm::dvec3(0), up, {0, 2, 0}));
     expectOccluded(geometry, visibility, ShadowRay::toPoint({0, 0, 0}, up, {0, 2, 0}), true,
