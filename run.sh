@@ -20,6 +20,7 @@ packages=(
     g++ cmake make git pkg-config clang-format
     libglm-dev libtbb-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
     libtinygltf-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev libhwy-dev
+    libembree-dev # the reference's shadow rays (lighting/shadows/RayVisibility.h)
     fonts-dejavu-core
     libtomlplusplus-dev libstb-dev
     clang-14 libclang-rt-14-dev ccache
