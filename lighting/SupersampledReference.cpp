@@ -9,6 +9,7 @@
 
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/shadows/RayShadows.h"
 
 namespace lighting {
 
@@ -89,9 +90,16 @@ std::vector<glm::dvec2> referenceSampleOffsets(int samplesPerPixel) {
 }
 
 StageResult renderSupersampledReference(scenes::Scene scene, int width, int height,
-                                        int samplesPerPixel) {
+                                        int samplesPerPixel,
+                                        const std::optional<ShadowSettings>& shadowSettings) {
     const std::vector<glm::dvec2> offsets = referenceSampleOffsets(samplesPerPixel);
     PreparedScene frame(std::move(scene), width, height, true);
+    std::unique_ptr<shadows::RayShadows> rays;
+    if (shadowSettings) {
+        rays = std::make_unique<shadows::RayShadows>(frame.scene, frame.geometry, frame.view,
+                                                     *shadowSettings);
+        frame.inputs.exactShadows = rays.get();
+    }
     const std::unique_ptr<ShadingStage> stage = makeStage("reference");
     if (samplesPerPixel == 1) { // the centre: the unjittered frame, bitwise the stage's image
         StageResult result;

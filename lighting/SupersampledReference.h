@@ -33,12 +33,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "lighting/ShadingStage.h"
+#include "lighting/shadows/ShadowSettings.h"
 #include "scenes/Scene.h"
 
 namespace lighting {
@@ -57,7 +59,10 @@ std::string referenceSamplePattern(int samplesPerPixel);
 
 // The supersampled reference of `scene` (its first camera) at width x height: the lossless
 // layout with reversed float depth, as the sweep's reference (experiments/render/RenderJob.h).
+// shadowSettings: the frame's shadow settings (`--shadows maps`), or none: the reference then
+// shadows the same casting lights by ray tracing (shadows/RayShadows.h), once per sub-frame sample.
 StageResult renderSupersampledReference(scenes::Scene scene, int width, int height,
-                                        int samplesPerPixel);
+                                        int samplesPerPixel,
+                                        const std::optional<ShadowSettings>& shadowSettings = {});
 
 } // namespace lighting

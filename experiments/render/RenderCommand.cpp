@@ -163,10 +163,84 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     if (!run.metrics.lightCountsNote.empty())
         std::cout << "  light counts: " << run.metrics.lightCountsNote << "\n";
     std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
-    for (const char* file : {"render.exr", "preview.png", "heatmap.png", "error.png",
-                             "reference.png", "flip.png", "complex.png", "stats.json"})
+    for (const char* file :
+         {"render.exr", "preview.png", "heatmap.png", "error.png", "reference.png", "flip.png",
+          "complex.png", "shadow-error.png", "stats.json"})
         if (std::filesystem::exists(out / file))
             std::cout << "  " << (out / file).string() << "\n";
+}
+
+// shadow-error.png: the render's luminance dimmed to grey, with the pixels where the shadow maps
+// disagree with the ray-traced truth for at least one casting light painted over: red where a
+// light reaches that should be shadowed (leaks, peter-panning, missing casters), blue where a
+// light is shadowed that should reach (acne, over-filtering), magenta where both.
+void writeShadowErrorPng(const std::filesystem::path& path, const RenderRun& run) {
+    const int w = run.options.width, h = run.options.height;
+    const lighting::shadows::ShadowErrorCounts& error = *run.shadowError;
+    std::vector<float> planes[3];
+    for (std::vector<float>& plane : planes)
+        plane.resize(size_t(w) * size_t(h));
+    for (size_t i = 0; i < planes[0].size(); ++i) {
+        const float grey =
+            0.25f * (0.2126f * run.result.radiance[0][i] + 0.7152f * run.result.radiance[1][i] +
+                     0.0722f * run.result.radiance[2][i]);
+        const float shown = std::isfinite(grey) ? std::min(grey, 0.25f) : 0.0f;
+        const bool leak = error.litShouldBeShadowedAt[i] > 0;
+        const bool acne = error.shadowedShouldBeLitAt[i] > 0;
+        planes[0][i] = leak ? 8.0f : shown;
+        planes[1][i] = leak || acne ? 0.0f : shown;
+        planes[2][i] = acne ? 8.0f : shown;
+    }
+    writePreviewPng(path, w, h, planes[0].data(), planes[1].data(), planes[2].data());
+}
+
+// The shadows block of stats.json (`--shadows maps`): the settings, the maps' cost (faces, bytes,
+// render time of the last repetition per light and in all; the pass shadow_maps in the timings is
+// the median over repetitions) and, for compared runs, the misclassification against the rays.
+nlohmann::json shadowsJson(const RenderRun& run) {
+    if (!run.shadowMaps)
+        return {{"mode", "off"}};
+    const lighting::ShadowMaps& maps = *run.shadowMaps;
+    const lighting::ShadowSettings& settings = maps.settings();
+    const lighting::ShadowStats& stats = maps.stats();
+    nlohmann::json lights = nlohmann::json::array();
+    for (const lighting::ShadowLightStats& light : stats.lights)
+        lights.push_back({{"light", light.lightIndex},
+                          {"faces", light.faceCount},
+                          {"bytes", light.bytes},
+                          {"triangles_drawn", light.trianglesDrawn},
+                          {"render_ms", light.renderMs}});
+    nlohmann::json shadows = {{"mode", "maps"},
+                              {"map_size", settings.mapSize},
+                              {"bias_constant_m", settings.biasConstant},
+                              {"bias_slope_texels", settings.biasSlope},
+                              {"normal_offset_texels", settings.normalOffset},
+                              {"filter", lighting::formatShadowFilter(settings.filter)},
+                              {"cascades", settings.cascades},
+                              {"shadow_lights", run.options.shadowLights},
+                              {"casting_lights", stats.castingLightCount},
+                              {"lights_with_maps", maps.shadowCount()},
+                              {"faces", stats.faceCount},
+                              {metric::kShadowMapBytes, stats.totalBytes},
+                              {"render_ms", stats.renderMs},
+                              {"per_light", lights}};
+    if (run.rayShadows)
+        shadows["ray_bvh"] = {{"triangles", run.rayShadows->rays().triangleCount()},
+                              {"build_ms", run.rayShadows->rays().buildMilliseconds()},
+                              {"bytes", run.rayShadows->rays().embreeBytes()}};
+    if (run.shadowError) {
+        const lighting::shadows::ShadowErrorCounts& error = *run.shadowError;
+        const double pairs = double(std::max<uint64_t>(error.pairs, 1));
+        shadows["misclassification"] = {
+            {"pixel_light_pairs", error.pairs},
+            {"truth_shadowed_pairs", error.truthShadowed},
+            {"lit_should_be_shadowed", error.litShouldBeShadowed},
+            {"shadowed_should_be_lit", error.shadowedShouldBeLit},
+            {"lit_should_be_shadowed_fraction", double(error.litShouldBeShadowed) / pairs},
+            {"shadowed_should_be_lit_fraction", double(error.shadowedShouldBeLit) / pairs},
+            {metric::kShadowMisclassified, error.misclassifiedFraction()}};
+    }
+    return shadows;
 }
 
 // Per pixel of a multisampled frame, the surfaces shaded there when the pixel is complex (a
@@ -275,6 +349,8 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
                       std::to_string(run.prepared->multisample->layers.samples()) + "x MSAA";
         writeScalarMapPng(dir / "complex.png", w, h, complex.data(), style);
     }
+    if (run.shadowError)
+        writeShadowErrorPng(dir / "shadow-error.png", run);
     writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
 }
 
@@ -445,6 +521,7 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["layout"] = layoutJson(run.gbuffer().layout(), metrics);
     stats[metric::kBytesPerPixel] = metrics.bytesPerPixel;
     stats["msaa"] = msaaJson(run);
+    stats["shadows"] = shadowsJson(run);
     // The G-buffer pass's phases in the last timed repetition (GBufferPass.h).
     const gbuffer::GBufferPassTimings& phases = run.prepared->gbufferTimings;
     stats["gbuffer_phases_ms"] = {{"transform", phases.transformMs},

@@ -144,13 +144,24 @@ void countOracle(RenderRun& run) {
 // supersampled reference of the run's scene (lighting/SupersampledReference.h), even when the
 // stage is `reference` itself (its image is then the 1-sample reference, measured against the
 // same anti-aliased truth as every other stage).
+// The run's ray-traced shadows (the reference's truth), built once when first needed.
+const lighting::shadows::RayShadows& rayShadows(RenderRun& run,
+                                                const lighting::ShadowSettings& settings) {
+    if (!run.rayShadows)
+        run.rayShadows = std::make_unique<lighting::shadows::RayShadows>(
+            run.prepared->scene, run.prepared->geometry, run.prepared->view, settings);
+    return *run.rayShadows;
+}
+
 void fillReference(RenderRun& run, const std::string& stageName,
-                   const lighting::StageResult* givenReference) {
+                   const lighting::StageResult* givenReference,
+                   const std::optional<lighting::ShadowSettings>& shadows) {
     if (givenReference) {
         run.reference = *givenReference;
     } else if (run.options.referenceSpp > 1) {
-        run.reference = lighting::renderSupersampledReference(
-            run.prepared->scene, run.options.width, run.options.height, run.options.referenceSpp);
+        run.reference = lighting::renderSupersampledReference(run.prepared->scene,
+                                                              run.options.width, run.options.height,
+                                                              run.options.referenceSpp, shadows);
     } else if (run.prepared->multisample) {
         // Not from this frame's exact surface (layer 0 only): the reference is its own render.
         run.reference = renderReference(run.options);
@@ -158,7 +169,10 @@ void fillReference(RenderRun& run, const std::string& stageName,
         run.reference = run.result;
     } else {
         run.prepared->addExactSurface();
-        lighting::makeStage(kReferenceStage)->shade(run.prepared->inputs, run.reference);
+        lighting::StageInputs frame = run.prepared->inputs;
+        if (shadows)
+            frame.exactShadows = &rayShadows(run, *shadows);
+        lighting::makeStage(kReferenceStage)->shade(frame, run.reference);
     }
 }
 
@@ -187,7 +201,8 @@ lighting::StageResult renderReference(const RenderOptions& options) {
     tbb::task_arena arena(effectiveThreads(options.threads));
     arena.execute([&] {
         reference = lighting::renderSupersampledReference(
-            loadRequestedScene(options), options.width, options.height, options.referenceSpp);
+            loadRequestedScene(options), options.width, options.height, options.referenceSpp,
+            shadowSettings(options));
     });
     return reference;
 }
@@ -221,9 +236,10 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
             plan.layout, multisampling);
         run.prepared->inputs.isa = plan.isa;
         run.prepared->inputs.simtWarpLanes = options.simtWarp;
-        std::vector<PassTiming> passes =
-            shadeRepetitions(run, *plan.stage, plan.requirements.exactSurface, plan.postAa,
-                             plan.shadows, step);
+        if (plan.shadows && plan.stage->name() == kReferenceStage) // it shadows by ray tracing
+            run.prepared->inputs.exactShadows = &rayShadows(run, *plan.shadows);
+        std::vector<PassTiming> passes = shadeRepetitions(
+            run, *plan.stage, plan.requirements.exactSurface, plan.postAa, plan.shadows, step);
 
         // The oracle and the reference are measurement, not part of the stage: timed apart.
         step("counting contributing lights (oracle)");
@@ -235,8 +251,13 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         if (compare) {
             step("reference (double precision, " + std::to_string(options.referenceSpp) + " spp)");
             start = Clock::now();
-            fillReference(run, plan.stage->name(), givenReference);
+            fillReference(run, plan.stage->name(), givenReference, plan.shadows);
             referenceMs = millisecondsSince(start);
+            if (plan.shadows && run.shadowMaps) {
+                step("shadow misclassification (one ray per pixel and casting light)");
+                run.shadowError = lighting::shadows::measureShadowError(
+                    run.prepared->inputs, rayShadows(run, *plan.shadows));
+            }
             error = compareImages(run.result, run.reference);
             step("HDR-FLIP");
             start = Clock::now();
@@ -258,6 +279,10 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         run.metrics.setSimtModel(run.result.parameters);
         setMultisampleMetrics(run.metrics, *run.prepared);
         run.metrics.cpuLoad = cpuLoad;
+        if (run.shadowMaps)
+            run.metrics.shadowMapBytes = double(run.shadowMaps->stats().totalBytes);
+        if (run.shadowError)
+            run.metrics.shadowMisclassified = run.shadowError->misclassifiedFraction();
         run.metrics.oracleMs = oracleMs;
         run.metrics.referenceMs = referenceMs;
         run.metrics.flipMs = flipMs;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,8 +17,10 @@
 #include "experiments/render/RenderPlan.h"
 #include "experiments/render/RunMetrics.h"
 #include "lighting/PreparedScene.h"
-#include "lighting/shadows/ShadowMaps.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/shadows/RayShadows.h"
+#include "lighting/shadows/ShadowError.h"
+#include "lighting/shadows/ShadowMaps.h"
 #include "scenes/Scene.h"
 
 namespace experiments {
@@ -41,6 +44,9 @@ struct RenderRun {
     // `--shadows maps`: the last repetition's shadow maps (inputs.shadows points here), and the
     // reference's ray-traced visibility of the same lights (null until the reference is made).
     std::unique_ptr<lighting::ShadowMaps> shadowMaps;
+    std::unique_ptr<lighting::shadows::RayShadows> rayShadows;
+    // The maps' visibility misclassification against the rays (compared runs with shadows only).
+    std::optional<lighting::shadows::ShadowErrorCounts> shadowError;
 
     const scenes::Scene& scene() const { return prepared->scene; }
     const gbuffer::GBuffer& gbuffer() const { return *prepared->gbuffer; }

@@ -218,12 +218,35 @@ std::string lightsText(const RenderOptions& options) {
 }
 
 std::vector<std::string> renderOptionKeys() {
-    return {
-        "scene",    "stage",          "lights",  "seed",    "light-density",     "width",
-        "height",   "resolution",     "threads", "isa",     "simt-warp",         "reference-spp",
-        "msaa",     "complex-detect", "layout",  "normals", "normal-space",      "depth",
-        "position", "view",           "brdf",    "post-aa", "shadows",           "shadow-map-size",
-        "shadow-bias", "shadow-filter", "shadow-lights", "shadow-cascades", "scene-option.<key>"};
+    return {"scene",
+            "stage",
+            "lights",
+            "seed",
+            "light-density",
+            "width",
+            "height",
+            "resolution",
+            "threads",
+            "isa",
+            "simt-warp",
+            "reference-spp",
+            "msaa",
+            "complex-detect",
+            "layout",
+            "normals",
+            "normal-space",
+            "depth",
+            "position",
+            "view",
+            "brdf",
+            "post-aa",
+            "shadows",
+            "shadow-map-size",
+            "shadow-bias",
+            "shadow-filter",
+            "shadow-lights",
+            "shadow-cascades",
+            "scene-option.<key>"};
 }
 
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value) {

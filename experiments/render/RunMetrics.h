@@ -61,6 +61,11 @@ inline constexpr const char* kComplexFraction = "complex_fraction";
 inline constexpr const char* kSurfacesPerPixel = "surfaces_per_covered_pixel";
 inline constexpr const char* kGBufferBytes = "gbuffer_bytes";
 inline constexpr const char* kGBufferAllocatedBytes = "gbuffer_allocated_bytes";
+// Shadows (--shadows maps, lighting/shadows): the maps' bytes, and the fraction of pixel-light
+// pairs whose shadow-map visibility disagrees with the ray-traced truth (ShadowError.h); null
+// without shadows (and the fraction without a reference).
+inline constexpr const char* kShadowMapBytes = "shadow_map_bytes";
+inline constexpr const char* kShadowMisclassified = "shadow_misclassified";
 } // namespace metric
 
 // Passes the runner adds around the stage's (lighting/passes/PassNames.h has the frame's passes).
@@ -110,6 +115,9 @@ struct RunMetrics {
     void setSimtModel(const std::map<std::string, std::string>& stageParameters);
     double bytesPerPixel = 0.0;
     double allocatedBytesPerPixel = 0.0;
+    // Shadow figures (see metric::kShadowMapBytes); empty without shadows / without a reference.
+    std::optional<double> shadowMapBytes;
+    std::optional<double> shadowMisclassified;
     // Anti-aliasing figures (see metric::kComplexFraction); samples 1 without MSAA.
     int msaaSamples = 1;
     double complexFraction = 0.0;

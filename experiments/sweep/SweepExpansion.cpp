@@ -94,19 +94,28 @@ std::string referenceKeyOf(const RenderOptions& o) {
         canonical += "reference-spp=" + std::to_string(o.referenceSpp) + "\n";
         samples = "-spp" + std::to_string(o.referenceSpp);
     }
+    // Shadows: the reference ray-traces the casting lights the maps get (the budget decides
+    // which); the maps' own settings (size, filter, bias, cascades) do not change it. Off keeps
+    // the older keys.
+    std::string shadows;
+    if (o.shadows != "off") {
+        canonical += "shadows=" + o.shadows + "\nshadow-lights=" + o.shadowLights + "\n";
+        shadows = "-shadows" + (o.shadowLights == "all" ? std::string() : o.shadowLights);
+    }
     return stem + "-" + std::to_string(o.width) + "x" + std::to_string(o.height) + "-" +
            (requestedLights(o) ? lightsText(o) + "l" : "file-lights") + "-s" +
-           std::to_string(o.seed) + samples + "-" + hex8(fnv1a(canonical));
+           std::to_string(o.seed) + samples + shadows + "-" + hex8(fnv1a(canonical));
 }
 
 } // namespace
 
 std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys) {
     static const std::vector<std::string> kOrder = {
-        "scene",         "stage",   "lights",         "seed",   "resolution",
-        "width",         "height",  "threads",        "isa",    "simt-warp",
-        "layout",        "normals", "normal-space",   "depth",  "position",
-        "reference-spp", "msaa",    "complex-detect", "post-aa"};
+        "scene",           "stage",         "lights",         "seed",          "resolution",
+        "width",           "height",        "threads",        "isa",           "simt-warp",
+        "layout",          "normals",       "normal-space",   "depth",         "position",
+        "reference-spp",   "msaa",          "complex-detect", "post-aa",       "shadows",
+        "shadow-map-size", "shadow-filter", "shadow-bias",    "shadow-lights", "shadow-cascades"};
     std::vector<std::string> columns;
     for (const std::string& key : kOrder)
         if (key == "width" || key == "height" ||

@@ -129,6 +129,10 @@ Json metricColumnsOf(const RunMetrics& metrics) {
     row[metric::kSurfacesPerPixel] = metrics.surfacesPerCoveredPixel;
     row[metric::kGBufferBytes] = metrics.gbufferBytes;
     row[metric::kGBufferAllocatedBytes] = metrics.gbufferAllocatedBytes;
+    row[metric::kShadowMapBytes] =
+        metrics.shadowMapBytes ? number(*metrics.shadowMapBytes) : Json(nullptr);
+    row[metric::kShadowMisclassified] =
+        metrics.shadowMisclassified ? number(*metrics.shadowMisclassified) : Json(nullptr);
     for (const NamedFigure& figure : metrics.errorFigures())
         row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
     if (metrics.error)
