@@ -46,10 +46,9 @@ std::string lowercase(std::string text) {
 // OpenEXR file whose beauty channels are half or float and whose colour-space attribute, if any,
 // names a linear space. Anything else (a PNG or JPEG preview, 8-bit or integer channels, an EXR
 // tagged sRGB or log) is refused, saying what it is, rather than compared as if linear.
-void checkLinearExr(const fs::path& path, const OIIO::ImageBuf& image) {
-    const std::string format = image.file_format_name();
-    // The file's own channel formats (spec() may already be converted for reading).
-    const OIIO::ImageSpec& header = image.nativespec();
+void checkLinearExr(const fs::path& path, const std::string& format,
+                    const OIIO::ImageSpec& header) {
+    // header: the file's own spec (its channel formats, before any conversion for reading).
     auto refuse = [&](const std::string& what) {
         throw std::runtime_error(path.string() + " is not a linear EXR: " + what +
                                  "; diff compares linear HDR renders (render.exr, a "
@@ -100,11 +99,16 @@ OIIO::ImageBuf readImage(const fs::path& path) {
         !problem.empty())
         throw std::runtime_error("cannot read " + path.string() + ": " + problem);
     checkExrAttributeSizes(path);
-    OIIO::ImageBuf image(path.string());
-    if (!image.init_spec(path.string(), 0, 0))
-        throw std::runtime_error("cannot read " + path.string() + ": " + image.geterror());
-    checkLinearExr(path, image);
-    const OIIO::ImageSpec& header = image.spec();
+    // One ImageInput gives the header and the pixels. Not ImageBuf(path): an ImageBuf made from
+    // a file name takes its spec through OpenImageIO's shared ImageCache, which remembers the
+    // spec of a path it has opened, so a file rewritten at the same path (a re-rendered
+    // reference, the fuzzer's input file) was read into a buffer sized for the OLD spec: an
+    // 8704-byte write into 1088 bytes (heap-buffer-overflow found by exr_fuzzer in CI).
+    std::unique_ptr<OIIO::ImageInput> input = OIIO::ImageInput::open(path.string());
+    if (!input)
+        throw std::runtime_error("cannot read " + path.string() + ": " + OIIO::geterror());
+    const OIIO::ImageSpec header = input->spec();
+    checkLinearExr(path, input->format_name(), header);
     if (header.width <= 0 || header.height <= 0 || header.depth != 1 ||
         header.width > scenes::limits::kMaxImageSide ||
         header.height > scenes::limits::kMaxImageSide ||
@@ -122,8 +126,12 @@ OIIO::ImageBuf readImage(const fs::path& path) {
             std::to_string(scenes::limits::kMaxPixels) + " pixels, 1.." +
             std::to_string(scenes::limits::kMaxImageChannels) + " flat channels, " +
             std::to_string(scenes::limits::kMaxImageValues) + " values)");
-    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
-        throw std::runtime_error("cannot read " + path.string() + ": " + image.geterror());
+    OIIO::ImageSpec pixels = header;
+    pixels.set_format(OIIO::TypeDesc::FLOAT);
+    pixels.channelformats.clear();
+    OIIO::ImageBuf image(pixels);
+    if (!input->read_image(0, 0, 0, header.nchannels, OIIO::TypeDesc::FLOAT, image.localpixels()))
+        throw std::runtime_error("cannot read " + path.string() + ": " + input->geterror());
     return image;
 }
 

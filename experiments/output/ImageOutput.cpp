@@ -129,6 +129,20 @@ void runImageLibraryOnTheCallingThread() {
     std::call_once(once, [] { OIIO::attribute("threads", 1); });
 }
 
+bool readFloatImage(const fs::path& path, OIIO::ImageBuf& image) {
+    runImageLibraryOnTheCallingThread();
+    std::unique_ptr<OIIO::ImageInput> input = OIIO::ImageInput::open(path.string());
+    if (!input)
+        return false;
+    OIIO::ImageSpec spec = input->spec();
+    if (spec.deep || spec.width <= 0 || spec.height <= 0 || spec.depth != 1 || spec.nchannels <= 0)
+        return false;
+    spec.set_format(OIIO::TypeDesc::FLOAT);
+    spec.channelformats.clear();
+    image.reset(spec);
+    return input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.localpixels());
+}
+
 void writeImageAtomically(const fs::path& path, const OIIO::ImageBuf& image,
                           OIIO::TypeDesc fileType, const char* formatName) {
     runImageLibraryOnTheCallingThread();

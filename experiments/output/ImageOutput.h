@@ -49,6 +49,14 @@ void runImageLibraryOnTheCallingThread();
 // write and the final flush (OpenImageIO's own file output ignores short writes), so a full disk
 // throws std::runtime_error naming path and leaves no file under that name. Every image file
 // the testbed writes goes through this or writeMultiLayerExr.
+// Reads every channel of the file's first subimage as float into `image` through one
+// ImageInput (header and pixels from the same open file). Returns false when the file cannot be
+// opened or read. Never ImageBuf(path): an ImageBuf made from a file name takes its spec from
+// OpenImageIO's shared ImageCache, which remembers a path's first spec, so a file rewritten at
+// that path (a sweep's re-rendered reference or job) was read into a buffer sized for the old
+// image: a heap overflow (exr_fuzzer found it in diff, tests/experiments/compare/diff_test.cpp).
+bool readFloatImage(const std::filesystem::path& path, OIIO::ImageBuf& image);
+
 void writeImageAtomically(const std::filesystem::path& path, const OIIO::ImageBuf& image,
                           OIIO::TypeDesc fileType, const char* formatName);
 

@@ -79,8 +79,8 @@ bool makeThumbnail(const fs::path& source, const fs::path& thumbnail, int width)
     if (fs::exists(thumbnail, error) &&
         fs::last_write_time(thumbnail, error) >= fs::last_write_time(source, error) && !error)
         return true;
-    OIIO::ImageBuf image(source.string());
-    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+    OIIO::ImageBuf image;
+    if (!readFloatImage(source, image))
         return false;
     const OIIO::ImageSpec& spec = image.spec();
     const int thumbWidth = std::min(width, spec.width);
@@ -211,8 +211,8 @@ std::optional<JobMaps> readJobMaps(const fs::path& exr) {
     std::error_code missing;
     if (!fs::is_regular_file(exr, missing))
         return std::nullopt;
-    OIIO::ImageBuf image(exr.string());
-    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+    OIIO::ImageBuf image;
+    if (!readFloatImage(exr, image))
         return std::nullopt;
     const OIIO::ImageSpec& spec = image.spec();
     auto plane = [&](const char* name) -> std::vector<float> {

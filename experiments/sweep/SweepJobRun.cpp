@@ -35,8 +35,8 @@ std::optional<lighting::StageResult> readReferenceExr(const fs::path& path, cons
     if (!fs::is_regular_file(path))
         return std::nullopt;
     runImageLibraryOnTheCallingThread();
-    OIIO::ImageBuf buffer(path.string());
-    if (!buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+    OIIO::ImageBuf buffer;
+    if (!readFloatImage(path, buffer))
         return std::nullopt;
     const OIIO::ImageSpec& spec = buffer.spec();
     if (spec.width != width || spec.height != height ||

@@ -69,8 +69,21 @@ for name in "${names[@]}"; do
         "$fuzzer" "$corpus" -dict="$here/$name.dict" -max_total_time="$seconds" \
         -timeout=30 -rss_limit_mb=8192 -malloc_limit_mb=2048 -max_len=65536 \
         -artifact_prefix="$artifacts/" -print_final_stats=1 > "$log" 2>&1; then
-        echo "run_fuzzers.sh: $name FAILED; last lines of $log:" >&2
-        tail -n 40 "$log" >&2
+        echo "run_fuzzers.sh: $name FAILED; the sanitizer's report and the last lines of $log:" >&2
+        # The report's head (what, where, the stack) is what tells the bug; the log's tail is
+        # shadow bytes and statistics. CI keeps only this output, not the build folder, so the
+        # failing input is printed too (base64, when small) to reproduce it from the CI log:
+        #   base64 -d > crash && build-asan/fuzz/NAME_fuzzer crash
+        grep -m1 -A45 -E '^==[0-9]+==ERROR|^SUMMARY|runtime error' "$log" >&2 || true
+        tail -n 12 "$log" >&2
+        for input in "$artifacts"/*; do
+            [ -f "$input" ] || continue
+            if [ "$(stat -c %s "$input")" -le 32768 ]; then
+                echo "run_fuzzers.sh: failing input $(basename "$input"), base64:" >&2
+                base64 -w 0 "$input" >&2
+                echo >&2
+            fi
+        done
         status=1
     fi
     grep -E '^stat::number_of_executed_units|^stat::peak_rss_mb|^#[0-9]+.*DONE' "$log" || true

@@ -201,6 +201,26 @@ TEST(DiffCommand, RefusesImagesOfDifferentSizes) {
     EXPECT_NE(testing::internal::GetCapturedStderr().find("cannot read"), std::string::npos);
 }
 
+// A file rewritten at the same path with another size and channel count is read as it is now:
+// diff once read images through an ImageBuf made from the file name, whose spec came from
+// OpenImageIO's shared ImageCache, which remembered the path's first spec; the second read then
+// wrote the new image into a buffer sized for the old one (a heap overflow exr_fuzzer found,
+// since it writes every input to one path). Under AddressSanitizer the old code crashes here.
+TEST(DiffCommand, ReadsAFileRewrittenAtTheSamePathAsItIsNow) {
+    const fs::path dir = freshTestFolder();
+    const fs::path path = dir / "rewritten.exr";
+    writeImage(path, 0.0f, nowhere, 1.0f, "", kWidth, 1);
+    ImageDiff first = diffImageFiles(path, path);
+    EXPECT_EQ(first.height, 1);
+    writeImage(path, 0.25f, everywhere, 2.0f, "extra", kWidth, kHeight);
+    const ImageDiff second = diffImageFiles(path, path);
+    EXPECT_EQ(second.width, kWidth);
+    EXPECT_EQ(second.height, kHeight);
+    ASSERT_EQ(second.beautyA[0].size(), size_t(kWidth) * kHeight);
+    EXPECT_EQ(second.beautyA[0].back(), 0.75f);
+    EXPECT_NE(channel(second, "extra"), nullptr);
+}
+
 // A valid EXR whose "channels" attribute is made to declare 1 769 108 595 bytes (as in the input
 // exr_fuzzer found): refused from the header's counts, before OpenEXR allocates that much.
 TEST(DiffCommand, RefusesAnExrAttributeLongerThanTheFile) {
