@@ -71,4 +71,31 @@ for name in aa-1x aa-4x aa-edge-blur; do
         "$work/$name/stats.json" "$name"
 done
 
+# Shadows (issue 29): atrium with tiled, 256 lights of which the 16 that matter most cast
+# (cube maps of 1024^2, pcf3, default bias): without shadows, with shadow maps, the reference
+# (the same 16 lights ray-traced) and shadow-error.png (red: lit but should be shadowed, blue:
+# shadowed but should be lit, over the dimmed render).
+shadows() { # NAME ARGS...
+    name=$1
+    shift
+    echo "testbed render --scene atrium --stage tiled --lights 256 $* --width 640 --height 360"
+    "$testbed" render --scene atrium --stage tiled --lights 256 "$@" --width 640 --height 360 \
+        --threads 2 --out "$work/$name" >/dev/null
+}
+shadows shadows-off
+shadows shadows-maps --shadows maps --shadow-lights 16 --shadow-map-size 1024 \
+    --compare-reference --reference-spp 1
+label() { # IN OUT LABEL
+    oiiotool "$1" --text:x=8:y=26:size=22:color=1,1,1:font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf "$3" \
+        -o "$2"
+}
+label "$work/shadows-off/preview.png" "$work/s1.png" "no shadows"
+label "$work/shadows-maps/preview.png" "$work/s2.png" "shadow maps (16 lights)"
+label "$work/shadows-maps/reference.png" "$work/s3.png" "reference: ray-traced"
+label "$work/shadows-maps/shadow-error.png" "$work/s4.png" "shadow-error.png"
+oiiotool "$work/s1.png" "$work/s2.png" "$work/s3.png" "$work/s4.png" --mosaic:pad=4 2x2 \
+    --ch R,G,B -o "$images/atrium-shadows.png"
+python3 -c "import json,sys; s=json.load(open(sys.argv[1])); m=s['shadows']; print('shadows', 'FLIP', s['error']['flip'], 'relative RMSE', s['error']['relative_rmse'], 'misclassified', m['misclassification'], 'maps ms', m['render_ms'], 'bytes', m['shadow_map_bytes'])" \
+    "$work/shadows-maps/stats.json"
+
 ls -l "$images"

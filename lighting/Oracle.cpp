@@ -19,7 +19,11 @@ void addBlended(const StageInputs& inputs, std::vector<uint32_t>& counts) {
 
 } // namespace
 
-std::vector<uint32_t> countContributingLights(const StageInputs& inputs) {
+namespace {
+
+// Both oracles: contributing lights, and with `visibility` only those that reach the surface.
+std::vector<uint32_t> countReaching(const StageInputs& inputs,
+                                    const shadows::ExactShadowLookup* visibility) {
     const gbuffer::GBuffer& gb = *inputs.gbuffer;
     const int width = gb.width(), height = gb.height();
     const std::vector<LightInView<float>>& lights = inputs.lights->lights;
@@ -37,16 +41,37 @@ std::vector<uint32_t> countContributingLights(const StageInputs& inputs) {
                     continue;
                 const glm::vec3 toViewer = glm::normalize(-point.positionView);
                 uint32_t contributing = 0;
+                auto count = [&](uint32_t light) {
+                    if (!contributes(evaluateLight(point, toViewer, lights[light])))
+                        return 0u;
+                    if (!visibility || !visibility->casts(light))
+                        return 1u;
+                    return visibility->visibility(light, glm::dvec3(point.positionView),
+                                                  glm::dvec3(point.normalView)) > 0.0
+                               ? 1u
+                               : 0u;
+                };
                 for (uint32_t light : grid.everywhere())
-                    contributing += contributes(evaluateLight(point, toViewer, lights[light]));
+                    contributing += count(light);
                 for (uint32_t light : grid.candidatesAt(point.positionView))
-                    contributing += contributes(evaluateLight(point, toViewer, lights[light]));
+                    contributing += count(light);
                 counts[size_t(y) * width + x] = contributing;
             }
         });
     }
     addBlended(inputs, counts);
     return counts;
+}
+
+} // namespace
+
+std::vector<uint32_t> countContributingLights(const StageInputs& inputs) {
+    return countReaching(inputs, nullptr);
+}
+
+std::vector<uint32_t> countVisibleLights(const StageInputs& inputs,
+                                         const shadows::ExactShadowLookup& visibility) {
+    return countReaching(inputs, &visibility);
 }
 
 std::vector<uint32_t> countContributingLightsBrute(const StageInputs& inputs) {

@@ -21,6 +21,14 @@ namespace lighting {
 
 std::vector<uint32_t> countContributingLights(const StageInputs& inputs);
 
+// The occlusion-aware oracle (`--oracle visibility`): the lights that contribute AND reach the
+// pixel's surface according to `visibility` (a light it does not cast for counts as reaching;
+// the runner passes ray-traced visibility of every light, shadows/RayShadows.h). Culling
+// efficiency against it says how much of a stage's work a perfect, occlusion-aware culling would
+// still save. Blended fragments are counted unshadowed. Cost: one shadow ray per contributing
+// pixel-light pair.
+std::vector<uint32_t> countVisibleLights(const StageInputs& inputs,
+                                         const shadows::ExactShadowLookup& visibility);
 // The same counts by brute force over every light (the grid's check).
 std::vector<uint32_t> countContributingLightsBrute(const StageInputs& inputs);
 

@@ -154,6 +154,11 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
                     "normals to the layout) or fxaa (luminance edges, FXAA 3.11)")
         ->capture_default_str();
     render
+        .add_option("--oracle", r.oracle,
+                    "light-count oracle for culling efficiency: unshadowed (radiance non-zero) "
+                    "or visibility (also reaches the surface: one shadow ray per pair)")
+        ->capture_default_str();
+    render
         .add_option("--shadows", r.shadows,
                     "off, or maps: shadow maps (spot: perspective, point: cube, directional: "
                     "cascades) looked up in the shading kernel by every stage; the reference "

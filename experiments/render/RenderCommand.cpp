@@ -522,6 +522,7 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats[metric::kBytesPerPixel] = metrics.bytesPerPixel;
     stats["msaa"] = msaaJson(run);
     stats["shadows"] = shadowsJson(run);
+    stats["oracle_mode"] = run.options.oracle;
     // The G-buffer pass's phases in the last timed repetition (GBufferPass.h).
     const gbuffer::GBufferPassTimings& phases = run.prepared->gbufferTimings;
     stats["gbuffer_phases_ms"] = {{"transform", phases.transformMs},

@@ -97,6 +97,26 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
 // The oracle counts lights on the surface the stage shades: its G-buffer when that holds every
 // channel the BRDF reads, else the lossless G-buffer (what forward stages shade).
 void countOracle(RenderRun& run) {
+    if (run.options.oracle == "visibility") {
+        // Every light's visibility by ray, on the surface the stage shades (checkOptions refuses
+        // multisampled frames): the G-buffer when it holds what the BRDF reads, else lossless.
+        const lighting::shadows::RayShadows everyLight(
+            run.prepared->scene, run.prepared->geometry, run.prepared->view,
+            lighting::shadows::RayShadows::everyLightCasts(run.prepared->scene));
+        const gbuffer::GBufferLayout& stored = run.prepared->gbuffer->layout();
+        if (stored.provides(gbuffer::Channel::Normal) &&
+            stored.provides(gbuffer::Channel::Albedo) &&
+            stored.provides(gbuffer::Channel::Specular)) {
+            run.oracle = lighting::countVisibleLights(run.prepared->inputs, everyLight);
+            return;
+        }
+        run.oracleFromLosslessGBuffer = true;
+        const std::unique_ptr<gbuffer::GBuffer> lossless = run.prepared->renderLosslessGBuffer();
+        lighting::StageInputs losslessFrame = run.prepared->inputs;
+        losslessFrame.gbuffer = lossless.get();
+        run.oracle = lighting::countVisibleLights(losslessFrame, everyLight);
+        return;
+    }
     if (!run.result.lightsOracle.empty()) {
         run.oracle = run.result.lightsOracle;
         return;

@@ -138,6 +138,12 @@ CheckedOptions checkOptions(const RenderOptions& options) {
         throw UsageError(std::string("option 'post-aa': ") + error.what());
     }
     checked.shadows = shadowSettings(options);
+    if (options.oracle != "unshadowed" && options.oracle != "visibility")
+        throw UsageError("--oracle '" + options.oracle +
+                         "' refused: must be unshadowed or visibility");
+    if (options.oracle == "visibility" && options.msaa > 1)
+        throw UsageError("--oracle visibility refused with --msaa " + std::to_string(options.msaa) +
+                         ": the occlusion-aware oracle counts the one-sample G-buffer only");
     return checked;
 }
 
@@ -240,6 +246,7 @@ std::vector<std::string> renderOptionKeys() {
             "view",
             "brdf",
             "post-aa",
+            "oracle",
             "shadows",
             "shadow-map-size",
             "shadow-bias",
@@ -297,6 +304,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.brdf = value;
     else if (key == "post-aa")
         options.postAa = value;
+    else if (key == "oracle")
+        options.oracle = value;
     else if (key == "shadows")
         options.shadows = value;
     else if (key == "shadow-map-size")

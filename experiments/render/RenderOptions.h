@@ -81,6 +81,10 @@ struct RenderOptions {
     // reference then ray-tracing the same lights' visibility (Embree) as the truth. Casting
     // lights: those the scene marks (JSON castsShadows, every glTF punctual light), or every
     // non-ambient light when it marks none; shadowLights keeps the N that matter most in view.
+    // The light-count oracle culling efficiency is measured against (lighting/Oracle.h):
+    // "unshadowed" (lights whose radiance at the surface is non-zero, occlusion ignored) or
+    // "visibility" (only those that also reach it: one Embree shadow ray per contributing pair).
+    std::string oracle = "unshadowed";
     std::string shadows = "off";
     int shadowMapSize = 1024;          // texels per face side (ShadowSettings::mapSize)
     std::string shadowBias;            // "CONSTANT,SLOPE" (metres, texels); "" = the defaults
@@ -105,7 +109,8 @@ std::string lightsText(const RenderOptions& options);
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
-// reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, shadows,
+// reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, oracle,
+// shadows,
 // shadow-map-size, shadow-bias, shadow-filter, shadow-lights, shadow-cascades, and
 // scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
 // throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or

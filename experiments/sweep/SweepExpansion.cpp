@@ -111,11 +111,13 @@ std::string referenceKeyOf(const RenderOptions& o) {
 
 std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys) {
     static const std::vector<std::string> kOrder = {
-        "scene",           "stage",         "lights",         "seed",          "resolution",
-        "width",           "height",        "threads",        "isa",           "simt-warp",
-        "layout",          "normals",       "normal-space",   "depth",         "position",
-        "reference-spp",   "msaa",          "complex-detect", "post-aa",       "shadows",
-        "shadow-map-size", "shadow-filter", "shadow-bias",    "shadow-lights", "shadow-cascades"};
+        "scene",         "stage",           "lights",        "seed",
+        "resolution",    "width",           "height",        "threads",
+        "isa",           "simt-warp",       "layout",        "normals",
+        "normal-space",  "depth",           "position",      "reference-spp",
+        "msaa",          "complex-detect",  "post-aa",       "oracle",
+        "shadows",       "shadow-map-size", "shadow-filter", "shadow-bias",
+        "shadow-lights", "shadow-cascades"};
     std::vector<std::string> columns;
     for (const std::string& key : kOrder)
         if (key == "width" || key == "height" ||

@@ -4,18 +4,33 @@
 
 namespace lighting::shadows {
 
+// The maps' view is never jittered (lighting/SupersampledReference.h jitters the projection
+// only), so the choice is the one the stage's maps made.
 RayShadows::RayShadows(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
                        const gbuffer::CameraView& view, const ShadowSettings& settings)
+    : RayShadows(scene, geometry, view,
+                 ShadowMaps::chooseLights(scene.lights, view, settings.maxShadowLights)) {}
+
+RayShadows::RayShadows(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
+                       const gbuffer::CameraView& view, const std::vector<uint32_t>& castingLights)
     : mRays(std::make_unique<RayVisibility>(geometry)),
       mWorldFromView(glm::inverse(view.viewFromWorldExact)),
       mWorldFromViewNormal(glm::dmat3(mWorldFromView)), mLights(scene.lights),
       mCasts(scene.lights.size(), false) {
-    // The maps' view is never jittered (lighting/SupersampledReference.h jitters the projection
-    // only), so the choice is the one the stage's maps made.
-    for (uint32_t light : ShadowMaps::chooseLights(scene.lights, view, settings.maxShadowLights)) {
-        mCasts[light] = true;
-        ++mCastingLightCount;
-    }
+    for (uint32_t light : castingLights)
+        if (light < mCasts.size() && !mCasts[light] &&
+            scene.lights[light].type != scenes::LightType::Ambient) {
+            mCasts[light] = true;
+            ++mCastingLightCount;
+        }
+}
+
+std::vector<uint32_t> RayShadows::everyLightCasts(const scenes::Scene& scene) {
+    std::vector<uint32_t> lights;
+    for (uint32_t i = 0; i < scene.lights.size(); ++i)
+        if (scene.lights[i].type != scenes::LightType::Ambient)
+            lights.push_back(i);
+    return lights;
 }
 
 double RayShadows::visibility(size_t lightIndex, const glm::dvec3& positionView,

@@ -31,6 +31,11 @@ public:
     // chooses the casting lights as ShadowMaps::render does for `settings` and `view`.
     RayShadows(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
                const gbuffer::CameraView& view, const ShadowSettings& settings);
+    // The given casting lights (indices into scene.lights; ambient ones are ignored): every
+    // non-ambient light for the occlusion-aware oracle (everyLightCasts).
+    RayShadows(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
+               const gbuffer::CameraView& view, const std::vector<uint32_t>& castingLights);
+    static std::vector<uint32_t> everyLightCasts(const scenes::Scene& scene);
 
     bool casts(size_t lightIndex) const override {
         return lightIndex < mCasts.size() && mCasts[lightIndex];

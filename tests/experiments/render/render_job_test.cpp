@@ -12,6 +12,7 @@
 
 #include "experiments/render/RenderCommand.h"
 #include "experiments/render/RenderJob.h"
+#include "lighting/passes/PassNames.h"
 
 namespace {
 
@@ -345,6 +346,66 @@ TEST(RenderJob, EveryStageIsMeasuredAgainstTheSameSupersampledReference) {
     EXPECT_FALSE(bitwiseEqual(centre.radiance[1], truth.radiance[1]));
 }
 
+// `--shadows maps` end to end: the maps are rendered and timed as their own pass, the stage
+// shades them, the reference ray-traces the same lights, and the run reports the maps' bytes and
+// the misclassification; the shadowed image is closer to the shadowed reference than the
+// unshadowed one (whose reference is unshadowed) is to it.
+TEST(RenderJob, ShadowMapsAreRenderedShadedAndMeasured) {
+    RenderOptions options = smallAtrium(1);
+    options.stage = "tiled";
+    options.compareReference = true;
+    options.referenceSpp = 1;
+    options.shadows = "maps";
+    options.shadowMapSize = 256;
+    options.shadowLights = "8";
+    const RenderRun run = runRender(planRender(options));
+    ASSERT_TRUE(run.shadowMaps);
+    EXPECT_EQ(run.shadowMaps->shadowCount(), 8u);
+    ASSERT_TRUE(run.shadowError);
+    EXPECT_GT(run.shadowError->pairs, 0u);
+    EXPECT_GT(run.shadowError->truthShadowed, 0u);
+    EXPECT_LT(run.shadowError->misclassifiedFraction(), 0.05);
+    ASSERT_TRUE(run.metrics.shadowMapBytes);
+    EXPECT_EQ(*run.metrics.shadowMapBytes, double(run.shadowMaps->stats().totalBytes));
+    bool timed = false;
+    for (const PassTiming& pass : run.metrics.passes)
+        timed |= pass.pass == lighting::pass::kShadowMaps;
+    EXPECT_TRUE(timed);
+    // Against the shadowed reference, shadows make the image closer than no shadows would.
+    RenderOptions unshadowed = options;
+    unshadowed.shadows = "off";
+    const RenderRun plain = runRender(planRender(unshadowed), {}, &run.reference);
+    EXPECT_LT(run.metrics.error->relativeRmse, 0.5 * plain.metrics.error->relativeRmse);
+    EXPECT_FALSE(plain.shadowMaps);
+    EXPECT_FALSE(plain.metrics.shadowMapBytes);
+}
+
+// `--oracle visibility`: at every pixel at most the unshadowed oracle's count, fewer in all on
+// an interior (the atrium's floors and pillars block lights), and a stage's evaluations are then
+// further from the oracle (culling efficiency lower), with or without shadows.
+TEST(RenderJob, VisibilityOracleCountsOnlyLightsThatReachTheSurface) {
+    RenderOptions options = smallAtrium(1);
+    options.stage = "tiled";
+    const RenderRun unshadowed = runRender(planRender(options));
+    options.oracle = "visibility";
+    const RenderRun visible = runRender(planRender(options));
+    ASSERT_EQ(visible.oracle.size(), unshadowed.oracle.size());
+    uint64_t all = 0, reaching = 0;
+    for (size_t pixel = 0; pixel < visible.oracle.size(); ++pixel) {
+        EXPECT_LE(visible.oracle[pixel], unshadowed.oracle[pixel]) << "pixel " << pixel;
+        all += unshadowed.oracle[pixel];
+        reaching += visible.oracle[pixel];
+    }
+    std::printf("atrium 320x180, 64 lights: %llu contributing pixel-light pairs, %llu reach "
+                "(%.1f%%)\n",
+                (unsigned long long)all, (unsigned long long)reaching, 100.0 * reaching / all);
+    EXPECT_LT(reaching, all);
+    EXPECT_GT(reaching, 0u);
+    EXPECT_LT(visible.metrics.cullingEfficiency, unshadowed.metrics.cullingEfficiency);
+    // The image does not depend on the oracle.
+    EXPECT_EQ(visible.result.radiance[1], unshadowed.result.radiance[1]);
+}
+
 struct BadCase {
     const char* name;
     RenderOptions options;
@@ -392,7 +453,33 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"scene_option", with([](RenderOptions& o) { o.sceneOptions["nosuch"] = "1"; })},
         BadCase{"reference_spp_not_square", with([](RenderOptions& o) { o.referenceSpp = 8; })},
         BadCase{"reference_spp_too_many", with([](RenderOptions& o) { o.referenceSpp = 1024; })},
-        BadCase{"reference_spp_zero", with([](RenderOptions& o) { o.referenceSpp = 0; })}),
+        BadCase{"reference_spp_zero", with([](RenderOptions& o) { o.referenceSpp = 0; })},
+        BadCase{"shadows_mode", with([](RenderOptions& o) { o.shadows = "rays"; })},
+        BadCase{"oracle_mode", with([](RenderOptions& o) { o.oracle = "occlusion"; })},
+        BadCase{"visibility_oracle_msaa", with([](RenderOptions& o) {
+                    o.oracle = "visibility";
+                    o.msaa = 4;
+                })},
+        BadCase{"shadow_map_size", with([](RenderOptions& o) {
+                    o.shadows = "maps";
+                    o.shadowMapSize = 100000;
+                })},
+        BadCase{"shadow_bias", with([](RenderOptions& o) {
+                    o.shadows = "maps";
+                    o.shadowBias = "0.01";
+                })},
+        BadCase{"shadow_filter", with([](RenderOptions& o) {
+                    o.shadows = "maps";
+                    o.shadowFilter = "pcf7";
+                })},
+        BadCase{"shadow_lights", with([](RenderOptions& o) {
+                    o.shadows = "maps";
+                    o.shadowLights = "-2";
+                })},
+        BadCase{"shadow_cascades", with([](RenderOptions& o) {
+                    o.shadows = "maps";
+                    o.shadowCascades = 9;
+                })}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(RenderCommand, UnwritableOutputFolderIsRefused) {

@@ -566,6 +566,13 @@ TEST(ShadowMaps, BudgetChoosesTheLightsThatMatterMostInView) {
     for (size_t light : {1, 2, 3, 4})
         EXPECT_EQ(frame.maps.shadowOf(light), ShadowMaps::kNoShadow);
     EXPECT_EQ(frame.maps.stats().castingLightCount, 3u);
+
+    // A scene that marks no caster (the built-in scenes' generated lights): every non-ambient
+    // light casts, under the same budget.
+    for (Light& light : t.scene.lights)
+        light.castsShadows = false;
+    EXPECT_EQ(ShadowMaps::chooseLights(t.scene.lights, view, -1), (V{0, 1, 2, 4}));
+    EXPECT_EQ(ShadowMaps::chooseLights(t.scene.lights, view, 2), (V{0, 4}));
 }
 
 TEST(ShadowSettings, FilterNamesRoundTrip) {
