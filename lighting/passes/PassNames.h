@@ -34,7 +34,7 @@ inline constexpr const char* kPostAa = "post_aa";
 
 // The order passes run in within a frame; tables list passes this way, others after by name.
 inline constexpr std::array<std::string_view, 14> kPipelineOrder = {
-    kGBuffer,  kExactSurface, kShadowMaps, kTransform, kPrepass, kCull,    kAssign,
-    kIndex,    kShading,      kLighting,   kMaterial,  kBlend,   kResolve, kPostAa};
+    kGBuffer, kExactSurface, kShadowMaps, kTransform, kPrepass, kCull,    kAssign,
+    kIndex,   kShading,      kLighting,   kMaterial,  kBlend,   kResolve, kPostAa};
 
 } // namespace lighting::pass

@@ -161,6 +161,8 @@ TEST(RunMetrics, TheTableColumnsAreTheRecordsFigures) {
                                                  "surfaces_per_covered_pixel",
                                                  "gbuffer_bytes",
                                                  "gbuffer_allocated_bytes",
+                                                 "shadow_map_bytes",
+                                                 "shadow_misclassified",
                                                  "rmse",
                                                  "relative_rmse",
                                                  "psnr",
