@@ -8,32 +8,9 @@
 #include <tbb/parallel_reduce.h>
 
 #include "lighting/brdf/Brdf.h"
+#include "lighting/shadows/LightReaches.h"
 
 namespace lighting::shadows {
-
-namespace {
-
-// Whether the light passes its range, cone and facing tests at the point (what the kernel asks
-// the lookup about), with evaluateLight's float operations.
-bool reaches(const gbuffer::Surface& s, const LightInView<float>& light) {
-    using scenes::LightType;
-    if (light.type == LightType::Ambient)
-        return false;
-    glm::vec3 toLight = -light.directionView;
-    if (light.type != LightType::Directional) {
-        const glm::vec3 offset = light.positionView - s.positionView;
-        const float distance2 = glm::dot(offset, offset);
-        if (!(distance2 < light.rangeMetres * light.rangeMetres))
-            return false;
-        toLight = distance2 > 0.0f ? offset / std::sqrt(distance2) : s.normalView;
-        if (light.type == LightType::Spot &&
-            !(-glm::dot(toLight, light.directionView) > light.spotOuterCos))
-            return false;
-    }
-    return glm::dot(s.normalView, toLight) > 0.0f;
-}
-
-} // namespace
 
 ShadowErrorCounts measureShadowError(const StageInputs& frame, const ExactShadowLookup& truth) {
     if (!frame.shadows)
@@ -63,7 +40,7 @@ ShadowErrorCounts measureShadowError(const StageInputs& frame, const ExactShadow
                         continue;
                     const size_t pixel = size_t(y) * size_t(width) + size_t(x);
                     for (uint32_t light : casting) {
-                        if (!reaches(s, lights[light]))
+                        if (!lightReaches(s, lights[light]))
                             continue;
                         ++sums.pairs;
                         const bool mapLit =

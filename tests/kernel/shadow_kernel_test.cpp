@@ -18,6 +18,7 @@
 #include "lighting/brdf/SplitLighting.h"
 #include "lighting/kernel/LightKernel.h"
 #include "lighting/kernel/SplitLightKernel.h"
+#include "lighting/shadows/LightReaches.h"
 #include "lighting/shadows/ShadowLookup.h"
 #include "tests/kernel/KernelTestInputs.h"
 
@@ -96,26 +97,6 @@ PacketAccumulator shade(const KernelIsa& isa, const Case& c, const KernelLights&
     accumulator.clear();
     lighting::kernel::shadePacket(isa, c.packet, kAllLanes, lights, indices, accumulator);
     return accumulator;
-}
-
-// Whether a light passes its range, cone and facing tests at a point (the lanes the kernel asks
-// the lookup about), with evaluateLight's float operations.
-bool reaches(const gbuffer::Surface& s, const LightInView<float>& light) {
-    using scenes::LightType;
-    if (light.type == LightType::Ambient)
-        return false;
-    glm::vec3 toLight = -light.directionView;
-    if (light.type != LightType::Directional) {
-        const glm::vec3 offset = light.positionView - s.positionView;
-        const float distance2 = glm::dot(offset, offset);
-        if (!(distance2 < light.rangeMetres * light.rangeMetres))
-            return false;
-        toLight = distance2 > 0.0f ? offset / std::sqrt(distance2) : s.normalView;
-        if (light.type == LightType::Spot &&
-            !(-glm::dot(toLight, light.directionView) > light.spotOuterCos))
-            return false;
-    }
-    return glm::dot(s.normalView, toLight) > 0.0f;
 }
 
 bool sameBits(float a, float b) {
@@ -245,11 +226,11 @@ TEST_P(ShadowKernelTest, SplitFormAppliesTheSameFactor) {
             const glm::vec3 toViewer = glm::normalize(-point.positionView);
             lighting::SplitLighting expected;
             for (uint32_t index : c.indices) {
-                const float v =
-                    lights.shadowOf(index) != kNoShadow && reaches(point, c.lights[index])
-                        ? shadows.visibility(lights.shadowOf(index), point.positionView,
-                                             point.normalView)
-                        : 1.0f;
+                const float v = lights.shadowOf(index) != kNoShadow &&
+                                        lighting::shadows::lightReaches(point, c.lights[index])
+                                    ? shadows.visibility(lights.shadowOf(index), point.positionView,
+                                                         point.normalView)
+                                    : 1.0f;
                 lighting::addSplitLight(point, points, toViewer, c.lights[index], expected, v);
             }
             const bool metallicRoughness = c.surfaces[lane].metallicRoughness;
