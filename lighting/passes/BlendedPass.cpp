@@ -180,10 +180,18 @@ void BlendedPass::compositeExact(std::span<const float> opaqueDepth, StageResult
                 const glm::dvec3 toViewer = glm::normalize(-s.positionView);
                 glm::dvec3 sum(0.0);
                 uint32_t contributing = 0;
-                for (const LightInView<double>& light : lights) {
-                    const glm::dvec3 radiance = evaluateLight(s, toViewer, light);
-                    sum += radiance;
-                    contributing += contributes(radiance) ? 1u : 0u;
+                const shadows::ExactShadowLookup* shadows = mInputs->exactShadows;
+                for (size_t l = 0; l < lights.size(); ++l) {
+                    const glm::dvec3 radiance = evaluateLight(s, toViewer, lights[l]);
+                    const bool contributesHere = contributes(radiance);
+                    // The reference's shadows (ray-traced), as for its opaque surfaces
+                    // (EveryLight.h): the stages shade blended fragments through the kernel,
+                    // whose shadow maps apply to them alike.
+                    if (shadows && contributesHere && shadows->casts(l))
+                        sum += radiance * shadows->visibility(l, s.positionView, s.normalView);
+                    else
+                        sum += radiance;
+                    contributing += contributesHere ? 1u : 0u;
                 }
                 sum += s.emissive; // as shade(): emitted plus lit, then "over"
                 colour = alphas[i] * sum + (1.0 - alphas[i]) * colour;

@@ -47,7 +47,12 @@ struct SceneCase {
 const SceneCase kScenes[] = {
     {"spheres_sun", "spheres", 24, {{"sun", "1"}}},
     {"atrium", "atrium", 24, {{"sun", "1"}}},
+    // Blended panes and an alpha-masked fence: the stages shade blended fragments through the
+    // kernel (BlendedPass), the reference composites them with the rays. Last: the every-stage
+    // suite below leaves it out (its approximate stages' blended paths are their own study).
+    {"glass_sun", "glass", 24, {{"sun", "1"}}},
 };
+constexpr int kEveryStageScenes = 2;
 
 lighting::ShadowSettings settings() {
     lighting::ShadowSettings s;
@@ -189,7 +194,7 @@ std::string caseName(const ::testing::TestParamInfo<std::tuple<std::string, int>
 
 INSTANTIATE_TEST_SUITE_P(AllStages, ShadowsEveryStageTest,
                          ::testing::Combine(::testing::ValuesIn(stageNames()),
-                                            ::testing::Range(0, int(std::size(kScenes)))),
+                                            ::testing::Range(0, kEveryStageScenes)),
                          caseName);
 
 } // namespace
