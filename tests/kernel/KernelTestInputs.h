@@ -178,6 +178,42 @@ inline glm::dvec3 referenceSum(const Surface& s, const std::vector<LightInView<f
 }
 
 // Distance in units in the last place between two finite floats of the same sign (or zeros).
+// A random packet and light list: 16 lanes around one point (a 4x4 block of a surface) or
+// scattered, ~15% background; `lightCount` lights, the first `nearCount` near the block and the
+// rest anywhere; a random ascending list of ~70% of them. models: 0 Blinn-Phong, 1
+// metallic-roughness, 2 mixed (each lane either, at random).
+struct PacketCase {
+    ShadingPacket packet = poisonedPacket();
+    Surface surfaces[kPacketLanes];
+    std::vector<LightInView<float>> lights;
+    std::vector<uint32_t> indices;
+};
+
+inline PacketCase randomPacketCase(RandomScene& random, int models, int lightCount, int nearCount) {
+    PacketCase c;
+    const bool coherent = random.chance(0.5f);
+    const Surface centre = random.surface();
+    for (int lane = 0; lane < kPacketLanes; ++lane) {
+        Surface s = random.surface();
+        if (coherent) {
+            s.position = centre.position + 0.05f * random.unitVector();
+            s.normal = glm::normalize(centre.normal + 0.1f * random.unitVector());
+        }
+        if (models == 1 || (models == 2 && random.chance(0.5f)))
+            random.makeMetallicRoughness(s);
+        c.surfaces[lane] = s;
+        if (!random.chance(0.15f))
+            setLane(c.packet, lane, s);
+    }
+    for (int i = 0; i < lightCount; ++i)
+        c.lights.push_back(
+            random.lightNear(i < nearCount ? centre.position : random.surface().position));
+    for (uint32_t i = 0; i < c.lights.size(); ++i)
+        if (random.chance(0.7f))
+            c.indices.push_back(i);
+    return c;
+}
+
 inline int64_t ulpDistance(float a, float b) {
     int32_t ia, ib;
     std::memcpy(&ia, &a, 4);

@@ -60,35 +60,10 @@ private:
     mutable std::atomic<uint64_t> mCalls{0};
 };
 
-struct Case {
-    ShadingPacket packet = poisonedPacket();
-    Surface surfaces[kPacketLanes];
-    std::vector<LightInView<float>> lights;
-    std::vector<uint32_t> indices;
-};
+using Case = PacketCase;
 
 Case randomCase(RandomScene& random, int models) {
-    Case c;
-    const bool coherent = random.chance(0.5f);
-    const Surface centre = random.surface();
-    for (int lane = 0; lane < kPacketLanes; ++lane) {
-        Surface s = random.surface();
-        if (coherent) {
-            s.position = centre.position + 0.05f * random.unitVector();
-            s.normal = glm::normalize(centre.normal + 0.1f * random.unitVector());
-        }
-        if (models == 1 || (models == 2 && random.chance(0.5f)))
-            random.makeMetallicRoughness(s);
-        c.surfaces[lane] = s;
-        if (!random.chance(0.15f))
-            setLane(c.packet, lane, s);
-    }
-    for (int i = 0; i < 48; ++i)
-        c.lights.push_back(random.lightNear(i < 36 ? centre.position : random.surface().position));
-    for (uint32_t i = 0; i < c.lights.size(); ++i)
-        if (random.chance(0.7f))
-            c.indices.push_back(i);
-    return c;
+    return randomPacketCase(random, models, 48, 36);
 }
 
 PacketAccumulator shade(const KernelIsa& isa, const Case& c, const KernelLights& lights,

@@ -36,37 +36,11 @@ constexpr double kPowRelative = 2e-5;
 
 enum class Models { BlinnPhong, MetallicRoughness, Mixed };
 
-struct Case {
-    ShadingPacket packet = poisonedPacket();
-    Surface surfaces[kPacketLanes];
-    std::vector<LightInView<float>> lights;
-    std::vector<uint32_t> indices;
-};
+using Case = PacketCase;
 
-// 16 lanes around one point (a 4x4 block of a surface) or scattered, ~15% background; 64 lights
-// near the block or anywhere; a random ascending list of ~70% of them.
+// 64 lights, 48 of them near the block.
 Case randomCase(RandomScene& random, Models models) {
-    Case c;
-    const bool coherent = random.chance(0.5f);
-    const Surface centre = random.surface();
-    for (int lane = 0; lane < kPacketLanes; ++lane) {
-        Surface s = random.surface();
-        if (coherent) {
-            s.position = centre.position + 0.05f * random.unitVector();
-            s.normal = glm::normalize(centre.normal + 0.1f * random.unitVector());
-        }
-        if (models == Models::MetallicRoughness || (models == Models::Mixed && random.chance(0.5f)))
-            random.makeMetallicRoughness(s);
-        c.surfaces[lane] = s;
-        if (!random.chance(0.15f))
-            setLane(c.packet, lane, s);
-    }
-    for (int i = 0; i < 64; ++i)
-        c.lights.push_back(random.lightNear(i < 48 ? centre.position : random.surface().position));
-    for (uint32_t i = 0; i < c.lights.size(); ++i)
-        if (random.chance(0.7f))
-            c.indices.push_back(i);
-    return c;
+    return randomPacketCase(random, int(models), 64, 48);
 }
 
 SplitPacketAccumulator shadeSplit(const KernelIsa& isa, const Case& c, uint32_t laneMask,
