@@ -62,6 +62,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
             mEmpty = std::make_unique<gbuffer::GBuffer>(prepared.gbuffer->layout(), prepared.view);
         StageInputs frame = prepared.inputs;
         frame.gbuffer = mEmpty.get();
+        frame.fragmentLayer = StageInputs::kBackgroundRun;
         stage.shade(frame, background);
         addTimings(result.timingsMs, background.timingsMs);
     }

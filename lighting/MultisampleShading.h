@@ -20,9 +20,10 @@
 // multisamples natively (ShadingStage::multisamplesNatively: the forward stages, which rasterize
 // the scene themselves at inputs.samples with per-sample colour, ForwardGeometry.h) is shaded
 // ONCE on the full frame and resolves itself: no layers, no background run, parameters "msaa"
-// and msaa_shading=native (the layered path records msaa_shading=layers). The other stages that
-// rasterize the scene (the light pre-pass and inferred material passes) would shade the whole
-// scene again per layer: they are refused (experiments/render/RenderOptions.cpp).
+// and msaa_shading=native (the layered path records msaa_shading=layers). The stages with a
+// material pass (light pre-pass, inferred) take the layers too: their material pass rasterizes
+// the scene at the sample count once per frame, on layer 0, and gives each layer's fragments
+// (StageInputs::fragmentLayer, MaterialPass.h). The reference refuses (it is supersampled).
 //
 // Exactness: a layer's image is the stage's own on that layer's G-buffer, so the exactness of each
 // stage per layer (tested against brute per layer) carries over, and the resolve is the same

@@ -47,6 +47,7 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
     inputs.exact = exact.get();
     inputs.lights = &lights;
     inputs.samples = multisample ? multisampling.samples : 1;
+    inputs.fragmentLayers = multisample ? &multisample->layers : nullptr;
 }
 
 PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,

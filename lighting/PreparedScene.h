@@ -70,6 +70,7 @@ struct PreparedScene {
     int layerCount() const { return multisample ? multisample->layers.layerCount() : 1; }
     StageInputs layerInputs(int layer) const {
         StageInputs layerFrame = inputs;
+        layerFrame.fragmentLayer = layer;
         if (layer > 0)
             layerFrame.gbuffer = multisample->upperLayers[size_t(layer - 1)].get();
         return layerFrame;

@@ -65,6 +65,7 @@
 
 #include "gbuffer/GBuffer.h"
 #include "gbuffer/GBufferLayout.h"
+#include "gbuffer/msaa/FragmentLayers.h"
 #include "gbuffer/visibility/CameraView.h"
 #include "gbuffer/visibility/ExactSurface.h"
 #include "gbuffer/visibility/SceneGeometry.h"
@@ -107,6 +108,17 @@ struct StageInputs {
     // this count and resolves itself; the G-buffer stages ignore it (their G-buffer is one
     // fragment layer, MultisampleShading.h).
     int samples = 1;
+    // Multisampled frames only (null and 0 otherwise): the frame's fragment layers
+    // (gbuffer/msaa/FragmentLayers.h) and which of them this call shades: 0, the main fragments
+    // (always shaded first in a frame), k >= 1, the k-th other fragments of the complex pixels,
+    // or kBackgroundRun, the run over an empty G-buffer that shades the blended surfaces over the
+    // background samples (MultisampleShading.h). A stage that shades from the G-buffer alone
+    // ignores both. A stage with a second geometry pass (MaterialPass) pairs its own fragments
+    // with the layer's through them, and may reuse what it computed on layer 0 for the layers
+    // above in the same frame (inferred's L-buffer).
+    const gbuffer::FragmentLayers* fragmentLayers = nullptr;
+    int fragmentLayer = 0;
+    static constexpr int kBackgroundRun = -1;
     // The frame's shadows (lighting/shadows/ShadowLookup.h; `--shadows`), or null: no light casts
     // one. Every stage that shades through the kernel applies them there (KernelLights).
     const shadows::ShadowLookup* shadows = nullptr;

@@ -62,6 +62,10 @@ struct StageInfo {
     // through the fragment layers or natively; otherwise why it refuses them (`testbed list` shows
     // it and the runner's error quotes it).
     std::string msaaRefusal;
+    // How the stage takes multisampled frames, when the generic description (per-sample shading
+    // at complex pixels through the fragment layers, or natively) does not say it all: `testbed
+    // list` shows it instead.
+    std::string msaaNote;
     // True when the stage multisamples natively (ShadingStage::multisamplesNatively: rasterized
     // at the frame's sample count, shaded once per pixel and triangle, per-sample colour resolved
     // by the stage), so MultisampleShading runs it once on the full frame, not per layer.

@@ -54,6 +54,7 @@ void printStages(std::ostream& out) {
         out << "  " << info.name << "  - " << info.description << "\n";
         out << "    msaa: "
             << (!info.msaaRefusal.empty() ? "refused: " + info.msaaRefusal
+                : !info.msaaNote.empty()  ? "yes (" + info.msaaNote + ")"
                 : info.msaaNative
                     ? std::string("yes, natively (rasterized at the sample count, shaded once per "
                                   "pixel and triangle, per-sample colour resolved)")

@@ -6,17 +6,30 @@
 //
 // Because the draw is the G-buffer pass's, the visible triangles and surfaces are bitwise the
 // G-buffer's (the normal and material a lossless G-buffer would hold).
+//
+// Multisampled frames (inputs.fragmentLayers set; MultisampleShading.h shades such a stage once
+// per fragment layer): as hardware MSAA would run it, the material pass rasterizes the scene at
+// the frame's sample count, once per frame (on layer 0, which is always shaded first), and splits
+// its samples into fragments with the G-buffer's own options (gbuffer::FragmentLayers), which
+// makes its layers bitwise the G-buffer's: the same draw, the same build. On layer k the pass
+// then gives layer k's fragments (codes, instances, surfaces), so the stage combines each
+// fragment's material with the light its light buffer holds for that fragment, and the frame's
+// resolve weights them by coverage. The background run gives no fragment.
 // Thread safety: draw() is parallel inside and not reentrant per object; forEachSurface calls
 // its function from several tasks at once, each pixel from one task only (rows in parallel).
 #pragma once
 
+#include <bit>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
+#include <glm/glm.hpp>
 #include <tbb/parallel_for.h>
 
 #include "gbuffer/GBuffer.h"
+#include "gbuffer/msaa/FragmentLayers.h"
 #include "gbuffer/visibility/VisibilityPass.h"
 #include "lighting/ShadingStage.h"
 #include "raster/Rasterizer.h"
@@ -37,13 +50,37 @@ public:
     static constexpr uint32_t kNoInstance = UINT32_MAX;
 
     // Transforms inputs.scene and draws it into the visibility buffer. Requires inputs.scene,
-    // inputs.geometry and inputs.view. Cost: one geometry pass without attributes.
+    // inputs.geometry and inputs.view. Cost: one geometry pass without attributes; multisampled,
+    // on layer 0 one multisampled pass and the fragment split, on the layers above nothing (they
+    // need this frame's layer 0 drawn first: std::logic_error otherwise).
     void draw(const StageInputs& inputs);
+
+    // The visible triangle's code per pixel (VisibilityPass::kNoTriangle for none): the draw's,
+    // or multisampled, the drawn layer's fragments (empty for the background run).
+    std::span<const uint32_t> codes() const { return mCodes; }
+
+    // Where the pixel's fragment lies in the pixel: the mean of the sample positions it covers,
+    // relative to the pixel centre, in pixels (x right, y down; hardware's centroid). Zero without
+    // multisampling and for a fragment that covers the whole pixel (the standard patterns are
+    // centred, and the sum is taken in integers, so exactly zero).
+    glm::vec2 coverageCentroid(size_t pixel) const {
+        if (mCoverage.empty())
+            return glm::vec2(0.0f);
+        int sumX = 0, sumY = 0, count = 0;
+        for (uint32_t mask = mCoverage[pixel]; mask != 0; mask &= mask - 1) {
+            const raster::SampleOffset offset = mPattern[size_t(std::countr_zero(mask))];
+            sumX += offset.x;
+            sumY += offset.y;
+            ++count;
+        }
+        return count == 0 ? glm::vec2(0.0f)
+                          : glm::vec2(float(sumX), float(sumY)) / (16.0f * float(count));
+    }
 
     // The scene instance of the pixel's visible triangle (SceneGeometry::triangleInstance), or
     // kNoInstance for background.
     uint32_t instanceAt(size_t pixel) const {
-        const uint32_t code = mVisibility.codes()[pixel];
+        const uint32_t code = mCodes.empty() ? gbuffer::VisibilityPass::kNoTriangle : mCodes[pixel];
         return code == gbuffer::VisibilityPass::kNoTriangle
                    ? kNoInstance
                    : mVisibility.geometry()
@@ -55,7 +92,9 @@ public:
     // position comes from `gb`). Rows in parallel, pixels of a row in order.
     template <class Combine>
     void forEachSurface(const gbuffer::GBuffer& gb, const Combine& combine) const {
-        const uint32_t* codes = mVisibility.codes().data();
+        if (mCodes.empty())
+            return; // the background run: no fragment
+        const uint32_t* codes = mCodes.data();
         const int width = gb.width();
         tbb::parallel_for(0, gb.height(), [&](int y) {
             gbuffer::VisibilityPass::RowSurfaces row(mVisibility, y);
@@ -72,7 +111,12 @@ public:
 private:
     gbuffer::VisibilityPass mVisibility;
     std::unique_ptr<raster::Rasterizer> mRasterizer;
-    std::vector<float> mDepth;
+    std::vector<float> mDepth;                      // per sample
+    gbuffer::FragmentLayers mLayers;                // multisampled frames: the draw's fragments
+    bool mLayersDrawn = false;                      // ... built on this frame's layer 0
+    std::span<const uint32_t> mCodes;               // the codes forEachSurface and instanceAt read
+    std::span<const uint8_t> mCoverage;             // multisampled: the same layer's coverage masks
+    std::span<const raster::SampleOffset> mPattern; // ... and the sample positions
 };
 
 } // namespace lighting

@@ -68,14 +68,28 @@
 // Blended (glTF BLEND) surfaces: stippled into the L-buffer, lit by the light pass, found again
 // through the DSF in the material pass, at most 3 layers (InferredStipple.h); timed as "blend",
 // with stipple_fragments, stipple_fallbacks and stipple_unlit among the parameters.
-// Threads: tiles in parallel for culling, warp rows of samples for lighting, rows for the material
-// pass; every sample and pixel written by one task only, light sums in ascending order:
-// deterministic. The stippled samples' light (InferredStipple) stays per sample and scalar.
+// Multisampling (--msaa N; MultisampleShading.h runs the stage once per fragment layer), as
+// Kircher & Lawrance describe it: the L-buffer is the frame's, lit once from layer 0's G-buffer
+// (its samples read main fragments); the material pass rasterizes the scene at N samples once
+// per frame (MaterialPass.h) and runs the DSF for every fragment of every layer, with that
+// fragment's own depth, normal and object ID, centred at the centroid of the samples it covers
+// (MaterialPass::coverageCentroid; the pixel centre for a fragment covering the pixel), so an edge
+// pixel's far fragment takes the light of its own surface's samples on its own side of the edge
+// (at the pixel centre their bilinear weights can all be zero, e.g. at scale=1). On the layers
+// above 0 only the material pass and the blended composite run (lightsEvaluated zero there: no
+// light is evaluated again). Blended surfaces are stippled against layer 0's depth: a blended
+// fragment behind a pixel's main fragment but in front of another of its fragments finds no
+// stippled sample of its own and falls back (stipple_fallbacks, stipple_unlit), an approximation
+// its error against the reference measures. Threads: tiles in parallel for culling, warp rows of
+// samples for lighting, rows for the material pass; every sample and pixel written by one task
+// only, light sums in ascending order: deterministic. The stippled samples' light (InferredStipple)
+// stays per sample and scalar.
 #include "lighting/StageRegistry.h"
 
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <stdexcept>
 
 #include <tbb/parallel_for.h>
 
@@ -130,6 +144,17 @@ public:
         // The pixels whose lights this stage evaluates (before any timed pass): the runner counts
         // evaluated and contributing lights there only (StageResult::lightingSamples).
         result.lightingSamples.assign(size_t(width) * height, 0);
+        // A multisampled frame's layers above 0 are lit from layer 0's L-buffer (the file comment).
+        const bool upperLayer = inputs.fragmentLayer > 0;
+        if (upperLayer) {
+            if (mSamples.size() != size_t(lowWidth) * lowHeight)
+                throw std::logic_error("inferred shades a multisampled frame's layer 0 first");
+            PassTimer blendPass(result, pass::kBlend); // the composite only, after "material"
+            blendPass.pause();
+            materialPassOverLBuffer(inputs, lowWidth, lowHeight, mFrameBlended, blendPass, result,
+                                    [] {});
+            return;
+        }
         for (int j = 0; j < lowHeight; ++j)
             for (int i = 0; i < lowWidth; ++i)
                 result.lightingSamples[size_t(sampleY(j)) * width + sampleX(i)] = 1;
@@ -200,24 +225,47 @@ public:
             blendPass.pause();
         }
 
+        // Object IDs of the low-res samples: the scene instance at the pixel each sample read in
+        // "lighting" (or its stippled surface's), from the material pass's draw, which the
+        // material pass below makes first.
+        mFrameBlended = blended;
+        materialPassOverLBuffer(inputs, lowWidth, lowHeight, blended, blendPass, result, [&] {
+            mSampleObjects.assign(size_t(lowWidth) * lowHeight, kNoObject);
+            if (mOptions.objectIds)
+                for (int j = 0; j < lowHeight; ++j)
+                    for (int i = 0; i < lowWidth; ++i)
+                        mSampleObjects[size_t(j) * lowWidth + i] =
+                            blended && mStipple.holds(size_t(j) * lowWidth + i)
+                                ? mStipple.sample(size_t(j) * lowWidth + i).instance
+                                : mMaterials.instanceAt(size_t(sampleY(j)) * width + sampleX(i));
+        });
+        result.parameters["tile_light_pairs"] = std::to_string(mTileLights.pairCount());
+    }
+
+    // The material pass over the frame's L-buffer (mSamples, mSampleObjects): the second geometry
+    // pass, the DSF upsampling and the combine at every fragment the material pass gives for
+    // inputs' layer, then the blended surfaces' composite (added to the paused `blendPass`, which
+    // is recorded after "material", or discarded without blended surfaces). afterDraw runs after
+    // the draw, inside the timed pass.
+    template <class AfterDraw>
+    void materialPassOverLBuffer(const StageInputs& inputs, int lowWidth, int lowHeight,
+                                 bool blended, PassTimer& blendPass, StageResult& result,
+                                 const AfterDraw& afterDraw) {
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
+        const int width = gb.width(), height = gb.height();
+        const int scale = mOptions.scale;
         // Material pass: second geometry pass, DSF upsampling, combine.
         PassTimer materialPass(result, pass::kMaterial);
         mMaterials.draw(inputs);
-        // Object IDs: the scene instance of the visible triangle, for every pixel (looked up on
-        // the fly) and for every low-res sample (the pixel the sample read in "lighting").
-        mSampleObjects.assign(size_t(lowWidth) * lowHeight, kNoObject);
-        if (mOptions.objectIds)
-            for (int j = 0; j < lowHeight; ++j)
-                for (int i = 0; i < lowWidth; ++i)
-                    mSampleObjects[size_t(j) * lowWidth + i] =
-                        blended && mStipple.holds(size_t(j) * lowWidth + i)
-                            ? mStipple.sample(size_t(j) * lowWidth + i).instance
-                            : mMaterials.instanceAt(size_t(sampleY(j)) * width + sampleX(i));
+        afterDraw();
         // Per row, so that each task counts into its own slot.
         std::vector<uint32_t> rowFallbacks(size_t(height), 0), rowIdFallbacks(size_t(height), 0);
         const float halfScale = float(scale / 2);
         mMaterials.forEachSurface(gb, [&](int x, int y, size_t pixel, const gbuffer::Surface& s) {
-            const float v = (float(y) - halfScale) / float(scale);
+            // The filter's position: the pixel centre, or multisampled, the fragment's centroid
+            // (the same for a fragment that covers the pixel).
+            const glm::vec2 centroid = mMaterials.coverageCentroid(pixel);
+            const float v = (float(y) + centroid.y - halfScale) / float(scale);
             const int j0 = int(std::floor(v));
             const float fy = v - float(j0);
             const int ja = std::clamp(j0, 0, lowHeight - 1),
@@ -228,7 +276,7 @@ public:
             const float depth = -here.positionView.z;
             const uint32_t object = mOptions.objectIds ? mMaterials.instanceAt(pixel) : kNoObject;
 
-            const float u = (float(x) - halfScale) / float(scale);
+            const float u = (float(x) + centroid.x - halfScale) / float(scale);
             const int i0 = int(std::floor(u));
             const float fx = u - float(i0);
             const int ia = std::clamp(i0, 0, lowWidth - 1),
@@ -270,7 +318,6 @@ public:
         });
         materialPass.stop();
 
-        const uint64_t pairs = mTileLights.pairCount();
         uint64_t fallbacks = 0, idFallbacks = 0;
         for (uint32_t f : rowFallbacks)
             fallbacks += f;
@@ -294,7 +341,6 @@ public:
         result.parameters["tile"] = std::to_string(mOptions.tileSizeSamples);
         result.parameters["ids"] = mOptions.objectIds ? "1" : "0";
         result.parameters["lbuffer"] = std::to_string(lowWidth) + "x" + std::to_string(lowHeight);
-        result.parameters["tile_light_pairs"] = std::to_string(pairs);
         result.parameters["dsf_fallbacks"] = std::to_string(fallbacks);
         result.parameters["dsf_id_fallbacks"] = std::to_string(idFallbacks);
     }
@@ -307,6 +353,7 @@ private:
     std::vector<LightSample> mSamples;
     std::vector<uint8_t> mExcluded; // per low-res sample: 1 = stippled (not lit by "lighting")
     std::vector<uint32_t> mSampleObjects; // object ID per low-res sample; all kNoObject with ids=0
+    bool mFrameBlended = false; // the frame has blended surfaces (stippled on its layer 0)
     MaterialPass mMaterials;
     LightIndexLists mTileLights; // per tile, ascending (buildTileLightLists)
 };
@@ -324,8 +371,9 @@ const StageRegistrar kRegistrar(
                  StageOption::integer("tile", 16, 4, 128, "culling tile size in low-res samples"),
                  StageOption::boolean("ids", true, "DSF object-ID test")},
      .listOrder = 110,
-     .msaaRefusal = "its DSF resolve already filters edges from the reduced-resolution light "
-                    "buffer; combining it with per-sample layers is not implemented yet"},
+     .msaaNote = "Kircher & Lawrance: one L-buffer per frame (layer 0's); the material pass "
+                 "rasterized at the sample count and the DSF run per fragment, resolved by "
+                 "coverage"},
     [](const StageOptions& table) {
         InferredOptions options;
         options.scale = table.integer("scale");

@@ -42,6 +42,14 @@
 // the specular part still adds a second lobe evaluation beside the diffuse one.
 // SIMT counters (simt_lane_slots, packet_*): warps of 8x4 pixels over the light pass, as
 // accumulateLights counts them (lighting/README.md, "SIMT cost model").
+// Multisampling (--msaa N; MultisampleShading.h runs the stage once per fragment layer): the
+// light buffer is the stage's per fragment layer, i.e. per sample at complex pixels only and once
+// per pixel elsewhere (the seeds' "light buffer per sample at edges": the samples of one fragment
+// have one surface, so one light); the material pass rasterizes the scene at N samples once per
+// frame, as hardware MSAA would, and combines each of its fragments with the light its layer
+// holds (MaterialPass.h: its fragments are the G-buffer's, bitwise); the resolve weights them
+// by coverage. Cost beyond 1x: the complex pixels' light, one multisampled draw and the fragment
+// split. With all-white lights the resolved image is brute's resolve up to rounding (tested).
 // Threads: tiles in parallel for culling, warp rows for lighting, rows for the material pass; every
 // pixel written by one task only, light sums in ascending light order: deterministic.
 #include "lighting/StageRegistry.h"
@@ -167,9 +175,9 @@ const StageRegistrar kRegistrar(
                                      "chromaticity of the diffuse light (Engel)"),
                  StageOption::integer("tile", 16, 4, 128, "culling tile size in pixels")},
      .listOrder = 100,
-     .msaaRefusal =
-         "its material pass rasterizes the scene again and reads the light buffer per pixel; the "
-         "per-sample light buffer at edges that the seeds describe is not implemented yet"},
+     .msaaNote = "light buffer per fragment layer: per sample at complex pixels only; the "
+                 "material pass rasterized at the sample count, its fragments combined with "
+                 "their own light and resolved by coverage"},
     [](const StageOptions& options) {
         return std::make_unique<LightPrepassStage>(options.text("spec") == "chroma",
                                                    options.integer("tile"));
