@@ -22,8 +22,8 @@
 
 namespace {
 
-const char* const kStages[] = {"brute",     "deferred", "light-indexed",
-                               "clustered", "tiled",    "tiled-backface"};
+const char* const kStages[] = {"brute", "deferred",       "light-indexed", "clustered",
+                               "tiled", "tiled-backface", "light-prepass", "inferred"};
 
 struct Sampled {
     std::vector<double> frameMs, gbufferMs;
