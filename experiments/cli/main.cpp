@@ -177,6 +177,11 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
     render.add_option("--shadow-cascades", r.shadowCascades, "directional lights' cascades, 1..8")
         ->capture_default_str();
+    render
+        .add_option("--shadow-caster-sets", r.shadowCasterSets,
+                    "on or off: draw into each light's maps only the objects that can cast onto a "
+                    "visible receiver (shadow-casting sets), or every object in range")
+        ->capture_default_str();
     render.add_option("--normal-space", r.normalSpace,
                       "space normals are encoded in: view (default) or world");
     render.add_flag(

@@ -209,21 +209,31 @@ nlohmann::json shadowsJson(const RenderRun& run) {
                           {"faces", light.faceCount},
                           {"bytes", light.bytes},
                           {"triangles_drawn", light.trianglesDrawn},
+                          {"caster_objects", light.casterObjects},
+                          {"light_in_frustum", light.lightInFrustum},
                           {"render_ms", light.renderMs}});
-    nlohmann::json shadows = {{"mode", "maps"},
-                              {"map_size", settings.mapSize},
-                              {"bias_constant_m", settings.biasConstant},
-                              {"bias_slope_texels", settings.biasSlope},
-                              {"normal_offset_texels", settings.normalOffset},
-                              {"filter", lighting::formatShadowFilter(settings.filter)},
-                              {"cascades", settings.cascades},
-                              {"shadow_lights", run.options.shadowLights},
-                              {"casting_lights", stats.castingLightCount},
-                              {"lights_with_maps", maps.shadowCount()},
-                              {"faces", stats.faceCount},
-                              {metric::kShadowMapBytes, stats.totalBytes},
-                              {"render_ms", stats.renderMs},
-                              {"per_light", lights}};
+    uint64_t casterObjects = 0;
+    for (const lighting::ShadowLightStats& light : stats.lights)
+        casterObjects += light.casterObjects;
+    nlohmann::json shadows = {
+        {"mode", "maps"},
+        {"map_size", settings.mapSize},
+        {"bias_constant_m", settings.biasConstant},
+        {"bias_slope_texels", settings.biasSlope},
+        {"normal_offset_texels", settings.normalOffset},
+        {"filter", lighting::formatShadowFilter(settings.filter)},
+        {"cascades", settings.cascades},
+        {"shadow_lights", run.options.shadowLights},
+        {"casting_lights", stats.castingLightCount},
+        {"lights_with_maps", maps.shadowCount()},
+        {"faces", stats.faceCount},
+        {"caster_sets", settings.casterSets},
+        {"objects", stats.objectCount},
+        {"caster_objects_per_light",
+         stats.lights.empty() ? 0.0 : double(casterObjects) / double(stats.lights.size())},
+        {metric::kShadowMapBytes, stats.totalBytes},
+        {"render_ms", stats.renderMs},
+        {"per_light", lights}};
     if (run.rayShadows)
         shadows["ray_bvh"] = {{"triangles", run.rayShadows->rays().triangleCount()},
                               {"build_ms", run.rayShadows->rays().buildMilliseconds()},

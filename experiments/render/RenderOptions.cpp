@@ -196,6 +196,10 @@ std::optional<lighting::ShadowSettings> shadowSettings(const RenderOptions& opti
         throw UsageError("--shadow-cascades " + std::to_string(options.shadowCascades) +
                          " refused: must be 1..8");
     settings.cascades = options.shadowCascades;
+    if (options.shadowCasterSets != "on" && options.shadowCasterSets != "off")
+        throw UsageError("--shadow-caster-sets '" + options.shadowCasterSets +
+                         "' refused: must be on or off");
+    settings.casterSets = options.shadowCasterSets == "on";
     return settings;
 }
 
@@ -253,6 +257,7 @@ std::vector<std::string> renderOptionKeys() {
             "shadow-filter",
             "shadow-lights",
             "shadow-cascades",
+            "shadow-caster-sets",
             "scene-option.<key>"};
 }
 
@@ -318,6 +323,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.shadowLights = value;
     else if (key == "shadow-cascades")
         options.shadowCascades = parseNumber<int>(key, value);
+    else if (key == "shadow-caster-sets")
+        options.shadowCasterSets = value;
     else if (key == "resolution") {
         const size_t x = value.find('x');
         if (x == std::string::npos)

@@ -91,6 +91,9 @@ struct RenderOptions {
     std::string shadowFilter = "pcf3"; // none | pcf3 | pcf5 | poisson
     std::string shadowLights = "all";  // N or all
     int shadowCascades = 1;            // directional lights' cascades, 1..8
+    // Shadow-casting sets (lighting/shadows/ShadowCasterSets.h): "on" draws into each light's
+    // maps only the objects that can cast onto a visible receiver; "off" every object in range.
+    std::string shadowCasterSets = "on";
     int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
     int repetitions = 1; // timed runs; timings are reported as median, min and max over them
 };
@@ -111,7 +114,8 @@ std::string lightsText(const RenderOptions& options);
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
 // reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, oracle,
 // shadows,
-// shadow-map-size, shadow-bias, shadow-filter, shadow-lights, shadow-cascades, and
+// shadow-map-size, shadow-bias, shadow-filter, shadow-lights, shadow-cascades,
+// shadow-caster-sets, and
 // scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
 // throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or
 // scene added later is reachable without touching the runner.

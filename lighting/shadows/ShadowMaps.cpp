@@ -2,6 +2,8 @@
 // renders and the lookup. Conventions in ShadowMaps.h.
 #include "lighting/shadows/ShadowMaps.h"
 
+#include "lighting/shadows/ShadowCasterSets.h"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -362,14 +364,68 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         maps.mShadows.push_back(std::move(shadow));
     }
 
-    // Casters per light: point and spot lights draw the triangles whose box touches their range
-    // sphere (chunk boxes first), in triangle order; directional lights draw everything.
+    // Shadow-casting sets (ShadowCasterSets.h): per light, the instances that may cast onto a
+    // visible receiver, kept within the reach of the filter's taps (the widest face texel of the
+    // light times the largest tap distance, the normal offset and a texel centre's half
+    // diagonal). Without receivers in view, or with settings.casterSets off, every instance.
+    const bool useSets = settings.casterSets && receiverFar > receiverNear && !sceneBounds.empty();
+    const std::vector<scenes::Aabb> objectBounds = instanceBounds(geometry, scene.instances.size());
+    const std::vector<glm::dvec3> frustumCorners =
+        useSets ? frustumCornersWorld(view, receiverNear, receiverFar) : std::vector<glm::dvec3>{};
+    const double sweepMetres = 1.01 * double(glm::length(sceneBounds.size())) + 1.0;
+    std::vector<std::vector<uint8_t>> mayCast(maps.mShadows.size()); // per instance; empty: all
+    std::vector<ShadowLightStats> setStats(maps.mShadows.size());
+    for (const scenes::Aabb& box : objectBounds)
+        maps.mStats.objectCount += box.empty() ? 0 : 1;
+    if (useSets)
+        tbb::parallel_for(size_t(0), maps.mShadows.size(), [&](size_t s) {
+            const Shadow& shadow = maps.mShadows[s];
+            double texelWorld = 0.0;
+            for (size_t f = shadow.firstFace; f < shadow.firstFace + shadow.faceCount; ++f) {
+                const ShadowFace& face = maps.mFaces[f];
+                if (face.empty)
+                    continue;
+                texelWorld = std::max(texelWorld,
+                                      face.orthographic
+                                          ? face.extentMetres / double(size)
+                                          : 2.0 * face.tanHalfFov * face.farMetres / double(size));
+            }
+            const double margin =
+                (kMaxTapDistanceTexels + 1.0 + double(settings.normalOffset)) * texelWorld;
+            const CasterVolume volume =
+                casterVolume(frustumCorners, scene.lights[shadow.lightIndex], sweepMetres);
+            std::vector<uint8_t>& set = mayCast[s];
+            set.resize(objectBounds.size());
+            for (size_t i = 0; i < objectBounds.size(); ++i) {
+                set[i] = volume.mayContain(objectBounds[i], margin) ? 1 : 0;
+                setStats[s].casterObjects += set[i];
+            }
+            setStats[s].lightInFrustum = volume.lightInFrustum;
+        });
+
+    // Casters per light: point and spot lights draw the triangles of their casting set whose box
+    // touches their range sphere (chunk boxes first), in triangle order; directional lights the
+    // triangles of their casting set (everything when the set holds every instance).
     std::vector<Casters> casters(maps.mShadows.size());
     tbb::parallel_for(size_t(0), maps.mShadows.size(), [&](size_t s) {
         const scenes::Light& light = scene.lights[maps.mShadows[s].lightIndex];
         Casters& set = casters[s];
+        const std::vector<uint8_t>& inSet = mayCast[s];
+        const bool everyObject = inSet.empty() || std::all_of(inSet.begin(), inSet.end(),
+                                                              [&](uint8_t in) { return in != 0; });
+        auto excluded = [&](uint32_t t) {
+            return !everyObject && !inSet[geometry.triangleInstance[t]];
+        };
         if (light.type == scenes::LightType::Directional) {
-            set.whole = true;
+            if (everyObject) {
+                set.whole = true;
+                return;
+            }
+            for (uint32_t t = 0; t < triangleCount; ++t)
+                if (!excluded(t))
+                    for (int k = 0; k < 3; ++k)
+                        set.ownPositions.push_back(
+                            geometry.positionWorld[geometry.indices[3 * t + k]]);
             return;
         }
         const glm::dvec3 centre(light.positionWorld);
@@ -379,6 +435,8 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                 continue;
             const uint32_t end = std::min(triangleCount, (c + 1) * kTrianglesPerChunk);
             for (uint32_t t = c * kTrianglesPerChunk; t < end; ++t) {
+                if (excluded(t))
+                    continue;
                 scenes::Aabb box;
                 for (int k = 0; k < 3; ++k)
                     box.extend(geometry.positionWorld[geometry.indices[3 * t + k]]);
@@ -451,6 +509,8 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         lightStats.lightIndex = shadow.lightIndex;
         lightStats.type = shadow.type;
         lightStats.faceCount = shadow.faceCount;
+        lightStats.casterObjects = useSets ? setStats[s].casterObjects : maps.mStats.objectCount;
+        lightStats.lightInFrustum = setStats[s].lightInFrustum;
         for (size_t f = shadow.firstFace; f < shadow.firstFace + shadow.faceCount; ++f) {
             lightStats.bytes += maps.mFaces[f].depth.size() * kBytesPerTexel;
             lightStats.renderMs += faceMs[f];

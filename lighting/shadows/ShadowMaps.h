@@ -1,7 +1,9 @@
 // ShadowMaps: the shadow maps of one frame (issue 29 item 1), rendered by raster::Rasterizer's
 // depth-only path (a no-op fragment function), and their scalar lookup.
 //
-// Which lights: every scene light with castsShadows that is not ambient; with a budget
+// Which objects: each light draws its shadow-casting set only (ShadowCasterSets.h; the objects
+// that can cast onto a visible receiver), and point and spot lights only the triangles within
+// their range. Which lights: every scene light with castsShadows that is not ambient; with a budget
 // (ShadowSettings::maxShadowLights = N >= 0) the N of them that matter most in view
 // (chooseLights). Per light, faces:
 //   spot         one perspective face along the axis, half-angle acos(spotOuterCos) plus a
@@ -61,6 +63,9 @@ inline constexpr double kCascadeLambda = 0.5;
 // tan(theta) of the slope bias and of the receiver plane is clamped here (84 degrees): beyond it
 // the tangent plane says nothing reliable about the depth a texel away.
 inline constexpr double kMaxBiasTan = 10.0;
+// The farthest texel centre a lookup reads from the receiver's projection, in texels: the
+// Poisson disk's radius (ShadowSettings.h; PCF 5x5 reaches 2).
+inline constexpr double kMaxTapDistanceTexels = 2.5;
 // A face's cost: mapSize^2 floats.
 inline constexpr size_t kBytesPerTexel = sizeof(float);
 
@@ -84,6 +89,10 @@ struct ShadowLightStats {
     size_t faceCount = 0;
     size_t bytes = 0;
     uint64_t trianglesDrawn = 0; // triangles submitted over all faces, after the range cull
+    // Its shadow-casting set (ShadowCasterSets.h): the instances drawn into its maps (every
+    // instance with triangles when the sets are off), and O'Rorke's case.
+    uint64_t casterObjects = 0;
+    bool lightInFrustum = false;
     // Sum of the wall time of its faces' render tasks (with faces in parallel, CPU time).
     double renderMs = 0.0;
 };
@@ -93,6 +102,7 @@ struct ShadowStats {
     size_t totalBytes = 0;
     double renderMs = 0.0;                // wall time of render(), all lights
     size_t castingLightCount = 0;         // lights that would cast without the budget
+    uint64_t objectCount = 0;             // scene instances with triangles
     std::vector<ShadowLightStats> lights; // one per shadow, in shadow index order
 };
 

@@ -58,6 +58,10 @@ struct ShadowSettings {
     // (ShadowMaps::chooseLights); -1 = all.
     int maxShadowLights = -1;
     ShadowSchedule schedule = ShadowSchedule::FacesInParallel;
+    // Shadow-casting sets (ShadowCasterSets.h): each light draws only the objects that can cast
+    // onto a visible receiver. Off: every object in range (the brute force the sets are tested
+    // against; the image is the same).
+    bool casterSets = true;
 };
 
 // The names parseShadowFilter accepts, for error messages.

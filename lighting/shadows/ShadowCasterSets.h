@@ -1,0 +1,64 @@
+// ShadowCasterSets: per shadow-casting light, the scene objects (instances) that can cast a
+// shadow onto something the camera sees: the shadow-casting sets of the forward-vs-deferred
+// dissertation (section 4.4.5), after O'Rorke ("Managing Visibility for Per-Pixel Lighting", GPU
+// Gems 2004). Only these objects are drawn into the light's shadow map (ShadowMaps.h).
+//
+// The volume. A visible receiver lies in the view frustum, clipped in depth to the scene's
+// bounds ([receiverNear, receiverFar]); a point shadows it only if it lies on the segment from the
+// receiver to the light. Those segments fill the convex hull of the frustum and the light
+// (directional: the frustum swept towards the light by the scene's diagonal, beyond which nothing
+// of the scene can be). O'Rorke's two cases are the two shapes that hull takes:
+//   light inside the frustum   the hull is the frustum itself: casters must be in view;
+//   light outside the frustum  the frustum grows towards the light (the dissertation left this
+//                              case unfinished: "the convex hull of the frustum and the light").
+// The hull is built as the planes through three of its points that have every point on one side
+// (at most 16 points: 560 triples), which needs no case analysis and is exact for both cases.
+//
+// Conservative for filtered lookups. A shadow-map lookup reads texels around the receiver's
+// projection (PCF taps up to 2.5 texels away, a receiver moved by the normal offset), whose rays
+// pass up to `marginMetres` beside the receiver; the segments to those points stay within that
+// distance of the hull (they share the light's end), so an object is kept when its bounding box
+// comes within marginMetres of the hull. An excluded object can then change no texel a visible
+// receiver reads: the image is the same with and without the sets (tested against brute force,
+// tests/lighting/shadows/shadow_caster_sets_test.cpp).
+//
+// Pure functions of their inputs; no state.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/SceneGeometry.h"
+#include "scenes/Scene.h"
+
+namespace lighting {
+
+// A convex volume as planes n.x + d <= 0 (inside), world space, n unit.
+struct CasterVolume {
+    std::vector<glm::dvec4> planes; // (n, d)
+    bool lightInFrustum = false;    // O'Rorke's case (the hull is then the frustum)
+    bool unbounded = false;         // degenerate frustum: every object is kept
+
+    // Whether `box` comes within `margin` metres of the volume (conservative: a box near a corner
+    // of the volume but outside it may be kept; none inside is dropped).
+    bool mayContain(const scenes::Aabb& box, double margin) const;
+};
+
+// The view frustum of `view` between view depths receiverNear and receiverFar, in world space
+// (8 corners: near then far, each (-x,-y), (+x,-y), (-x,+y), (+x,+y)).
+std::vector<glm::dvec3> frustumCornersWorld(const gbuffer::CameraView& view, double receiverNear,
+                                            double receiverFar);
+
+// The hull of `frustumCorners` and `light` (see the file comment); `sweepMetres` is how far a
+// directional light's frustum is swept towards the light (the scene's diagonal).
+CasterVolume casterVolume(const std::vector<glm::dvec3>& frustumCorners, const scenes::Light& light,
+                          double sweepMetres);
+
+// World-space bounds of every scene instance's triangles (empty boxes for instances without any).
+std::vector<scenes::Aabb> instanceBounds(const gbuffer::SceneGeometry& geometry,
+                                         size_t instanceCount);
+
+} // namespace lighting
