@@ -124,6 +124,15 @@ struct Fragment {
     uint8_t coverage = 1;
 };
 
+// The fragment function of a depth-only draw (shadow maps, depth pre-passes): draw() given it
+// takes the depth-only path, which finds each row's span of covered pixels from the three edge
+// functions at once (the same integer tests, so exactly the pixels the generic path covers) and
+// runs the depth test and write over the span in a loop without a fragment, with the same depth
+// values bitwise. Without multisampling only (a multisampled draw calls it per fragment).
+struct DepthOnly {
+    void operator()(const Fragment&) const {}
+};
+
 template <class T>
 inline T interpolate(const T& a, const T& b, const T& c, const glm::vec3& weights) {
     return a * weights.x + b * weights.y + c * weights.z;
@@ -388,6 +397,7 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     constexpr int64_t kHalf = kSubpixelScale / 2;
     constexpr bool kCanDiscard =
         std::is_same_v<std::invoke_result_t<FragmentFn&, const Fragment&>, bool>;
+    constexpr bool kDepthOnly = std::is_same_v<std::remove_cvref_t<FragmentFn>, DepthOnly>;
 
     // Counted in registers, stored once: a memory increment per sample costs measurably.
     uint64_t samplesCovered = 0, samplesPassed = 0;
@@ -423,6 +433,55 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
             int64_t row0 = edge(x[1], y[1], x[2], y[2], px0, py0);
             int64_t row1 = edge(x[2], y[2], x[0], y[0], px0, py0);
             int64_t row2 = edge(x[0], y[0], x[1], y[1], px0, py0);
+
+            if constexpr (kDepthOnly) {
+                const int64_t steps[3] = {stepX0, stepX1, stepX2};
+                const int64_t biases[3] = {bias0, bias1, bias2};
+                for (int py = minY; py <= maxY; ++py) {
+                    const int64_t rows[3] = {row0, row1, row2};
+                    row0 += stepY0;
+                    row1 += stepY1;
+                    row2 += stepY2;
+                    // Pixel minX + k is covered when rows[e] + biases[e] + k steps[e] >= 0 for
+                    // every edge: an interval of k, found by integer division.
+                    int64_t kLo = 0, kHi = maxX - minX;
+                    for (int e = 0; e < 3; ++e) {
+                        const int64_t v = rows[e] + biases[e], step = steps[e];
+                        if (step == 0) {
+                            if (v < 0)
+                                kHi = -1;
+                        } else if (step > 0) {
+                            if (v < 0)
+                                kLo = std::max(kLo, (-v + step - 1) / step);
+                        } else if (v < 0) {
+                            kHi = -1;
+                        } else {
+                            kHi = std::min(kHi, v / -step);
+                        }
+                    }
+                    if (kLo > kHi)
+                        continue;
+                    const int lo = minX + int(kLo), hi = minX + int(kHi);
+                    samplesCovered += uint64_t(hi - lo + 1);
+                    if (!depth) {
+                        samplesPassed += uint64_t(hi - lo + 1);
+                        continue;
+                    }
+                    float* depthRow = depth + size_t(py) * mWidth;
+                    const double zRow = t.z[0] + t.z[2] * py;
+                    const double zStep = t.z[1];
+                    const bool write = state.depthWrite;
+                    uint64_t passedHere = 0;
+                    for (int px = lo; px <= hi; ++px) {
+                        const float z = float(std::clamp(zRow + zStep * double(px), 0.0, 1.0));
+                        const bool pass = detail::depthPasses<kDepthTest>(z, depthRow[px]);
+                        passedHere += pass;
+                        depthRow[px] = pass && write ? z : depthRow[px];
+                    }
+                    samplesPassed += passedHere;
+                }
+                continue;
+            }
 
             for (int py = minY; py <= maxY; ++py) {
                 int64_t w0 = row0, w1 = row1, w2 = row2;

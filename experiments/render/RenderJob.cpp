@@ -64,8 +64,13 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
             // the frame, read by the stage through inputs.shadows.
             const Clock::time_point start = Clock::now();
             run.prepared->inputs.shadows = nullptr;
-            run.shadowMaps = std::make_unique<lighting::ShadowMaps>(lighting::ShadowMaps::render(
-                run.prepared->scene, run.prepared->geometry, run.prepared->view, *shadows));
+            lighting::ShadowMaps maps =
+                lighting::ShadowMaps::render(run.prepared->scene, run.prepared->geometry,
+                                             run.prepared->view, *shadows, run.shadowMaps.get());
+            if (run.shadowMaps)
+                *run.shadowMaps = std::move(maps); // the last frame's buffers, taken over
+            else
+                run.shadowMaps = std::make_unique<lighting::ShadowMaps>(std::move(maps));
             run.prepared->inputs.shadows = run.shadowMaps.get();
             repetition.emplace_back(lighting::pass::kShadowMaps, millisecondsSince(start));
         }

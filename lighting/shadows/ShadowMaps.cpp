@@ -177,7 +177,8 @@ std::vector<uint32_t> ShadowMaps::chooseLights(const std::vector<scenes::Light>&
 }
 
 ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
-                              const gbuffer::CameraView& view, const ShadowSettings& settings) {
+                              const gbuffer::CameraView& view, const ShadowSettings& settings,
+                              ShadowMaps* recycled) {
     const auto start = Clock::now();
     if (!(settings.mapSize >= 1 && settings.mapSize <= raster::kMaxViewportSize))
         throw std::invalid_argument("shadow map size must be in [1, " +
@@ -188,6 +189,15 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                                     std::to_string(settings.cascades));
 
     ShadowMaps maps;
+    // The depth buffers of a previous frame's maps, reused: a fresh face costs its page faults
+    // (the kernel zeroes every new page) on top of its clear.
+    std::vector<std::vector<float>> depthPool;
+    if (recycled) {
+        for (ShadowFace& face : recycled->mFaces)
+            if (face.depth.capacity() > 0)
+                depthPool.push_back(std::move(face.depth));
+        recycled->mFaces.clear();
+    }
     maps.mSettings = settings;
     maps.mShadowOfLight.assign(scene.lights.size(), kNoShadow);
     const glm::dmat4 worldFromView = glm::inverse(view.viewFromWorldExact);
@@ -466,6 +476,12 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     };
     tbb::enumerable_thread_specific<Scratch> scratches;
     std::vector<double> faceMs(maps.mFaces.size(), 0.0);
+    std::vector<std::vector<float>> pooled(maps.mFaces.size());
+    for (size_t f = 0; f < maps.mFaces.size() && !depthPool.empty(); ++f)
+        if (!maps.mFaces[f].empty) {
+            pooled[f] = std::move(depthPool.back());
+            depthPool.pop_back();
+        }
     auto renderFace = [&](size_t f) {
         ShadowFace& face = maps.mFaces[f];
         if (face.empty)
@@ -483,9 +499,10 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         const glm::mat4& clipFromWorld = jobs[f].clipFromWorld;
         for (size_t i = 0; i < positions.size(); ++i)
             scratch.clip[i] = clipFromWorld * glm::vec4(positions[i], 1.0f);
+        face.depth = std::move(pooled[f]);
         face.depth.assign(size_t(size) * size_t(size), 0.0f);
         scratch.rasterizer->draw(raster::TriangleList{scratch.clip, indices}, state,
-                                 face.depth.data(), [](const raster::Fragment&) {});
+                                 face.depth.data(), raster::DepthOnly{});
         faceMs[f] = milliseconds(faceStart);
     };
     if (settings.schedule == ShadowSchedule::FacesInParallel) {

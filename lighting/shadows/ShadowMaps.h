@@ -115,9 +115,12 @@ public:
     // result is bitwise independent of the thread count. Cost: per light the triangles within
     // its range (spot, point) or all (directional), set up once per face; memory: mapSize^2
     // floats per face. Throws std::invalid_argument for a mapSize outside [1, 16384] or
-    // cascades outside [1, 8].
+    // cascades outside [1, 8]. `recycled`, when given, is a previous frame's maps whose depth
+    // buffers the new maps take over (it is left without faces): a frame then pays no page
+    // faults for its maps, only their clear.
     static ShadowMaps render(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
-                             const gbuffer::CameraView& view, const ShadowSettings& settings);
+                             const gbuffer::CameraView& view, const ShadowSettings& settings,
+                             ShadowMaps* recycled = nullptr);
 
     // The casting lights (indices into scene.lights, ascending) that get maps under the budget
     // (casting: castsShadows and not ambient; when no light of the scene is marked, every

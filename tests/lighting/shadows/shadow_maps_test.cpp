@@ -8,6 +8,7 @@
 // schedules), no NaN, and the shadow-light budget.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -581,6 +582,40 @@ TEST(ShadowSettings, FilterNamesRoundTrip) {
         EXPECT_EQ(lighting::parseShadowFilter(lighting::formatShadowFilter(filter)), filter);
     EXPECT_FALSE(lighting::parseShadowFilter("pcf7").has_value());
     EXPECT_FALSE(lighting::parseShadowFilter("").has_value());
+}
+
+} // namespace
+
+namespace {
+
+// A frame that takes over the last frame's buffers (what the runner does every repetition)
+// renders bitwise the same maps into the same memory.
+TEST(ShadowMaps, RecycledBuffersGiveTheSameMapsInTheSameMemory) {
+    TestScene t;
+    t.ground(10.0f);
+    t.box({-1, 0, -4}, {1, 2, -3});
+    t.camera({0, 2, 3}, {0, 0, -4});
+    t.light(pointLight({0, 3, -2}, 10.0f));
+    t.light(spotLight({2, 4, 0}, {-0.3f, -1.0f, -0.5f}, 12.0f, 40.0f));
+    t.light(directionalLight({0.2f, -1.0f, -0.3f}));
+    const Frame fresh(t.scene, noFilter());
+    ShadowMaps previous = ShadowMaps::render(fresh.scene, fresh.geometry, fresh.view, noFilter());
+    std::vector<const float*> buffers;
+    for (size_t f = 0; f < previous.faceCount(); ++f)
+        if (!previous.face(f).empty)
+            buffers.push_back(previous.face(f).depth.data());
+    ASSERT_GE(buffers.size(), 8u);
+    const ShadowMaps next =
+        ShadowMaps::render(fresh.scene, fresh.geometry, fresh.view, noFilter(), &previous);
+    EXPECT_EQ(previous.faceCount(), 0u) << "the recycled maps give their faces away";
+    ASSERT_EQ(next.faceCount(), fresh.maps.faceCount());
+    for (size_t f = 0; f < next.faceCount(); ++f) {
+        EXPECT_EQ(next.face(f).depth, fresh.maps.face(f).depth) << "face " << f;
+        if (!next.face(f).empty)
+            EXPECT_NE(std::find(buffers.begin(), buffers.end(), next.face(f).depth.data()),
+                      buffers.end())
+                << "face " << f << " allocated a new buffer";
+    }
 }
 
 } // namespace
