@@ -28,6 +28,16 @@
 
 namespace lighting {
 
+// The render's per-thread scratch (ShadowMaps::mScratch): a rasterizer of the map's size and the
+// clip positions of the face being drawn.
+struct ShadowMaps::RenderScratch {
+    struct Thread {
+        std::unique_ptr<raster::Rasterizer> rasterizer;
+        std::vector<glm::vec4> clip;
+    };
+    tbb::enumerable_thread_specific<Thread> threads;
+};
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -470,11 +480,11 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     state.cullMode = raster::CullMode::None;
     state.depthTest = raster::DepthTest::Greater;
     state.barycentrics = false;
-    struct Scratch {
-        std::unique_ptr<raster::Rasterizer> rasterizer;
-        std::vector<glm::vec4> clip;
-    };
-    tbb::enumerable_thread_specific<Scratch> scratches;
+    // Per-thread rasterizers and clip buffers, taken over from the recycled maps (their bins and
+    // buffers then cost no allocation and no page fault).
+    maps.mScratch = recycled && recycled->mScratch ? std::move(recycled->mScratch)
+                                                   : std::make_shared<RenderScratch>();
+    tbb::enumerable_thread_specific<RenderScratch::Thread>& scratches = maps.mScratch->threads;
     std::vector<double> faceMs(maps.mFaces.size(), 0.0);
     std::vector<std::vector<float>> pooled(maps.mFaces.size());
     for (size_t f = 0; f < maps.mFaces.size() && !depthPool.empty(); ++f)
@@ -487,8 +497,8 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         if (face.empty)
             return;
         const auto faceStart = Clock::now();
-        Scratch& scratch = scratches.local();
-        if (!scratch.rasterizer)
+        RenderScratch::Thread& scratch = scratches.local();
+        if (!scratch.rasterizer || scratch.rasterizer->width() != size)
             scratch.rasterizer = std::make_unique<raster::Rasterizer>(size, size);
         const Casters& set = casters[jobs[f].shadow];
         const std::span<const glm::vec3> positions = set.positions(geometry);

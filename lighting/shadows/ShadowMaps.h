@@ -37,6 +37,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -116,8 +117,8 @@ public:
     // its range (spot, point) or all (directional), set up once per face; memory: mapSize^2
     // floats per face. Throws std::invalid_argument for a mapSize outside [1, 16384] or
     // cascades outside [1, 8]. `recycled`, when given, is a previous frame's maps whose depth
-    // buffers the new maps take over (it is left without faces): a frame then pays no page
-    // faults for its maps, only their clear.
+    // buffers and rasterizers the new maps take over (it is left without faces): a frame then
+    // pays no allocation or page fault for its maps, only their clear.
     static ShadowMaps render(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
                              const gbuffer::CameraView& view, const ShadowSettings& settings,
                              ShadowMaps* recycled = nullptr);
@@ -171,7 +172,10 @@ private:
     float faceVisibility(const ShadowFace& face, glm::dvec3 positionView,
                          const glm::dvec3& normalView) const;
 
+    struct RenderScratch; // per-thread rasterizers, handed from frame to frame (ShadowMaps.cpp)
+
     ShadowSettings mSettings;
+    std::shared_ptr<RenderScratch> mScratch;
     std::vector<Shadow> mShadows;
     std::vector<ShadowFace> mFaces;
     std::vector<uint32_t> mShadowOfLight; // per scene light
