@@ -517,15 +517,17 @@ void JsonSceneReader::addViews(const Json& root, const std::optional<Camera>& ob
         std::vector<Camera> keyCameras;
         for (size_t i = 0; i < keys->size(); ++i)
             keyCameras.push_back(camera((*keys)[i], elementOf("cameraPath.keys", i)));
+        std::vector<Camera> frameCameras;
         try {
-            for (const Camera& view : cameraPath(name, keyCameras, int(frames->get<int64_t>()))) {
-                // Interpolated up and forward may come close to parallel between two keys.
-                if (const std::string problem = cameraProblem(view); !problem.empty())
-                    fail("cameraPath", "frame '" + view.name + "': " + problem);
-                scene.cameras.push_back(view);
-            }
+            frameCameras = cameraPath(name, keyCameras, int(frames->get<int64_t>()));
         } catch (const SceneError& error) {
             fail("cameraPath", error.what());
+        }
+        for (const Camera& view : frameCameras) {
+            // Interpolated up and forward may come close to parallel between two keys.
+            if (const std::string problem = cameraProblem(view); !problem.empty())
+                fail("cameraPath", "frame '" + view.name + "': " + problem);
+            scene.cameras.push_back(view);
         }
     }
     makeViewNamesUnique(scene.cameras);

@@ -70,6 +70,8 @@ void expectError(const fs::path& path, const std::vector<std::string>& fragments
                                 << fragments.front();
     EXPECT_EQ(result.error.rfind(path.string() + ": ", 0), 0u) << result.error;
     EXPECT_EQ(result.error.find('\n'), std::string::npos) << result.error;
+    // Named once: a check inside a loader's catch-and-rethrow would prefix the file twice.
+    EXPECT_EQ(result.error.find(path.string(), 1), std::string::npos) << result.error;
     for (const std::string& fragment : fragments)
         EXPECT_NE(result.error.find(fragment), std::string::npos)
             << "'" << fragment << "' not in: " << result.error;
