@@ -2,12 +2,30 @@
 
 #include <cmath>
 
-#include <glm/gtc/matrix_transform.hpp>
-
 namespace scenes {
 
+glm::dmat4 Camera::viewFromWorldExact() const {
+    // glm::lookAtRH(eye, eye + forward, up) without forming eye + forward: far from the origin
+    // that sum rounds back to eye (in float from ~1e7 m, in double from ~1e15 m) and the
+    // direction recovered from it is zero or wrong. The basis comes from forward and up alone.
+    const glm::dvec3 eye(positionWorld);
+    const glm::dvec3 f = glm::normalize(glm::dvec3(forwardWorld));
+    const glm::dvec3 s = glm::normalize(glm::cross(f, glm::dvec3(upWorld)));
+    const glm::dvec3 u = glm::cross(s, f);
+    glm::dmat4 view(1.0);
+    for (int column = 0; column < 3; ++column) {
+        view[column][0] = s[column];
+        view[column][1] = u[column];
+        view[column][2] = -f[column];
+    }
+    view[3][0] = -glm::dot(s, eye);
+    view[3][1] = -glm::dot(u, eye);
+    view[3][2] = glm::dot(f, eye);
+    return view;
+}
+
 glm::mat4 Camera::viewFromWorld() const {
-    return glm::lookAtRH(positionWorld, positionWorld + forwardWorld, upWorld);
+    return glm::mat4(viewFromWorldExact());
 }
 
 uint64_t Scene::triangleCount() const {
@@ -26,68 +44,6 @@ Aabb Scene::boundsWorld() const {
     for (const Camera& camera : cameras)
         bounds.extend(camera.positionWorld);
     return bounds;
-}
-
-static bool finite(const glm::vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-void validate(const Scene& scene) {
-    auto fail = [&](const std::string& what) { throw SceneError(scene.name + ": " + what); };
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-        const Mesh& mesh = scene.meshes[m];
-        const std::string where = "mesh " + std::to_string(m) + " '" + mesh.name + "'";
-        if (mesh.indices.size() % 3 != 0)
-            fail(where + ": index count is not a multiple of 3");
-        if (mesh.normals.size() != mesh.positions.size())
-            fail(where + ": " + std::to_string(mesh.normals.size()) + " normals for " +
-                 std::to_string(mesh.positions.size()) + " positions");
-        if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
-            fail(where + ": uv count differs from position count");
-        if (!mesh.uvs1.empty() && mesh.uvs1.size() != mesh.positions.size())
-            fail(where + ": second uv set's count differs from position count");
-        if (!mesh.tangents.empty() && mesh.tangents.size() != mesh.positions.size())
-            fail(where + ": tangent count differs from position count");
-        for (uint32_t index : mesh.indices)
-            if (index >= mesh.positions.size())
-                fail(where + ": index " + std::to_string(index) + " out of range (" +
-                     std::to_string(mesh.positions.size()) + " vertices)");
-        for (const glm::vec3& p : mesh.positions)
-            if (!finite(p))
-                fail(where + ": position is NaN or infinite");
-        for (const glm::vec3& n : mesh.normals)
-            if (!finite(n))
-                fail(where + ": normal is NaN or infinite");
-        if (mesh.material >= scene.materials.size())
-            fail(where + ": material " + std::to_string(mesh.material) + " out of range");
-    }
-    for (const Material& material : scene.materials) {
-        for (int t : material.textureIndices())
-            if (t >= int(scene.textures.size()))
-                fail("material '" + material.name + "': texture index out of range");
-        for (const TextureMapping* mapping : material.textureMappings())
-            if (mapping->texCoord != 0 && mapping->texCoord != 1)
-                fail("material '" + material.name + "': texCoord " +
-                     std::to_string(mapping->texCoord) + " (only 0 and 1 are kept)");
-    }
-    for (const Instance& instance : scene.instances)
-        if (instance.mesh >= scene.meshes.size())
-            fail("instance refers to a missing mesh");
-    if (scene.cameras.empty())
-        fail("no camera");
-    for (const Camera& camera : scene.cameras) {
-        if (!finite(camera.positionWorld) || !finite(camera.forwardWorld))
-            fail("camera '" + camera.name + "' is not finite");
-        if (!(camera.nearMetres > 0.0f) || !(camera.farMetres > camera.nearMetres))
-            fail("camera '" + camera.name + "': need 0 < near < far");
-        if (!(camera.verticalFovRadians > 0.0f && camera.verticalFovRadians < 3.1f))
-            fail("camera '" + camera.name + "': vertical field of view out of (0, pi)");
-    }
-    for (const Light& light : scene.lights) {
-        if (!finite(light.positionWorld) || !finite(light.color) ||
-            !std::isfinite(light.intensity) || !(light.rangeMetres >= 0.0f))
-            fail("a light is not finite or has a negative range");
-    }
 }
 
 } // namespace scenes

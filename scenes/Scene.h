@@ -74,6 +74,8 @@ struct Camera {
     float nearMetres = 0.1f;
     float farMetres = 100.0f;
 
+    // The view matrix (lookAt), built in double from the basis; the float one is its rounding.
+    glm::dmat4 viewFromWorldExact() const;
     glm::mat4 viewFromWorld() const;
 };
 
@@ -112,8 +114,10 @@ struct Scene {
     Aabb boundsWorld() const;       // over instances
 };
 
-// Throws SceneError naming the scene when indices are out of range, attributes have the wrong
-// count, or positions are not finite. Every builder and loader calls it before returning.
+// Throws SceneError naming the scene and the element when indices are out of range, attributes
+// have the wrong count, positions are not finite, or a rule of SceneChecks.h is broken (float
+// range of composed transforms, placed bounds, radiance; degenerate cameras). Every builder and
+// loader calls it before returning (SceneChecks.cpp).
 void validate(const Scene& scene);
 
 } // namespace scenes

@@ -162,6 +162,8 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     }
     if (!run.metrics.lightCountsNote.empty())
         std::cout << "  light counts: " << run.metrics.lightCountsNote << "\n";
+    if (!run.coverage.warning.empty())
+        std::cout << "  WARNING: " << run.coverage.warning << "\n";
     std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
     for (const char* file :
          {"render.exr", "preview.png", "heatmap.png", "error.png", "reference.png", "flip.png",
@@ -560,7 +562,10 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["raster"] = rasterJson(run.prepared->rasterStats);
     if (metrics.error)
         stats["error"] = errorJson(run);
+    stats["coverage"] = run.coverage.toJson();
     stats["warnings"] = run.scene().warnings;
+    if (!run.coverage.warning.empty())
+        stats["warnings"].push_back(run.coverage.warning);
     return stats;
 }
 
@@ -664,6 +669,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
         writeRenderOutputs(run, options.out, options.scales);
         delayed.finish();
         printSummary(run, options.out);
+        if (!run.coverage.warning.empty())
+            reportWarning(run.coverage.warning);
         if (run.metrics.cpuLoad.loaded)
             reportWarning(run.metrics.cpuLoad.warning);
         return 0;

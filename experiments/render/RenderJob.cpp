@@ -265,6 +265,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
             run.prepared->inputs.exactShadows = &rayShadows(run, *plan.shadows);
         std::vector<PassTiming> passes = shadeRepetitions(
             run, *plan.stage, plan.requirements.exactSurface, plan.postAa, plan.shadows, step);
+        run.coverage = measureCoverage(*run.prepared);
 
         // The oracle and the reference are measurement, not part of the stage: timed apart.
         step("counting contributing lights (oracle)");

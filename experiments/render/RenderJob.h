@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "experiments/render/Coverage.h"
 #include "experiments/render/RenderOptions.h"
 #include "experiments/render/RenderPlan.h"
 #include "experiments/render/RunMetrics.h"
@@ -47,6 +48,8 @@ struct RenderRun {
     std::unique_ptr<lighting::shadows::RayShadows> rayShadows;
     // The maps' visibility misclassification against the rays (compared runs with shadows only).
     std::optional<lighting::shadows::ShadowErrorCounts> shadowError;
+    // Covered pixels of the last repetition, and the warning when none is (Coverage.h).
+    Coverage coverage;
 
     const scenes::Scene& scene() const { return prepared->scene; }
     const gbuffer::GBuffer& gbuffer() const { return *prepared->gbuffer; }

@@ -17,8 +17,8 @@ CameraView CameraView::fromCamera(const scenes::Camera& camera, int width, int h
     view.farMetres = camera.farMetres;
     const double aspect = double(width) / double(height);
     // Built in double, then rounded: the float matrices and the exact ones describe one camera.
-    const glm::dvec3 eye(camera.positionWorld), forward(camera.forwardWorld), up(camera.upWorld);
-    view.viewFromWorldExact = glm::lookAtRH(eye, eye + forward, up);
+    // From the camera's basis (Scene.h), never from eye + forward, which rounds to eye far out.
+    view.viewFromWorldExact = camera.viewFromWorldExact();
     glm::dmat4 clipFromViewExact =
         glm::perspectiveRH_ZO(double(camera.verticalFovRadians), aspect, double(camera.nearMetres),
                               double(camera.farMetres));

@@ -92,6 +92,15 @@ public:
 private:
     [[noreturn]] void fail(const std::string& what) const { gltf::fail(mPath, what); }
     void warn(const std::string& what);
+    // value as a float, or a SceneError naming the field (its glTF JSON path, e.g.
+    // "nodes[3].scale[0]") when it is not finite in float (scenes/input/FloatRange.h). Every
+    // number the converter stores passes through here (issue 32, class 1).
+    float narrow(double value, const std::string& field) const;
+    // A problem of SceneChecks.h (or "") as a SceneError naming the element.
+    void check(const std::string& problem, const std::string& element) const {
+        if (!problem.empty())
+            fail(element + ": " + problem);
+    }
 
     void checkExtensions() const;
     void checkSizes() const;
@@ -102,6 +111,7 @@ private:
     glm::mat4 parentFromNode(int nodeIndex) const;
     void considerCamera(int cameraIndex, const glm::mat4& worldFromCamera);
     void addCamera(int cameraIndex, const glm::mat4& worldFromCamera);
+    void setCameraBasis(Camera& camera, const glm::mat3& worldFromCamera, const std::string& field);
     void addLights();
 
     int meshFor(int meshIndex, size_t primitiveIndex);
@@ -131,6 +141,7 @@ private:
     std::map<std::pair<int, bool>, int> mTextureOf;        // (image, srgb) -> Scene::textures index
     std::vector<std::pair<int, glm::mat4>> mPlacedCameras; // (camera, worldFromCamera), walk order
     std::vector<std::pair<int, glm::mat4>> mPlacedLights;  // (KHR light, worldFromLight)
+    std::map<int, Aabb> mBoundsOfMesh; // Scene::meshes index -> object-space bounds, once each
 };
 
 } // namespace scenes::gltf

@@ -50,7 +50,9 @@
 #include <stb/stb_image.h>
 #include <tiny_gltf.h>
 
+#include "scenes/SceneChecks.h"
 #include "scenes/Viewpoints.h"
+#include "scenes/input/FloatRange.h"
 #include "scenes/input/Limits.h"
 #include "scenes/input/MessageText.h"
 #include "scenes/input/NestingDepth.h"
@@ -109,6 +111,12 @@ std::vector<uint32_t> triangleList(int mode, std::vector<uint32_t> v) {
 }
 
 } // namespace
+
+float GltfConverter::narrow(double value, const std::string& field) const {
+    if (const std::string problem = floatRangeProblem(value); !problem.empty())
+        fail(field + ": " + problem);
+    return float(value);
+}
 
 void GltfConverter::warn(const std::string& what) {
     const std::string warning = mPath.string() + ": " + what;
@@ -305,14 +313,24 @@ void GltfConverter::visitNode(int nodeIndex, const glm::mat4& worldFromParent, i
 
     const tinygltf::Node& node = mModel.nodes[size_t(nodeIndex)];
     const glm::mat4 worldFromNode = worldFromParent * parentFromNode(nodeIndex);
+    // Each node's transform is finite in float (parentFromNode); their product may not be.
+    const std::string nodeField = "nodes[" + std::to_string(nodeIndex) + "]";
+    check(transformProblem(worldFromNode), nodeField + " (composed with its ancestors)");
     if (node.mesh >= int(mModel.meshes.size()))
         fail("node " + std::to_string(nodeIndex) + ": mesh " + std::to_string(node.mesh) +
              " out of range");
     if (node.mesh >= 0) {
         for (size_t p = 0; p < mModel.meshes[size_t(node.mesh)].primitives.size(); ++p) {
             const int mesh = meshFor(node.mesh, p);
-            if (mesh >= 0)
-                mScene.instances.push_back({uint32_t(mesh), worldFromNode});
+            if (mesh < 0)
+                continue;
+            auto bounds = mBoundsOfMesh.find(mesh);
+            if (bounds == mBoundsOfMesh.end())
+                bounds = mBoundsOfMesh.emplace(mesh, boundsOf(mScene.meshes[size_t(mesh)])).first;
+            check(placedBoundsProblem(bounds->second, worldFromNode),
+                  nodeField + " (composed with its ancestors), mesh " + std::to_string(node.mesh) +
+                      " primitive " + str(p));
+            mScene.instances.push_back({uint32_t(mesh), worldFromNode});
         }
     }
     if (node.camera >= int(mModel.cameras.size()))
@@ -337,41 +355,52 @@ void GltfConverter::visitNode(int nodeIndex, const glm::mat4& worldFromParent, i
 glm::mat4 GltfConverter::parentFromNode(int nodeIndex) const {
     const tinygltf::Node& node = mModel.nodes[size_t(nodeIndex)];
     const std::string where = "node " + std::to_string(nodeIndex);
-    auto finite = [](const std::vector<double>& values) {
-        return std::all_of(values.begin(), values.end(), [](double x) { return std::isfinite(x); });
+    const std::string field = "nodes[" + std::to_string(nodeIndex) + "].";
+    // Every number as the float it is used as (narrow names the field: "nodes[2].scale[1]").
+    auto floats = [&](const std::vector<double>& values, const char* name) {
+        std::vector<float> narrowed;
+        for (size_t i = 0; i < values.size(); ++i)
+            narrowed.push_back(narrow(values[i], field + name + "[" + str(i) + "]"));
+        return narrowed;
     };
-    if (!finite(node.matrix) || !finite(node.translation) || !finite(node.rotation) ||
-        !finite(node.scale))
-        fail(where + ": transform is not finite");
-    if (!node.matrix.empty()) {
-        if (node.matrix.size() != 16)
+    const std::vector<float> matrix = floats(node.matrix, "matrix");
+    const std::vector<float> translation = floats(node.translation, "translation");
+    const std::vector<float> rotationXyzw = floats(node.rotation, "rotation");
+    const std::vector<float> scale = floats(node.scale, "scale");
+    if (!matrix.empty()) {
+        if (matrix.size() != 16)
             fail(where + ": matrix needs 16 numbers");
-        glm::dmat4 matrix;
-        std::copy(node.matrix.begin(), node.matrix.end(), glm::value_ptr(matrix));
-        return glm::mat4(matrix);
+        glm::mat4 parentFromNode;
+        std::copy(matrix.begin(), matrix.end(), glm::value_ptr(parentFromNode));
+        return parentFromNode;
     }
     glm::mat4 transform(1.0f);
-    if (!node.translation.empty()) {
-        if (node.translation.size() != 3)
+    if (!translation.empty()) {
+        if (translation.size() != 3)
             fail(where + ": translation needs 3 numbers");
-        transform = glm::translate(
-            transform, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
+        transform =
+            glm::translate(transform, glm::vec3(translation[0], translation[1], translation[2]));
     }
-    if (!node.rotation.empty()) {
-        if (node.rotation.size() != 4)
+    if (!rotationXyzw.empty()) {
+        if (rotationXyzw.size() != 4)
             fail(where + ": rotation needs 4 numbers");
         // glTF stores quaternions as (x, y, z, w); glm's constructor takes w first. Exporters
         // write them to a few digits, so they are renormalised rather than required to be unit.
-        const glm::quat rotation(float(node.rotation[3]), float(node.rotation[0]),
-                                 float(node.rotation[1]), float(node.rotation[2]));
+        // A quaternion of huge components has an infinite float length: scaled down first.
+        glm::vec4 xyzw(rotationXyzw[0], rotationXyzw[1], rotationXyzw[2], rotationXyzw[3]);
+        const float largest = glm::max(glm::max(std::abs(xyzw.x), std::abs(xyzw.y)),
+                                       glm::max(std::abs(xyzw.z), std::abs(xyzw.w)));
+        if (largest > 0.0f)
+            xyzw /= largest;
+        const glm::quat rotation(xyzw.w, xyzw.x, xyzw.y, xyzw.z);
         if (!(glm::length(rotation) > 0.0f))
             fail(where + ": rotation is a zero quaternion");
         transform *= glm::mat4_cast(glm::normalize(rotation));
     }
-    if (!node.scale.empty()) {
-        if (node.scale.size() != 3)
+    if (!scale.empty()) {
+        if (scale.size() != 3)
             fail(where + ": scale needs 3 numbers");
-        transform = glm::scale(transform, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+        transform = glm::scale(transform, glm::vec3(scale[0], scale[1], scale[2]));
     }
     return transform;
 }
@@ -391,17 +420,16 @@ void GltfConverter::considerCamera(int cameraIndex, const glm::mat4& worldFromCa
 void GltfConverter::addCamera(int cameraIndex, const glm::mat4& worldFromCamera) {
     const tinygltf::Camera& source = mModel.cameras[size_t(cameraIndex)];
     const tinygltf::PerspectiveCamera& lens = source.perspective;
+    const std::string field = "cameras[" + std::to_string(cameraIndex) + "]";
     Camera camera;
     camera.name = source.name.empty() ? "camera " + std::to_string(cameraIndex) : source.name;
-    const glm::mat3 linear(worldFromCamera);
     camera.positionWorld = glm::vec3(worldFromCamera[3]);
-    camera.forwardWorld = glm::normalize(linear * glm::vec3(0.0f, 0.0f, -1.0f));
-    camera.upWorld = glm::normalize(linear * glm::vec3(0.0f, 1.0f, 0.0f));
-    camera.verticalFovRadians = float(lens.yfov);
-    camera.nearMetres = float(lens.znear);
+    setCameraBasis(camera, glm::mat3(worldFromCamera), field);
+    camera.verticalFovRadians = narrow(lens.yfov, field + ".perspective.yfov");
+    camera.nearMetres = narrow(lens.znear, field + ".perspective.znear");
     // zfar absent (0) means infinite; see kInfiniteFarOverNear. The far plane also reaches past
     // the farthest point of the model so that nothing of it is clipped.
-    float farMetres = float(lens.zfar);
+    float farMetres = narrow(lens.zfar, field + ".perspective.zfar");
     if (!(farMetres > 0.0f)) {
         const Aabb bounds = mScene.boundsWorld();
         const glm::vec3 farthestCorner = glm::max(glm::abs(bounds.min - camera.positionWorld),
@@ -410,7 +438,45 @@ void GltfConverter::addCamera(int cameraIndex, const glm::mat4& worldFromCamera)
             std::max(kInfiniteFarOverNear * camera.nearMetres, 2.0f * glm::length(farthestCorner));
     }
     camera.farMetres = farMetres;
+    check(cameraProblem(camera), field + " ('" + camera.name + "')");
     mScene.cameras.push_back(camera);
+}
+
+// The camera looks down its node's -Z with +Y up (glTF). A transform that flattens -Z leaves no
+// viewing direction: an error. One that flattens +Y (a zero scale, or a shear onto the view
+// axis) leaves the view defined but not the image's vertical: up is then taken from +X (up =
+// X x forward), as a camera rolled by the transform's X axis would have it, with a warning.
+// Otherwise up is +Y made perpendicular to the view (Gram-Schmidt; what lookAt does anyway).
+void GltfConverter::setCameraBasis(Camera& camera, const glm::mat3& worldFromCamera,
+                                   const std::string& field) {
+    const glm::vec3 forward = worldFromCamera * glm::vec3(0.0f, 0.0f, -1.0f);
+    const float forwardLength = glm::length(forward);
+    if (!(forwardLength > 0.0f) || !std::isfinite(forwardLength))
+        fail(field + ": the world transform of its node flattens the camera's viewing axis (-Z), "
+                     "so it has no viewing direction");
+    camera.forwardWorld = forward / forwardLength;
+    // The part of an axis perpendicular to the view, if it is long enough to give a direction.
+    auto perpendicular = [&](const glm::vec3& axis) -> std::optional<glm::vec3> {
+        const float axisLength = glm::length(axis);
+        if (!(axisLength > 0.0f) || !std::isfinite(axisLength))
+            return std::nullopt;
+        const glm::vec3 unit = axis / axisLength;
+        const glm::vec3 across = unit - glm::dot(unit, camera.forwardWorld) * camera.forwardWorld;
+        if (!(glm::length(across) >= kMinUpViewSine))
+            return std::nullopt;
+        return glm::normalize(across);
+    };
+    if (const std::optional<glm::vec3> up = perpendicular(worldFromCamera[1])) {
+        camera.upWorld = *up;
+        return;
+    }
+    const std::optional<glm::vec3> right = perpendicular(worldFromCamera[0]);
+    if (!right)
+        fail(field + ": the world transform of its node flattens the camera's up (+Y) and right "
+                     "(+X) axes onto its viewing axis, so the image has no orientation");
+    camera.upWorld = glm::normalize(glm::cross(*right, camera.forwardWorld));
+    warn(field + ": the world transform of its node flattens the camera's up axis (+Y) or makes "
+                 "it parallel to the view; up is taken from the camera's right axis (+X)");
 }
 
 // KHR_lights_punctual lights, placed once the geometry is known: a light without a range is
@@ -441,11 +507,15 @@ void GltfConverter::addLights() {
         else
             fail(where + ": unknown type '" + source.type + "'");
         auto finiteNonNegative = [](double x) { return std::isfinite(x) && x >= 0.0; };
+        const std::string field =
+            "extensions.KHR_lights_punctual.lights[" + std::to_string(lightIndex) + "]";
         if (!source.color.empty()) {
             if (source.color.size() != 3 ||
                 !std::all_of(source.color.begin(), source.color.end(), finiteNonNegative))
                 fail(where + ": color needs 3 finite numbers >= 0");
-            light.color = glm::vec3(source.color[0], source.color[1], source.color[2]);
+            light.color = glm::vec3(narrow(source.color[0], field + ".color[0]"),
+                                    narrow(source.color[1], field + ".color[1]"),
+                                    narrow(source.color[2], field + ".color[2]"));
         }
         if (!finiteNonNegative(source.intensity))
             fail(where + ": intensity must be a finite number >= 0");
@@ -458,16 +528,18 @@ void GltfConverter::addLights() {
                      "outerConeAngle <= pi/2 (radians), got " + std::to_string(inner) + " and " +
                      std::to_string(outer));
         }
-        light.intensity = float(source.intensity);
+        light.intensity = narrow(source.intensity, field + ".intensity");
         light.positionWorld = glm::vec3(worldFromLight[3]);
         light.directionWorld =
             glm::normalize(glm::mat3(worldFromLight) * glm::vec3(0.0f, 0.0f, -1.0f));
         const glm::vec3 farthestCorner = glm::max(glm::abs(bounds.min - light.positionWorld),
                                                   glm::abs(bounds.max - light.positionWorld));
-        light.rangeMetres =
-            source.range > 0.0 ? float(source.range) : 1.01f * glm::length(farthestCorner);
+        light.rangeMetres = source.range > 0.0 ? narrow(source.range, field + ".range")
+                                               : 1.01f * glm::length(farthestCorner);
         light.spotInnerCos = float(std::cos(source.spot.innerConeAngle));
         light.spotOuterCos = float(std::cos(source.spot.outerConeAngle));
+        // Derived in float: colour x intensity, and a position or range the placement overflowed.
+        check(lightProblem(light), field);
         // Every punctual light of a glTF file casts shadows (issue 29: the file has no flag).
         light.castsShadows = true;
         mScene.lights.push_back(light);

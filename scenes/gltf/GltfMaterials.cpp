@@ -21,6 +21,7 @@
 #include <stb/stb_image.h>
 #include <tiny_gltf.h>
 
+#include "scenes/SceneChecks.h"
 #include "scenes/Viewpoints.h"
 #include "scenes/input/Limits.h"
 #include "scenes/input/NestingDepth.h"
@@ -54,13 +55,16 @@ uint32_t GltfConverter::materialFor(int materialIndex) {
     const tinygltf::Material& source = mModel.materials[size_t(materialIndex)];
     const tinygltf::PbrMetallicRoughness& pbr = source.pbrMetallicRoughness;
     const std::string where = "material " + std::to_string(materialIndex);
+    const std::string field = "materials[" + std::to_string(materialIndex) + "]";
     Material material;
     material.name = source.name.empty() ? where : source.name;
     material.model = MaterialModel::MetallicRoughness;
     if (pbr.baseColorFactor.size() != 4)
         fail(where + ": baseColorFactor needs 4 numbers");
-    material.baseColorFactor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
-                                         pbr.baseColorFactor[2], pbr.baseColorFactor[3]);
+    for (int c = 0; c < 4; ++c)
+        material.baseColorFactor[c] =
+            narrow(pbr.baseColorFactor[size_t(c)],
+                   field + ".pbrMetallicRoughness.baseColorFactor[" + std::to_string(c) + "]");
     if (!(pbr.metallicFactor >= 0.0 && pbr.metallicFactor <= 1.0))
         fail(where + ": metallicFactor outside [0, 1]");
     if (!(pbr.roughnessFactor >= 0.0 && pbr.roughnessFactor <= 1.0))
@@ -89,9 +93,7 @@ uint32_t GltfConverter::materialFor(int materialIndex) {
                    source.emissiveTexture.extensions, true, where + " emissiveTexture",
                    material.emissiveMapping);
 
-    if (!std::isfinite(source.normalTexture.scale))
-        fail(where + ": normalTexture.scale is not finite");
-    material.normalScale = float(source.normalTexture.scale);
+    material.normalScale = narrow(source.normalTexture.scale, field + ".normalTexture.scale");
     if (!(source.occlusionTexture.strength >= 0.0 && source.occlusionTexture.strength <= 1.0))
         fail(where + ": occlusionTexture.strength outside [0, 1]");
     material.occlusionStrength = float(source.occlusionTexture.strength);
@@ -113,7 +115,9 @@ uint32_t GltfConverter::materialFor(int materialIndex) {
                 !std::isfinite(number.GetNumberAsDouble()))
                 fail(where + ": KHR_materials_emissive_strength.emissiveStrength must be a "
                              "finite number >= 0");
-            material.emissiveStrength = float(number.GetNumberAsDouble());
+            material.emissiveStrength =
+                narrow(number.GetNumberAsDouble(),
+                       field + ".extensions.KHR_materials_emissive_strength.emissiveStrength");
         }
     }
 
@@ -127,8 +131,9 @@ uint32_t GltfConverter::materialFor(int materialIndex) {
         fail(where + ": alphaMode '" + source.alphaMode + "' (expected OPAQUE, MASK or BLEND)");
     if (!(source.alphaCutoff >= 0.0) || !std::isfinite(source.alphaCutoff))
         fail(where + ": alphaCutoff must be a finite number >= 0");
-    material.alphaCutoff = float(source.alphaCutoff);
+    material.alphaCutoff = narrow(source.alphaCutoff, field + ".alphaCutoff");
     material.doubleSided = source.doubleSided;
+    check(materialProblem(material), field + " ('" + material.name + "')");
 
     mMaterialOf[size_t(materialIndex)] = int(mScene.materials.size());
     mScene.materials.push_back(material);
@@ -151,7 +156,9 @@ int GltfConverter::textureFor(int textureIndex, int texCoord,
         auto number = [&](const tinygltf::Value& v, const std::string& field) {
             if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()))
                 fail(where + ": KHR_texture_transform." + field + " must be a finite number");
-            return float(v.GetNumberAsDouble());
+            // Finite in double is not enough: an offset of 1e39 is +Inf as the float the uvs
+            // are mapped with, and every lookup would fall back to white.
+            return narrow(v.GetNumberAsDouble(), where + ": KHR_texture_transform." + field);
         };
         auto pair = [&](const std::string& field, glm::vec2& into) {
             if (!value.Has(field))
@@ -159,7 +166,8 @@ int GltfConverter::textureFor(int textureIndex, int texCoord,
             const tinygltf::Value& array = value.Get(field);
             if (!array.IsArray() || array.ArrayLen() != 2)
                 fail(where + ": KHR_texture_transform." + field + " needs 2 numbers");
-            into = glm::vec2(number(array.Get(0), field), number(array.Get(1), field));
+            into =
+                glm::vec2(number(array.Get(0), field + "[0]"), number(array.Get(1), field + "[1]"));
         };
         pair("offset", mapping.offset);
         pair("scale", mapping.scale);

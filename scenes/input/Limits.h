@@ -65,6 +65,19 @@ inline constexpr uint64_t kMaxPixels = uint64_t(8192) * 8192;
 inline constexpr int kMaxImageChannels = 64;
 inline constexpr uint64_t kMaxImageValues = uint64_t(1) << 30;
 
+// Magnitudes of a scene's numbers, checked in float (the precision the renderer computes in) after
+// every transform is composed (scenes::validate, issue 32 class 1). A world coordinate, a light's
+// range and a camera's far plane are at most 1e15 m: lighting squares distances (|d|^2 of two
+// points up to 1e15 m apart per axis is at most 1.2e31) and the projection multiplies them by up
+// to ~1e5 more, all far below float's 3.4e38. 1e15 m is ~6700 astronomical units: no real scene
+// comes near it. A value finite in double but over float's range is refused wherever it is read.
+inline constexpr double kMaxCoordinateMetres = 1e15;
+// A light's radiance (colour x intensity, per channel) and a material's emitted radiance
+// (emissive factor x strength): at most 1e30, so that 10^6 lights (kMaxLights) summed at a pixel
+// and weighted by a BRDF's peak (~1e2 for Blinn-Phong's largest exponent) stay below float's
+// 3.4e38 instead of summing to infinity.
+inline constexpr double kMaxRadiance = 1e30;
+
 // Jobs of one sweep (after crossing axes and cases). Each job's settings are kept in memory
 // while the sweep runs (about 1 KiB per job), so 10^6 jobs are ~1 GiB.
 inline constexpr uint64_t kMaxSweepJobs = 1'000'000;

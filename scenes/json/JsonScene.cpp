@@ -24,8 +24,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
+#include "scenes/SceneChecks.h"
 #include "scenes/Viewpoints.h"
 #include "scenes/input/DuplicateKeys.h"
+#include "scenes/input/FloatRange.h"
 #include "scenes/input/Limits.h"
 #include "scenes/input/NestingDepth.h"
 #include "scenes/input/WholeFile.h"
@@ -82,6 +84,9 @@ struct Placeable {
     std::vector<Light> lights;
     // Triangles one placement draws, an instance counting at least 1 (limits::kMaxTriangles).
     uint64_t drawnTriangles = 0;
+    // Object-space bounds of the part's meshes (by the part's mesh index): each placement's
+    // composed transforms are checked against them (SceneChecks.h) before they are stored.
+    std::vector<Aabb> meshBounds;
 };
 
 // Moves `part`'s textures, materials, meshes and warnings into `scene`, rebasing their indices;
@@ -103,6 +108,7 @@ Placeable addResources(Scene& scene, Scene&& part) {
         placeable.drawnTriangles +=
             std::max<uint64_t>(1, part.meshes.at(instance.mesh).triangleCount());
     for (Mesh& mesh : part.meshes) {
+        placeable.meshBounds.push_back(boundsOf(mesh));
         mesh.material += materialOffset;
         scene.meshes.push_back(std::move(mesh));
     }
@@ -183,8 +189,25 @@ void JsonSceneReader::placeWithinLimits(Scene& scene, const Placeable& object,
     if (scene.lights.size() + object.lights.size() > size_t(limits::kMaxLights))
         fail(field, "the objects placed so far and this one bring more than " +
                         std::to_string(limits::kMaxLights) + " lights");
+    // The object's own transforms composed with this placement, checked in float (SceneChecks.h)
+    // before anything is stored: a model's node scale times the object's scale may overflow.
+    for (size_t i = 0; i < object.instances.size(); ++i) {
+        const Instance& instance = object.instances[i];
+        const std::string problem = placedBoundsProblem(object.meshBounds.at(instance.mesh),
+                                                        worldFromObject * instance.worldFromObject);
+        if (!problem.empty())
+            fail(fieldOf(field, "transform"),
+                 "composed with the object's own transforms, its instance " + std::to_string(i) +
+                     " (mesh '" + scene.meshes.at(object.meshOffset + instance.mesh).name +
+                     "'): " + problem);
+    }
     mDrawnTriangles += object.drawnTriangles;
+    const size_t firstLight = scene.lights.size();
     place(scene, object, worldFromObject);
+    for (size_t i = firstLight; i < scene.lights.size(); ++i)
+        if (const std::string problem = lightProblem(scene.lights[i]); !problem.empty())
+            fail(fieldOf(field, "transform"),
+                 "moves the object's light " + std::to_string(i - firstLight) + ": " + problem);
 }
 
 void JsonSceneReader::fail(const std::string& field, const std::string& what) const {
@@ -205,8 +228,8 @@ float JsonSceneReader::number(const Json& value, const std::string& field) const
     if (!value.is_number())
         fail(field, std::string("expected a number, got ") + value.type_name());
     const double number = value.get<double>();
-    if (std::abs(number) > std::numeric_limits<float>::max())
-        fail(field, "number out of the range of float");
+    if (const std::string problem = floatRangeProblem(number); !problem.empty())
+        fail(field, problem);
     return float(number);
 }
 
@@ -337,6 +360,8 @@ glm::mat4 JsonSceneReader::transform(const Json& value, const std::string& field
             fail(scaleField, "expected a positive number or an array of 3 positive numbers");
         worldFromObject = glm::scale(worldFromObject, scale);
     }
+    if (const std::string problem = transformProblem(worldFromObject); !problem.empty())
+        fail(field, problem);
     return worldFromObject;
 }
 
@@ -400,8 +425,12 @@ void JsonSceneReader::addObject(const Json& value, const std::string& field, Sce
         } catch (const SceneError& error) {
             fail(field, error.what());
         }
-        if (!objectCamera && !part.cameras.empty())
+        if (!objectCamera && !part.cameras.empty()) {
             objectCamera = movedCamera(part.cameras.front(), worldFromObject);
+            if (const std::string problem = cameraProblem(*objectCamera); !problem.empty())
+                fail(fieldOf(field, "transform"),
+                     "moves the object's camera '" + objectCamera->name + "': " + problem);
+        }
         placeWithinLimits(scene, addResources(scene, std::move(part)), worldFromObject, field);
     }
 }
@@ -429,8 +458,8 @@ Camera JsonSceneReader::camera(const Json& value, const std::string& field) cons
     }
     if (const Json* up = member(value, "up"))
         camera.upWorld = direction(*up, fieldOf(field, "up"));
-    if (!(glm::length(glm::cross(camera.forwardWorld, camera.upWorld)) > 1e-6f))
-        fail(fieldOf(field, "up"), "parallel to the viewing direction");
+    if (!(glm::length(glm::cross(camera.forwardWorld, camera.upWorld)) >= kMinUpViewSine))
+        fail(fieldOf(field, "up"), "parallel to the viewing direction (within 0.057 degrees)");
 
     const float fovYDegrees = member(value, "fovYDegrees")
                                   ? number(value["fovYDegrees"], fieldOf(field, "fovYDegrees"))
@@ -445,6 +474,11 @@ Camera JsonSceneReader::camera(const Json& value, const std::string& field) cons
         member(value, "far") ? positive(value["far"], fieldOf(field, "far")) : kDefaultFarMetres;
     if (!(camera.farMetres > camera.nearMetres))
         fail(field, "'far' must exceed 'near'");
+    if (const std::string problem = lengthProblem(camera.farMetres); !problem.empty())
+        fail(fieldOf(field, "far"), problem);
+    // What the fields allow one by one may still make an unusable camera (SceneChecks.h).
+    if (const std::string problem = cameraProblem(camera); !problem.empty())
+        fail(field, problem);
     return camera;
 }
 
@@ -483,11 +517,17 @@ void JsonSceneReader::addViews(const Json& root, const std::optional<Camera>& ob
         std::vector<Camera> keyCameras;
         for (size_t i = 0; i < keys->size(); ++i)
             keyCameras.push_back(camera((*keys)[i], elementOf("cameraPath.keys", i)));
+        std::vector<Camera> frameCameras;
         try {
-            for (const Camera& view : cameraPath(name, keyCameras, int(frames->get<int64_t>())))
-                scene.cameras.push_back(view);
+            frameCameras = cameraPath(name, keyCameras, int(frames->get<int64_t>()));
         } catch (const SceneError& error) {
             fail("cameraPath", error.what());
+        }
+        for (const Camera& view : frameCameras) {
+            // Interpolated up and forward may come close to parallel between two keys.
+            if (const std::string problem = cameraProblem(view); !problem.empty())
+                fail("cameraPath", "frame '" + view.name + "': " + problem);
+            scene.cameras.push_back(view);
         }
     }
     makeViewNamesUnique(scene.cameras);
@@ -557,6 +597,9 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
         light.spotInnerCos = std::cos(glm::radians(inner));
         light.spotOuterCos = std::cos(glm::radians(outer));
     }
+    // Derived in float: colour x intensity (each finite alone), position and range limits.
+    if (const std::string problem = lightProblem(light); !problem.empty())
+        fail(field, problem);
     return light;
 }
 
@@ -679,6 +722,9 @@ void JsonSceneReader::applyMaterial(const Json& value, const std::string& field,
             material.specularPower = *specularPower;
             material.roughness = roughnessForSpecularPower(*specularPower);
         }
+        // Derived in float: emissive x emissiveStrength (each finite alone).
+        if (const std::string problem = materialProblem(material); !problem.empty())
+            fail(field, "material '" + material.name + "': " + problem);
     }
     if (matched == 0) {
         std::vector<std::string> names;
@@ -728,6 +774,11 @@ void JsonSceneReader::generateLights(const Json* generator, Scene& scene) const 
                           vec3(*regionMax, fieldOf(field, "regionMax"))};
             if (glm::any(glm::greaterThan(region->min, region->max)))
                 fail(field, "'regionMin' exceeds 'regionMax'");
+            for (const char* key : {"regionMin", "regionMax"})
+                if (const std::string problem =
+                        pointProblem(key == std::string("regionMin") ? region->min : region->max);
+                    !problem.empty())
+                    fail(fieldOf(field, key), problem);
         }
         auto optionalPositive = [&](const char* key, std::optional<float>& into) {
             if (const Json* value = member(*generator, key))
@@ -735,6 +786,9 @@ void JsonSceneReader::generateLights(const Json* generator, Scene& scene) const 
         };
         optionalPositive("minRange", minRange);
         optionalPositive("maxRange", maxRange);
+        if (maxRange)
+            if (const std::string problem = lengthProblem(*maxRange); !problem.empty())
+                fail(fieldOf(field, "maxRange"), problem);
         optionalPositive("minIntensity", minIntensity);
         optionalPositive("maxIntensity", maxIntensity);
     }

@@ -30,9 +30,13 @@ seed_corpus() {
                 -exec cp -t "$corpus" {} + 2>/dev/null || true
         fi
         printf '{"asset":{"version":"2.0"}}' > "$corpus/minimal.gltf"
+        # Issue 32, classes 1 and 2: values past float's range, overflowing node chains,
+        # flattened camera transforms (tests/scenes/input/hostile-values).
+        cp "$source_dir"/tests/scenes/input/hostile-values/*.gltf "$corpus/"
         ;;
     json_scene)
         cp "$here"/corpus/json_scene/*.json "$corpus/"
+        cp "$source_dir"/tests/scenes/input/hostile-values/*.json "$corpus/"
         ;;
     sweep)
         # The first byte selects the format (odd: TOML, see sweep_fuzzer.cpp).
