@@ -4,13 +4,12 @@
 
 namespace scenes {
 
-glm::dmat4 Camera::viewFromWorldExact() const {
+glm::dmat4 viewFromBasis(const glm::dvec3& eye, const glm::dvec3& forward, const glm::dvec3& up) {
     // glm::lookAtRH(eye, eye + forward, up) without forming eye + forward: far from the origin
     // that sum rounds back to eye (in float from ~1e7 m, in double from ~1e15 m) and the
     // direction recovered from it is zero or wrong. The basis comes from forward and up alone.
-    const glm::dvec3 eye(positionWorld);
-    const glm::dvec3 f = glm::normalize(glm::dvec3(forwardWorld));
-    const glm::dvec3 s = glm::normalize(glm::cross(f, glm::dvec3(upWorld)));
+    const glm::dvec3 f = glm::normalize(forward);
+    const glm::dvec3 s = glm::normalize(glm::cross(f, up));
     const glm::dvec3 u = glm::cross(s, f);
     glm::dmat4 view(1.0);
     for (int column = 0; column < 3; ++column) {
@@ -22,6 +21,10 @@ glm::dmat4 Camera::viewFromWorldExact() const {
     view[3][1] = -glm::dot(u, eye);
     view[3][2] = glm::dot(f, eye);
     return view;
+}
+
+glm::dmat4 Camera::viewFromWorldExact() const {
+    return viewFromBasis(glm::dvec3(positionWorld), glm::dvec3(forwardWorld), glm::dvec3(upWorld));
 }
 
 glm::mat4 Camera::viewFromWorld() const {

@@ -63,6 +63,10 @@ struct Instance {
     glm::mat4 worldFromObject{1.0f};
 };
 
+// The right-handed view matrix of an eye looking along `forward` with `up` (not parallel to it):
+// glm::lookAtRH's, built from the basis alone so that it stays exact far from the origin.
+glm::dmat4 viewFromBasis(const glm::dvec3& eye, const glm::dvec3& forward, const glm::dvec3& up);
+
 // A pinhole camera. Depth conventions (reversed Z, infinite far) are chosen by the G-buffer
 // layout, not here; this only says where the camera is and what it sees.
 struct Camera {

@@ -305,7 +305,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             const glm::dmat4 clipFromLight = perspectiveReversed(1.0, nearMetres, farMetres);
             for (const auto& axes : kCube) {
                 const glm::dvec3 forward(axes[0], axes[1], axes[2]), up(axes[3], axes[4], axes[5]);
-                addFace(shadowIndex, clipFromLight, glm::lookAtRH(position, position + forward, up),
+                addFace(shadowIndex, clipFromLight, scenes::viewFromBasis(position, forward, up),
                         false, nearMetres, farMetres, 1.0, 0.0);
             }
             shadow.positionView = glm::dvec3(viewFromWorld * glm::dvec4(position, 1.0));
@@ -316,13 +316,13 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             const double tanHalf = std::tan(halfAngle) * marginScale;
             const glm::dvec3 forward = glm::normalize(glm::dvec3(light.directionWorld));
             addFace(shadowIndex, perspectiveReversed(tanHalf, nearMetres, farMetres),
-                    glm::lookAtRH(position, position + forward, upFor(forward)), false, nearMetres,
+                    scenes::viewFromBasis(position, forward, upFor(forward)), false, nearMetres,
                     farMetres, tanHalf, 0.0);
         } else { // directional
             const glm::dvec3 forward = glm::normalize(glm::dvec3(light.directionWorld));
             const glm::dvec3 centre(sceneBounds.centre());
             const glm::dmat4 lightFromWorld =
-                glm::lookAtRH(centre, centre + forward, upFor(forward));
+                scenes::viewFromBasis(centre, forward, upFor(forward));
             const glm::dmat4 lightFromView = lightFromWorld * worldFromView;
             glm::dvec3 sceneLo(std::numeric_limits<double>::max()), sceneHi(-sceneLo);
             for (const glm::dvec3& corner : sceneCornersWorld) {
