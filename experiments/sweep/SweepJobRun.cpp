@@ -137,6 +137,12 @@ Json metricColumnsOf(const RunMetrics& metrics) {
         row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
     if (metrics.error)
         row[metric::kFlipUnavailable] = metrics.error->flipUnavailable;
+    // The non-finite pixels behind inf (here null) error figures, as stats.json counts them;
+    // null without a reference.
+    row[metric::kNonFinitePixels] =
+        metrics.error ? Json(metrics.error->nonFinitePixels) : Json(nullptr);
+    row[metric::kReferenceNonFinitePixels] =
+        metrics.error ? Json(metrics.error->referenceNonFinitePixels) : Json(nullptr);
     return row;
 }
 
