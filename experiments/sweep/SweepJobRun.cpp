@@ -5,6 +5,7 @@
 #include <OpenImageIO/imagebuf.h>
 
 #include "experiments/output/ImageOutput.h"
+#include "experiments/output/StagedFolder.h"
 #include "experiments/render/RenderCommand.h"
 #include "experiments/render/RenderJob.h"
 
@@ -153,7 +154,11 @@ Json runSweepJob(const SweepJob& job, const fs::path& jobDir, ReferenceStore& re
     RenderOptions options = job.options;
     options.compareReference = job.compareReference;
     const RenderRun run = runRender(planRender(options), {}, referenceImage);
-    writeRenderOutputs(run, jobDir, {job.heatmapMax, job.errorScale, float(job.errorMax)});
+    // Staged, as `testbed render` writes: a job that fails while writing leaves its folder as it
+    // was (its marker, written by the runner, says why).
+    StagedFolder staged(jobDir);
+    writeRenderOutputs(run, staged.path(), {job.heatmapMax, job.errorScale, float(job.errorMax)});
+    staged.commit(renderOutputNames());
     return metricColumnsOf(run.metrics);
 }
 
