@@ -376,7 +376,10 @@ std::vector<std::string> writeRenderOutputs(const RenderRun& run, const std::fil
         writeShadowErrorPng(dir / "shadow-error.png", run);
         written.push_back("shadow-error.png");
     }
-    writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
+    // The peak after every image was written (the EXR header's copy was taken before).
+    nlohmann::json finalStats = stats;
+    finalStats["memory"]["measured_peak_rss_bytes"] = peakResidentBytes();
+    writeTextAtomically(dir / "stats.json", finalStats.dump(2) + "\n");
     written.push_back("stats.json");
     return written;
 }
@@ -578,6 +581,8 @@ nlohmann::json statsJson(const RenderRun& run) {
     if (metrics.error)
         stats["error"] = errorJson(run);
     stats["warnings"] = run.scene().warnings;
+    stats["memory"] = run.memory.toJson();
+    stats["memory"]["measured_peak_rss_bytes"] = peakResidentBytes();
     return stats;
 }
 
@@ -681,7 +686,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
         RenderPlan plan = planRender(options.render); // every input error stops here
         if (options.explainLayout) {
             std::cout << "stage " << options.render.stage << " on " << options.render.scene << ":\n"
-                      << plan.layout.explain() << explainMultisampleBytes(plan);
+                      << plan.layout.explain() << explainMultisampleBytes(plan)
+                      << plan.memory.explain();
             return 0;
         }
         StagedFolder staged(options.out); // before the G-buffer pass and the stage

@@ -1,5 +1,7 @@
 #include "experiments/render/RenderOptions.h"
 
+#include "experiments/render/MemoryEstimate.h"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -253,6 +255,7 @@ std::vector<std::string> renderOptionKeys() {
             "shadow-filter",
             "shadow-lights",
             "shadow-cascades",
+            "max-memory",
             "scene-option.<key>"};
 }
 
@@ -318,6 +321,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.shadowLights = value;
     else if (key == "shadow-cascades")
         options.shadowCascades = parseNumber<int>(key, value);
+    else if (key == "max-memory")
+        options.maxMemoryBytes = parseByteSize(value, "option 'max-memory'");
     else if (key == "resolution") {
         const size_t x = value.find('x');
         if (x == std::string::npos)

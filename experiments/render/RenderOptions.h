@@ -91,6 +91,9 @@ struct RenderOptions {
     std::string shadowFilter = "pcf3"; // none | pcf3 | pcf5 | poisson
     std::string shadowLights = "all";  // N or all
     int shadowCascades = 1;            // directional lights' cascades, 1..8
+    // Peak memory a render may need (MemoryEstimate.h), bytes; 0 = kDefaultMaxMemoryFraction of
+    // the machine's memory. A render estimated over it is refused before allocating.
+    uint64_t maxMemoryBytes = 0;
     int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
     int repetitions = 1; // timed runs; timings are reported as median, min and max over them
 };
@@ -111,10 +114,10 @@ std::string lightsText(const RenderOptions& options);
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
 // reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, oracle,
 // shadows,
-// shadow-map-size, shadow-bias, shadow-filter, shadow-lights, shadow-cascades, and
-// scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
-// throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or
-// scene added later is reachable without touching the runner.
+// shadow-map-size, shadow-bias, shadow-filter, shadow-lights, shadow-cascades, max-memory (bytes,
+// K/M/G/T suffixes) and scene-option.KEY. Values are checked later by validate(); a malformed
+// number or an unknown key throws UsageError naming it. The sweep runner goes through this, so
+// every stage, encoding or scene added later is reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();

@@ -36,6 +36,7 @@ RenderPlan planRender(const RenderOptions& options) {
     RenderPlan plan;
     plan.options = options;
     plan.threads = effectiveThreads(options.threads);
+    checkSceneLoadMemory(options); // a 10^6-node glTF takes a GiB to parse
     plan.scene = loadRequestedScene(options);
     plan.stage = std::move(checked.stage);
     plan.isa = checked.isa;
@@ -64,6 +65,7 @@ RenderPlan planRender(const RenderOptions& options) {
                      ? filterReads + reason.substr(kStageReads.size())
                      : filterReads + gbuffer::channelName(channel) + ": " + reason;
     }
+    plan.memory = estimateRenderMemory(options, plan.scene, plan.layout, plan.requirements);
     return plan;
 }
 
