@@ -22,6 +22,7 @@
 #include "experiments/CommandErrors.h"
 #include "experiments/output/AtomicFile.h"
 #include "experiments/output/ImageOutput.h"
+#include "experiments/output/JsonText.h"
 #include "experiments/output/Progress.h"
 #include "experiments/output/StagedFolder.h"
 #include "experiments/render/LightOrigins.h"
@@ -31,6 +32,7 @@
 #include "lighting/postaa/PostAa.h"
 #include "scenes/Scene.h"
 #include "scenes/Viewpoints.h"
+#include "scenes/input/MessageText.h"
 
 namespace experiments {
 
@@ -512,8 +514,9 @@ nlohmann::json msaaJson(const RenderRun& run) {
 nlohmann::json statsJson(const RenderRun& run) {
     const RunMetrics& metrics = run.metrics;
     nlohmann::json stats;
-    stats["scene"] = run.scene().name;
-    stats["scene_source"] = run.options.scene;
+    // Names and paths as reversible escapes (output/JsonText.h): a file name need not be UTF-8.
+    stats["scene"] = bytesForJson(run.scene().name);
+    stats["scene_source"] = bytesForJson(run.options.scene);
     stats["brdf"] = run.options.brdf;
     stats["scene_options"] = run.options.sceneOptions;
     stats["view"] = run.scene().cameras.front().name;
@@ -580,7 +583,10 @@ nlohmann::json statsJson(const RenderRun& run) {
     stats["raster"] = rasterJson(run.prepared->rasterStats);
     if (metrics.error)
         stats["error"] = errorJson(run);
-    stats["warnings"] = run.scene().warnings;
+    nlohmann::json warnings = nlohmann::json::array();
+    for (const std::string& warning : run.scene().warnings) // messages: may quote a file name
+        warnings.push_back(scenes::escapeControlCharacters(warning));
+    stats["warnings"] = warnings;
     stats["memory"] = run.memory.toJson();
     stats["memory"]["measured_peak_rss_bytes"] = peakResidentBytes();
     return stats;

@@ -41,6 +41,9 @@ struct RenderPlan {
 };
 
 RenderPlan planRender(const RenderOptions& options);
+// The same with the scene already loaded (loadRequestedScene(options)): the sweep plans every job
+// before running any (SweepPreflight.h) and loads each scene once for its jobs.
+RenderPlan planRenderWithScene(const RenderOptions& options, scenes::Scene scene);
 
 // The scene of the options (lights generated with the seed, scene options applied, the requested
 // view made cameras[0]). Throws scenes::SceneError for a bad file, option or view name.
