@@ -2,6 +2,7 @@
 #include "experiments/sweep/SweepPreflight.h"
 
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "experiments/render/RenderPlan.h"
@@ -22,6 +23,18 @@ std::string sceneKey(const RenderOptions& options) {
     return key;
 }
 
+// What the job's plan depends on: every setting but the seed, and the runs and reference. Jobs
+// with the same key get the same verdict, so a seed axis of 1000 values plans once.
+std::string planKey(const SweepJob& job) {
+    std::string key = std::to_string(job.options.warmup) + " " +
+                      std::to_string(job.options.repetitions) + " " +
+                      (job.compareReference ? "1" : "0");
+    for (const SweepSetting& setting : job.settings)
+        if (setting.key != "seed")
+            key += "\n" + setting.key + "=" + settingText(setting.value, setting.key);
+    return key;
+}
+
 } // namespace
 
 void preflightSweepJobs(const SweepExpansion& expansion, size_t first, size_t last,
@@ -30,11 +43,19 @@ void preflightSweepJobs(const SweepExpansion& expansion, size_t first, size_t la
     std::optional<scenes::Scene> loaded;
     std::string loadError;
     std::vector<std::string> errors;
+    std::unordered_map<std::string, std::string> verdicts; // plan key -> "" or the error
     size_t invalid = 0;
     for (size_t position = first; position < last; ++position) {
         const SweepJob job = expansion.job(position);
         RenderOptions options = job.options;
         options.compareReference = job.compareReference;
+        const auto [verdict, isNew] = verdicts.try_emplace(planKey(job));
+        if (!isNew) {
+            if (!verdict->second.empty() && ++invalid <= kMaxListedInvalidJobs)
+                errors.push_back("job " + job.id + " (" + describeSettings(job.settings) +
+                                 "): " + verdict->second);
+            continue;
+        }
         try {
             const std::string key = sceneKey(options);
             if (key != loadedKey) {
@@ -53,6 +74,9 @@ void preflightSweepJobs(const SweepExpansion& expansion, size_t first, size_t la
             const RenderPlan plan = planRenderWithScene(options, *loaded);
             checkMemoryEstimate(plan.memory);
         } catch (const std::exception& e) {
+            verdict->second = e.what();
+            if (verdict->second.empty())
+                verdict->second = "unknown error";
             if (++invalid <= kMaxListedInvalidJobs)
                 errors.push_back("job " + job.id + " (" + describeSettings(job.settings) +
                                  "): " + e.what());

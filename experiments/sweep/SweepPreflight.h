@@ -6,9 +6,11 @@
 // (max-memory, default a fraction of the machine's memory). Each job is planned with
 // planRenderWithScene, exactly as it will be run.
 //
-// Cost: each distinct scene (scene, scene options, lights, light density, brdf, view) is loaded
-// once, in run order (jobs sharing a reference are adjacent), one kept at a time; each job copies
-// it for its plan. Nothing is rendered and nothing is written.
+// Cost: one pass over the shard's jobs (as expandSweep's validation); jobs that differ only in
+// their seed share one plan (the seed moves generated lights, never their count or kind), and each
+// distinct scene (scene, scene options, lights, light density, brdf, view) is loaded once, in run
+// order (jobs sharing a reference are adjacent), one kept at a time; each distinct plan copies
+// it. Nothing is rendered and nothing is written.
 //
 // Errors: SweepError (exit code 2) listing the first kMaxListedInvalidJobs invalid jobs (id,
 // settings, reason) and how many there are.
