@@ -22,6 +22,7 @@
 #include "experiments/advise/Advisor.h"
 #include "experiments/cli/ListCommand.h"
 #include "experiments/compare/DiffCommand.h"
+#include "experiments/render/MemoryEstimate.h"
 #include "experiments/render/RenderCommand.h"
 #include "experiments/render/RenderPlan.h"
 #include "experiments/report/ReportCommand.h"
@@ -187,6 +188,20 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
     render.add_flag(
         "--explain-layout", options.explainLayout,
         "print the G-buffer layout and why each plane is there, then exit without rendering");
+    render
+        .add_option_function<std::string>(
+            "--max-memory",
+            [&r](const std::string& text) {
+                try {
+                    experiments::setRenderOption(r, "max-memory", text);
+                } catch (const experiments::UsageError& e) {
+                    throw CLI::ValidationError(e.what()); // reported as every parse error
+                }
+            },
+            "refuse a render whose estimated peak memory exceeds this many bytes (K, M, G, T "
+            "suffixes, powers of 1024; --explain-layout prints the estimate)")
+        ->default_str(std::to_string(int(experiments::kDefaultMaxMemoryFraction * 100)) +
+                      "% of the machine's memory");
     render.add_option("--warmup", r.warmup, "untimed runs before the timed ones")
         ->capture_default_str();
     render.add_option("--repetitions", r.repetitions, "timed runs (median, min, max are recorded)")

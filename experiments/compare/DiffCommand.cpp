@@ -22,6 +22,7 @@
 #include "experiments/compare/ImageMetrics.h"
 #include "experiments/output/AtomicFile.h"
 #include "experiments/output/ImageOutput.h"
+#include "experiments/output/JsonText.h"
 #include "experiments/output/PlotScript.h"
 #include "experiments/output/ReportHtml.h"
 #include "scenes/input/Limits.h"
@@ -598,8 +599,8 @@ json diffJson(const ImageDiff& diff, const fs::path& a, const fs::path& b) {
              {"difference",
               {{"min", c.minDifference}, {"max", c.maxDifference}, {"mean", c.meanDifference}}},
              {"abs_difference", {{"max", c.maxAbsDifference}, {"mean", c.meanAbsDifference}}}});
-    return {{"a", a.string()},
-            {"b", b.string()},
+    return {{"a", pathForJson(a)}, // reversible escapes: a file name need not be UTF-8
+            {"b", pathForJson(b)},
             {"width", diff.width},
             {"height", diff.height},
             {"metrics",

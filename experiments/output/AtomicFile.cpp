@@ -117,6 +117,10 @@ size_t removeStaleTemporaries(const fs::path& dir) {
             continue;
         if (entry.is_regular_file(ec) && fs::remove(entry.path(), ec))
             ++removed;
+        // A staging folder (StagedFolder.h) of a process killed before its commit.
+        else if (!entry.is_symlink(ec) && entry.is_directory(ec) &&
+                 fs::remove_all(entry.path(), ec) > 0)
+            ++removed;
     }
     return removed;
 }

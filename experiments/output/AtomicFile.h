@@ -20,6 +20,8 @@
 // process with that pid exists (kill(pid, 0) fails with ESRCH). A temporary of a live process, of
 // another host, or of a recycled pid (another process now has it) is left alone, so a concurrent
 // writer never loses its file; a leftover of a recycled pid is removed by a later run.
+// Staging folders of the same naming scheme (StagedFolder.h: a run's outputs before its commit)
+// are removed the same way, with their contents.
 //
 // Scope: this protects against the process failing mid-write (exception, crash, Ctrl-C). It does
 // not fsync, so after a power loss the file system decides; results are reproducible, so a rerun

@@ -417,6 +417,13 @@ const char* mapScaleName(MapScale scale) {
     return scale == MapScale::Log ? "log" : "linear";
 }
 
+std::string scaleMaximumProblem(double max) {
+    if (max >= 0.0 && std::isfinite(float(max)))
+        return "";
+    return "must be a number >= 0 that is finite as a 32-bit float (at most 3.4e38; 0 = the "
+           "image's largest value)";
+}
+
 std::pair<float, float> scalarMapRange(const float* values, size_t n, const ScalarMapStyle& style) {
     float top = style.max;
     if (!(top > 0.0f)) {
@@ -439,9 +446,9 @@ void writeScalarMapPng(const fs::path& path, int width, int height, const float*
     if (style.scale == MapScale::Log && !(style.logDecades > 0.0f && style.logDecades <= 30.0f))
         throw std::invalid_argument("cannot write " + path.string() +
                                     ": log scale needs 0 < decades <= 30");
-    if (!(style.max >= 0.0f) || !std::isfinite(style.max))
-        throw std::invalid_argument("cannot write " + path.string() +
-                                    ": the scale maximum must be finite and >= 0");
+    if (const std::string problem = scaleMaximumProblem(style.max); !problem.empty())
+        throw std::invalid_argument("cannot write " + path.string() + ": the scale maximum " +
+                                    problem);
     const size_t pixelCount = size_t(width) * height;
     // Not a structured binding: the lambda below captures both, which clang 14 (the sanitizer
     // and fuzzer builds) refuses for bindings.

@@ -131,6 +131,12 @@ struct ScalarMapStyle {
 // bottom is 0 (linear) or top / 10^logDecades (log).
 std::pair<float, float> scalarMapRange(const float* values, size_t n, const ScalarMapStyle& style);
 
+// Why `max` cannot be a ScalarMapStyle::max (a scale's top): "" when it is >= 0 and finite as the
+// float it is stored in (1e300 is finite as a double, inf as a float), else what is expected.
+// writeScalarMapPng refuses such a style; `render --error-max` and a sweep file's error-max are
+// checked with it before any work (issue 32, class 4).
+std::string scaleMaximumProblem(double max);
+
 inline constexpr int kScalarMapLegendHeight = 70; // pixels: title, colour bar, ticks, labels
 inline constexpr int kScalarMapMinWidth = 420;    // pixels: fits the title and ~8 labels
 

@@ -22,7 +22,9 @@
 #include "experiments/CommandErrors.h"
 #include "experiments/output/AtomicFile.h"
 #include "experiments/output/ImageOutput.h"
+#include "experiments/output/JsonText.h"
 #include "experiments/output/Progress.h"
+#include "experiments/output/StagedFolder.h"
 #include "experiments/render/LightOrigins.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/SupersampledReference.h"
@@ -30,6 +32,7 @@
 #include "lighting/postaa/PostAa.h"
 #include "scenes/Scene.h"
 #include "scenes/Viewpoints.h"
+#include "scenes/input/MessageText.h"
 
 namespace experiments {
 
@@ -126,7 +129,8 @@ std::string timingFigure(const RenderOptions& options) {
 }
 
 // What `testbed render` prints when done: the run, its pass medians, the error, the files.
-void printSummary(const RenderRun& run, const std::filesystem::path& out) {
+void printSummary(const RenderRun& run, const std::filesystem::path& out,
+                  const std::vector<std::string>& written) {
     std::cout << "testbed: " << run.options.stage << " on " << run.scene().name << " ("
               << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
               << " lights) at " << run.options.width << "x" << run.options.height << ", "
@@ -165,10 +169,8 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out) {
     if (!run.coverage.warning.empty())
         std::cout << "  WARNING: " << run.coverage.warning << "\n";
     std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
-    for (const char* file :
-         {"render.exr", "preview.png", "heatmap.png", "error.png", "reference.png", "flip.png",
-          "complex.png", "shadow-error.png", "stats.json"})
-        if (std::filesystem::exists(out / file))
+    for (const std::string& file : renderOutputNames())
+        if (std::find(written.begin(), written.end(), file) != written.end())
             std::cout << "  " << (out / file).string() << "\n";
 }
 
@@ -284,8 +286,23 @@ ScalarMapStyle errorMapStyle(const RenderOutputScales& scales) {
     return style;
 }
 
-void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
-                        const RenderOutputScales& scales) {
+void checkOutputScales(const RenderOutputScales& scales) {
+    if (const std::string problem = scaleMaximumProblem(scales.errorMax); !problem.empty())
+        throw UsageError("--error-max " + (std::ostringstream() << scales.errorMax).str() +
+                         " refused: " + problem);
+}
+
+const std::vector<std::string>& renderOutputNames() {
+    static const std::vector<std::string> names = {"render.exr",  "preview.png",      "heatmap.png",
+                                                   "error.png",   "reference.png",    "flip.png",
+                                                   "complex.png", "shadow-error.png", "stats.json"};
+    return names;
+}
+
+std::vector<std::string> writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
+                                            const RenderOutputScales& scales) {
+    checkOutputScales(scales);
+    std::vector<std::string> written;
     const gbuffer::GBuffer& gb = run.gbuffer();
     const int w = gb.width(), h = gb.height();
     const nlohmann::json stats = statsJson(run);
@@ -339,10 +356,13 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
          "reduced-resolution stage only filtered"},
     };
     writeMultiLayerExr(dir / "render.exr", w, h, planes, metadata);
+    written.push_back("render.exr");
     writePreviewPng(dir / "preview.png", w, h, run.result.radiance[0].data(),
                     run.result.radiance[1].data(), run.result.radiance[2].data());
+    written.push_back("preview.png");
     writeHeatmapPng(dir / "heatmap.png", w, h, run.result.lightsEvaluated.data(),
                     scales.heatmapMax);
+    written.push_back("heatmap.png");
     if (run.metrics.error) {
         writeScalarMapPng(dir / "error.png", w, h, largestChannelError(error).data(),
                           errorMapStyle(scales));
@@ -350,9 +370,13 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         // preview's tone map: the two side by side show what the error maps quantify.
         writePreviewPng(dir / "reference.png", w, h, run.reference.radiance[0].data(),
                         run.reference.radiance[1].data(), run.reference.radiance[2].data());
+        written.push_back("error.png");
+        written.push_back("reference.png");
     }
-    if (!run.flipMap.empty())
+    if (!run.flipMap.empty()) {
         writeScalarMapPng(dir / "flip.png", w, h, run.flipMap.data(), flipMapStyle());
+        written.push_back("flip.png");
+    }
     if (!complex.empty()) {
         ScalarMapStyle style;
         style.max = float(run.prepared->multisample->layers.samples());
@@ -360,10 +384,18 @@ void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
         style.title = "surfaces shaded at complex pixels (black: simple or background), " +
                       std::to_string(run.prepared->multisample->layers.samples()) + "x MSAA";
         writeScalarMapPng(dir / "complex.png", w, h, complex.data(), style);
+        written.push_back("complex.png");
     }
-    if (run.shadowError)
+    if (run.shadowError) {
         writeShadowErrorPng(dir / "shadow-error.png", run);
-    writeTextAtomically(dir / "stats.json", stats.dump(2) + "\n");
+        written.push_back("shadow-error.png");
+    }
+    // The peak after every image was written (the EXR header's copy was taken before).
+    nlohmann::json finalStats = stats;
+    finalStats["memory"]["measured_peak_rss_bytes"] = peakResidentBytes();
+    writeTextAtomically(dir / "stats.json", finalStats.dump(2) + "\n");
+    written.push_back("stats.json");
+    return written;
 }
 
 namespace {
@@ -494,8 +526,9 @@ nlohmann::json msaaJson(const RenderRun& run) {
 nlohmann::json statsJson(const RenderRun& run) {
     const RunMetrics& metrics = run.metrics;
     nlohmann::json stats;
-    stats["scene"] = run.scene().name;
-    stats["scene_source"] = run.options.scene;
+    // Names and paths as reversible escapes (output/JsonText.h): a file name need not be UTF-8.
+    stats["scene"] = bytesForJson(run.scene().name);
+    stats["scene_source"] = bytesForJson(run.options.scene);
     stats["brdf"] = run.options.brdf;
     stats["scene_options"] = run.options.sceneOptions;
     stats["view"] = run.scene().cameras.front().name;
@@ -563,9 +596,14 @@ nlohmann::json statsJson(const RenderRun& run) {
     if (metrics.error)
         stats["error"] = errorJson(run);
     stats["coverage"] = run.coverage.toJson();
-    stats["warnings"] = run.scene().warnings;
+    nlohmann::json warnings = nlohmann::json::array();
+    for (const std::string& warning : run.scene().warnings) // messages: may quote a file name
+        warnings.push_back(scenes::escapeControlCharacters(warning));
     if (!run.coverage.warning.empty())
-        stats["warnings"].push_back(run.coverage.warning);
+        warnings.push_back(scenes::escapeControlCharacters(run.coverage.warning));
+    stats["warnings"] = warnings;
+    stats["memory"] = run.memory.toJson();
+    stats["memory"]["measured_peak_rss_bytes"] = peakResidentBytes();
     return stats;
 }
 
@@ -596,12 +634,15 @@ std::vector<std::string> viewFolderNames(const std::vector<std::string>& views) 
 // what `render --view NAME --out OUT/views/FOLDER` writes (its stats.json holds its figures), and
 // OUT/views.json listing the views and their folders in the scene's order.
 int renderEveryView(const RenderCommandOptions& options) {
+    checkOutputScales(options.scales);
     RenderOptions sceneOnly = options.render;
     sceneOnly.view.clear();
     checkOptions(sceneOnly); // every input error before the scene is loaded
     const std::vector<std::string> views = scenes::viewNames(loadRequestedScene(sceneOnly));
     const std::vector<std::string> folders = viewFolderNames(views);
-    ensureWritableDirectory(options.out);
+    // Every view into one staging folder, committed when the last one is written: a view that
+    // fails leaves OUT as it was, the views rendered before it included.
+    StagedFolder staged(options.out);
     nlohmann::json index = nlohmann::json::array();
     for (size_t i = 0; i < views.size(); ++i) {
         RenderCommandOptions one = options;
@@ -609,12 +650,17 @@ int renderEveryView(const RenderCommandOptions& options) {
         one.out = options.out / "views" / folders[i];
         std::cout << "testbed: view " << (i + 1) << "/" << views.size() << " '" << views[i]
                   << "'\n";
-        const int status = runRenderCommand(one);
-        if (status != 0)
-            return status;
+        const std::filesystem::path dir = staged.path() / "views" / folders[i];
+        std::filesystem::create_directories(dir);
+        const RenderRun run = runRender(planRender(one.render));
+        const std::vector<std::string> written = writeRenderOutputs(run, dir, one.scales);
+        printSummary(run, one.out, written);
+        if (run.metrics.cpuLoad.loaded)
+            reportWarning(run.metrics.cpuLoad.warning);
         index.push_back({{"view", views[i]}, {"folder", "views/" + folders[i]}});
     }
-    writeTextAtomically(options.out / "views.json", index.dump(2) + "\n");
+    writeTextAtomically(staged.path() / "views.json", index.dump(2) + "\n");
+    staged.commit({"views.json"});
     return 0;
 }
 
@@ -656,19 +702,23 @@ int runRenderCommand(const RenderCommandOptions& options) {
         // Progress on stderr as sweeps print it, but only for a render longer than 2 s.
         DelayedProgress delayed(std::cerr, kLongRenderSeconds);
         auto progress = [&](const std::string& step) { delayed.step(step); };
+        checkOutputScales(options.scales); // every option before any work
         progress("loading scene " + options.render.scene);
         RenderPlan plan = planRender(options.render); // every input error stops here
         if (options.explainLayout) {
             std::cout << "stage " << options.render.stage << " on " << options.render.scene << ":\n"
-                      << plan.layout.explain() << explainMultisampleBytes(plan);
+                      << plan.layout.explain() << explainMultisampleBytes(plan)
+                      << plan.memory.explain();
             return 0;
         }
-        ensureWritableDirectory(options.out); // before the G-buffer pass and the stage
+        StagedFolder staged(options.out); // before the G-buffer pass and the stage
         const RenderRun run = runRender(std::move(plan), progress);
         progress("writing outputs");
-        writeRenderOutputs(run, options.out, options.scales);
+        const std::vector<std::string> written =
+            writeRenderOutputs(run, staged.path(), options.scales);
+        staged.commit(renderOutputNames());
         delayed.finish();
-        printSummary(run, options.out);
+        printSummary(run, options.out, written);
         if (!run.coverage.warning.empty())
             reportWarning(run.coverage.warning);
         if (run.metrics.cpuLoad.loaded)

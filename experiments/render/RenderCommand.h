@@ -8,13 +8,20 @@
 //                colour with a legend, linear or log scale (RenderOutputScales)
 //   flip.png     with a reference: the HDR-ꟻLIP map, magma from 0 to 1
 //   stats.json   configuration, machine, commit, timings, light counts, error metrics
-// The command plans the render (RenderPlan.h: options validated once, scene loaded, layout
-// derived), checks the output folder for writability, then runs the plan (RenderJob.h). Every
-// file is written under a temporary name and renamed, so a failed run leaves no partial output.
+// The command validates every option first (the output scales included), plans the render
+// (RenderPlan.h: options validated once, scene loaded, layout derived, peak memory estimated),
+// then runs the plan (RenderJob.h: refused before allocating when the estimate is over
+// --max-memory). Outputs are written into a staging folder inside --out and moved into place
+// only when every one of them was written (output/StagedFolder.h): a failed run leaves --out
+// byte for byte as it was (and no --out at all when it did not exist). A successful run also
+// removes the outputs of an earlier run there that it did not write (renderOutputNames), so the
+// folder never mixes two runs.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -40,6 +47,12 @@ struct RenderCommandOptions {
 
 // The style of error.png for the scales (title, colour map, scale, maximum).
 ScalarMapStyle errorMapStyle(const RenderOutputScales& scales);
+// Throws UsageError naming the option when a scale cannot be drawn (--error-max negative, NaN or
+// infinite as a float): checked before any work, not when error.png is written.
+void checkOutputScales(const RenderOutputScales& scales);
+
+// The file names a render writes into its folder (those of writeRenderOutputs).
+const std::vector<std::string>& renderOutputNames();
 
 // stats.json: the run's configuration, layout and machine, and its RunMetrics (RunMetrics.h
 // names the figures).
@@ -47,9 +60,9 @@ nlohmann::json statsJson(const RenderRun& run);
 
 // Writes render.exr (with error.R,G,B when the run was compared with a reference, and flip when
 // ꟻLIP was computed), preview.png, heatmap.png, error.png and flip.png (with a reference) and
-// stats.json into `dir` (which must exist), each atomically.
-void writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
-                        const RenderOutputScales& scales = {});
+// stats.json into `dir` (which must exist), each atomically; returns the names written.
+std::vector<std::string> writeRenderOutputs(const RenderRun& run, const std::filesystem::path& dir,
+                                            const RenderOutputScales& scales = {});
 
 // Plans, renders, writes; returns the process exit code (0 on success). Errors are reported on
 // stderr as one line starting with "testbed: error:" (CommandErrors.h) before any file is written.

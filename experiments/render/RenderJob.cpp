@@ -239,6 +239,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
             progress(what);
     };
     const RenderOptions& options = plan.options;
+    checkMemoryEstimate(plan.memory); // before the G-buffer, the stage and the reference
     if (givenReference &&
         (givenReference->width != options.width || givenReference->height != options.height))
         throw UsageError("the given reference image is " + std::to_string(givenReference->width) +
@@ -248,6 +249,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
     RenderRun run;
     run.options = options;
     run.threads = plan.threads;
+    run.memory = plan.memory;
     tbb::task_arena arena(run.threads);
     arena.execute([&] {
         step("G-buffer pass");

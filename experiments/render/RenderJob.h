@@ -50,6 +50,7 @@ struct RenderRun {
     std::optional<lighting::shadows::ShadowErrorCounts> shadowError;
     // Covered pixels of the last repetition, and the warning when none is (Coverage.h).
     Coverage coverage;
+    MemoryEstimate memory; // the plan's estimate (stats.json "memory")
 
     const scenes::Scene& scene() const { return prepared->scene; }
     const gbuffer::GBuffer& gbuffer() const { return *prepared->gbuffer; }
@@ -64,7 +65,8 @@ struct RenderRun {
 // name of each step as it starts (for a terminal display). When `reference` is given it is the
 // image the error is measured against (compareReference is implied) and no reference is rendered:
 // a sweep renders it once per scene, lights and size. Throws UsageError when the given reference
-// has another size than the render.
+// has another size than the render, and when the plan's memory estimate is over its limit (before
+// anything is allocated).
 RenderRun runRender(RenderPlan plan, const std::function<void(const std::string&)>& progress = {},
                     const lighting::StageResult* reference = nullptr);
 

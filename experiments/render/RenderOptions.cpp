@@ -1,5 +1,7 @@
 #include "experiments/render/RenderOptions.h"
 
+#include "experiments/render/MemoryEstimate.h"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -258,6 +260,7 @@ std::vector<std::string> renderOptionKeys() {
             "shadow-lights",
             "shadow-cascades",
             "shadow-caster-sets",
+            "max-memory",
             "scene-option.<key>"};
 }
 
@@ -325,6 +328,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.shadowCascades = parseNumber<int>(key, value);
     else if (key == "shadow-caster-sets")
         options.shadowCasterSets = value;
+    else if (key == "max-memory")
+        options.maxMemoryBytes = parseByteSize(value, "option 'max-memory'");
     else if (key == "resolution") {
         const size_t x = value.find('x');
         if (x == std::string::npos)

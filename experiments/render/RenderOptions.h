@@ -94,6 +94,9 @@ struct RenderOptions {
     // Shadow-casting sets (lighting/shadows/ShadowCasterSets.h): "on" draws into each light's
     // maps only the objects that can cast onto a visible receiver; "off" every object in range.
     std::string shadowCasterSets = "on";
+    // Peak memory a render may need (MemoryEstimate.h), bytes; 0 = kDefaultMaxMemoryFraction of
+    // the machine's memory. A render estimated over it is refused before allocating.
+    uint64_t maxMemoryBytes = 0;
     int warmup = 0;      // untimed runs of the G-buffer pass and the stage before the timed ones
     int repetitions = 1; // timed runs; timings are reported as median, min and max over them
 };
@@ -115,10 +118,10 @@ std::string lightsText(const RenderOptions& options);
 // reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, oracle,
 // shadows,
 // shadow-map-size, shadow-bias, shadow-filter, shadow-lights, shadow-cascades,
-// shadow-caster-sets, and
-// scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
-// throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or
-// scene added later is reachable without touching the runner.
+// shadow-caster-sets, max-memory (bytes, K/M/G/T suffixes) and scene-option.KEY. Values are
+// checked later by validate(); a malformed number or an unknown key throws UsageError naming it.
+// The sweep runner goes through this, so every stage, encoding or scene added later is reachable
+// without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();

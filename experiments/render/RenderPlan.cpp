@@ -32,11 +32,17 @@ scenes::Scene loadRequestedScene(const RenderOptions& options) {
 }
 
 RenderPlan planRender(const RenderOptions& options) {
+    checkOptions(options);         // every input error before the scene is loaded
+    checkSceneLoadMemory(options); // a 10^6-node glTF takes a GiB to parse
+    return planRenderWithScene(options, loadRequestedScene(options));
+}
+
+RenderPlan planRenderWithScene(const RenderOptions& options, scenes::Scene scene) {
     CheckedOptions checked = checkOptions(options);
     RenderPlan plan;
     plan.options = options;
     plan.threads = effectiveThreads(options.threads);
-    plan.scene = loadRequestedScene(options);
+    plan.scene = std::move(scene);
     plan.stage = std::move(checked.stage);
     plan.isa = checked.isa;
     plan.postAa = checked.postAa;
@@ -64,6 +70,7 @@ RenderPlan planRender(const RenderOptions& options) {
                      ? filterReads + reason.substr(kStageReads.size())
                      : filterReads + gbuffer::channelName(channel) + ": " + reason;
     }
+    plan.memory = estimateRenderMemory(options, plan.scene, plan.layout, plan.requirements);
     return plan;
 }
 

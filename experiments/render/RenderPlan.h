@@ -9,13 +9,15 @@
 // a channel only the filter reads says so in the layout's reasons (--explain-layout, stats.json).
 // plan.requirements stays the stage's own.
 //
-// Cost: planning loads the scene (a glTF file with its textures) but rasterizes nothing and
-// allocates no image. Errors: UsageError for bad options and a layout lacking a channel the stage
-// reads, lighting::StageError for a bad stage spec, scenes::SceneError for a bad scene file.
+// Cost: planning loads the scene (a glTF file with its textures; refused first when parsing the
+// file alone is estimated over the memory limit) but rasterizes nothing and allocates no image.
+// Errors: UsageError for bad options and a layout lacking a channel the stage reads,
+// lighting::StageError for a bad stage spec, scenes::SceneError for a bad scene file.
 #pragma once
 
 #include <memory>
 
+#include "experiments/render/MemoryEstimate.h"
 #include "experiments/render/RenderOptions.h"
 #include "gbuffer/GBufferLayout.h"
 #include "lighting/ShadingStage.h"
@@ -33,9 +35,15 @@ struct RenderPlan {
     lighting::kernel::KernelIsa isa = lighting::kernel::KernelIsa::scalar(); // options.isa
     lighting::postaa::PostAa postAa = lighting::postaa::PostAa::None;        // options.postAa
     std::optional<lighting::ShadowSettings> shadows; // options.shadow*; empty: --shadows off
+    // The run's peak memory, estimated from the scene, size, layout and stage; runRender refuses
+    // the plan before allocating when it is over its limit (MemoryEstimate.h).
+    MemoryEstimate memory;
 };
 
 RenderPlan planRender(const RenderOptions& options);
+// The same with the scene already loaded (loadRequestedScene(options)): the sweep plans every job
+// before running any (SweepPreflight.h) and loads each scene once for its jobs.
+RenderPlan planRenderWithScene(const RenderOptions& options, scenes::Scene scene);
 
 // The scene of the options (lights generated with the seed, scene options applied, the requested
 // view made cameras[0]). Throws scenes::SceneError for a bad file, option or view name.

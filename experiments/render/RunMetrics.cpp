@@ -150,6 +150,10 @@ std::vector<std::string> runFigureColumns() {
     for (const NamedFigure& figure : withError.errorFigures())
         columns.push_back(figure.name);
     columns.push_back(metric::kFlipUnavailable);
+    // How many pixels of the image and of its reference hold a NaN or Inf channel: when either
+    // is non-zero the error figures of the row are inf (null in the table) and unreliable.
+    columns.push_back(metric::kNonFinitePixels);
+    columns.push_back(metric::kReferenceNonFinitePixels);
     return columns;
 }
 

@@ -21,6 +21,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "experiments/output/JsonText.h"
 #include "experiments/sweep/SanitizerBuild.h"
 #include "experiments/sweep/SweepJobRun.h"
 
@@ -148,7 +149,7 @@ pid_t spawnJob(const fs::path& executable, const SweepJob& job, const fs::path& 
     posix_spawn_file_actions_adddup2(&actions, writeFd, kReportFd);
     const std::string parent = std::to_string(getpid());
     const std::string fd = std::to_string(kReportFd);
-    const std::string jobText = Json{{"out", out.string()}, {"job", sweepJobJson(job)}}.dump();
+    const std::string jobText = Json{{"out", pathForJson(out)}, {"job", sweepJobJson(job)}}.dump();
     const std::string program = executable.string();
     std::vector<std::string> arguments = {program,       "sweep-job", "--parent", parent,
                                           "--report-fd", fd,          jobText};
@@ -358,7 +359,7 @@ int runSweepJobCommand(const std::string& jobText, long parentPid, int reportFd)
     fs::path out;
     try {
         const Json input = Json::parse(jobText);
-        out = input.at("out").get<std::string>();
+        out = pathFromJson(input.at("out").get<std::string>());
         job = sweepJobFromJson(input.at("job"));
     } catch (const std::exception& e) {
         report(reportFd, Json{{"status", "failed"}, {"error", e.what()}});

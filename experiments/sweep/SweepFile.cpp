@@ -336,11 +336,8 @@ SweepSpec parseSweep(const Json& object, const std::string& origin) {
     }
     if (object.contains("error-max")) {
         const Json& value = object["error-max"];
-        if (!value.is_number() || !(value.get<double>() >= 0.0) ||
-            !std::isfinite(value.get<double>()))
-            failSweep(origin,
-                      "'error-max' must be a number >= 0 (0 = each image's largest error), got " +
-                          value.dump());
+        if (!value.is_number() || !scaleMaximumProblem(value.get<double>()).empty())
+            failSweep(origin, "'error-max' " + scaleMaximumProblem(-1.0) + ", got " + value.dump());
         spec.errorMax = value.get<double>();
     }
     if (object.contains("error-scale")) {

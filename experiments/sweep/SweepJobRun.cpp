@@ -5,6 +5,7 @@
 #include <OpenImageIO/imagebuf.h>
 
 #include "experiments/output/ImageOutput.h"
+#include "experiments/output/StagedFolder.h"
 #include "experiments/render/RenderCommand.h"
 #include "experiments/render/RenderJob.h"
 
@@ -137,6 +138,12 @@ Json metricColumnsOf(const RunMetrics& metrics) {
         row[figure.name] = number(figure.value); // psnr +inf (identical images) -> null
     if (metrics.error)
         row[metric::kFlipUnavailable] = metrics.error->flipUnavailable;
+    // The non-finite pixels behind inf (here null) error figures, as stats.json counts them;
+    // null without a reference.
+    row[metric::kNonFinitePixels] =
+        metrics.error ? Json(metrics.error->nonFinitePixels) : Json(nullptr);
+    row[metric::kReferenceNonFinitePixels] =
+        metrics.error ? Json(metrics.error->referenceNonFinitePixels) : Json(nullptr);
     return row;
 }
 
@@ -147,7 +154,11 @@ Json runSweepJob(const SweepJob& job, const fs::path& jobDir, ReferenceStore& re
     RenderOptions options = job.options;
     options.compareReference = job.compareReference;
     const RenderRun run = runRender(planRender(options), {}, referenceImage);
-    writeRenderOutputs(run, jobDir, {job.heatmapMax, job.errorScale, float(job.errorMax)});
+    // Staged, as `testbed render` writes: a job that fails while writing leaves its folder as it
+    // was (its marker, written by the runner, says why).
+    StagedFolder staged(jobDir);
+    writeRenderOutputs(run, staged.path(), {job.heatmapMax, job.errorScale, float(job.errorMax)});
+    staged.commit(renderOutputNames());
     return metricColumnsOf(run.metrics);
 }
 

@@ -10,12 +10,15 @@
 
 #include "experiments/CommandErrors.h"
 #include "experiments/output/AtomicFile.h"
+#include "experiments/output/JsonText.h"
 #include "experiments/output/Progress.h"
 #include "experiments/sweep/JobProcess.h"
 #include "experiments/sweep/ResultsTable.h"
 #include "experiments/sweep/SweepFile.h"
 #include "experiments/sweep/SweepJobRun.h"
 #include "experiments/sweep/SweepLock.h"
+#include "experiments/sweep/SweepPreflight.h"
+#include "scenes/input/MessageText.h"
 #include "scenes/input/WholeFile.h"
 
 namespace experiments {
@@ -120,6 +123,8 @@ public:
         mExpansion = expandSweep(spec, mOptions.threads);
         const auto [first, last] =
             shardRange(mExpansion.size(), mOptions.shardIndex, mOptions.shardCount);
+        // Every job planned against its scene (and its memory estimate) before DIR is touched.
+        preflightSweepJobs(mExpansion, first, last, spec.origin);
         ensureWritableDirectory(mOptions.out);
         const SweepLock lock(mOptions.out, first, last, mOptions.waitForLock, mLog);
         fs::create_directories(mOptions.out / "jobs");
@@ -222,7 +227,8 @@ private:
             for (const auto& [column, value] : metrics.items())
                 row[column] = value;
         } catch (const std::exception& e) {
-            error = e.what();
+            // A message (it may quote a file name that is not UTF-8): escaped for JSON.
+            error = scenes::escapeControlCharacters(e.what());
             if (error.empty())
                 error = "unknown error";
             row["status"] = "failed";
@@ -287,8 +293,9 @@ private:
                 rows.push_back(std::move(*row));
         }
         mSummary.rowsInTable = rows.size();
-        writeResults(mOptions.out, resultsJson(mSpec.source, mOptions.file.string(), mOptions.quick,
-                                               mExpansion.axisColumns(), std::move(rows)));
+        writeResults(mOptions.out,
+                     resultsJson(mSpec.source, pathForJson(mOptions.file), mOptions.quick,
+                                 mExpansion.axisColumns(), std::move(rows)));
         mLastRebuild = Clock::now();
         mLastRebuildSeconds = secondsSince(start);
     }

@@ -1,6 +1,8 @@
 // SweepRunner: `testbed sweep FILE --out DIR`: expands a sweep file (SweepFile.h, jobs made on
-// demand), validates every job before running any, locks the shard's jobs in DIR against a second
-// sweep (SweepLock.h), then runs the jobs of this shard one after the other:
+// demand), validates every job before running any (its options, then its plan against its scene
+// and its memory estimate: SweepPreflight.h) and before DIR is created or touched, locks the
+// shard's jobs in DIR against a second sweep (SweepLock.h), then runs the jobs of this shard one
+// after the other:
 //   - isolation: the CLI runs each job in a child process (JobProcess.h), so a job that crashes,
 //     aborts or is killed (SIGKILL by the out-of-memory killer) is recorded as failed with its
 //     signal and the sweep goes on; tests may run jobs in this process (JobIsolation::InProcess);

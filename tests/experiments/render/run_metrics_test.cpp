@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "experiments/render/RenderJob.h"
 #include "experiments/render/RunMetrics.h"
 #include "experiments/sweep/ResultsTable.h"
+#include "experiments/sweep/SweepJobRun.h"
 #include "lighting/StageRegistry.h"
 
 namespace {
@@ -173,7 +175,27 @@ TEST(RunMetrics, TheTableColumnsAreTheRecordsFigures) {
                                                  "flip_weighted_median",
                                                  "flip_p95",
                                                  "flip_p99",
-                                                 "flip_unavailable"}));
+                                                 "flip_unavailable",
+                                                 "non_finite_pixels",
+                                                 "reference_non_finite_pixels"}));
+}
+
+// Issue 32 (class 3): a sweep's row counts the non-finite pixels of the image and of its
+// reference, as stats.json does, so that a null (inf) error figure in the table says why; without
+// a reference both are null.
+TEST(RunMetrics, SweepRowsCountNonFinitePixels) {
+    RunMetrics metrics;
+    nlohmann::ordered_json row = experiments::metricColumnsOf(metrics);
+    EXPECT_TRUE(row.at("non_finite_pixels").is_null());
+    EXPECT_TRUE(row.at("reference_non_finite_pixels").is_null());
+    metrics.error = experiments::ErrorMetrics{};
+    metrics.error->nonFinitePixels = 3;
+    metrics.error->referenceNonFinitePixels = 1;
+    metrics.error->rmse = std::numeric_limits<double>::infinity();
+    row = experiments::metricColumnsOf(metrics);
+    EXPECT_EQ(row.at("non_finite_pixels"), 3);
+    EXPECT_EQ(row.at("reference_non_finite_pixels"), 1);
+    EXPECT_TRUE(row.at("rmse").is_null()); // inf: unreliable, and the counts say why
 }
 
 } // namespace

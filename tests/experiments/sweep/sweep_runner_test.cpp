@@ -128,8 +128,49 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
         EXPECT_EQ(redone[metric], victim[metric]) << metric;
 }
 
+// A job that fails while it runs (here: its reference cannot be cached, a folder is where the
+// reference EXR goes) is recorded as failed and the sweep goes on; a rerun retries it.
 TEST(SweepRunner, FailingJobIsRecordedAndTheSweepGoesOn) {
     const fs::path dir = testDir("failing");
+    Json sweep = tinySweep();
+    sweep["axes"] = Json::object();
+    sweep["axes"]["scene"] = Json::array({"spheres", "wall"});
+    sweep["fixed"]["stage"] = "brute";
+    sweep["fixed"]["lights"] = 4;
+    sweep["fixed"].erase("scene");
+    const fs::path file = writeSweep(dir, sweep);
+    const std::vector<experiments::SweepJob> jobs =
+        experiments::expandSweep(experiments::readSweepFile(file)).jobs();
+    ASSERT_EQ(jobs.size(), 2u);
+    const fs::path blocker = dir / "out" / "references" / (jobs[1].referenceKey + ".exr");
+    fs::create_directories(blocker);
+    const auto summary = run(file, dir / "out");
+    EXPECT_EQ(summary.ran, 2u);
+    EXPECT_EQ(summary.failed, 1u);
+    const Json results = experiments::readResults(dir / "out");
+    ASSERT_EQ(results["jobs"].size(), 2u);
+    EXPECT_EQ(results["jobs"][0]["status"], "ok");
+    EXPECT_EQ(results["jobs"][1]["status"], "failed");
+    EXPECT_NE(results["jobs"][1]["error"].get<std::string>().find(jobs[1].referenceKey),
+              std::string::npos)
+        << results["jobs"][1]["error"];
+    EXPECT_TRUE(results["jobs"][1]["time_total_median_ms"].is_null());
+
+    experiments::SweepOptions options;
+    options.file = file;
+    options.out = dir / "out";
+    EXPECT_EQ(experiments::runSweepCommand(options), 1) << "a failed job must fail the command";
+    fs::remove_all(blocker);
+    const auto retried = run(file, dir / "out"); // the failed job is retried, the ok one skipped
+    EXPECT_EQ(retried.skipped, 1u);
+    EXPECT_EQ(retried.ran, 1u);
+    EXPECT_EQ(retried.failed, 0u);
+}
+
+// A scene file that cannot be loaded is found before any job runs (issue 32, class 4), with the
+// job, the file and the reason; the output folder is not created.
+TEST(SweepRunner, ABrokenSceneIsRefusedBeforeAnyJobRuns) {
+    const fs::path dir = testDir("broken-scene");
     std::ofstream(dir / "broken.json") << "{ this is not a scene";
     Json sweep = tinySweep();
     sweep["axes"] = Json::object();
@@ -138,24 +179,16 @@ TEST(SweepRunner, FailingJobIsRecordedAndTheSweepGoesOn) {
     sweep["fixed"]["lights"] = 4;
     sweep["fixed"].erase("scene");
     const fs::path file = writeSweep(dir, sweep);
-    const auto summary = run(file, dir / "out");
-    EXPECT_EQ(summary.ran, 2u);
-    EXPECT_EQ(summary.failed, 1u);
-    const Json results = experiments::readResults(dir / "out");
-    ASSERT_EQ(results["jobs"].size(), 2u);
-    EXPECT_EQ(results["jobs"][0]["status"], "ok");
-    EXPECT_EQ(results["jobs"][1]["status"], "failed");
-    EXPECT_NE(results["jobs"][1]["error"].get<std::string>().find("broken.json"), std::string::npos)
-        << results["jobs"][1]["error"];
-    EXPECT_TRUE(results["jobs"][1]["time_total_median_ms"].is_null());
-
-    experiments::SweepOptions options;
-    options.file = file;
-    options.out = dir / "out";
-    EXPECT_EQ(experiments::runSweepCommand(options), 1) << "a failed job must fail the command";
-    const auto retried = run(file, dir / "out"); // the failed job is retried, the ok one skipped
-    EXPECT_EQ(retried.skipped, 1u);
-    EXPECT_EQ(retried.ran, 1u);
+    try {
+        run(file, dir / "out");
+        FAIL() << "a sweep with a broken scene ran";
+    } catch (const experiments::SweepError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("1 of 2 jobs cannot run; nothing was run"), std::string::npos)
+            << message;
+        EXPECT_NE(message.find("broken.json: invalid JSON"), std::string::npos) << message;
+    }
+    EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 TEST(SweepRunner, InvalidSweepRunsNothing) {
