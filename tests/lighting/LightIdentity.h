@@ -4,13 +4,15 @@
 // instead; the identity check cannot be fooled that way. The evaluated lights come from the
 // stage's light trace (StageResult::traceLights), the contributing ones from
 // lighting::ContributingLights on the same G-buffer; for blended fragments from the stage's
-// blendedTrace and BlendedPass::contributingLights on each fragment's surface.
+// blendedTrace and BlendedPass::contributingLights on each fragment's surface. Also the relative
+// RMSE the approximate and multisampled stages' tests measure with.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <sstream>
 #include <string>
@@ -181,6 +183,19 @@ everyBlendedContributingLightEvaluated(const lighting::StageResult& result,
     return ::testing::AssertionFailure()
            << badPixels << " pixels fail, " << missingPairs
            << " contributing (blended fragment, light) pairs dropped:" << failures.str();
+}
+
+// RMSE over every pixel and channel divided by the RMS of `truth` (a black truth divides by
+// 1e-30: an image that differs from it never scores 0).
+inline double relativeRmse(const lighting::StageResult& image, const lighting::StageResult& truth) {
+    double error = 0.0, energy = 0.0;
+    for (int c = 0; c < 3; ++c)
+        for (size_t p = 0; p < truth.radiance[c].size(); ++p) {
+            const double d = double(image.radiance[c][p]) - double(truth.radiance[c][p]);
+            error += d * d;
+            energy += double(truth.radiance[c][p]) * double(truth.radiance[c][p]);
+        }
+    return std::sqrt(error / std::max(energy, 1e-30));
 }
 
 // Success when every radiance value has the same bits in both images; failures name up to five

@@ -265,17 +265,7 @@ std::unique_ptr<lighting::PreparedScene> whiteLightFrame(const SceneCase& c) {
         gbuffer::GBufferLayout::lossless(gbuffer::DepthConvention::Reversed), multisampling);
 }
 
-// Relative RMSE of `image` against `truth` over every pixel and channel.
-double relativeRmse(const lighting::StageResult& image, const lighting::StageResult& truth) {
-    double error = 0.0, energy = 0.0;
-    for (int c = 0; c < 3; ++c)
-        for (size_t i = 0; i < truth.radiance[c].size(); ++i) {
-            const double d = double(image.radiance[c][i]) - double(truth.radiance[c][i]);
-            error += d * d;
-            energy += double(truth.radiance[c][i]) * double(truth.radiance[c][i]);
-        }
-    return std::sqrt(error / std::max(energy, 1e-30));
-}
+using stagecheck::relativeRmse;
 
 TEST(MaterialPassStages, LightPrepassWithWhiteLightsResolvesLikeBrute) {
     for (const SceneCase& c : kScenes) {

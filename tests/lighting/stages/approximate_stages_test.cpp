@@ -26,6 +26,7 @@
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "scenes/procedural/ProceduralScenes.h"
+#include "tests/lighting/LightIdentity.h"
 
 namespace {
 
@@ -85,17 +86,7 @@ const Case& atrium() {
     return frame("atrium", false);
 }
 
-// RMSE over all pixels and channels divided by the RMS of `truth`.
-double relativeRmse(const lighting::StageResult& image, const lighting::StageResult& truth) {
-    double error = 0.0, energy = 0.0;
-    for (int c = 0; c < 3; ++c)
-        for (size_t i = 0; i < truth.radiance[c].size(); ++i) {
-            const double d = double(image.radiance[c][i]) - double(truth.radiance[c][i]);
-            error += d * d;
-            energy += double(truth.radiance[c][i]) * truth.radiance[c][i];
-        }
-    return energy > 0.0 ? std::sqrt(error / energy) : 0.0;
-}
+using stagecheck::relativeRmse;
 
 // What an image of zeros scores against `truth` (1.0 whenever truth is not black).
 double blackImageScore(const lighting::StageResult& truth) {

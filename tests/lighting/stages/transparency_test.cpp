@@ -80,16 +80,7 @@ lighting::StageResult render(const lighting::PreparedScene& frame, const std::st
     return result;
 }
 
-double relativeRmse(const lighting::StageResult& image, const lighting::StageResult& reference) {
-    double error = 0.0, energy = 0.0;
-    for (int c = 0; c < 3; ++c)
-        for (size_t p = 0; p < reference.radiance[c].size(); ++p) {
-            const double d = double(image.radiance[c][p]) - double(reference.radiance[c][p]);
-            error += d * d;
-            energy += double(reference.radiance[c][p]) * double(reference.radiance[c][p]);
-        }
-    return std::sqrt(error / std::max(energy, 1e-30));
-}
+using stagecheck::relativeRmse;
 
 const lighting::PreparedScene& glassFrame() {
     static const auto frame =
