@@ -1,10 +1,14 @@
 // Test helper: runs the built testbed binary with arguments through the shell and returns its
-// exit code and its combined stdout and stderr, for the CLI-level tests of tests/experiments/.
+// exit code and its combined stdout and stderr (or both apart: runSeparately), for the CLI-level
+// tests of tests/experiments/.
 #pragma once
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <sys/wait.h>
 
@@ -31,6 +35,37 @@ inline CliRun run(const std::string& arguments) {
     const int status = pclose(pipe);
     result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return result;
+}
+
+// A run with stdout and stderr apart, for tests that check which stream a line goes to.
+struct SeparateRun {
+    int exitCode = -1; // 128 + signal when killed
+    std::string stdoutText;
+    std::string stderrText;
+};
+
+// `testbed ARGUMENTS` with no stdin, killed after timeoutSeconds (a hang detector, not a timing);
+// its streams go through files in `dir`.
+inline SeparateRun runSeparately(const std::string& arguments, const std::filesystem::path& dir,
+                                 int timeoutSeconds = 20) {
+    const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+    const std::string command = "timeout -s KILL " + std::to_string(timeoutSeconds) + " " +
+                                kTestbed.string() + " " + arguments + " > '" + out.string() +
+                                "' 2> '" + err.string() + "' < /dev/null";
+    const int status = std::system(command.c_str());
+    auto read = [](const std::filesystem::path& path) {
+        std::ifstream file(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(file), {});
+    };
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), read(out), read(err)};
+}
+
+// Lines in `text` (newline characters).
+inline int lineCount(const std::string& text) {
+    int count = 0;
+    for (char c : text)
+        count += c == '\n';
+    return count;
 }
 
 } // namespace clitest

@@ -17,6 +17,7 @@
 
 #include "experiments/output/ReportHtml.h"
 #include "tests/experiments/TestFolders.h"
+#include "tests/experiments/cli/CliRun.h"
 
 namespace experiments {
 namespace {
@@ -25,32 +26,14 @@ namespace fs = std::filesystem;
 using experiments::test_files::freshTestFolder;
 using experiments::test_files::readText;
 
-const fs::path kTestbed = fs::path(TESTBED_BINARY_DIR) / "bin" / "testbed";
-// A hang detector, not a timing: every case here fails in well under a second.
-constexpr int kTimeoutSeconds = 20;
-
-struct CommandResult {
-    int exitCode;
-    std::string stderrText;
-};
+using clitest::kTestbed;
+using CommandResult = clitest::SeparateRun;
+using clitest::lineCount;
 
 CommandResult runTestbed(const std::string& args, const fs::path& dir) {
-    const fs::path errors = dir / "stderr.txt";
-    const std::string command = "timeout -s KILL " + std::to_string(kTimeoutSeconds) + " " +
-                                kTestbed.string() + " " + args + " > /dev/null 2> " +
-                                errors.string() + " < /dev/null";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), readText(errors)};
+    return clitest::runSeparately(args, dir);
 }
 
-int lineCount(const std::string& text) {
-    int count = 0;
-    for (char c : text)
-        count += c == '\n';
-    return count;
-}
-
-// Exactly one line, "testbed: error: " + something that contains each of parts.
 void expectOneErrorLine(const CommandResult& run, int exitCode,
                         const std::vector<std::string>& parts) {
     EXPECT_EQ(run.exitCode, exitCode) << run.stderrText;

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/experiments/TestFolders.h"
+#include "tests/experiments/cli/CliRun.h"
 
 namespace experiments {
 namespace {
@@ -26,33 +27,17 @@ namespace fs = std::filesystem;
 using experiments::test_files::freshTestFolder;
 using experiments::test_files::readText;
 
-const fs::path kTestbed = fs::path(TESTBED_BINARY_DIR) / "bin" / "testbed";
+using clitest::kTestbed;
 const fs::path kCorpus =
     fs::path(TESTBED_SOURCE_DIR) / "tests" / "scenes" / "input" / "hostile-values";
-constexpr int kTimeoutSeconds = 20;
-
-struct CommandResult {
-    int exitCode;
-    std::string stdoutText;
-    std::string stderrText;
-};
+using CommandResult = clitest::SeparateRun;
+using clitest::lineCount;
 
 CommandResult render(const fs::path& scene, const fs::path& out, const fs::path& dir) {
-    const std::string command = "timeout -s KILL " + std::to_string(kTimeoutSeconds) + " " +
-                                kTestbed.string() + " render --scene '" + scene.string() +
-                                "' --width 64 --height 48 --lights 4 --out '" + out.string() +
-                                "' > " + (dir / "stdout.txt").string() + " 2> " +
-                                (dir / "stderr.txt").string() + " < /dev/null";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
-            readText(dir / "stdout.txt"), readText(dir / "stderr.txt")};
-}
-
-int lineCount(const std::string& text) {
-    int count = 0;
-    for (char c : text)
-        count += c == '\n';
-    return count;
+    return clitest::runSeparately("render --scene '" + scene.string() +
+                                      "' --width 64 --height 48 --lights 4 --out '" + out.string() +
+                                      "'",
+                                  dir);
 }
 
 std::string trim(const std::string& text) {
