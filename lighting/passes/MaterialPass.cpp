@@ -10,7 +10,8 @@ void MaterialPass::draw(const StageInputs& inputs) {
     if (!inputs.scene || !inputs.geometry || !inputs.view)
         throw std::invalid_argument("the material pass needs the frame's scene, geometry and view");
     const gbuffer::CameraView& view = *inputs.view;
-    mVisibility.transform(*inputs.scene, *inputs.geometry, view);
+    // One sample per pixel: alpha-to-coverage is the alpha test here (AlphaCoverage.h).
+    mVisibility.transform(*inputs.scene, *inputs.geometry, view, inputs.alphaToCoverage);
     fitRasterizer(mRasterizer, view);
     mDepth.resize(size_t(view.width) * view.height);
     mVisibility.draw(*mRasterizer, mDepth);
