@@ -110,14 +110,33 @@ std::string referenceKeyOf(const RenderOptions& o) {
 } // namespace
 
 std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys) {
-    static const std::vector<std::string> kOrder = {
-        "scene",         "stage",           "lights",        "seed",
-        "resolution",    "width",           "height",        "threads",
-        "isa",           "simt-warp",       "layout",        "normals",
-        "normal-space",  "depth",           "position",      "reference-spp",
-        "msaa",          "complex-detect",  "post-aa",       "oracle",
-        "shadows",       "shadow-map-size", "shadow-filter", "shadow-bias",
-        "shadow-lights", "shadow-cascades"};
+    static const std::vector<std::string> kOrder = {"scene",
+                                                    "stage",
+                                                    "lights",
+                                                    "seed",
+                                                    "resolution",
+                                                    "width",
+                                                    "height",
+                                                    "threads",
+                                                    "isa",
+                                                    "simt-warp",
+                                                    "layout",
+                                                    "normals",
+                                                    "normal-space",
+                                                    "depth",
+                                                    "position",
+                                                    "reference-spp",
+                                                    "msaa",
+                                                    "complex-detect",
+                                                    "alpha-to-coverage",
+                                                    "post-aa",
+                                                    "oracle",
+                                                    "shadows",
+                                                    "shadow-map-size",
+                                                    "shadow-filter",
+                                                    "shadow-bias",
+                                                    "shadow-lights",
+                                                    "shadow-cascades"};
     std::vector<std::string> columns;
     for (const std::string& key : kOrder)
         if (key == "width" || key == "height" ||
