@@ -77,7 +77,7 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     GBufferPassTimings timings;
     const CameraView& view = target.view();
     auto start = std::chrono::steady_clock::now();
-    mVisibility.transform(mScene, mGeometry, view);
+    mVisibility.transform(mScene, mGeometry, view, multisample && multisample->alphaToCoverage);
     timings.transformMs = millisecondsSince(start);
 
     start = std::chrono::steady_clock::now();

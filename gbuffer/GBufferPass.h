@@ -35,6 +35,9 @@ struct GBufferPassTimings {
 // view, each covered only where the layer has a fragment.
 struct MultisampleTarget {
     int samples = 4; // 2, 4 or 8
+    // Alpha-masked materials as sample masks instead of the alpha test (visibility/AlphaCoverage.h,
+    // `--alpha-to-coverage on`).
+    bool alphaToCoverage = false;
     FragmentLayerOptions options;
     FragmentLayers layers;
     std::vector<std::unique_ptr<GBuffer>> upperLayers; // layers 1 .. layerCount - 1

@@ -29,6 +29,7 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
         multisample = std::make_unique<gbuffer::MultisampleTarget>();
         multisample->samples = multisampling.samples;
         multisample->options = multisampling.layers;
+        multisample->alphaToCoverage = multisampling.alphaToCoverage;
     }
     geometry = gbuffer::SceneGeometry::build(scene);
     view = gbuffer::CameraView::fromCamera(scene.cameras.front(), width, height,
@@ -48,6 +49,7 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
     inputs.lights = &lights;
     inputs.samples = multisample ? multisampling.samples : 1;
     inputs.fragmentLayers = multisample ? &multisample->layers : nullptr;
+    inputs.alphaToCoverage = multisample && multisampling.alphaToCoverage;
 }
 
 PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool withExactSurface,

@@ -26,6 +26,9 @@ namespace lighting {
 struct Multisampling {
     int samples = 1;
     gbuffer::FragmentLayerOptions layers;
+    // Alpha-masked materials as sample masks (gbuffer/visibility/AlphaCoverage.h); only used with
+    // samples > 1 (at one sample the alpha test applies).
+    bool alphaToCoverage = false;
 };
 
 struct PreparedScene {

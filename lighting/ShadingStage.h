@@ -119,6 +119,12 @@ struct StageInputs {
     const gbuffer::FragmentLayers* fragmentLayers = nullptr;
     int fragmentLayer = 0;
     static constexpr int kBackgroundRun = -1;
+    // Alpha-to-coverage (`--alpha-to-coverage on`, gbuffer/visibility/AlphaCoverage.h): at
+    // samples > 1 alpha-masked fragments keep round(alpha * samples) of their samples instead of
+    // being alpha-tested. The G-buffer pass drew the frame this way (Multisampling); a stage that
+    // rasterizes the scene itself (the forward stages, the material passes) draws it the same way,
+    // so that it keeps the same fragments. Shadow maps ignore it (every caster is opaque).
+    bool alphaToCoverage = false;
     // The frame's shadows (lighting/shadows/ShadowLookup.h; `--shadows`), or null: no light casts
     // one. Every stage that shades through the kernel applies them there (KernelLights).
     const shadows::ShadowLookup* shadows = nullptr;

@@ -41,8 +41,11 @@
 // per pixel without multisampling) that passes the (early) depth test; it may be called
 // concurrently for different tiles and must only write data belonging to its own pixel. A fragment
 // function that returns bool can discard the fragment (an alpha test): false means no depth write
-// and no count in samplesPassed; one that returns void keeps every fragment (the choice is made at
-// compile time, so draws without a discard pay nothing for it). A Rasterizer object keeps scratch
+// and no count in samplesPassed; one that returns SampleMask keeps only the samples of
+// Fragment::coverage whose bits it returns (alpha-to-coverage, AlphaToCoverage.h: the other
+// samples are neither depth-written nor counted; 0 discards the fragment); one that returns void
+// keeps every fragment (the choice is made at compile time, so draws without a discard pay
+// nothing for it). A Rasterizer object keeps scratch
 // memory between draws: one draw at a time per object.
 #pragma once
 
@@ -131,6 +134,12 @@ struct Fragment {
 // values bitwise. Without multisampling only (a multisampled draw calls it per fragment).
 struct DepthOnly {
     void operator()(const Fragment&) const {}
+};
+
+// What a fragment function returns to keep a subset of its samples (see the file comment): the
+// kept samples are `bits & Fragment::coverage`. Without multisampling, bit 0 keeps the fragment.
+struct SampleMask {
+    uint8_t bits = 0;
 };
 
 template <class T>
@@ -297,6 +306,14 @@ template <DepthTest test> inline bool depthPasses(float fragmentDepth, float sto
     return false;
 }
 
+// Whether a discarding fragment function's result keeps the (one-sample) fragment.
+inline bool keepsAny(bool kept) {
+    return kept;
+}
+inline bool keepsAny(SampleMask mask) {
+    return (mask.bits & 1u) != 0;
+}
+
 // Top-left rule as a bias: with our orientation (positive area, y down), an edge a->b is a
 // left edge when dy < 0 and a top edge when dy == 0 and dx > 0. Samples exactly on any other
 // edge are excluded by requiring edge >= 1 there.
@@ -395,8 +412,8 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     const int tileMaxX = std::min(tileMinX + kTileSize, mWidth) - 1;
     const int tileMaxY = std::min(tileMinY + kTileSize, mHeight) - 1;
     constexpr int64_t kHalf = kSubpixelScale / 2;
-    constexpr bool kCanDiscard =
-        std::is_same_v<std::invoke_result_t<FragmentFn&, const Fragment&>, bool>;
+    using Result = std::invoke_result_t<FragmentFn&, const Fragment&>;
+    constexpr bool kCanDiscard = std::is_same_v<Result, bool> || std::is_same_v<Result, SampleMask>;
     constexpr bool kDepthOnly = std::is_same_v<std::remove_cvref_t<FragmentFn>, DepthOnly>;
 
     // Counted in registers, stored once: a memory increment per sample costs measurably.
@@ -513,7 +530,7 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                             fragment.frontFacing = t.frontFacing;
                             if constexpr (kCanDiscard) {
                                 // Discard (alpha test) before the depth write.
-                                if (fragmentFn(fragment)) {
+                                if (detail::keepsAny(fragmentFn(fragment))) {
                                     ++samplesPassed;
                                     if (depthRow && state.depthWrite)
                                         depthRow[px] = z;
@@ -551,8 +568,11 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
     constexpr int64_t kHalf = kSubpixelScale / 2;
     // Sample offsets are in 1/16 pixel: this many fixed-point units each.
     constexpr int64_t kOffsetUnit = kSubpixelScale / 16;
-    constexpr bool kCanDiscard =
-        std::is_same_v<std::invoke_result_t<FragmentFn&, const Fragment&>, bool>;
+    using Result = std::invoke_result_t<FragmentFn&, const Fragment&>;
+    constexpr bool kCanDiscard = std::is_same_v<Result, bool>;
+    constexpr bool kCanMask = std::is_same_v<Result, SampleMask>;
+    static_assert(std::is_void_v<Result> || kCanDiscard || kCanMask,
+                  "a fragment function returns void, bool or SampleMask");
     const int sampleCount = state.samples;
     const std::span<const SampleOffset> pattern = standardSamplePattern(sampleCount);
 
@@ -647,10 +667,15 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
                     fragment.frontFacing = t.frontFacing;
                     fragment.coverage = uint8_t(passed);
                     bool kept = true;
-                    if constexpr (kCanDiscard)
+                    if constexpr (kCanMask) {
+                        // Alpha-to-coverage: only these samples are written and counted.
+                        passed &= fragmentFn(fragment).bits;
+                        kept = passed != 0;
+                    } else if constexpr (kCanDiscard) {
                         kept = fragmentFn(fragment);
-                    else
+                    } else {
                         fragmentFn(fragment);
+                    }
                     if (!kept)
                         continue;
                     ++fragments;

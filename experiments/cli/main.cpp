@@ -103,6 +103,12 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
                     "complex pixels by primitive (samples show different triangles) or "
                     "discontinuity (depth + normal + material differ)")
         ->capture_default_str();
+    render
+        .add_option("--alpha-to-coverage", r.alphaToCoverage,
+                    "on: alpha-masked materials keep round(alpha x samples) of each fragment's "
+                    "samples (fixed 2x2-dithered pattern) instead of the alpha test; needs "
+                    "--msaa 2, 4 or 8 (refused at 1)")
+        ->capture_default_str();
     render.add_option("--out", options.out, "output folder")->capture_default_str();
     render
         .add_option("--heatmap-max", options.scales.heatmapMax,

@@ -499,6 +499,7 @@ nlohmann::json msaaJson(const RenderRun& run) {
     const RunMetrics& metrics = run.metrics;
     nlohmann::json msaa = {{"samples", metrics.msaaSamples},
                            {"complex_detect", run.options.complexDetect},
+                           {"alpha_to_coverage", run.options.alphaToCoverage},
                            {metric::kComplexFraction, metrics.complexFraction},
                            {metric::kSurfacesPerPixel, metrics.surfacesPerCoveredPixel},
                            {metric::kGBufferBytes, metrics.gbufferBytes},

@@ -258,6 +258,7 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
         lighting::Multisampling multisampling;
         multisampling.samples = options.msaa;
         gbuffer::parseComplexDetection(options.complexDetect, multisampling.layers.detection);
+        multisampling.alphaToCoverage = options.alphaToCoverage == "on";
         run.prepared = std::make_unique<lighting::PreparedScene>(
             std::move(plan.scene), options.width, options.height, plan.requirements.exactSurface,
             plan.layout, multisampling);

@@ -121,6 +121,13 @@ CheckedOptions checkOptions(const RenderOptions& options) {
     if (!gbuffer::parseComplexDetection(options.complexDetect, detection))
         throw UsageError("--complex-detect '" + options.complexDetect +
                          "' refused: must be primitive or discontinuity");
+    if (options.alphaToCoverage != "on" && options.alphaToCoverage != "off")
+        throw UsageError("--alpha-to-coverage '" + options.alphaToCoverage +
+                         "' refused: must be on or off");
+    if (options.alphaToCoverage == "on" && options.msaa == 1)
+        throw UsageError("--alpha-to-coverage on refused with --msaa 1: one sample per pixel has "
+                         "no coverage to dither; alpha-masked materials are alpha-tested at 1x "
+                         "(use --msaa 2, 4 or 8)");
     if (options.msaa > 1) {
         const std::string stageName = lighting::StageSpec::parse(options.stage).name;
         for (const lighting::StageInfo& info : lighting::stageInfos())
@@ -244,6 +251,7 @@ std::vector<std::string> renderOptionKeys() {
             "reference-spp",
             "msaa",
             "complex-detect",
+            "alpha-to-coverage",
             "layout",
             "normals",
             "normal-space",
@@ -296,6 +304,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.msaa = parseNumber<int>(key, value);
     else if (key == "complex-detect")
         options.complexDetect = value;
+    else if (key == "alpha-to-coverage")
+        options.alphaToCoverage = value;
     else if (key == "reference-spp")
         options.referenceSpp = parseNumber<int>(key, value);
     else if (key == "layout")

@@ -55,6 +55,11 @@ struct RenderOptions {
     // how complex pixels are found (primitive | discontinuity; gbuffer/msaa/FragmentLayers.h).
     int msaa = 1;
     std::string complexDetect = "primitive";
+    // Alpha-masked (glTF MASK) materials at msaa > 1: "off" alpha-tests each fragment against its
+    // alphaCutoff (all of its samples or none); "on" keeps round(alpha * msaa) of its samples in a
+    // fixed 2x2-dithered pattern (raster/AlphaToCoverage.h), in every draw that must keep the same
+    // fragments (G-buffer pass, forward stages, their pre-passes). Refused with --msaa 1.
+    std::string alphaToCoverage = "off";
     bool compareReference = false;
     // Samples per pixel of the reference compared with (lighting/SupersampledReference.h): a
     // square 1..256; 1 is the pixel-centre reference, 16 the D3D 16x pattern, other squares a
@@ -115,13 +120,12 @@ std::string lightsText(const RenderOptions& options);
 
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
-// reference-spp, layout, normals, normal-space, depth, position, view, brdf, post-aa, oracle,
-// shadows,
-// shadow-map-size, shadow-bias, shadow-filter, shadow-lights, shadow-cascades,
-// shadow-caster-sets, max-memory (bytes, K/M/G/T suffixes) and scene-option.KEY. Values are
-// checked later by validate(); a malformed number or an unknown key throws UsageError naming it.
-// The sweep runner goes through this, so every stage, encoding or scene added later is reachable
-// without touching the runner.
+// alpha-to-coverage, reference-spp, layout, normals, normal-space, depth, position, view, brdf,
+// post-aa, oracle, shadows, shadow-map-size, shadow-bias, shadow-filter, shadow-lights,
+// shadow-cascades, shadow-caster-sets, max-memory (bytes, K/M/G/T suffixes) and
+// scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
+// throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or
+// scene added later is reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();

@@ -128,6 +128,7 @@ std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys
                                                     "reference-spp",
                                                     "msaa",
                                                     "complex-detect",
+                                                    "alpha-to-coverage",
                                                     "post-aa",
                                                     "oracle",
                                                     "shadows",

@@ -4,10 +4,11 @@
 
 namespace gbuffer {
 
-void AlphaCoverage::build(const scenes::Scene& scene) {
+void AlphaCoverage::build(const scenes::Scene& scene, bool alphaToCoverage) {
     mRules.assign(scene.materials.size(), Rule::Keep);
     mActive = false;
     mAnyBlend = false;
+    mAlphaToCoverage = alphaToCoverage;
     for (size_t m = 0; m < scene.materials.size(); ++m) {
         const scenes::Material& material = scene.materials[m];
         switch (material.alphaMode) {
@@ -19,7 +20,9 @@ void AlphaCoverage::build(const scenes::Scene& scene) {
             break;
         case scenes::AlphaMode::Mask:
             mActive = true;
-            if (material.baseColorTexture >= 0)
+            if (alphaToCoverage)
+                mRules[m] = Rule::ToCoverage; // even a constant alpha: its coverage is partial
+            else if (material.baseColorTexture >= 0)
                 mRules[m] = Rule::TestTexture;
             else if (!(material.baseColorFactor.a >= material.alphaCutoff))
                 mRules[m] = Rule::Discard;

@@ -5,6 +5,13 @@
 // from the same draw (ExactSurface.h), sees through the same fragments:
 // - Opaque: kept (alpha ignored);
 // - Mask: kept when alpha >= alphaCutoff, discarded otherwise (glTF 2.0, "Alpha Coverage");
+//   with alpha-to-coverage on (build(scene, true), `--alpha-to-coverage on`) and more than one
+//   sample per pixel, instead kept at the samples raster::alphaToCoverageMask(alpha, N, x, y)
+//   selects (round(alpha * N) of the N, a fixed 2x2-dithered pattern, raster/AlphaToCoverage.h)
+//   ANDed with the fragment's geometric coverage, as MSAA hardware does: alphaCutoff is then not
+//   used (alpha >= 1 keeps the whole coverage, alpha 0 nothing). At one sample per pixel there is
+//   no coverage to dither and the alpha test applies unchanged (the CLI refuses the combination,
+//   experiments/render/RenderOptions.cpp, so that no output claims alpha-to-coverage at 1x);
 // - Blend: always discarded from the opaque draws: blended surfaces are shaded and composited
 //   afterwards (lighting/passes/BlendedPass.h).
 // alpha = baseColorFactor.a * base colour texture alpha (linear) at the pixel centre, the uv found
@@ -26,6 +33,7 @@
 
 #include "gbuffer/visibility/CameraView.h"
 #include "gbuffer/visibility/SceneGeometry.h"
+#include "raster/AlphaToCoverage.h"
 #include "scenes/Scene.h"
 
 namespace gbuffer {
@@ -37,10 +45,13 @@ public:
         Keep,        // Opaque, or Mask with a constant alpha >= cutoff
         Discard,     // Blend, or Mask with a constant alpha < cutoff
         TestTexture, // Mask with a base colour texture: alpha per fragment
+        ToCoverage,  // Mask with alpha-to-coverage: alpha per fragment becomes a sample mask
     };
 
-    // One rule per material of `scene`. Cost O(materials).
-    void build(const scenes::Scene& scene);
+    // One rule per material of `scene`; `alphaToCoverage` turns every Mask material's rule into
+    // ToCoverage. Cost O(materials).
+    void build(const scenes::Scene& scene, bool alphaToCoverage = false);
+    bool alphaToCoverage() const { return mAlphaToCoverage; }
     // True when some material is Mask or Blend: the draws then test every fragment.
     bool active() const { return mActive; }
     // True when some material is Blend (lighting/passes/BlendedPass.h has work).
@@ -64,16 +75,34 @@ public:
         case Rule::Discard:
             return false;
         case Rule::TestTexture:
+        case Rule::ToCoverage: // one sample: the alpha test (see the file comment)
             return alphaAt(scene, geometry, clipPositions, view, triangle, x, y) >=
                    scene.materials[material].alphaCutoff;
         }
         return true;
     }
 
+    // The samples of `coverage` (a fragment's geometric coverage at `samples` samples per pixel,
+    // raster::Fragment::coverage) the opaque draws keep for `triangle`'s fragment at (x, y): all
+    // or none by keeps(), except that a ToCoverage material at samples > 1 keeps
+    // coverage & raster::alphaToCoverageMask(alpha, samples, x, y). Pure: every draw of the same
+    // frame keeps the same samples.
+    uint8_t keptSamples(const scenes::Scene& scene, const SceneGeometry& geometry,
+                        std::span<const glm::vec4> clipPositions, const CameraView& view,
+                        uint32_t triangle, int x, int y, int samples, uint8_t coverage) const {
+        if (samples > 1 && mRules[geometry.triangleMaterial[triangle]] == Rule::ToCoverage)
+            return uint8_t(
+                coverage &
+                raster::alphaToCoverageMask(
+                    alphaAt(scene, geometry, clipPositions, view, triangle, x, y), samples, x, y));
+        return keeps(scene, geometry, clipPositions, view, triangle, x, y) ? coverage : 0;
+    }
+
 private:
     std::vector<Rule> mRules;
     bool mActive = false;
     bool mAnyBlend = false;
+    bool mAlphaToCoverage = false;
 };
 
 } // namespace gbuffer

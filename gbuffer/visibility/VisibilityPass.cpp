@@ -15,7 +15,7 @@ void VisibilityPass::checkTriangleCount(const scenes::Scene& scene, const SceneG
 }
 
 void VisibilityPass::transform(const scenes::Scene& scene, const SceneGeometry& geometry,
-                               const CameraView& view) {
+                               const CameraView& view, bool alphaToCoverage) {
     checkTriangleCount(scene, geometry);
     mScene = &scene;
     mGeometry = &geometry;
@@ -37,7 +37,7 @@ void VisibilityPass::transform(const scenes::Scene& scene, const SceneGeometry& 
                               geometry.tangentWorld[v].w);
         }
     });
-    mAlpha.build(scene);
+    mAlpha.build(scene, alphaToCoverage);
     mMaterials = MaterialSampling::of(scene, geometry);
     mNdcXOfColumn.resize(size_t(view.width));
     for (int x = 0; x < view.width; ++x)
@@ -91,10 +91,11 @@ void VisibilityPass::draw(raster::Rasterizer& rasterizer, std::span<float> depth
         };
         if (mAlpha.active())
             rasterizer.draw(triangles(), state, depth.data(), [&](const raster::Fragment& f) {
-                if (!keeps(f))
-                    return false;
-                record(f);
-                return true;
+                raster::Fragment kept = f;
+                kept.coverage = keptCoverage(f, samples);
+                if (kept.coverage != 0)
+                    record(kept);
+                return raster::SampleMask{kept.coverage};
             });
         else
             rasterizer.draw(triangles(), state, depth.data(), record);

@@ -57,9 +57,11 @@ public:
     static void checkTriangleCount(const scenes::Scene& scene, const SceneGeometry& geometry);
 
     // Transforms `geometry` (of `scene`; both must outlive the pass's use of this frame) for
-    // `view`. Cost O(vertices), parallel; reuses the previous frame's storage.
+    // `view`. `alphaToCoverage`: the frame's multisampled draws turn alpha-masked fragments into
+    // sample masks (AlphaCoverage.h) instead of alpha-testing them. Cost O(vertices), parallel;
+    // reuses the previous frame's storage.
     void transform(const scenes::Scene& scene, const SceneGeometry& geometry,
-                   const CameraView& view);
+                   const CameraView& view, bool alphaToCoverage = false);
     const CameraView& view() const { return mView; }
     const SceneGeometry& geometry() const { return *mGeometry; }
     std::span<const glm::vec4> clipPositions() const { return mClipPositions; }
@@ -77,18 +79,25 @@ public:
 
     // The alpha test of the opaque draws (AlphaCoverage.h; inactive when every material is
     // opaque). Every draw of the scene's opaque surfaces keeps exactly the fragments keeps()
-    // accepts: draw() here, the forward stages' draws through lighting::ForwardGeometry.
+    // accepts (multisampled: the samples keptCoverage() returns, which with alpha-to-coverage
+    // may be a part of the fragment's coverage): draw() here, the forward stages' draws through
+    // lighting::ForwardGeometry. fragment.triangle is the scene's triangle index.
     const AlphaCoverage& alphaCoverage() const { return mAlpha; }
     bool keeps(const raster::Fragment& fragment) const {
         return mAlpha.keeps(*mScene, *mGeometry, mClipPositions, mView, fragment.triangle,
                             fragment.x, fragment.y);
+    }
+    uint8_t keptCoverage(const raster::Fragment& fragment, int samples) const {
+        return mAlpha.keptSamples(*mScene, *mGeometry, mClipPositions, mView, fragment.triangle,
+                                  fragment.x, fragment.y, samples, fragment.coverage);
     }
     const scenes::Scene& scene() const { return *mScene; }
 
     // Clears `depth` (view width x height x `samples` floats) to the view's far value and the
     // visibility buffer to kNoTriangle, then draws the scene with drawState() at `samples` samples
     // per pixel (raster/Rasterizer.h: 1, 2, 4 or 8), recording codes; with an active alpha test,
-    // discarded fragments write neither depth nor code (the whole fragment: no alpha-to-coverage).
+    // discarded fragments write neither depth nor code (with alpha-to-coverage, multisampled:
+    // neither at the samples keptCoverage() drops).
     void draw(raster::Rasterizer& rasterizer, std::span<float> depth, int samples = 1);
     // The visibility buffer of the last draw(): one code per sample, pixel-major
     // (codes()[pixel * sampleCount() + s]), row-major pixels.

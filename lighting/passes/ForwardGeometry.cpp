@@ -116,7 +116,7 @@ void ForwardGeometry::prepare(const StageInputs& inputs) {
         throw std::invalid_argument("forward shading needs the frame's scene, geometry and view");
     const gbuffer::SceneGeometry& geometry = *inputs.geometry;
     const gbuffer::CameraView& view = *inputs.view;
-    mVisibility.transform(*inputs.scene, geometry, view);
+    mVisibility.transform(*inputs.scene, geometry, view, inputs.alphaToCoverage);
     mEmits = std::any_of(inputs.scene->materials.begin(), inputs.scene->materials.end(),
                          [](const scenes::Material& material) { return material.emits(); });
     mDepthDecoder =

@@ -146,8 +146,11 @@ public:
     // Draws `triangles` (visibility().triangles(), or a subset indexing its clip positions) with
     // `state` over depth(), calling fragmentFn per fragment (raster::Rasterizer::draw). With an
     // alpha test (gbuffer::AlphaCoverage) the fragments the visibility draw discards are
-    // discarded here too, before the depth write; `toSceneTriangle` maps a drawn triangle index
-    // to the scene's (identity for visibility().triangles()).
+    // discarded here too, before the depth write, and with alpha-to-coverage (inputs
+    // .alphaToCoverage, multisampled) fragmentFn sees the fragment's coverage reduced to the
+    // samples the visibility draw keeps (VisibilityPass::keptCoverage: the same function of the
+    // same alpha at the same pixel) and only those are depth-written; `toSceneTriangle` maps a
+    // drawn triangle index to the scene's (identity for visibility().triangles()).
     template <class FragmentFn, class ToSceneTriangle = std::identity>
     void draw(const raster::TriangleList& triangles, const raster::RasterState& state,
               FragmentFn&& fragmentFn, ToSceneTriangle toSceneTriangle = {}) {
@@ -161,10 +164,11 @@ public:
                           [&](const raster::Fragment& fragment) {
                               raster::Fragment scene = fragment;
                               scene.triangle = toSceneTriangle(fragment.triangle);
-                              if (!mVisibility.keeps(scene))
-                                  return false;
-                              fragmentFn(fragment);
-                              return true;
+                              raster::Fragment kept = fragment;
+                              kept.coverage = mVisibility.keptCoverage(scene, mSamples);
+                              if (kept.coverage != 0)
+                                  fragmentFn(kept);
+                              return raster::SampleMask{kept.coverage};
                           });
     }
     // The forward stages' depth plane (the frame's convention; samples() floats per pixel, as

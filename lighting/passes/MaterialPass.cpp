@@ -26,7 +26,9 @@ void MaterialPass::draw(const StageInputs& inputs) {
         return;
     }
     const int samples = frameLayers ? frameLayers->samples() : 1;
-    mVisibility.transform(*inputs.scene, *inputs.geometry, view);
+    // Alpha-to-coverage as the G-buffer pass drew it, so that the layers are its layers (at one
+    // sample it is the alpha test, AlphaCoverage.h).
+    mVisibility.transform(*inputs.scene, *inputs.geometry, view, inputs.alphaToCoverage);
     fitRasterizer(mRasterizer, view);
     mDepth.resize(size_t(view.width) * size_t(view.height) * size_t(samples));
     mVisibility.draw(*mRasterizer, mDepth, samples);

@@ -687,6 +687,122 @@ Scene buildGlass(const SceneRequest& request) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// foliage: alpha-masked leaf cards, the anti-aliasing hard case "alpha-masked foliage" (issue 28)
+// and the scene alpha-to-coverage is measured on (raster/AlphaToCoverage.h). Twelve MASK cards
+// (cutoff 0.5) of 2 m x 2 m stand in three rows 4.5 to 9 m from the `front` camera, turned up to
+// +-25 degrees about +Y, all facing it (front faces: the draws cull back faces), before an opaque
+// ground and back wall. Their texture is 256 x 256 texels of leaves (ellipses 6..16 texels wide,
+// 24..48 long) whose alpha falls from 1 to 0 over one texel at the leaf outline, as an authored
+// cut-out texture does: at 1280 x 720 a card spans about 170..310 pixels, so a texel is about a
+// pixel and a leaf a few pixels wide, where the per-pixel alpha test aliases and the alpha ramp is
+// about a pixel (what alpha-to-coverage turns into coverage). Blinn-Phong materials.
+std::vector<SceneOption> foliageOptions(int) {
+    return withAmbientAndSun({}, 1);
+}
+
+Scene buildFoliage(const SceneRequest& request) {
+    Scene scene;
+    scene.name = "foliage";
+    const std::map<std::string, int> options =
+        readOptions(scene.name, request, foliageOptions(request.lightCount.value_or(0)));
+    // A fixed splitmix64 stream: the scene never depends on the request's seed (the lights do).
+    uint64_t state = 0xf011a6eULL;
+    auto uniform = [&state](float lo, float hi) {
+        uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+        z ^= z >> 31;
+        return lo + (hi - lo) * float(double(z >> 11) * 0x1.0p-53);
+    };
+
+    auto addQuadMesh = [&](const std::string& name, uint32_t material, const glm::vec3& corner,
+                           const glm::vec3& edgeU, const glm::vec3& edgeV, int cells) {
+        const uint32_t mesh = addMesh(scene, name, material);
+        appendQuad(scene.meshes[mesh], corner, edgeU, edgeV, cells, cells);
+        addInstance(scene, mesh);
+    };
+    addQuadMesh("ground", addMaterial(scene, "ground", {0.45f, 0.4f, 0.32f}, 0.04f, 16.0f),
+                {-8.0f, 0.0f, 6.0f}, {16.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -12.0f}, 16);
+    addQuadMesh("back-wall", addMaterial(scene, "back-wall", {0.75f, 0.72f, 0.65f}, 0.04f, 8.0f),
+                {-8.0f, 0.0f, -6.0f}, {16.0f, 0.0f, 0.0f}, {0.0f, 6.0f, 0.0f}, 8);
+
+    // The leaf texture: each texel takes the alpha and colour of the leaf whose outline it is
+    // deepest inside; alpha = clamp(0.5 - distance outside the ellipse in texels, 0, 1).
+    struct Leaf {
+        glm::vec2 centre, axis; // texels; axis = unit direction of the long semi-axis
+        float length, width;    // semi-axes, texels
+        glm::u8vec3 colour;     // sRGB
+    };
+    constexpr int kTexels = 256;
+    std::vector<Leaf> leaves;
+    for (int i = 0; i < 70; ++i) {
+        Leaf leaf;
+        leaf.length = uniform(12.0f, 24.0f);
+        leaf.width = uniform(3.0f, 8.0f);
+        const float margin = leaf.length + 2.0f;
+        leaf.centre = {uniform(margin, kTexels - margin), uniform(margin, kTexels - margin)};
+        const float angle = uniform(0.0f, float(std::numbers::pi));
+        leaf.axis = {std::cos(angle), std::sin(angle)};
+        leaf.colour = {uint8_t(uniform(40.0f, 90.0f)), uint8_t(uniform(100.0f, 160.0f)),
+                       uint8_t(uniform(25.0f, 60.0f))};
+        leaves.push_back(leaf);
+    }
+    const int leafTexture = addTexture(scene, "leaves", kTexels, kTexels, [&](int x, int y) {
+        const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
+        float best = -1.0f;
+        glm::u8vec3 colour(60, 120, 40);
+        for (const Leaf& leaf : leaves) {
+            const glm::vec2 d = p - leaf.centre;
+            const float along = glm::dot(d, leaf.axis) / leaf.length;
+            const float across = (d.x * -leaf.axis.y + d.y * leaf.axis.x) / leaf.width;
+            // Distance outside the outline, in texels, to first order (the radial excess scaled
+            // by the semi-axis it runs along the most).
+            const float radial = std::sqrt(along * along + across * across);
+            const float outside =
+                (radial - 1.0f) * (std::abs(across) > std::abs(along) ? leaf.width : leaf.length);
+            const float alpha = std::clamp(0.5f - outside, 0.0f, 1.0f);
+            if (alpha > best) {
+                best = alpha;
+                colour = leaf.colour;
+            }
+        }
+        return glm::u8vec4(colour, uint8_t(std::lround(best * 255.0f)));
+    });
+    const uint32_t leavesMaterial = addMaterial(scene, "leaves", {1.0f, 1.0f, 1.0f}, 0.1f, 24.0f);
+    scene.materials[leavesMaterial].baseColorTexture = leafTexture;
+    scene.materials[leavesMaterial].alphaMode = AlphaMode::Mask;
+
+    // Three rows of four cards, back to front; each card's lower-left corner, its turn about +Y
+    // (its front, +Z when unturned, stays towards the camera).
+    constexpr float kCardMetres = 2.0f;
+    int card = 0;
+    for (int row = 0; row < 3; ++row) {
+        const float z = -2.5f + 1.5f * float(row);
+        for (int column = 0; column < 4; ++column) {
+            const float x = -5.0f + 2.6f * float(column) + uniform(-0.4f, 0.4f) + 0.8f * row;
+            const float turn = uniform(-0.44f, 0.44f); // radians, about +-25 degrees
+            const glm::vec3 edgeU = kCardMetres * glm::vec3(std::cos(turn), 0.0f, -std::sin(turn));
+            const glm::vec3 corner(x, uniform(0.0f, 0.6f), z + uniform(-0.3f, 0.3f));
+            addQuadMesh("card-" + std::to_string(card++), leavesMaterial, corner, edgeU,
+                        {0.0f, kCardMetres, 0.0f}, 1);
+        }
+    }
+
+    scene.cameras.push_back(makeCamera("front", {0.0f, 1.6f, 4.5f}, {0.0f, 1.2f, -2.0f}, 40.0f));
+    PointLightScatter scatter;
+    scatter.region.min = {-6.0f, 0.2f, -5.0f};
+    scatter.region.max = {6.0f, 4.0f, 3.5f};
+    scatter.minRangeMetres = 1.5f;
+    scatter.maxRangeMetres = 4.0f;
+    scatter.minIntensity = 0.3f;
+    scatter.maxIntensity = 1.5f;
+    scatterPointLights(scene, scatter, request.lightCount.value_or(0), request.seed);
+    addAmbientAndSun(scene, options.at("ambient") == 1, options.at("sun") == 1);
+    scene.cameras.push_back(makeCamera("side", {4.5f, 1.8f, 3.5f}, {0.0f, 1.0f, -2.0f}, 40.0f));
+    return scene;
+}
+
+// ---------------------------------------------------------------------------------------------
 // Registry
 
 struct ProceduralScene {
@@ -696,10 +812,9 @@ struct ProceduralScene {
 };
 
 constexpr ProceduralScene kProceduralScenes[] = {
-    {"atrium", buildAtrium, atriumOptions},
-    {"wall", buildWall, wallOptions},
-    {"spheres", buildSpheres, spheresOptions},
-    {"glass", buildGlass, glassOptions},
+    {"atrium", buildAtrium, atriumOptions},    {"wall", buildWall, wallOptions},
+    {"spheres", buildSpheres, spheresOptions}, {"glass", buildGlass, glassOptions},
+    {"foliage", buildFoliage, foliageOptions},
 };
 static_assert(kProceduralScenes[0].name == kDefaultSceneName, "the default scene comes first");
 

@@ -3,6 +3,7 @@
 //   wall    long wall seen at an angle, lights on both sides ("behind=N" lights behind it)
 //   spheres analytic spheres on a plane, for precision tests
 //   glass   alpha-tested (MASK) and overlapping blended (BLEND) panes, for transparency
+//   foliage alpha-masked leaf cards (about a texel per pixel), for alpha-to-coverage
 // Each builder places request.lightCount point lights itself (scene-appropriate region and radii)
 // and may add one directional and one ambient light.
 #pragma once

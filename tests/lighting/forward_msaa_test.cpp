@@ -10,6 +10,10 @@
 //   counts at least the layers' contributing lights;
 // - forward:prepass=1 shades exactly the layers' fragments (msaa_shaded_fragments);
 // - 1 and 2 threads give bitwise the same image and counts.
+// The `_a2c` cases draw the alpha-masked materials with alpha-to-coverage (glass's fence and ghost
+// pane, foliage's leaf cards; raster/AlphaToCoverage.h) in the G-buffer pass and in the forward
+// stages' own draws, where all of the above must hold too; and a forward draw without pre-pass
+// leaves at every sample bitwise the code the G-buffer pass's draw left there.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,6 +30,7 @@
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/lists/ContributingLights.h"
+#include "lighting/passes/ForwardGeometry.h"
 #include "scenes/SceneLoader.h"
 #include "scenes/procedural/ProceduralScenes.h"
 #include "tests/lighting/LightIdentity.h"
@@ -40,12 +45,15 @@ struct SceneCase {
     const char* name;
     const char* scene;
     int lights;
+    bool alphaToCoverage = false;
 };
 
 const SceneCase kScenes[] = {
     {"atrium", "atrium", 300},
     {"glass", "glass", 200},
     {"helmet", TESTBED_GLTF_DIR "/DamagedHelmet/DamagedHelmet.gltf", 64},
+    {"glass_a2c", "glass", 200, true},
+    {"foliage_a2c", "foliage", 200, true},
 };
 
 const std::vector<std::string> kForwardStages = {"forward", "forward:prepass=1",
@@ -63,6 +71,7 @@ scenes::Scene loadCase(const SceneCase& c) {
 std::unique_ptr<lighting::PreparedScene> prepareMultisampled(const SceneCase& c, int samples) {
     lighting::Multisampling multisampling;
     multisampling.samples = samples;
+    multisampling.alphaToCoverage = c.alphaToCoverage;
     multisampling.layers.detection = gbuffer::ComplexDetection::Primitive;
     return std::make_unique<lighting::PreparedScene>(
         loadCase(c), kWidth, kHeight, false,
@@ -200,7 +209,7 @@ INSTANTIATE_TEST_SUITE_P(ForwardStages, ForwardMsaa,
 
 TEST(ForwardMsaaThreads, SameImageAndCountsForOneAndTwoThreads) {
     for (const std::string& spec : kForwardStages)
-        for (int sceneIndex : {1, 2}) {
+        for (int sceneIndex : {1, 2, 4}) {
             lighting::StageResult images[2];
             for (int t = 0; t < 2; ++t)
                 tbb::task_arena(t + 1).execute([&] {
@@ -211,6 +220,60 @@ TEST(ForwardMsaaThreads, SameImageAndCountsForOneAndTwoThreads) {
             EXPECT_TRUE(stagecheck::bitwiseEqualImages(images[0], images[1])) << spec;
             EXPECT_EQ(images[0].lightsEvaluated, images[1].lightsEvaluated) << spec;
             EXPECT_EQ(images[0].parameters, images[1].parameters) << spec;
+        }
+}
+
+// The sample codes of a forward draw without pre-pass (the visibility draw's state, every
+// fragment applied to the samples it keeps, later ones replacing earlier ones) against the
+// G-buffer pass's (from its fragment layers: with primitive detection each layer's coverage is
+// exactly the samples that show its code).
+std::vector<uint32_t> forwardSampleCodes(const lighting::PreparedScene& frame) {
+    lighting::ForwardGeometry forward;
+    forward.prepare(frame.inputs);
+    forward.clearDepth();
+    const int samples = forward.samples();
+    std::vector<uint32_t> codes(size_t(kWidth) * kHeight * size_t(samples),
+                                gbuffer::VisibilityPass::kNoTriangle);
+    const gbuffer::VisibilityPass& visibility = forward.visibility();
+    forward.draw(visibility.triangles(), visibility.drawState(), [&](const raster::Fragment& f) {
+        for (int s = 0; s < samples; ++s)
+            if (f.coverage >> s & 1u)
+                codes[(size_t(f.y) * kWidth + size_t(f.x)) * size_t(samples) + size_t(s)] =
+                    gbuffer::VisibilityPass::code(f.triangle, f.frontFacing);
+    });
+    return codes;
+}
+
+std::vector<uint32_t> layerSampleCodes(const lighting::PreparedScene& frame) {
+    const gbuffer::FragmentLayers& layers = frame.multisample->layers;
+    const int samples = layers.samples();
+    std::vector<uint32_t> codes(layers.pixelCount() * size_t(samples),
+                                gbuffer::VisibilityPass::kNoTriangle);
+    for (int k = 0; k < layers.layerCount(); ++k)
+        for (size_t pixel = 0; pixel < layers.pixelCount(); ++pixel)
+            for (int s = 0; s < samples; ++s)
+                if (layers.coverage(k)[pixel] >> s & 1u)
+                    codes[pixel * size_t(samples) + size_t(s)] = layers.codes(k)[pixel];
+    return codes;
+}
+
+TEST(ForwardMsaaAlphaToCoverage, NativeDrawKeepsTheGBufferDrawsSamples) {
+    for (int sceneIndex : {3, 4})
+        for (int samples : {2, 4, 8}) {
+            const auto frame = prepareMultisampled(kScenes[sceneIndex], samples);
+            const std::vector<uint32_t> forward = forwardSampleCodes(*frame);
+            ASSERT_EQ(forward, layerSampleCodes(*frame))
+                << kScenes[sceneIndex].name << ", " << samples << " samples";
+            // And alpha-to-coverage did change the samples against the alpha test.
+            SceneCase tested = kScenes[sceneIndex];
+            tested.alphaToCoverage = false;
+            const auto testedFrame = prepareMultisampled(tested, samples);
+            const std::vector<uint32_t> testedCodes = forwardSampleCodes(*testedFrame);
+            EXPECT_EQ(testedCodes, layerSampleCodes(*testedFrame));
+            size_t differ = 0;
+            for (size_t i = 0; i < forward.size(); ++i)
+                differ += forward[i] != testedCodes[i];
+            EXPECT_GT(differ, forward.size() / 200) << kScenes[sceneIndex].name << ", " << samples;
         }
 }
 

@@ -3,7 +3,10 @@
 // (the exactness tests' identity check and bitwise image, per layer: "per-sample exactness", since
 // a layer's fragment stands for its samples, shaded once); the resolved image against brute's
 // resolve (bitwise for ascending-order stages); the resolve's arithmetic; determinism across
-// thread counts; and the refusal of the stages that cannot take a multisampled frame.
+// thread counts; and the refusal of the stages that cannot take a multisampled frame. The scenes
+// with alpha-masked materials are also drawn with alpha-to-coverage (raster/AlphaToCoverage.h:
+// the `_a2c` cases), where the same must hold per sample, and the layers must be the same for 1,
+// 2 and 4 threads.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -36,12 +39,15 @@ struct SceneCase {
     const char* name;
     const char* scene;
     int lights;
+    bool alphaToCoverage = false;
 };
 
 const SceneCase kScenes[] = {
     {"atrium", "atrium", 300},
     {"glass", "glass", 200}, // alpha-masked fence and blended panes
     {"helmet", TESTBED_GLTF_DIR "/DamagedHelmet/DamagedHelmet.gltf", 64},
+    {"glass_a2c", "glass", 200, true},     // the fence and the ghost pane as sample masks
+    {"foliage_a2c", "foliage", 200, true}, // leaf cards as sample masks
 };
 
 scenes::Scene loadCase(const SceneCase& c) {
@@ -58,6 +64,7 @@ std::unique_ptr<lighting::PreparedScene> prepareMultisampled(const SceneCase& c,
     lighting::Multisampling multisampling;
     multisampling.samples = samples;
     multisampling.layers.detection = detection;
+    multisampling.alphaToCoverage = c.alphaToCoverage;
     return std::make_unique<lighting::PreparedScene>(
         loadCase(c), kWidth, kHeight, false,
         gbuffer::GBufferLayout::lossless(gbuffer::DepthConvention::Reversed), multisampling);
@@ -212,6 +219,45 @@ TEST(MultisampleResolve, SameImageForAnyThreadCount) {
         EXPECT_TRUE(stagecheck::bitwiseEqualImages(images[0], images[1])) << stageName;
         EXPECT_EQ(images[0].lightsEvaluated, images[1].lightsEvaluated) << stageName;
     }
+}
+
+TEST(MultisampleAlphaToCoverage, SameLayersAndImageForOneTwoAndFourThreads) {
+    for (int samples : {2, 4, 8}) {
+        std::vector<std::vector<uint8_t>> coverage(3);
+        std::vector<std::vector<uint32_t>> codes(3);
+        lighting::StageResult images[3];
+        for (int t = 0; t < 3; ++t)
+            tbb::task_arena(1 << t).execute([&] {
+                auto frame =
+                    prepareMultisampled(kScenes[4], samples, gbuffer::ComplexDetection::Primitive);
+                const gbuffer::FragmentLayers& layers = frame->multisample->layers;
+                for (int k = 0; k < layers.layerCount(); ++k) {
+                    codes[t].insert(codes[t].end(), layers.codes(k).begin(), layers.codes(k).end());
+                    coverage[t].insert(coverage[t].end(), layers.coverage(k).begin(),
+                                       layers.coverage(k).end());
+                }
+                lighting::MultisampleShading shading;
+                shading.shade(*lighting::makeStage("tiled"), *frame, images[t]);
+            });
+        for (int t = 1; t < 3; ++t) {
+            EXPECT_EQ(codes[0], codes[t]) << samples << " samples, " << (1 << t) << " threads";
+            EXPECT_EQ(coverage[0], coverage[t]) << samples << " samples, " << (1 << t);
+            EXPECT_TRUE(stagecheck::bitwiseEqualImages(images[0], images[t])) << samples;
+        }
+    }
+}
+
+TEST(MultisampleAlphaToCoverage, PartialAlphaLeavesSamplesOfMaskedFragmentsUncovered) {
+    // Against the alpha-tested frame: with alpha-to-coverage, more pixels of the foliage have a
+    // partial fragment (some of its samples show the leaves, the others what lies behind).
+    SceneCase tested = kScenes[4];
+    tested.alphaToCoverage = false;
+    const auto masked = prepareMultisampled(kScenes[4], 4, gbuffer::ComplexDetection::Primitive);
+    const auto alphaTested = prepareMultisampled(tested, 4, gbuffer::ComplexDetection::Primitive);
+    const uint64_t maskedComplex = masked->multisample->layers.counts().complexPixels;
+    const uint64_t testedComplex = alphaTested->multisample->layers.counts().complexPixels;
+    EXPECT_GT(maskedComplex, testedComplex + testedComplex / 10)
+        << "alpha-to-coverage splits the pixels along the leaves' alpha ramps";
 }
 
 TEST(MultisampleResolve, TwoAndEightSamplesResolveLikeBrute) {

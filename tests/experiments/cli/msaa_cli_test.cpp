@@ -48,6 +48,23 @@ TEST(MsaaCli, BadSampleCountsAndDetectionsAreRefused) {
     expectRefused("render --msaa 16", "must be 1, 2, 4 or 8");
     expectRefused("render --msaa 0", "must be 1, 2, 4 or 8");
     expectRefused("render --msaa 4 --complex-detect edges", "must be primitive or discontinuity");
+    expectRefused("render --msaa 4 --alpha-to-coverage yes", "must be on or off");
+    expectRefused("render --alpha-to-coverage on",
+                  "--alpha-to-coverage on refused with --msaa 1: one sample per pixel has no "
+                  "coverage to dither; alpha-masked materials are alpha-tested at 1x");
+}
+
+TEST(MsaaCli, AlphaToCoverageIsRecordedInStats) {
+    for (const char* setting : {"on", "off"}) {
+        const fs::path out = outDir(std::string("msaa-a2c-") + setting);
+        const CliRun result = run(
+            std::string("render --scene foliage --stage forward --msaa 4 --alpha-to-coverage ") +
+            setting + " --width 96 --height 54 --lights 8 --threads 2 --out " + out.string());
+        ASSERT_EQ(result.exitCode, 0) << result.output;
+        std::ifstream file(out / "stats.json");
+        const nlohmann::json stats = nlohmann::json::parse(file);
+        EXPECT_EQ(stats.at("msaa").at("alpha_to_coverage"), setting);
+    }
 }
 
 TEST(MsaaCli, StagesThatCannotTakeMultisampledFramesSaySo) {

@@ -454,11 +454,33 @@ SceneRequest requestWith(std::map<std::string, std::string> options, int lightCo
 
 TEST(ProceduralScenes, RegistryListsTheScenesWithTheDefaultFirst) {
     const std::vector<std::string> names = proceduralSceneNames();
-    EXPECT_EQ(names, (std::vector<std::string>{"atrium", "wall", "spheres", "glass"}));
+    EXPECT_EQ(names, (std::vector<std::string>{"atrium", "wall", "spheres", "glass", "foliage"}));
     EXPECT_EQ(names.front(), kDefaultSceneName);
     for (const std::string& name : names)
         EXPECT_TRUE(isProceduralScene(name));
     EXPECT_FALSE(isProceduralScene("sponza"));
+}
+
+TEST(ProceduralScenes, FoliageCardsAreAlphaMaskedWithAPixelWideRamp) {
+    const Scene scene = buildProceduralScene("foliage", requestWith({}));
+    int cards = 0;
+    for (const Instance& instance : scene.instances) {
+        const Material& material = scene.materials[scene.meshes[instance.mesh].material];
+        if (material.alphaMode != AlphaMode::Mask)
+            continue;
+        ++cards;
+        ASSERT_GE(material.baseColorTexture, 0);
+    }
+    EXPECT_EQ(cards, 12);
+    // The leaf texture: mostly cut out or solid, with partial alpha only along the outlines.
+    const Texture& leaves = scene.textures.at(0);
+    size_t solid = 0, empty = 0, partial = 0;
+    for (size_t i = 3; i < leaves.rgba8.size(); i += 4)
+        (leaves.rgba8[i] == 255 ? solid : leaves.rgba8[i] == 0 ? empty : partial) += 1;
+    EXPECT_GT(solid, partial);
+    EXPECT_GT(empty, partial);
+    EXPECT_GT(partial, 0u);
+    EXPECT_EQ(scene.cameras.size(), 2u);
 }
 
 TEST(ProceduralScenes, UnknownNameListsTheValidOnes) {
