@@ -128,10 +128,13 @@ std::string timingFigure(const RenderOptions& options) {
     return "median of " + std::to_string(options.repetitions) + " (min\u2013max)" + warmup;
 }
 
-// What `testbed render` prints when done: the run, its pass medians, the error, the files.
+// What `testbed render` prints when done: the run, its pass medians, the error, the files. Text
+// that an input controls (the scene's name, a warning quoting a file, the output paths, which are
+// bytes) is printed escaped, so that it cannot forge a line or drive the terminal.
 void printSummary(const RenderRun& run, const std::filesystem::path& out,
                   const std::vector<std::string>& written) {
-    std::cout << "testbed: " << run.options.stage << " on " << run.scene().name << " ("
+    std::cout << "testbed: " << run.options.stage << " on "
+              << scenes::escapeControlCharacters(run.scene().name) << " ("
               << run.scene().triangleCount() << " triangles, " << run.scene().lights.size()
               << " lights) at " << run.options.width << "x" << run.options.height << ", "
               << run.threads << " threads\n";
@@ -167,11 +170,12 @@ void printSummary(const RenderRun& run, const std::filesystem::path& out,
     if (!run.metrics.lightCountsNote.empty())
         std::cout << "  light counts: " << run.metrics.lightCountsNote << "\n";
     if (!run.coverage.warning.empty())
-        std::cout << "  WARNING: " << run.coverage.warning << "\n";
-    std::cout << "outputs in " << std::filesystem::absolute(out).string() << ":\n";
+        std::cout << "  WARNING: " << scenes::escapeControlCharacters(run.coverage.warning) << "\n";
+    std::cout << "outputs in "
+              << scenes::escapeControlCharacters(std::filesystem::absolute(out).string()) << ":\n";
     for (const std::string& file : renderOutputNames())
         if (std::find(written.begin(), written.end(), file) != written.end())
-            std::cout << "  " << (out / file).string() << "\n";
+            std::cout << "  " << scenes::escapeControlCharacters((out / file).string()) << "\n";
 }
 
 // shadow-error.png: the render's luminance dimmed to grey, with the pixels where the shadow maps
@@ -633,14 +637,27 @@ std::vector<std::string> viewFolderNames(const std::vector<std::string>& views) 
 
 // `render --view all`: one render per view of the scene into OUT/views/FOLDER/, each exactly
 // what `render --view NAME --out OUT/views/FOLDER` writes (its stats.json holds its figures), and
-// OUT/views.json listing the views and their folders in the scene's order.
+// OUT/views.json listing the views and their folders in the scene's order. The scene is loaded
+// once, and every view is planned (options, layout, memory estimate) before the first is
+// rendered, so that an error in any view stops the command before any work.
 int renderEveryView(const RenderCommandOptions& options) {
     checkOutputScales(options.scales);
     RenderOptions sceneOnly = options.render;
     sceneOnly.view.clear();
     checkOptions(sceneOnly); // every input error before the scene is loaded
-    const std::vector<std::string> views = scenes::viewNames(loadRequestedScene(sceneOnly));
+    checkSceneLoadMemory(sceneOnly);
+    const scenes::Scene scene = loadRequestedScene(sceneOnly);
+    const std::vector<std::string> views = scenes::viewNames(scene);
     const std::vector<std::string> folders = viewFolderNames(views);
+    auto planView = [&](const std::string& view) {
+        RenderOptions one = options.render;
+        one.view = view;
+        scenes::Scene viewed = scene;
+        scenes::selectView(viewed, view);
+        return planRenderWithScene(one, std::move(viewed));
+    };
+    for (const std::string& view : views)
+        checkMemoryEstimate(planView(view).memory);
     // Every view into one staging folder, committed when the last one is written: a view that
     // fails leaves OUT as it was, the views rendered before it included.
     StagedFolder staged(options.out);
@@ -649,11 +666,11 @@ int renderEveryView(const RenderCommandOptions& options) {
         RenderCommandOptions one = options;
         one.render.view = views[i];
         one.out = options.out / "views" / folders[i];
-        std::cout << "testbed: view " << (i + 1) << "/" << views.size() << " '" << views[i]
-                  << "'\n";
+        std::cout << "testbed: view " << (i + 1) << "/" << views.size() << " '"
+                  << scenes::escapeControlCharacters(views[i]) << "'\n";
         const std::filesystem::path dir = staged.path() / "views" / folders[i];
         std::filesystem::create_directories(dir);
-        const RenderRun run = runRender(planRender(one.render));
+        const RenderRun run = runRender(planView(views[i]));
         const std::vector<std::string> written = writeRenderOutputs(run, dir, one.scales);
         printSummary(run, one.out, written);
         if (run.metrics.cpuLoad.loaded)
