@@ -347,4 +347,11 @@ uint64_t peakResidentBytes() {
     return uint64_t(usage.ru_maxrss) * 1024; // Linux: kilobytes
 }
 
+bool resetPeakResident() {
+    std::ofstream clearRefs("/proc/self/clear_refs");
+    clearRefs << "5";
+    clearRefs.flush();
+    return bool(clearRefs);
+}
+
 } // namespace experiments

@@ -110,7 +110,12 @@ MemoryEstimate estimateRenderMemory(const RenderOptions& options, const scenes::
 // Y (--max-memory ...)") when the estimate exceeds its limit.
 void checkMemoryEstimate(const MemoryEstimate& estimate);
 
-// The process's peak resident set size so far (getrusage ru_maxrss), bytes.
+// The process's peak resident set size so far (getrusage ru_maxrss), bytes: since the process
+// started, or since the last resetPeakResident().
 uint64_t peakResidentBytes();
+// Lowers the peak to the current resident set (Linux: writes 5 to /proc/self/clear_refs), so
+// that a sweep job measures its render without the reference it rendered before; false when the
+// kernel refuses (the peak then stays the process's).
+bool resetPeakResident();
 
 } // namespace experiments

@@ -140,11 +140,12 @@ std::vector<NamedFigure> RunMetrics::errorFigures() const {
 
 std::vector<std::string> runFigureColumns() {
     std::vector<std::string> columns = {
-        metric::kLightEvaluations,   metric::kOracleLightEvaluations, metric::kCullingEfficiency,
-        metric::kCountedPixels,      metric::kSimtLaneSlots,          metric::kSimtEfficiency,
-        metric::kBytesPerPixel,      metric::kComplexFraction,        metric::kSurfacesPerPixel,
-        metric::kGBufferBytes,       metric::kGBufferAllocatedBytes,  metric::kShadowMapBytes,
-        metric::kShadowMisclassified};
+        metric::kLightEvaluations,    metric::kOracleLightEvaluations, metric::kCullingEfficiency,
+        metric::kCountedPixels,       metric::kSimtLaneSlots,          metric::kSimtEfficiency,
+        metric::kBytesPerPixel,       metric::kComplexFraction,        metric::kSurfacesPerPixel,
+        metric::kGBufferBytes,        metric::kGBufferAllocatedBytes,  metric::kShadowMapBytes,
+        metric::kShadowMisclassified, metric::kMemoryEstimateBytes,    metric::kPeakRssBytes,
+        metric::kCoveredFraction};
     RunMetrics withError;
     withError.error = ErrorMetrics{};
     for (const NamedFigure& figure : withError.errorFigures())

@@ -66,6 +66,13 @@ inline constexpr const char* kGBufferAllocatedBytes = "gbuffer_allocated_bytes";
 // without shadows (and the fraction without a reference).
 inline constexpr const char* kShadowMapBytes = "shadow_map_bytes";
 inline constexpr const char* kShadowMisclassified = "shadow_misclassified";
+// Memory of the run: the estimate it was checked against before allocating (MemoryEstimate.h)
+// and the measured peak resident set of the process that rendered it; a sweep job's peak
+// excludes the reference it rendered first (resetPeakResident).
+inline constexpr const char* kMemoryEstimateBytes = "memory_estimate_bytes";
+inline constexpr const char* kPeakRssBytes = "peak_rss_bytes";
+// The fraction of pixels that show a surface (Coverage.h): 0 flags an image of the background.
+inline constexpr const char* kCoveredFraction = "covered_fraction";
 } // namespace metric
 
 // Passes the runner adds around the stage's (lighting/passes/PassNames.h has the frame's passes).

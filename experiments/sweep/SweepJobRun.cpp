@@ -6,6 +6,7 @@
 
 #include "experiments/output/ImageOutput.h"
 #include "experiments/output/StagedFolder.h"
+#include "experiments/render/MemoryEstimate.h"
 #include "experiments/render/RenderCommand.h"
 #include "experiments/render/RenderJob.h"
 
@@ -153,13 +154,22 @@ Json runSweepJob(const SweepJob& job, const fs::path& jobDir, ReferenceStore& re
         job.compareReference ? &references.get(job, listener) : nullptr;
     RenderOptions options = job.options;
     options.compareReference = job.compareReference;
+    const bool peakIsTheRenders = resetPeakResident(); // the reference's peak is not the job's
     const RenderRun run = runRender(planRender(options), {}, referenceImage);
+    const uint64_t peakBytes = peakResidentBytes();
     // Staged, as `testbed render` writes: a job that fails while writing leaves its folder as it
     // was (its marker, written by the runner, says why).
     StagedFolder staged(jobDir);
     writeRenderOutputs(run, staged.path(), {job.heatmapMax, job.errorScale, float(job.errorMax)});
     staged.commit(renderOutputNames());
-    return metricColumnsOf(run.metrics);
+    Json row = metricColumnsOf(run.metrics);
+    row[metric::kMemoryEstimateBytes] = run.memory.totalBytes();
+    row[metric::kPeakRssBytes] = peakIsTheRenders ? Json(peakBytes) : Json(nullptr);
+    row[metric::kCoveredFraction] =
+        run.coverage.pixels
+            ? number(double(run.coverage.coveredPixels) / double(run.coverage.pixels))
+            : Json(nullptr);
+    return row;
 }
 
 } // namespace experiments

@@ -101,6 +101,17 @@ TEST(SweepRunner, RunsEachJobOnceAndSharesReferences) {
         for (const char* pass : {"gbuffer", "total"})
             EXPECT_EQ(job[std::string("time_") + pass + "_median_ms"], stats["timings_ms"][pass])
                 << pass;
+        // Memory and coverage as stats.json has them: the estimate the job was checked against,
+        // a measured peak (the job's render, after its reference), the covered fraction.
+        EXPECT_EQ(job["memory_estimate_bytes"], stats["memory"]["estimate_bytes"]);
+        ASSERT_TRUE(job["peak_rss_bytes"].is_number()) << job.dump();
+        EXPECT_GT(job["peak_rss_bytes"].get<double>(), 1e6);
+        EXPECT_LE(job["peak_rss_bytes"].get<double>(),
+                  stats["memory"]["measured_peak_rss_bytes"].get<double>());
+        const double covered = stats["coverage"]["covered_pixels"].get<double>() /
+                               stats["coverage"]["pixels"].get<double>();
+        EXPECT_DOUBLE_EQ(job["covered_fraction"].get<double>(), covered);
+        EXPECT_GT(covered, 0.0);
     }
     std::ifstream csv(dir / "out" / "results.csv");
     size_t lines = 0;
@@ -228,8 +239,8 @@ TEST(SweepRunner, TwoShardsMergedEqualOneRun) {
     ASSERT_EQ(merged["jobs"].size(), one["jobs"].size());
     for (size_t i = 0; i < one["jobs"].size(); ++i)
         for (const auto& [column, value] : one["jobs"][i].items()) {
-            if (column.rfind("time_", 0) == 0)
-                continue; // timings differ from run to run
+            if (column.rfind("time_", 0) == 0 || column == "peak_rss_bytes")
+                continue; // timings and the measured peak differ from run to run
             EXPECT_EQ(merged["jobs"][i][column], value)
                 << one["jobs"][i]["job_id"] << " " << column;
         }
