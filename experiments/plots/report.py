@@ -203,19 +203,17 @@ def pareto_plot(report, group, jobs, metric, method_columns, x_column=TIME, kind
     report.save(fig, "%s_%s" % (kind, gid), title, caption, gid, kind)
 
 
-def context_plots(report, jobs, groups, x_of, x_columns, x_label, y_column, y_label, name, title,
-                  kind):
-    """y against x across groups: one plot per context (the grouping settings other than x's and
-    those that change with x), one line per method."""
+def split_contexts(jobs, groups, x_of, x_columns, y_column):
+    """The jobs with x and y measured, split by context: the grouping settings other than x's and
+    those that change with x. Returns (contexts {key: jobs}, context_columns, varying_context,
+    covarying), or None when fewer than two distinct x values are measured."""
     grouping = [c for c in groups["axis_columns"] if c not in groups["method_columns"]
                 and c not in ("stage", "layout", "normals", "normal-space", "depth", "position",
                               "resolution")]
     others = [c for c in grouping if c not in x_columns]
     measured = [j for j in jobs if x_of(j) is not None and number(j.get(y_column)) is not None]
     if len({x_of(j) for j in measured}) < 2:
-        report.skip(title, "fewer than two distinct values of %s among the jobs with %s measured"
-                    % (" x ".join(x_columns), y_column), "", kind)
-        return
+        return None
     # Settings that change together with x (one value per x) are not a context of their own.
     covarying = []
     for column in others:
@@ -232,6 +230,19 @@ def context_plots(report, jobs, groups, x_of, x_columns, x_label, y_column, y_la
         contexts.setdefault(key, []).append(job)
     varying_context = [c for i, c in enumerate(context_columns)
                        if len({k[i] for k in contexts}) > 1]
+    return contexts, context_columns, varying_context, covarying
+
+
+def context_plots(report, jobs, groups, x_of, x_columns, x_label, y_column, y_label, name, title,
+                  kind):
+    """y against x across groups: one plot per context (the grouping settings other than x's and
+    those that change with x), one line per method."""
+    split = split_contexts(jobs, groups, x_of, x_columns, y_column)
+    if split is None:
+        report.skip(title, "fewer than two distinct values of %s among the jobs with %s measured"
+                    % (" x ".join(x_columns), y_column), "", kind)
+        return
+    contexts, context_columns, varying_context, covarying = split
     for index, (key, members) in enumerate(sorted(contexts.items())):
         context = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)
                             if c in varying_context)
@@ -283,6 +294,101 @@ def context_plots(report, jobs, groups, x_of, x_columns, x_label, y_column, y_la
                     "Points with several jobs are their median; those jobs differ in: %s." %
                     ", ".join(sorted(aggregated)))
         report.save(fig, "%s_%d" % (name, index + 1), plot_title, caption, "", kind)
+
+
+ASSIGNMENT_PASSES = ("cull", "assign", "index")
+
+
+def assignment_ms(job):
+    """The median time of the job's light-assignment passes (cull, assign, index), or None."""
+    times = [number(job.get("time_%s_median_ms" % p)) for p in ASSIGNMENT_PASSES]
+    times = [t for t in times if t is not None]
+    return sum(times) if times else None
+
+
+def loglog_slope(points):
+    """Least-squares slope of log(y) against log(x) over points with x >= 1000 (the issue's range;
+    below it fixed costs dominate), or None with fewer than two such points."""
+    pts = [(math.log(x), math.log(y)) for x, y in points if x >= 1000 and y > 0]
+    if len(pts) < 2:
+        return None
+    mx = sum(p[0] for p in pts) / len(pts)
+    my = sum(p[1] for p in pts) / len(pts)
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx if sxx > 0 else None
+
+
+def scaling_plots(report, jobs, groups):
+    """The light-scaling study: per context, light assignment time, shading time and peak resident
+    memory against the light count on log-log axes, one line per method, the fitted slope of each
+    line from 10^3 lights up in its label; the 'ideal' stage's shading (each pixel shades exactly its
+    contributing lights: the oracle-bounded ceiling of exact culling) drawn as the ideal line."""
+    lights = lambda j: number(j.get("lights"))  # noqa: E731
+    title = "Scaling with the light count"
+    split = split_contexts(jobs, groups, lights, ["lights"], "time_shading_median_ms")
+    if split is None or len({lights(j) for j in jobs if lights(j)}) < 3:
+        report.skip(title, "fewer than three light counts with shading measured", "", "scaling")
+        return
+    contexts, context_columns, varying_context, covarying = split
+    panels = (("light assignment, median (ms)", assignment_ms),
+              ("shading, median (ms)", lambda j: number(j.get("time_shading_median_ms"))),
+              ("peak resident memory (MiB)",
+               lambda j: (number(j.get("peak_rss_bytes")) or 0) / 2**20 or None))
+    for index, (key, members) in enumerate(sorted(contexts.items())):
+        context = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)
+                            if c in varying_context)
+        plot_title = title + (" (%s)" % context if context else "")
+        series = {}
+        for job in members:
+            series.setdefault(method_label(job, groups["method_columns"]), []).append(job)
+        fig, axes = plt.subplots(1, 3, figsize=(14.4, 4.8))
+        slopes = []
+        for ax, (label, value_of) in zip(axes, panels):
+            drawn = 0
+            panel_ys = []
+            for i, (method, method_jobs) in enumerate(sorted(series.items())):
+                per_x = {}
+                for job in method_jobs:
+                    v = value_of(job)
+                    if v is not None and v > 0:
+                        per_x.setdefault(lights(job), []).append(v)
+                if len(per_x) < 2:
+                    continue
+                xs = sorted(per_x)
+                ys = [statistics.median(per_x[x]) for x in xs]
+                slope = loglog_slope(list(zip(xs, ys)))
+                ideal = method.startswith("ideal")
+                if ideal and value_of is not panels[1][1]:
+                    continue  # the ideal stage's lists are made outside the timer: shading only
+                legend = ("ideal (oracle-bounded)" if ideal else method) + (
+                    "" if slope is None else ", slope %.2f" % slope)
+                if slope is not None and value_of is panels[0][1]:
+                    slopes.append("%s %.2f" % (method, slope))
+                panel_ys += ys
+                ax.plot(xs, ys, label=legend, color="black" if ideal else colour_of(i),
+                        linestyle="--" if ideal else "-", marker=MARKERS[i % len(MARKERS)],
+                        markersize=4)
+                drawn += 1
+            ax.set_xscale("log")
+            if log_scale_fits(panel_ys):  # else linear: a log axis over 5% says nothing
+                ax.set_yscale("log")
+            ax.set_xlabel("generated lights")
+            ax.set_ylabel(label)
+            ax.grid(True, alpha=0.3, which="both")
+            if drawn:
+                ax.legend(fontsize=6, loc="best")
+        fig.suptitle(plot_title, fontsize=10)
+        fig.tight_layout()
+        fixed = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)) or "nothing else"
+        caption = ("Fixed: %s. Each point is the median over the jobs of that method and "
+                   "light count; axes are log-log where the values span over 20x; slopes are "
+                   "least-squares fits of log value against log lights from 10^3 lights up (1 = linear; N log N from 10^3 to 10^6 fits a slope of "
+                   "about 1.10). Assignment = cull + assign + index passes. Memory is the job "
+                   "process's peak resident set (the whole render, reference excluded)."
+                   % fixed)
+        if slopes:
+            caption += " Assignment slopes: %s." % "; ".join(slopes)
+        report.save(fig, "scaling_%d" % (index + 1), plot_title, caption, "", "scaling")
 
 
 def published_ratios(report, table, index):
@@ -368,6 +474,8 @@ def plot_results(args):
         context_plots(report, jobs, groups, pixels, ["width", "height", "resolution"], "megapixels",
                       TIME, "total time, median (ms)", "time_vs_pixels", "Time against resolution",
                       "vs_pixels")
+        if len({lights(j) for j in jobs if assignment_ms(j) is not None}) >= 3:
+            scaling_plots(report, jobs, groups)
     for i, table in enumerate(published):
         published_ratios(report, table, i)
     write_text(os.path.join(args.out, "plots.json"), report.manifest())
