@@ -88,6 +88,7 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
         mVisibility.draw(rasterizer, target.depthPlane());
     }
     timings.rasterMs = millisecondsSince(start);
+    timings.rasterPhases = rasterizer.lastPhaseTimes();
 
     std::span<const uint32_t> codes = mVisibility.codes();
     if (multisample) {

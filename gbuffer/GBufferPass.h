@@ -28,6 +28,9 @@ struct GBufferPassTimings {
     double exactMs = 0.0;   // double-precision surface reconstruction (0 when not asked)
     double layersMs = 0.0;  // multisampled: complex-pixel detection and the fragment layers
                             // (the layers' resolve counts in resolveMs)
+    // rasterMs broken down by the rasterizer (raster::RasterPhaseTimes: project, set-up, bin sort,
+    // traversal; their sum is rasterMs less the visibility buffer's clear).
+    raster::RasterPhaseTimes rasterPhases;
 };
 
 // What a multisampled G-buffer pass fills besides its target (layer 0): the fragment layers

@@ -182,6 +182,12 @@ void Rasterizer::setUpAndBin(const TriangleList& triangles, const RasterState& s
     const uint32_t batchCount = (triangleCount + kTrianglesPerBatch - 1) / kTrianglesPerBatch;
     // Project and snap every vertex once: a vertex is shared by about six triangles. Vertices
     // outside the guard band are projected too (finite, unused: their triangles are clipped).
+    using Clock = std::chrono::steady_clock;
+    auto millisecondsSince = [](Clock::time_point start) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    };
+    mPhaseTimes = RasterPhaseTimes{};
+    auto start = Clock::now();
     const size_t vertexCount = triangles.clipPositions.size();
     mProjected.resize(vertexCount);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexCount, 8192), [&](const auto& range) {
@@ -196,12 +202,25 @@ void Rasterizer::setUpAndBin(const TriangleList& triangles, const RasterState& s
             mProjected[v] = projected;
         }
     });
+    mPhaseTimes.projectMs = millisecondsSince(start);
+    start = Clock::now();
     mBatches.resize(batchCount);
     tbb::parallel_for(uint32_t(0), batchCount, [&](uint32_t b) {
         const uint32_t first = b * kTrianglesPerBatch;
         const uint32_t last = std::min(first + kTrianglesPerBatch, triangleCount);
         setUpBatch(triangles, first, last, state, mBatches[b]);
     });
+    const double batchesMs = millisecondsSince(start);
+    double setupSeconds = 0.0, binSortSeconds = 0.0;
+    for (const Batch& batch : mBatches) {
+        setupSeconds += batch.setupSeconds;
+        binSortSeconds += batch.binSortSeconds;
+    }
+    const double sortShare = setupSeconds + binSortSeconds > 0.0
+                                 ? binSortSeconds / (setupSeconds + binSortSeconds)
+                                 : 0.0;
+    mPhaseTimes.binSortMs = batchesMs * sortShare;
+    mPhaseTimes.setupMs = batchesMs - mPhaseTimes.binSortMs;
     mStats = RasterStats{};
     for (const Batch& batch : mBatches) {
         mStats.trianglesIn += batch.stats.trianglesIn;
@@ -213,6 +232,7 @@ void Rasterizer::setUpAndBin(const TriangleList& triangles, const RasterState& s
 
 void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last,
                             const RasterState& state, Batch& batch) const {
+    const auto setupStart = std::chrono::steady_clock::now();
     batch.triangles.clear();
     batch.triangles.reserve(last - first); // address space only; pages are touched on use
     batch.barycentrics.clear();
@@ -282,6 +302,8 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
         }
     }
     // Counting sort of the (tile, triangle) pairs; stable, so each bin keeps submission order.
+    const auto sortStart = std::chrono::steady_clock::now();
+    batch.setupSeconds = std::chrono::duration<double>(sortStart - setupStart).count();
     const size_t tileCount = size_t(mTilesX) * mTilesY;
     batch.binOffsets.assign(tileCount + 1, 0);
     for (uint32_t tile : batch.pairTile)
@@ -297,6 +319,8 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
     for (size_t tile = tileCount; tile > 0; --tile)
         batch.binOffsets[tile] = batch.binOffsets[tile - 1];
     batch.binOffsets[0] = 0;
+    batch.binSortSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sortStart).count();
 }
 
 void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVertex projected[3],

@@ -52,6 +52,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <chrono>
 #include <cstdint>
 #include <span>
 #include <type_traits>
@@ -157,6 +158,19 @@ struct RasterStats {
     uint64_t fragments = 0;        // fragment-function calls that kept their fragment
 };
 
+// Where a draw's time goes (issue 31's breakdown), wall-clock milliseconds of its phases in the
+// order they run. Each phase is parallel inside and the phases are separated by a join (the
+// traversal needs every batch's bins): the serial part of a draw is only those joins and the
+// fixed-order sums of the statistics. Set-up and bin sorting run in the same parallel loop (one
+// task per batch); their wall time is split in proportion to the thread time each took there.
+struct RasterPhaseTimes {
+    double projectMs = 0.0;   // vertices to fixed point, guard band and frustum outcodes
+    double setupMs = 0.0;     // cull, clip, snap, edge and barycentric set-up, tile overlap
+    double binSortMs = 0.0;   // counting sort of (tile, triangle) pairs into each batch's bins
+    double traversalMs = 0.0; // tiles: coverage, depth test, fragment function, depth writes
+    double totalMs() const { return projectMs + setupMs + binSortMs + traversalMs; }
+};
+
 // A triangle after clipping, snapping and orientation fix-up, as the traversal reads it for
 // every tile it is binned into: one cache line. Set-up writes these for every surviving
 // triangle and the traversal reads them back in tile order, so on a dense scene the stream does
@@ -211,6 +225,7 @@ public:
               FragmentFn&& fragmentFn);
 
     const RasterStats& lastStats() const { return mStats; }
+    const RasterPhaseTimes& lastPhaseTimes() const { return mPhaseTimes; }
     int tileCountX() const { return mTilesX; }
     int tileCountY() const { return mTilesY; }
     // The screen tile of pixel (x, y): draw() calls the fragment function for one tile's pixels
@@ -233,6 +248,7 @@ private:
         std::vector<uint32_t> binOffsets;
         std::vector<uint32_t> binItems;
         RasterStats stats;
+        double setupSeconds = 0.0, binSortSeconds = 0.0; // thread time of setUpBatch's two parts
     };
 
     static void checkSampleCount(int samples);
@@ -284,6 +300,7 @@ private:
     };
     std::vector<TileStats> mTileStats;
     RasterStats mStats;
+    RasterPhaseTimes mPhaseTimes;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -329,6 +346,7 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
                       FragmentFn&& fragmentFn) {
     checkSampleCount(state.samples);
     setUpAndBin(triangles, state);
+    const auto traversalStart = std::chrono::steady_clock::now();
     const int tileCount = mTilesX * mTilesY;
     mTileStats.assign(size_t(tileCount), TileStats{});
     auto rasterize = [&](int tile) {
@@ -379,6 +397,9 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
                 rasterize(tile);
         },
         tbb::simple_partitioner());
+    mPhaseTimes.traversalMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - traversalStart)
+            .count();
     // Sum in a fixed order so the statistics are as deterministic as the pixels.
     for (const TileStats& tile : mTileStats) {
         mStats.samplesCovered += tile.stats.samplesCovered;

@@ -579,6 +579,12 @@ nlohmann::json statsJson(const RenderRun& run) {
                                   {"raster", phases.rasterMs},
                                   {"layers", phases.layersMs},
                                   {"resolve", phases.resolveMs}};
+    // The raster phase broken down (raster::RasterPhaseTimes; the rest of "raster" is the
+    // visibility buffer's clear).
+    stats["gbuffer_phases_ms"]["raster_phases"] = {{"project", phases.rasterPhases.projectMs},
+                                                   {"setup", phases.rasterPhases.setupMs},
+                                                   {"bin_sort", phases.rasterPhases.binSortMs},
+                                                   {"traversal", phases.rasterPhases.traversalMs}};
     addTimings(stats, run);
     stats["oracle_surface"] = run.oracleFromLosslessGBuffer
                                   ? "lossless G-buffer (the layout lacks BRDF channels)"

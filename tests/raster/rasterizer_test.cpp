@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -651,6 +652,28 @@ ClipMesh screenCoveringFan(int width, int height, glm::dvec2 centre, int rimCoun
             fan.addTriangle(c, b, a);
     }
     return toClip(fan, width, height);
+}
+
+// The phase times a draw reports (RasterPhaseTimes, issue 31's breakdown) are each measured,
+// non-negative and together no longer than the draw (its parts, not another clock's figure).
+TEST(RasterPhaseTimes, ThePhasesOfADrawAreMeasuredAndFitInsideIt) {
+    const int width = 640, height = 480;
+    Random random(3);
+    const ClipMesh mesh = screenCoveringFan(width, height, {301.7, 222.2}, 20000, random);
+    Rasterizer rasterizer(width, height);
+    std::atomic<uint64_t> fragments{0}; // tiles run in parallel
+    const auto start = std::chrono::steady_clock::now();
+    rasterizer.draw(mesh.list(), {CullMode::None, DepthTest::Always, false}, nullptr,
+                    [&](const Fragment&) { ++fragments; });
+    const double drawMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const RasterPhaseTimes& phases = rasterizer.lastPhaseTimes();
+    for (double ms : {phases.projectMs, phases.setupMs, phases.binSortMs, phases.traversalMs})
+        EXPECT_GE(ms, 0.0);
+    EXPECT_GT(phases.setupMs, 0.0);
+    EXPECT_GT(phases.traversalMs, 0.0);
+    EXPECT_LE(phases.totalMs(), drawMs);
+    EXPECT_EQ(fragments.load(), uint64_t(width) * height);
 }
 
 TEST(RasterWatertight, ThinFanCoversEveryPixelOnce) {
