@@ -148,6 +148,32 @@ TEST(HostileMessages, AForgedLightTypeStaysOnOneEscapedLine) {
         << missing.stderrText;
 }
 
+// A successful render's summary quotes the scene's name, its views and the output folder, all
+// input-controlled: printed escaped, they cannot forge a line or recolour the terminal.
+TEST(HostileMessages, TheRenderSummaryPrintsNamesAndPathsEscaped) {
+    const fs::path dir = freshTestFolder();
+    const fs::path scene = dir / "named.json";
+    writeFile(scene, R"({"name": "atrium\n testbed: error: forged\u001b[31m",
+        "objects": [{"procedural": "spheres"}],
+        "cameras": [{"name": "front\u001b[2J", "position": [0, 1, 6], "target": [0, 0.5, 0]}],
+        "lights": [{"type": "point", "position": [0, 3, 2], "range": 10}]})");
+    const fs::path out = dir / "out\x1b";
+    for (const char* view : {"", " --view all"}) {
+        const CommandResult run =
+            runTestbed("render --scene " + scene.string() + " --width 32 --height 18 --out '" +
+                           out.string() + "'" + view,
+                       dir);
+        EXPECT_EQ(run.exitCode, 0) << run.stderrText;
+        EXPECT_EQ(run.stdoutText.find('\x1b'), std::string::npos) << view;
+        EXPECT_EQ(run.stdoutText.find("\ntestbed: error:"), std::string::npos) << view;
+        EXPECT_EQ(run.stdoutText.find("\n testbed: error:"), std::string::npos) << view;
+        EXPECT_NE(run.stdoutText.find("atrium\\n testbed: error: forged\\x1b[31m"),
+                  std::string::npos)
+            << run.stdoutText;
+        EXPECT_NE(run.stdoutText.find("out\\x1b"), std::string::npos) << run.stdoutText;
+    }
+}
+
 TEST(HostileMessages, HtmlEscapeAlsoEscapesControlCharacters) {
     EXPECT_EQ(htmlEscape("<b>\x1b[31m\xff & \"x\"\n</b>"),
               "&lt;b&gt;\\x1b[31m\\xff &amp; &quot;x&quot;\n&lt;/b&gt;");
