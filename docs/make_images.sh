@@ -71,6 +71,32 @@ for name in aa-1x aa-4x aa-edge-blur; do
         "$work/$name/stats.json" "$name"
 done
 
+# Alpha-to-coverage (issue 28): foliage with tiled at 4x MSAA, alpha-tested and with
+# alpha-to-coverage, and the 16-spp reference; HDR-FLIP maps below, a 160x100 crop of the leaves
+# enlarged 2x.
+a2c() { # NAME ARGS...
+    name=$1
+    shift
+    echo "testbed render --scene foliage --stage tiled --msaa 4 $* --compare-reference --width 640 --height 360"
+    "$testbed" render --scene foliage --stage tiled --msaa 4 "$@" --compare-reference --width 640 \
+        --height 360 --threads 2 --out "$work/$name" >/dev/null
+}
+a2c a2c-off
+a2c a2c-on --alpha-to-coverage on
+crop="160x100+230+100"
+tile "$work/a2c-off/preview.png" "$work/a1.png" "4x MSAA, alpha test"
+tile "$work/a2c-on/preview.png" "$work/a2.png" "4x MSAA + alpha-to-coverage"
+tile "$work/a2c-off/reference.png" "$work/a3.png" "reference, 16 spp"
+flipTile "$work/a2c-off" "$work/b1.png"
+flipTile "$work/a2c-on" "$work/b2.png"
+oiiotool --create 320x200 3 -o "$work/b3.png"
+oiiotool "$work/a1.png" "$work/a2.png" "$work/a3.png" "$work/b1.png" "$work/b2.png" \
+    "$work/b3.png" --mosaic:pad=4 3x2 --ch R,G,B -o "$images/foliage-a2c.png"
+for name in a2c-off a2c-on; do
+    python3 -c "import json,sys; e=json.load(open(sys.argv[1]))['error']; print(sys.argv[2], 'FLIP', e['flip'], 'relative RMSE', e['relative_rmse'])" \
+        "$work/$name/stats.json" "$name"
+done
+
 # Shadows (issue 29): atrium with tiled, 256 lights of which the 16 that matter most cast
 # (cube maps of 1024^2, pcf3, default bias): without shadows, with shadow maps, the reference
 # (the same 16 lights ray-traced) and shadow-error.png (red: lit but should be shadowed, blue:
