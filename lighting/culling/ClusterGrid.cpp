@@ -235,6 +235,10 @@ bool ClusterGrid::candidateRanges(const LightSphere& sphere, AssignMethod method
 }
 
 void ClusterGrid::assign(const std::vector<LightSphere>& spheres) {
+    if (mOptions.assign == AssignMethod::Bvh) {
+        assignWithBvh(spheres);
+        return;
+    }
     const size_t batchCount = (spheres.size() + kLightsPerBatch - 1) / kLightsPerBatch;
     // Per batch: (cluster, light) pairs in light order.
     auto& batches = mBatchPairs;
@@ -257,6 +261,41 @@ void ClusterGrid::assign(const std::vector<LightSphere>& spheres) {
     });
     // Stable counting sort by cluster, batches in order: each list comes out ascending.
     mLists.assignFromPairs(mBounds.size(), batches);
+}
+
+void ClusterGrid::assignWithBvh(const std::vector<LightSphere>& spheres) {
+    mBvh.build(spheres);
+    // Each light's candidate ranges, as walk and binary compute them (they agree).
+    mLightRanges.resize(spheres.size());
+    tbb::parallel_for(size_t(0), spheres.size(), [&](size_t light) {
+        LightRanges& r = mLightRanges[light];
+        if (!candidateRanges(spheres[light], AssignMethod::Binary, r.columns, r.rows, r.slices))
+            r = {};
+    });
+    // One chunk per (slice, row): its clusters' lists, in cluster order.
+    const int nx = mOptions.tilesX, ny = mOptions.tilesY, nz = mOptions.slices;
+    mChunkLights.resize(size_t(ny) * size_t(nz));
+    mClusterCounts.assign(mBounds.size(), 0);
+    tbb::parallel_for(size_t(0), mChunkLights.size(), [&](size_t chunk) {
+        const int ty = int(chunk % size_t(ny)), k = int(chunk / size_t(ny));
+        std::vector<uint32_t>& lights = mChunkLights[chunk];
+        lights.clear();
+        for (int tx = 0; tx < nx; ++tx) {
+            const size_t cluster = clusterIndex(tx, ty, k);
+            const size_t begin = lights.size();
+            mBvh.candidates(mBounds[cluster], lights);
+            const auto kept = std::remove_if(
+                lights.begin() + std::ptrdiff_t(begin), lights.end(), [&](uint32_t light) {
+                    const LightRanges& r = mLightRanges[light];
+                    return !(tx >= r.columns.first && tx <= r.columns.last && ty >= r.rows.first &&
+                             ty <= r.rows.last && k >= r.slices.first && k <= r.slices.last &&
+                             mayTouch(spheres[light], tx, ty, k));
+                });
+            lights.erase(kept, lights.end());
+            mClusterCounts[cluster] = uint32_t(lights.size() - begin);
+        }
+    });
+    mLists.assign(mClusterCounts, mChunkLights);
 }
 
 } // namespace lighting
