@@ -28,10 +28,10 @@
 // with each cluster's light indices ascending. Parallel over fixed batches of lights, merged by a
 // stable counting sort in batch order: the lists never depend on the thread count, and no
 // atomics are used. `bvh` turns the loop around: a LightBvh (LightBvh.h) over the spheres is
-// queried with each cluster's box, and each light it returns meets the same two conditions
-// (its candidate ranges, by binary search, hold the cluster; the cluster test), so the lists are
-// those of walk and binary; parallel over (slice, row) chunks of clusters, each written by one
-// task, concatenated in cluster order.
+// queried once per tile column of clusters (all slices of one tile) with the union of their
+// boxes, and each light it returns meets the same two conditions in each cluster (its candidate
+// ranges, by binary search, hold the cluster; the cluster test), so the lists are those of walk
+// and binary; parallel over tile columns, each cluster's list written by one task.
 //
 // Thread safety: construction and assign() are not reentrant; the const queries are.
 #pragma once
@@ -117,8 +117,8 @@ public:
 
     // Assigns lights (spheres indexed like the frame's light list) to clusters; replaces the
     // previous lists. Cost: walk, binary O(lights * candidate clusters + clusters + pairs),
-    // parallel over lights; bvh O(lights log lights + clusters * (log lights + candidates)),
-    // parallel over clusters.
+    // parallel over lights; bvh O(lights log lights + tiles * (log lights + candidates) + pairs),
+    // parallel over tiles.
     void assign(const std::vector<LightSphere>& spheres);
     std::span<const uint32_t> lightsOf(size_t cluster) const { return mLists[cluster]; }
     size_t pairCount() const { return mLists.pairCount(); }
@@ -144,8 +144,7 @@ private:
     };
     LightBvh mBvh;
     std::vector<LightRanges> mLightRanges;
-    std::vector<std::vector<uint32_t>> mChunkLights;
-    std::vector<uint32_t> mClusterCounts;
+    std::vector<std::vector<uint32_t>> mClusterLights; // per cluster, capacity kept
 };
 
 } // namespace lighting
