@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 namespace lighting {
@@ -397,8 +398,20 @@ TileLightListStats buildTileLightLists(const gbuffer::CameraView& view, const Ti
                 }
         });
 
-        // Each unit's candidates, ascending: what the fine tiles of the unit test.
-        std::vector<std::vector<CandidateLight>> unitCandidates(groupCount);
+        // Each unit's candidates, ascending (what its fine tiles test), gathered by its own task
+        // into per-thread scratch, then its tiles' lists: no per-frame storage per candidate.
+        tbb::enumerable_thread_specific<std::vector<CandidateLight>> scratch;
+        auto listTilesOf = [&](size_t group, std::span<const CandidateLight> unitCandidates) {
+            const TileGroup& g = groups[group];
+            for (int ty = g.ty0; ty <= g.ty1; ++ty)
+                for (int tx = g.tx0; tx <= g.tx1; ++tx) {
+                    const size_t tile = size_t(ty) * size_t(grid.tileCountX) + size_t(tx);
+                    const TileSurfaceBounds& b = bounds[tile];
+                    if (b.covered)
+                        tileBackfaceRejected[tile] = appendTileLights(
+                            unitCandidates, tx, ty, b, boxes[tile], options, tileLights[tile]);
+                }
+        };
         if (options.assign == TileAssign::Loop) {
             const std::vector<CandidateLight> candidates =
                 candidateLights(view, grid, edges, spheres, options.frustumCull);
@@ -406,9 +419,12 @@ TileLightListStats buildTileLightLists(const gbuffer::CameraView& view, const Ti
             tbb::parallel_for(size_t(0), groupCount, [&](size_t group) {
                 if (!groups[group].covered)
                     return;
+                std::vector<CandidateLight>& unitCandidates = scratch.local();
+                unitCandidates.clear();
                 for (const CandidateLight& c : candidates)
                     if (mayTouchGroup(c, groups[group]))
-                        unitCandidates[group].push_back(c);
+                        unitCandidates.push_back(c);
+                listTilesOf(group, unitCandidates);
             });
         } else {
             LightBvh localBvh;
@@ -449,29 +465,18 @@ TileLightListStats buildTileLightLists(const gbuffer::CameraView& view, const Ti
                 records[k] = candidateOf(grid, edges, spheres[neededLights[k]], neededLights[k]);
             });
             tbb::parallel_for(size_t(0), groupCount, [&](size_t group) {
+                if (!groups[group].covered)
+                    return;
+                std::vector<CandidateLight>& unitCandidates = scratch.local();
+                unitCandidates.clear();
                 for (uint32_t light : unitLights[group]) {
                     const CandidateLight& c = records[slot[light]];
                     if (!options.hierarchical || mayTouchGroup(c, groups[group]))
-                        unitCandidates[group].push_back(c);
+                        unitCandidates.push_back(c);
                 }
+                listTilesOf(group, unitCandidates);
             });
         }
-
-        // Fine tiles: the per-tile test on their unit's candidates (one task per unit).
-        tbb::parallel_for(size_t(0), groupCount, [&](size_t group) {
-            const TileGroup& g = groups[group];
-            if (!g.covered)
-                return;
-            for (int ty = g.ty0; ty <= g.ty1; ++ty)
-                for (int tx = g.tx0; tx <= g.tx1; ++tx) {
-                    const size_t tile = size_t(ty) * size_t(grid.tileCountX) + size_t(tx);
-                    const TileSurfaceBounds& b = bounds[tile];
-                    if (b.covered)
-                        tileBackfaceRejected[tile] =
-                            appendTileLights(unitCandidates[group], tx, ty, b, boxes[tile], options,
-                                             tileLights[tile]);
-                }
-        });
     }
     lists.assign(tileLights);
     for (uint64_t rejected : tileBackfaceRejected)

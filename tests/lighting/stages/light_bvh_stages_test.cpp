@@ -183,6 +183,15 @@ TEST_P(LightBvhScene, StagesGiveTheDefaultImageAndEvaluateEveryContributingLight
         EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, expected));
         EXPECT_EQ(result.lightsEvaluated, expected.lightsEvaluated);
         EXPECT_TRUE(stagecheck::everyContributingLightEvaluated(result, f.contributing, true));
+        // The options reached the stage (it records what it ran).
+        const std::string options = spec;
+        EXPECT_EQ(result.parameters.at("assign"), options.find("assign=bvh") != std::string::npos
+                                                      ? "bvh"
+                                                  : options.starts_with("clustered") ? "walk"
+                                                                                     : "loop");
+        if (!options.starts_with("clustered"))
+            EXPECT_EQ(result.parameters.at("hier"),
+                      options.find("hier=1") != std::string::npos ? "1" : "0");
         for (const char* key : {"tile_light_pairs", "cluster_light_pairs", "lights_after_vfc"})
             if (expected.parameters.count(key))
                 EXPECT_EQ(result.parameters.at(key), expected.parameters.at(key)) << key;
