@@ -181,3 +181,50 @@ BENCHMARK(lightBvh)
     ->ReportAggregatesOnly(true);
 
 } // namespace
+
+// Where hierarchical tile culling pays: buildTileLightLists with the loop, flat vs 4x4 groups
+// (hier=1), over tile sizes and few lights (same frames, constant overlap; 1 thread).
+//   testbed_bench --benchmark_filter=lightBvhHier --benchmark_counters_tabular=true
+void lightBvhHier(benchmark::State& state) {
+    const int lightCount = int(state.range(0));
+    const int tileSize = int(state.range(1));
+    const bool hierarchical = state.range(2) != 0;
+    state.SetLabel(std::string(hierarchical ? "hier=1" : "hier=0") +
+                   " tile=" + std::to_string(tileSize));
+    const BvhBenchScene& f = benchScene(lightCount);
+    const gbuffer::GBuffer& gb = *f.prepared->gbuffer;
+    const lighting::TileGrid tiles = lighting::TileGrid::make(gb.width(), gb.height(), tileSize);
+    const std::vector<lighting::TileSurfaceBounds> bounds =
+        lighting::computeTileSurfaceBounds(gb, tiles, {});
+    lighting::TileCullOptions options{true, false, false};
+    options.hierarchical = hierarchical;
+    lighting::LightIndexLists lists;
+    tbb::task_arena arena(1);
+    auto build = [&] {
+        lighting::buildTileLightLists(gb.view(), tiles, bounds, f.spheres, options, lists);
+    };
+    arena.execute(build); // warm-up
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        arena.execute(build);
+        state.SetIterationTime(secondsSince(start));
+    }
+    state.counters["pairs"] = double(lists.pairCount());
+    state.counters["lights"] = lightCount;
+}
+BENCHMARK(lightBvhHier)
+    ->Apply([](benchmark::internal::Benchmark* b) {
+        for (int lightCount : {10, 100, 1000})
+            for (int tileSize : {8, 16, 32, 64})
+                for (int hier : {0, 1})
+                    b->Args({lightCount, tileSize, hier});
+    })
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(5)
+    ->ComputeStatistics("min",
+                        [](const std::vector<double>& v) {
+                            return *std::min_element(v.begin(), v.end());
+                        })
+    ->ReportAggregatesOnly(true);
