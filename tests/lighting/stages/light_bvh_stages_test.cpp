@@ -11,7 +11,7 @@
 // Seen failing under these mutations: LightBvh node boxes shrunk by 1% and the last leaf child
 // skipped (every test here), a tile group's box taken from its first tile only (tile lists and
 // stages: lights dropped), the candidate-range check left out of ClusterGrid's bvh assignment
-// (cluster lists: extra lights).
+// (cluster lists: extra lights), the `tiled` factory ignoring hier (stages: the recorded option).
 #include <gtest/gtest.h>
 
 #include <algorithm>
