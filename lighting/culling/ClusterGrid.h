@@ -27,7 +27,11 @@
 // lights (directional, ambient) go into every cluster. The result is a LightIndexLists (CSR)
 // with each cluster's light indices ascending. Parallel over fixed batches of lights, merged by a
 // stable counting sort in batch order: the lists never depend on the thread count, and no
-// atomics are used.
+// atomics are used. `bvh` turns the loop around: a LightBvh (LightBvh.h) over the spheres is
+// queried once per tile column of clusters (all slices of one tile) with the union of their
+// boxes, and each light it returns meets the same two conditions in each cluster (its candidate
+// ranges, by binary search, hold the cluster; the cluster test), so the lists are those of walk
+// and binary; parallel over tile columns, each cluster's list written by one task.
 //
 // Thread safety: construction and assign() are not reentrant; the const queries are.
 #pragma once
@@ -42,12 +46,13 @@
 #include "gbuffer/visibility/CameraView.h"
 #include "lighting/culling/CullingTests.h"
 #include "lighting/culling/LightBounds.h"
+#include "lighting/culling/LightBvh.h"
 #include "lighting/culling/LightIndexLists.h"
 
 namespace lighting {
 
 enum class SliceSpacing { Exponential, Uniform };
-enum class AssignMethod { Walk, Binary };
+enum class AssignMethod { Walk, Binary, Bvh };
 enum class ClusterTest { Aabb, Frustum };
 
 struct ClusterGridOptions {
@@ -103,15 +108,17 @@ public:
 
     // The cluster test (the option `test`): may the sphere touch the cluster? Conservative.
     bool mayTouch(const LightSphere& sphere, int tileX, int tileY, int slice) const;
-    // Candidate ranges of a bounded sphere by the configured method; false when it misses the grid.
+    // Candidate ranges of a bounded sphere by the configured method (binary search for bvh);
+    // false when it misses the grid.
     bool candidateRanges(const LightSphere& sphere, Range& columns, Range& rows,
                          Range& slices) const;
     bool candidateRanges(const LightSphere& sphere, AssignMethod method, Range& columns,
                          Range& rows, Range& slices) const;
 
     // Assigns lights (spheres indexed like the frame's light list) to clusters; replaces the
-    // previous lists. Cost: O(lights * candidate clusters + clusters + pairs), parallel over
-    // lights.
+    // previous lists. Cost: walk, binary O(lights * candidate clusters + clusters + pairs),
+    // parallel over lights; bvh O(lights log lights + tiles * (log lights + candidates) + pairs),
+    // parallel over tiles.
     void assign(const std::vector<LightSphere>& spheres);
     std::span<const uint32_t> lightsOf(size_t cluster) const { return mLists[cluster]; }
     size_t pairCount() const { return mLists.pairCount(); }
@@ -130,6 +137,14 @@ private:
     std::vector<ViewBox> mBounds;
     LightIndexLists mLists;                                              // per cluster
     std::vector<std::vector<std::pair<uint32_t, uint32_t>>> mBatchPairs; // assign() scratch
+    // assign=bvh scratch, reused across frames: the hierarchy, each light's candidate ranges.
+    void assignWithBvh(const std::vector<LightSphere>& spheres);
+    struct LightRanges {
+        Range columns, rows, slices; // empty when the light misses the grid
+    };
+    LightBvh mBvh;
+    std::vector<LightRanges> mLightRanges;
+    std::vector<std::vector<uint32_t>> mClusterLights; // per cluster, capacity kept
 };
 
 } // namespace lighting

@@ -1,9 +1,11 @@
 #include "lighting/culling/TileFrusta.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 namespace lighting {
@@ -238,6 +240,39 @@ bool lightBackFacesTile(const TileBox& box, const BackfaceTileCone& cone,
     return axisAngle + cone.normalHalfAngle + delta + kBackfaceSlackRadians <= kHalfPi;
 }
 
+namespace {
+
+// One candidate: the light's sphere and the tile columns and rows whose slabs it reaches.
+CandidateLight candidateOf(const TileGrid& grid, const TileEdgePlanes& edges, const LightSphere& s,
+                           uint32_t index) {
+    CandidateLight c;
+    c.index = index;
+    c.centreView = s.centreView;
+    c.positionView = s.positionView;
+    c.radius = s.radius;
+    c.unbounded = s.unbounded;
+    if (s.unbounded)
+        return c;
+    int columnMin = grid.tileCountX, columnMax = -1, rowMin = grid.tileCountY, rowMax = -1;
+    for (int tx = 0; tx < grid.tileCountX; ++tx)
+        if (sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius)) {
+            columnMin = std::min(columnMin, tx);
+            columnMax = tx;
+        }
+    for (int ty = 0; ty < grid.tileCountY; ++ty)
+        if (sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius)) {
+            rowMin = std::min(rowMin, ty);
+            rowMax = ty;
+        }
+    c.columnMin = columnMin;
+    c.columnMax = columnMax;
+    c.rowMin = rowMin;
+    c.rowMax = rowMax;
+    return c;
+}
+
+} // namespace
+
 std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, const TileGrid& grid,
                                             const TileEdgePlanes& edges,
                                             const std::vector<LightSphere>& spheres,
@@ -245,30 +280,7 @@ std::vector<CandidateLight> candidateLights(const gbuffer::CameraView& view, con
     const std::vector<uint32_t> visible = ViewFrustum(view).visibleLights(spheres, frustumCull);
     std::vector<CandidateLight> candidates(visible.size());
     tbb::parallel_for(size_t(0), visible.size(), [&](size_t k) {
-        const LightSphere& s = spheres[visible[k]];
-        CandidateLight& c = candidates[k];
-        c.index = visible[k];
-        c.centreView = s.centreView;
-        c.positionView = s.positionView;
-        c.radius = s.radius;
-        c.unbounded = s.unbounded;
-        if (s.unbounded)
-            return;
-        int columnMin = grid.tileCountX, columnMax = -1, rowMin = grid.tileCountY, rowMax = -1;
-        for (int tx = 0; tx < grid.tileCountX; ++tx)
-            if (sphereInColumnSlab(edges, tx, tx + 1, s.centreView, s.radius)) {
-                columnMin = std::min(columnMin, tx);
-                columnMax = tx;
-            }
-        for (int ty = 0; ty < grid.tileCountY; ++ty)
-            if (sphereInRowSlab(edges, ty, ty + 1, s.centreView, s.radius)) {
-                rowMin = std::min(rowMin, ty);
-                rowMax = ty;
-            }
-        c.columnMin = columnMin;
-        c.columnMax = columnMax;
-        c.rowMin = rowMin;
-        c.rowMax = rowMax;
+        candidates[k] = candidateOf(grid, edges, spheres[visible[k]], visible[k]);
     });
     return candidates;
 }
@@ -303,28 +315,170 @@ uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, in
     return backfaceRejected;
 }
 
+namespace {
+
+// A unit of the list build: one tile, or with `hierarchical` a group of kTileGroupTiles^2 tiles,
+// bounded by the union of its covered tiles' bounds.
+struct TileGroup {
+    bool covered = false;
+    int tx0 = 0, tx1 = -1, ty0 = 0, ty1 = -1; // inclusive tile ranges
+    float minDepthMetres = INFINITY, maxDepthMetres = -INFINITY;
+    ViewBox box{glm::vec3(INFINITY), glm::vec3(-INFINITY)};
+};
+
+// May the candidate pass appendTileLights' basic tests in some tile of the group? The tests are
+// those of appendTileLights with the group's union bounds, each monotone in its bound (integer
+// range overlap, depth interval, sphereTouchesBox: a larger box only shrinks the float distance),
+// so every light a tile of the group keeps passes here.
+bool mayTouchGroup(const CandidateLight& c, const TileGroup& g) {
+    if (c.unbounded)
+        return true;
+    if (g.tx1 < c.columnMin || g.tx0 > c.columnMax || g.ty1 < c.rowMin || g.ty0 > c.rowMax)
+        return false;
+    const float centreDepth = -c.centreView.z;
+    const float low = centreDepth - c.radius, high = centreDepth + c.radius;
+    if (high < g.minDepthMetres || low > g.maxDepthMetres)
+        return false;
+    return sphereTouchesBox(c.centreView, c.radius, g.box.lo, g.box.hi);
+}
+
+} // namespace
+
 TileLightListStats buildTileLightLists(const gbuffer::CameraView& view, const TileGrid& grid,
                                        const std::vector<TileSurfaceBounds>& bounds,
                                        const std::vector<LightSphere>& spheres,
-                                       const TileCullOptions& options, LightIndexLists& lists) {
+                                       const TileCullOptions& options, LightIndexLists& lists,
+                                       LightBvh* bvh) {
     const TileEdgePlanes edges = TileEdgePlanes::make(view, grid);
-    const std::vector<CandidateLight> candidates =
-        candidateLights(view, grid, edges, spheres, options.frustumCull);
     const size_t tileCount = size_t(grid.tileCount());
     std::vector<std::vector<uint32_t>> tileLights(tileCount);
     std::vector<uint64_t> tileBackfaceRejected(tileCount, 0);
-    tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-        const TileSurfaceBounds& b = bounds[size_t(tile)];
-        if (!b.covered)
-            return;
-        const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-        const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
-        tileBackfaceRejected[size_t(tile)] =
-            appendTileLights(candidates, tx, ty, b, box, options, tileLights[size_t(tile)]);
-    });
-    lists.assign(tileLights);
     TileLightListStats stats;
-    stats.lightsAfterVfc = candidates.size();
+
+    if (options.assign == TileAssign::Loop && !options.hierarchical) {
+        // Every candidate against every tile.
+        const std::vector<CandidateLight> candidates =
+            candidateLights(view, grid, edges, spheres, options.frustumCull);
+        tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
+            const TileSurfaceBounds& b = bounds[size_t(tile)];
+            if (!b.covered)
+                return;
+            const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
+            const TileBox box = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
+            tileBackfaceRejected[size_t(tile)] =
+                appendTileLights(candidates, tx, ty, b, box, options, tileLights[size_t(tile)]);
+        });
+        stats.lightsAfterVfc = candidates.size();
+    } else {
+        // Units (tiles or groups of tiles) and their bounds.
+        const int groupTiles = options.hierarchical ? kTileGroupTiles : 1;
+        const int groupsX = (grid.tileCountX + groupTiles - 1) / groupTiles;
+        const int groupsY = (grid.tileCountY + groupTiles - 1) / groupTiles;
+        const size_t groupCount = size_t(groupsX) * size_t(groupsY);
+        std::vector<TileBox> boxes(tileCount);
+        std::vector<TileGroup> groups(groupCount);
+        tbb::parallel_for(size_t(0), groupCount, [&](size_t group) {
+            TileGroup& g = groups[group];
+            g.tx0 = int(group % size_t(groupsX)) * groupTiles;
+            g.ty0 = int(group / size_t(groupsX)) * groupTiles;
+            g.tx1 = std::min(g.tx0 + groupTiles, grid.tileCountX) - 1;
+            g.ty1 = std::min(g.ty0 + groupTiles, grid.tileCountY) - 1;
+            for (int ty = g.ty0; ty <= g.ty1; ++ty)
+                for (int tx = g.tx0; tx <= g.tx1; ++tx) {
+                    const size_t tile = size_t(ty) * size_t(grid.tileCountX) + size_t(tx);
+                    const TileSurfaceBounds& b = bounds[tile];
+                    if (!b.covered)
+                        continue;
+                    boxes[tile] = tileBox(edges, grid, tx, ty, b.minDepthMetres, b.maxDepthMetres);
+                    g.covered = true;
+                    g.minDepthMetres = std::min(g.minDepthMetres, b.minDepthMetres);
+                    g.maxDepthMetres = std::max(g.maxDepthMetres, b.maxDepthMetres);
+                    g.box.lo = glm::min(g.box.lo, boxes[tile].boxMin);
+                    g.box.hi = glm::max(g.box.hi, boxes[tile].boxMax);
+                }
+        });
+
+        // Each unit's candidates, ascending (what its fine tiles test), gathered by its own task
+        // into per-thread scratch, then its tiles' lists: no per-frame storage per candidate.
+        tbb::enumerable_thread_specific<std::vector<CandidateLight>> scratch;
+        auto listTilesOf = [&](size_t group, std::span<const CandidateLight> unitCandidates) {
+            const TileGroup& g = groups[group];
+            for (int ty = g.ty0; ty <= g.ty1; ++ty)
+                for (int tx = g.tx0; tx <= g.tx1; ++tx) {
+                    const size_t tile = size_t(ty) * size_t(grid.tileCountX) + size_t(tx);
+                    const TileSurfaceBounds& b = bounds[tile];
+                    if (b.covered)
+                        tileBackfaceRejected[tile] = appendTileLights(
+                            unitCandidates, tx, ty, b, boxes[tile], options, tileLights[tile]);
+                }
+        };
+        if (options.assign == TileAssign::Loop) {
+            const std::vector<CandidateLight> candidates =
+                candidateLights(view, grid, edges, spheres, options.frustumCull);
+            stats.lightsAfterVfc = candidates.size();
+            tbb::parallel_for(size_t(0), groupCount, [&](size_t group) {
+                if (!groups[group].covered)
+                    return;
+                std::vector<CandidateLight>& unitCandidates = scratch.local();
+                unitCandidates.clear();
+                for (const CandidateLight& c : candidates)
+                    if (mayTouchGroup(c, groups[group]))
+                        unitCandidates.push_back(c);
+                listTilesOf(group, unitCandidates);
+            });
+        } else {
+            LightBvh localBvh;
+            LightBvh& tree = bvh ? *bvh : localBvh;
+            tree.build(spheres);
+            // View-frustum culling as candidateLights does it, as a flag per light.
+            const ViewFrustum frustum(view);
+            std::vector<uint8_t> visible(spheres.size(), 1);
+            if (options.frustumCull)
+                tbb::parallel_for(size_t(0), spheres.size(), [&](size_t light) {
+                    visible[light] = frustum.mayTouch(spheres[light]) ? 1 : 0;
+                });
+            stats.lightsAfterVfc = size_t(std::count(visible.begin(), visible.end(), uint8_t(1)));
+            // The hierarchy's candidates of each unit's box (a superset of the lights whose
+            // sphere touches any of its tiles' boxes), without the culled ones.
+            std::vector<std::vector<uint32_t>> unitLights(groupCount);
+            std::vector<uint8_t> needed(spheres.size(), 0);
+            tbb::parallel_for(size_t(0), groupCount, [&](size_t group) {
+                if (!groups[group].covered)
+                    return;
+                std::vector<uint32_t>& found = unitLights[group];
+                tree.candidates(groups[group].box, found);
+                std::erase_if(found, [&](uint32_t light) { return visible[light] == 0; });
+                // Every writer stores the same value: the flags do not depend on the schedule.
+                for (uint32_t light : found)
+                    std::atomic_ref<uint8_t>(needed[light]).store(1, std::memory_order_relaxed);
+            });
+            // Column and row ranges only for lights some unit found (O(tile columns + rows)
+            // each), in a compact array indexed through `slot`.
+            std::vector<uint32_t> neededLights, slot(spheres.size(), 0);
+            for (uint32_t light = 0; light < uint32_t(spheres.size()); ++light)
+                if (needed[light]) {
+                    slot[light] = uint32_t(neededLights.size());
+                    neededLights.push_back(light);
+                }
+            std::vector<CandidateLight> records(neededLights.size());
+            tbb::parallel_for(size_t(0), neededLights.size(), [&](size_t k) {
+                records[k] = candidateOf(grid, edges, spheres[neededLights[k]], neededLights[k]);
+            });
+            tbb::parallel_for(size_t(0), groupCount, [&](size_t group) {
+                if (!groups[group].covered)
+                    return;
+                std::vector<CandidateLight>& unitCandidates = scratch.local();
+                unitCandidates.clear();
+                for (uint32_t light : unitLights[group]) {
+                    const CandidateLight& c = records[slot[light]];
+                    if (!options.hierarchical || mayTouchGroup(c, groups[group]))
+                        unitCandidates.push_back(c);
+                }
+                listTilesOf(group, unitCandidates);
+            });
+        }
+    }
+    lists.assign(tileLights);
     for (uint64_t rejected : tileBackfaceRejected)
         stats.backfaceRejected += rejected;
     return stats;

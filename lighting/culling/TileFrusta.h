@@ -27,6 +27,7 @@
 #include "gbuffer/visibility/CameraView.h"
 #include "lighting/culling/CullingTests.h"
 #include "lighting/culling/LightBounds.h"
+#include "lighting/culling/LightBvh.h"
 #include "lighting/culling/LightIndexLists.h"
 
 namespace lighting {
@@ -183,11 +184,23 @@ bool lightBackFacesTile(const TileBox& box, const BackfaceTileCone& cone,
 
 // Which tests the tile lists use beyond the basic ones (tile-column/row slabs, depth range,
 // sphere vs tile box): view-frustum culling first (ViewFrustum), Harada's 2.5D depth mask, the
-// thesis' back-face normal-cone test (needs bounds computed with normalCone).
+// thesis' back-face normal-cone test (needs bounds computed with normalCone). And how a tile finds
+// the lights to test (speed only: the lists are the same for every choice, tested):
+//   assign   Loop: every candidate light against every tile (the cheap integer column/row test
+//            first); Bvh: the tile's box queries a LightBvh over the spheres, and only the lights
+//            it returns meet the per-tile test
+//   hierarchical: coarse groups of kTileGroupTiles x kTileGroupTiles tiles get a list first (the
+//            union of their covered tiles' boxes, depth ranges, columns and rows: tests that are
+//            monotone in the bound, so a light a fine tile keeps is always in its group's list);
+//            fine tiles then test only their group's list
+enum class TileAssign { Loop, Bvh };
+inline constexpr int kTileGroupTiles = 4; // 4x4 tiles: 64x64 pixels at the default tile size
 struct TileCullOptions {
     bool frustumCull = false;
     bool depthMask = false;
     bool backface = false;
+    TileAssign assign = TileAssign::Loop;
+    bool hierarchical = false;
 };
 
 // The per-tile light test: appends to `list`, in the candidates' (ascending) order, every
@@ -208,11 +221,14 @@ struct TileLightListStats {
 // `light-prepass`, `inferred` and the overflow path of `light-indexed`: one list per tile of
 // `grid` (row-major), ascending light indices, empty for tiles without a covered sample.
 // `bounds` must come from computeTileSurfaceBounds / computeTileDepthBounds with the depth mask
-// and normal cone that `options` uses. Tiles in parallel, each list written by one task, then
-// concatenated in tile order: the lists never depend on the thread count.
+// and normal cone that `options` uses. Tiles (or tile groups) in parallel, each list written by
+// one task, then concatenated in tile order: the lists never depend on the thread count. With
+// assign = Bvh the hierarchy is built into `bvh` (storage reused across frames) or, when null,
+// into a local one; the build is part of the call.
 TileLightListStats buildTileLightLists(const gbuffer::CameraView& view, const TileGrid& grid,
                                        const std::vector<TileSurfaceBounds>& bounds,
                                        const std::vector<LightSphere>& spheres,
-                                       const TileCullOptions& options, LightIndexLists& lists);
+                                       const TileCullOptions& options, LightIndexLists& lists,
+                                       LightBvh* bvh = nullptr);
 
 } // namespace lighting

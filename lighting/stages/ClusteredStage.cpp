@@ -11,7 +11,9 @@
 //   slices=exp|uniform   geometric (self-similar clusters) or linear slice boundaries between the
 //                        nearest and farthest view depth found in the G-buffer (a tighter range
 //                        than the camera's near/far planes, so no slice is wasted on empty space)
-//   assign=walk|binary   candidate ranges by walking the sorted planes or by binary search
+//   assign=walk|binary|bvh  candidate ranges by walking the sorted planes or by binary search;
+//                        bvh: each cluster's box queries a light BVH (culling/LightBvh.h), the
+//                        lights found meet the same range and cluster tests (same lists)
 //   test=aabb|frustum    cluster test: sphere vs AABB, or AABB and the four side planes
 // Passes: "assign" (depth range, cluster bounds, light lists), "shading".
 // Conventions: view space right-handed, -Z forward; a pixel's slice comes from the depth of its
@@ -178,7 +180,9 @@ public:
         result.parameters["grid"] = grid;
         result.parameters["slices"] =
             mOptions.spacing == SliceSpacing::Exponential ? "exp" : "uniform";
-        result.parameters["assign"] = mOptions.assign == AssignMethod::Walk ? "walk" : "binary";
+        result.parameters["assign"] = mOptions.assign == AssignMethod::Walk     ? "walk"
+                                      : mOptions.assign == AssignMethod::Binary ? "binary"
+                                                                                : "bvh";
         result.parameters["test"] = mOptions.test == ClusterTest::Aabb ? "aabb" : "frustum";
         result.parameters["cluster_light_pairs"] = pairs;
     }
@@ -208,8 +212,9 @@ std::vector<StageOption> clusteredOptionTable() {
         StageOption::choice("slices", {"exp", "uniform"},
                             "slice boundaries between the G-buffer's nearest and farthest depth: "
                             "geometric or linear"),
-        StageOption::choice("assign", {"walk", "binary"},
-                            "a light's cluster ranges by walking the planes or by binary search"),
+        StageOption::choice("assign", {"walk", "binary", "bvh"},
+                            "per light, its cluster ranges by walking the planes or by binary "
+                            "search; or per cluster, its lights from a light BVH (same lists)"),
         StageOption::choice("test", {"aabb", "frustum"},
                             "cluster test: sphere vs AABB, or AABB and the four side planes")};
 }
@@ -226,7 +231,10 @@ const StageRegistrar kRegistrar(
         parseClusterGrid(table.text("grid"), options.tilesX, options.tilesY, options.slices);
         options.spacing =
             table.text("slices") == "exp" ? SliceSpacing::Exponential : SliceSpacing::Uniform;
-        options.assign = table.text("assign") == "walk" ? AssignMethod::Walk : AssignMethod::Binary;
+        const std::string assign = table.text("assign");
+        options.assign = assign == "walk"     ? AssignMethod::Walk
+                         : assign == "binary" ? AssignMethod::Binary
+                                              : AssignMethod::Bvh;
         options.test = table.text("test") == "aabb" ? ClusterTest::Aabb : ClusterTest::Frustum;
         return std::make_unique<ClusteredStage>(options);
     });

@@ -17,6 +17,8 @@
 //   vfc=1     first cull lights against the camera frustum (ViewFrustum); only speed
 //   mask=0    Harada's 2.5D culling (his proposal was for Forward+): a 32-bin depth mask per
 //             tile from the pre-pass depths against each light's depth range, as in `tiled`
+//   assign=loop|bvh, hier=0  as in `tiled` (TiledStage.cpp): how tiles find their lights; only
+//             speed, the lists are the same
 // Parameters record the options and lights_after_vfc, vfc_culled and tile_light_pairs.
 //
 // Shading on the light kernel (FragmentShading.h): the shading draw queues each visible fragment
@@ -51,6 +53,7 @@
 #include "lighting/passes/ForwardGeometry.h"
 #include "lighting/passes/FragmentShading.h"
 #include "lighting/passes/PassNames.h"
+#include "lighting/stages/TiledStageOptions.h"
 
 namespace lighting {
 
@@ -60,6 +63,8 @@ struct TiledForwardOptions {
     int tileSizePixels = 16;
     bool viewFrustumCulling = true;
     bool depthMask = false;
+    TileAssign assign = TileAssign::Loop;
+    bool hierarchical = false;
 };
 
 class TiledForwardStage final : public ShadingStage {
@@ -80,8 +85,9 @@ public:
             mForward.depthDecoder(), mForward.shadedDepth(), grid, mOptions.depthMask);
         const size_t lightsAfterVfc =
             buildTileLightLists(view, grid, bounds, boundingSpheresView(*inputs.lights),
-                                {mOptions.viewFrustumCulling, mOptions.depthMask, false},
-                                mTileLights)
+                                {mOptions.viewFrustumCulling, mOptions.depthMask, false,
+                                 mOptions.assign, mOptions.hierarchical},
+                                mTileLights, &mBvh)
                 .lightsAfterVfc;
         cull.stop();
 
@@ -115,6 +121,8 @@ public:
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
+        result.parameters["assign"] = mOptions.assign == TileAssign::Bvh ? "bvh" : "loop";
+        result.parameters["hier"] = mOptions.hierarchical ? "1" : "0";
         result.parameters["lights_after_vfc"] = std::to_string(lightsAfterVfc);
         result.parameters["vfc_culled"] =
             std::to_string(inputs.lights->lights.size() - lightsAfterVfc);
@@ -129,6 +137,7 @@ private:
     ForwardGeometry mForward;
     FragmentShading mShading;
     LightIndexLists mTileLights; // per tile, ascending light indices (buildTileLightLists)
+    LightBvh mBvh;               // assign=bvh; storage reused across frames
 };
 
 const StageRegistrar kRegistrar(
@@ -139,7 +148,8 @@ const StageRegistrar kRegistrar(
                  StageOption::boolean("vfc", true,
                                       "cull lights against the camera frustum first (speed only)"),
                  StageOption::boolean("mask", false,
-                                      "Harada's 2.5D culling: a 32-bin depth mask per tile")},
+                                      "Harada's 2.5D culling: a 32-bin depth mask per tile"),
+                 tiledAssignOption(), tiledHierOption()},
      .listOrder = 120,
      .msaaNative = true},
     [](const StageOptions& table) {
@@ -147,6 +157,8 @@ const StageRegistrar kRegistrar(
         options.tileSizePixels = table.integer("tile");
         options.viewFrustumCulling = table.boolean("vfc");
         options.depthMask = table.boolean("mask");
+        options.assign = table.text("assign") == "bvh" ? TileAssign::Bvh : TileAssign::Loop;
+        options.hierarchical = table.boolean("hier");
         return std::make_unique<TiledForwardStage>(options);
     });
 

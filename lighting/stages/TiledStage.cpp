@@ -17,6 +17,10 @@
 //   tile=16   tile size in pixels, 4..128
 //   vfc=1     first cull lights against the camera frustum (thesis 4.1 item 4); only speed
 //   mask=0    Harada's 2.5D culling: 32-bin depth mask per tile against the light's depth range
+//   assign=loop|bvh  how a tile finds the lights to test: every light, or the lights a light BVH
+//             (culling/LightBvh.h) returns for the tile's box; only speed, the lists are the same
+//   hier=0    hierarchical tile culling: 4x4 groups of tiles get a list first, fine tiles test
+//             only their group's list; only speed (buildTileLightLists in culling/TileFrusta.h)
 // Passes: "cull" (light spheres, view-frustum culling, tile bounds and cones, light lists) and
 // "shading". Parameters record the options and counts: lights_after_vfc, vfc_culled,
 // tile_light_pairs and (tiled-backface) backface_rejected.
@@ -39,6 +43,7 @@
 #include "lighting/passes/BlendedPass.h"
 #include "lighting/passes/LightAccumulation.h"
 #include "lighting/passes/PassNames.h"
+#include "lighting/stages/TiledStageOptions.h"
 
 namespace lighting {
 
@@ -49,6 +54,8 @@ struct TiledOptions {
     bool viewFrustumCulling = true;
     bool depthMask = false;
     bool backface = false;
+    TileAssign assign = TileAssign::Loop;
+    bool hierarchical = false;
 };
 
 class TiledStage final : public ShadingStage {
@@ -68,9 +75,11 @@ public:
         const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
         const std::vector<TileSurfaceBounds> bounds =
             computeTileSurfaceBounds(gb, grid, {mOptions.depthMask, mOptions.backface});
-        const TileLightListStats lists = buildTileLightLists(
-            view, grid, bounds, spheres,
-            {mOptions.viewFrustumCulling, mOptions.depthMask, mOptions.backface}, mTileLights);
+        const TileLightListStats lists =
+            buildTileLightLists(view, grid, bounds, spheres,
+                                {mOptions.viewFrustumCulling, mOptions.depthMask, mOptions.backface,
+                                 mOptions.assign, mOptions.hierarchical},
+                                mTileLights, &mBvh);
         cull.stop();
 
         PassTimer shading(result, pass::kShading);
@@ -84,6 +93,8 @@ public:
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["vfc"] = mOptions.viewFrustumCulling ? "1" : "0";
         result.parameters["mask"] = mOptions.depthMask ? "1" : "0";
+        result.parameters["assign"] = mOptions.assign == TileAssign::Bvh ? "bvh" : "loop";
+        result.parameters["hier"] = mOptions.hierarchical ? "1" : "0";
         result.parameters["lights_after_vfc"] = std::to_string(lists.lightsAfterVfc);
         result.parameters["vfc_culled"] = std::to_string(spheres.size() - lists.lightsAfterVfc);
         result.parameters["tile_light_pairs"] = std::to_string(mTileLights.pairCount());
@@ -94,6 +105,7 @@ public:
 private:
     TiledOptions mOptions;
     LightIndexLists mTileLights; // per tile, ascending; storage reused across frames
+    LightBvh mBvh;               // assign=bvh; storage reused across frames
     BlendedPass mBlended;        // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
@@ -103,7 +115,8 @@ std::vector<StageOption> tiledOptionTable() {
         StageOption::integer("tile", 16, 4, 128, "tile size in pixels"),
         StageOption::boolean("vfc", true,
                              "cull lights against the camera frustum first (speed only)"),
-        StageOption::boolean("mask", false, "Harada's 2.5D culling: a 32-bin depth mask per tile")};
+        StageOption::boolean("mask", false, "Harada's 2.5D culling: a 32-bin depth mask per tile"),
+        tiledAssignOption(), tiledHierOption()};
 }
 
 StageFactory tiledFactory(bool backface) {
@@ -112,6 +125,8 @@ StageFactory tiledFactory(bool backface) {
         options.tileSizePixels = table.integer("tile");
         options.viewFrustumCulling = table.boolean("vfc");
         options.depthMask = table.boolean("mask");
+        options.assign = table.text("assign") == "bvh" ? TileAssign::Bvh : TileAssign::Loop;
+        options.hierarchical = table.boolean("hier");
         options.backface = backface;
         return std::make_unique<TiledStage>(options);
     };

@@ -137,9 +137,10 @@ TEST(StageOptionTables, UnknownKeysAreRefusedWithTheValidOnesAndTheClosest) {
 }
 
 TEST(StageOptionTables, ResolvedOptionsAreCanonical) {
-    const auto tiled = lighting::resolvedStageOptions("tiled:vfc=off,tile=032");
+    const auto tiled = lighting::resolvedStageOptions("tiled:vfc=off,tile=032,hier=on");
     EXPECT_EQ(tiled,
-              (std::map<std::string, std::string>{{"tile", "32"}, {"vfc", "0"}, {"mask", "0"}}));
+              (std::map<std::string, std::string>{
+                  {"tile", "32"}, {"vfc", "0"}, {"mask", "0"}, {"assign", "loop"}, {"hier", "1"}}));
     EXPECT_EQ(lighting::resolvedStageOptions("inferred:depth=0.10,normal=-1").at("depth"), "0.1");
     EXPECT_EQ(lighting::resolvedStageOptions("inferred:normal=-1.0").at("normal"), "-1");
     EXPECT_EQ(lighting::resolvedStageOptions("clustered:grid=8x4x16").at("grid"), "8x4x16");

@@ -510,8 +510,10 @@ TEST(RenderCommand, StatsRecordTheStagesResolvedOptions) {
     const nlohmann::json stats = nlohmann::json::parse(statsFile);
     // The spec as given, and every option of the table with defaults filled in, canonical.
     EXPECT_EQ(stats["stage"], "tiled:vfc=off,tile=032");
-    EXPECT_EQ(stats["stage_options"],
-              nlohmann::json({{"tile", "32"}, {"vfc", "0"}, {"mask", "0"}}));
+    EXPECT_EQ(
+        stats["stage_options"],
+        nlohmann::json(
+            {{"tile", "32"}, {"vfc", "0"}, {"mask", "0"}, {"assign", "loop"}, {"hier", "0"}}));
     // What the stage ran with agrees with what is recorded.
     for (const auto& [key, value] : stats["stage_options"].items())
         EXPECT_EQ(stats["stage_parameters"][key], value) << key;

@@ -139,12 +139,13 @@ TEST(ClusteredStage, RejectsBadOptions) {
          {"clustered:grid=24x12", "clustered:grid=0x12x32", "clustered:grid=24x12x0",
           "clustered:grid=100000x1x1", "clustered:grid=1024x1024x1024", "clustered:grid=24x12x32x",
           "clustered:grid=abc", "clustered:grid=", "clustered:grid=-1x2x3",
-          "clustered:grid=24X12X32", "clustered:slices=log", "clustered:assign=bvh",
+          "clustered:grid=24X12X32", "clustered:slices=log", "clustered:assign=octree",
           "clustered:test=sphere", "clustered:tiles=16"})
         EXPECT_THROW(lighting::makeStage(bad), lighting::StageError) << bad;
     EXPECT_NO_THROW(
         lighting::makeStage("clustered:grid=1x1x1,slices=uniform,assign=binary,test=frustum"));
     EXPECT_NO_THROW(lighting::makeStage("clustered:grid=64x32x64"));
+    EXPECT_NO_THROW(lighting::makeStage("clustered:assign=bvh"));
 }
 
 // ---- ClusterGrid alone ------------------------------------------------------------------------
