@@ -45,38 +45,14 @@ uint32_t ClusterKeying::normalBin(const glm::vec3& n) const {
 
 ExplicitCluster clusterOfSamples(std::span<const glm::vec3> positionsView,
                                  std::span<const glm::vec3> normalsView) {
-    ExplicitCluster c;
-    c.sampleCount = uint32_t(positionsView.size());
-    if (positionsView.empty())
-        return c;
-    glm::vec3 lo = positionsView[0], hi = positionsView[0];
-    for (const glm::vec3& p : positionsView) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-    c.boundsView = {lo, hi};
-    // The cone as TileFrusta's tile cones (boundsOfSamples): unit normals, axis their normalised
-    // sum, half-angle from the smallest dot; open when the sum nearly cancels or a normal is zero.
-    glm::vec3 sum(0.0f);
-    bool zeroNormal = false;
-    for (const glm::vec3& n : normalsView) {
-        const float length = glm::length(n);
-        if (!(length > 0.0f)) {
-            zeroNormal = true;
-            continue;
-        }
-        sum += n / length;
-    }
-    const float sumLength = glm::length(sum);
-    if (zeroNormal || !(sumLength > 1e-3f * float(normalsView.size())))
-        return c;
-    const glm::vec3 axis = sum / sumLength;
-    float minDot = 1.0f;
-    for (const glm::vec3& n : normalsView)
-        minDot = std::min(minDot, glm::dot(axis, n / glm::length(n)));
-    c.normalAxisView = axis;
-    c.normalHalfAngle = std::acos(std::clamp(minDot, -1.0f, 1.0f));
-    return c;
+    ClusterBoundsAccumulator bounds;
+    for (size_t i = 0; i < positionsView.size(); ++i)
+        bounds.add(positionsView[i], ClusterBoundsAccumulator::unit(normalsView[i]));
+    bounds.axis();
+    if (!bounds.coneOpen)
+        for (const glm::vec3& n : normalsView)
+            bounds.addToCone(ClusterBoundsAccumulator::unit(n));
+    return bounds.finish();
 }
 
 ClusterCone backfaceClusterCone(const ExplicitCluster& cluster) {
@@ -125,13 +101,27 @@ void ExplicitClusters::find(const gbuffer::GBuffer& gb, const ExplicitClusterOpt
     const int tileCountY = (gb.height() + options.tileSizePixels - 1) / options.tileSizePixels;
     const ClusterKeying keying =
         ClusterKeying::make(gb.view(), tileCountY, options.normalDivisions);
+    // Positions from the depth decoder and normals from the float planes are bitwise
+    // GBuffer::decode's (which reads them the same way); layouts with encoded normals go through
+    // decode().
+    const gbuffer::DepthDecoder& decoder = gb.depthDecoder();
+    const std::span<const float> depth = gb.depth();
+    const std::span<const float> normal[3] = {gb.normalPlane(0), gb.normalPlane(1),
+                                              gb.normalPlane(2)};
+    const bool planes = !normal[0].empty();
     find(gb.width(), gb.height(), keying, options.tileSizePixels,
-         [&gb](int x, int y, glm::vec3& positionView, glm::vec3& normalView) {
-             if (!gb.covered(size_t(y) * size_t(gb.width()) + size_t(x)))
+         [&](int x, int y, glm::vec3& positionView, glm::vec3& normalView) {
+             const size_t pixel = size_t(y) * size_t(gb.width()) + size_t(x);
+             if (!gb.covered(pixel))
                  return false;
-             const gbuffer::Surface s = gb.decode(x, y);
-             positionView = s.positionView;
-             normalView = s.normalView;
+             if (planes) {
+                 positionView = decoder.positionView(x, y, depth[pixel]);
+                 normalView = {normal[0][pixel], normal[1][pixel], normal[2][pixel]};
+             } else {
+                 const gbuffer::Surface s = gb.decode(x, y);
+                 positionView = s.positionView;
+                 normalView = s.normalView;
+             }
              return true;
          });
 }

@@ -14,8 +14,10 @@
 //     the normal's largest component, then normalDivisions x normalDivisions cells of that face
 //     (the paper's 3x3 per face); a zero normal has a bin of its own.
 // Within a tile the key is slice * normalBins + normalBin; the tile's unique keys, ascending, are
-// its clusters, and clusters are numbered tile by tile (tiles row-major). Each tile is sorted on
-// its own, so the numbering and everything computed from it never depend on the thread count.
+// its clusters, and clusters are numbered tile by tile (tiles row-major). Each tile finds its
+// distinct keys on its own (a short list searched linearly, neighbours mostly sharing a key;
+// sort and bisection past 32 distinct keys) and accumulates its clusters' bounds in pixel order,
+// so the numbering and every bound never depend on the thread count.
 //
 // Bounds. Per cluster, from its samples alone (nothing from slice or tile geometry):
 //   - a view-space AABB: the min/max of the samples' positions. Rule 2 of the slack policy
@@ -170,51 +172,148 @@ uint64_t appendClusterLights(const ExplicitCluster& cluster, const ClusterCone* 
 ExplicitCluster clusterOfSamples(std::span<const glm::vec3> positionsView,
                                  std::span<const glm::vec3> normalsView);
 
+// Accumulates one cluster's bounds from its samples in a fixed order (what find() and
+// clusterOfSamples share): add() every sample, then axis(), then addToCone() every normal again,
+// then finish().
+struct ClusterBoundsAccumulator {
+    glm::vec3 lo{INFINITY}, hi{-INFINITY};
+    glm::vec3 normalSum{0.0f};
+    uint32_t count = 0;
+    bool zeroNormal = false;
+    float minDot = 1.0f;
+    glm::vec3 axisView{0.0f, 0.0f, 1.0f};
+    bool coneOpen = true;
+
+    // The unit normal the bounds use (zero for a zero or non-finite-length normal): computed once
+    // per sample by the caller and given to add() and addToCone().
+    static glm::vec3 unit(const glm::vec3& n) {
+        const float length = glm::length(n);
+        return length > 0.0f ? n / length : glm::vec3(0.0f);
+    }
+    void add(const glm::vec3& positionView, const glm::vec3& unitNormalView) {
+        lo = glm::min(lo, positionView);
+        hi = glm::max(hi, positionView);
+        normalSum += unitNormalView;
+        zeroNormal = zeroNormal || unitNormalView == glm::vec3(0.0f);
+        ++count;
+    }
+    // Normals cancelling out (sum ~ 0) or a zero normal leave the cone open, as TileFrusta's.
+    void axis() {
+        const float sumLength = glm::length(normalSum);
+        coneOpen = zeroNormal || !(sumLength > 1e-3f * float(count));
+        if (!coneOpen)
+            axisView = normalSum / sumLength;
+    }
+    void addToCone(const glm::vec3& unitNormalView) {
+        minDot = std::min(minDot, glm::dot(axisView, unitNormalView));
+    }
+    ExplicitCluster finish() const {
+        ExplicitCluster c;
+        c.sampleCount = count;
+        if (count == 0)
+            return c;
+        c.boundsView = {lo, hi};
+        if (!coneOpen) {
+            c.normalAxisView = axisView;
+            c.normalHalfAngle = std::acos(std::clamp(minDot, -1.0f, 1.0f));
+        }
+        return c;
+    }
+};
+
 template <class SampleAt>
 void ExplicitClusters::find(int widthPixels, int heightPixels, const ClusterKeying& keying,
                             int tileSizePixels, const SampleAt& sampleAt) {
     mGrid = TileGrid::make(widthPixels, heightPixels, tileSizePixels);
     const size_t tileCount = size_t(mGrid.tileCount());
-    mPixelCluster.assign(size_t(widthPixels) * size_t(heightPixels), kNoCluster);
+    mPixelCluster.resize(size_t(widthPixels) * size_t(heightPixels));
     mTileClusters.resize(tileCount);
     tbb::parallel_for(size_t(0), tileCount, [&](size_t tile) {
         const int tx = int(tile) % mGrid.tileCountX, ty = int(tile) / mGrid.tileCountX;
-        // (key, pixel) of the tile's covered samples, sorted: runs of one key are its clusters.
-        struct Sample {
-            uint64_t keyPixel; // key << 32 | pixel
-            glm::vec3 positionView, normalView;
+        // The tile's covered samples in pixel order: positions, unit normals, keys, pixels.
+        struct Scratch {
+            std::vector<glm::vec3> positions, normals;
+            std::vector<uint32_t> keys, pixels, slots, distinct, sorted, rank;
+            std::vector<ClusterBoundsAccumulator> bounds;
         };
-        thread_local std::vector<Sample> samples;
-        thread_local std::vector<glm::vec3> positions, normals;
-        samples.clear();
+        thread_local Scratch t;
+        t.positions.clear();
+        t.normals.clear();
+        t.keys.clear();
+        t.pixels.clear();
         for (int y = mGrid.y0(ty); y < mGrid.y1(ty); ++y)
             for (int x = mGrid.x0(tx); x < mGrid.x1(tx); ++x) {
-                Sample s;
-                if (!sampleAt(x, y, s.positionView, s.normalView))
+                const size_t pixel = size_t(y) * size_t(widthPixels) + size_t(x);
+                mPixelCluster[pixel] = kNoCluster;
+                glm::vec3 position, normal;
+                if (!sampleAt(x, y, position, normal))
                     continue;
-                const uint32_t pixel = uint32_t(size_t(y) * size_t(widthPixels) + size_t(x));
-                s.keyPixel = uint64_t(keying.key(s.positionView, s.normalView)) << 32 | pixel;
-                samples.push_back(s);
+                t.positions.push_back(position);
+                t.normals.push_back(ClusterBoundsAccumulator::unit(normal));
+                t.keys.push_back(keying.key(position, normal));
+                t.pixels.push_back(uint32_t(pixel));
             }
-        std::sort(samples.begin(), samples.end(),
-                  [](const Sample& a, const Sample& b) { return a.keyPixel < b.keyPixel; });
+        const size_t n = t.keys.size();
+        // Each sample's slot among the tile's distinct keys: a short list searched linearly
+        // (neighbours mostly share a key), or, past kLinear distinct keys, the sorted unique
+        // keys searched by bisection. Either way the slots end as ranks in ascending key order.
+        constexpr size_t kLinear = 32;
+        t.slots.resize(n);
+        t.distinct.clear();
+        bool many = false;
+        uint32_t lastKey = UINT32_MAX, lastSlot = 0;
+        for (size_t i = 0; i < n && !many; ++i) {
+            if (t.keys[i] != lastKey) {
+                lastKey = t.keys[i];
+                const auto it = std::find(t.distinct.begin(), t.distinct.end(), lastKey);
+                if (it != t.distinct.end()) {
+                    lastSlot = uint32_t(it - t.distinct.begin());
+                } else if (t.distinct.size() == kLinear) {
+                    many = true;
+                    break;
+                } else {
+                    lastSlot = uint32_t(t.distinct.size());
+                    t.distinct.push_back(lastKey);
+                }
+            }
+            t.slots[i] = lastSlot;
+        }
+        if (many) {
+            t.sorted.assign(t.keys.begin(), t.keys.end());
+            std::sort(t.sorted.begin(), t.sorted.end());
+            t.sorted.erase(std::unique(t.sorted.begin(), t.sorted.end()), t.sorted.end());
+            for (size_t i = 0; i < n; ++i)
+                t.slots[i] =
+                    uint32_t(std::lower_bound(t.sorted.begin(), t.sorted.end(), t.keys[i]) -
+                             t.sorted.begin());
+        } else {
+            t.sorted.assign(t.distinct.begin(), t.distinct.end());
+            std::sort(t.sorted.begin(), t.sorted.end());
+            t.rank.resize(t.distinct.size());
+            for (size_t d = 0; d < t.distinct.size(); ++d)
+                t.rank[d] =
+                    uint32_t(std::lower_bound(t.sorted.begin(), t.sorted.end(), t.distinct[d]) -
+                             t.sorted.begin());
+            for (size_t i = 0; i < n; ++i)
+                t.slots[i] = t.rank[t.slots[i]];
+        }
+        // Bounds in pixel order, per cluster: box and normal sum, axis, then the cone.
+        t.bounds.assign(t.sorted.size(), ClusterBoundsAccumulator{});
+        for (size_t i = 0; i < n; ++i) {
+            t.bounds[t.slots[i]].add(t.positions[i], t.normals[i]);
+            mPixelCluster[t.pixels[i]] = t.slots[i];
+        }
+        for (ClusterBoundsAccumulator& b : t.bounds)
+            b.axis();
+        for (size_t i = 0; i < n; ++i)
+            if (!t.bounds[t.slots[i]].coneOpen)
+                t.bounds[t.slots[i]].addToCone(t.normals[i]);
         std::vector<ExplicitCluster>& clusters = mTileClusters[tile];
-        clusters.clear();
-        for (size_t first = 0; first < samples.size();) {
-            const uint32_t key = uint32_t(samples[first].keyPixel >> 32);
-            size_t end = first;
-            positions.clear();
-            normals.clear();
-            for (; end < samples.size() && uint32_t(samples[end].keyPixel >> 32) == key; ++end) {
-                positions.push_back(samples[end].positionView);
-                normals.push_back(samples[end].normalView);
-                mPixelCluster[uint32_t(samples[end].keyPixel)] = uint32_t(clusters.size());
-            }
-            ExplicitCluster c = clusterOfSamples(positions, normals);
-            c.tile = uint32_t(tile);
-            c.key = key;
-            clusters.push_back(c);
-            first = end;
+        clusters.resize(t.sorted.size());
+        for (size_t c = 0; c < clusters.size(); ++c) {
+            clusters[c] = t.bounds[c].finish();
+            clusters[c].tile = uint32_t(tile);
+            clusters[c].key = t.sorted[c];
         }
     });
     mTileFirst.resize(tileCount + 1);
@@ -225,6 +324,8 @@ void ExplicitClusters::find(int widthPixels, int heightPixels, const ClusterKeyi
     tbb::parallel_for(size_t(0), tileCount, [&](size_t tile) {
         std::copy(mTileClusters[tile].begin(), mTileClusters[tile].end(),
                   mClusters.begin() + mTileFirst[tile]);
+        if (mTileFirst[tile] == 0 || mTileClusters[tile].empty())
+            return;
         const int tx = int(tile) % mGrid.tileCountX, ty = int(tile) / mGrid.tileCountX;
         for (int y = mGrid.y0(ty); y < mGrid.y1(ty); ++y)
             for (int x = mGrid.x0(tx); x < mGrid.x1(tx); ++x) {
