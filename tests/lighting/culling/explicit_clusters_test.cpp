@@ -201,6 +201,32 @@ TEST(ExplicitClusters, ClusterTestCullsBackFacingLightsAndKeepsFrontLights) {
     EXPECT_EQ(list, (std::vector<uint32_t>{0, 1, 3, 4}));
 }
 
+// The cone's float arc cosine can be narrower than the true cone: two unit normals 1.5e-4 rad
+// either side of +z have float dot 1 with the axis, so the cone's half-angle is 0. A light
+// 1e-4 rad behind the samples' plane (seen from them) still lights the sample whose normal
+// leans towards it (dot > 0, checked in double); the back-face test's angular slack
+// (kBackfaceSlackRadians) is what keeps it.
+TEST(ExplicitClusters, ConeSlackKeepsAGrazingLightTheFloatConeMisses) {
+    const double tilt = 1.5e-4;
+    const std::vector<glm::vec3> positions(2, glm::vec3(0.0f, 0.0f, -5.0f));
+    const std::vector<glm::vec3> normals = {
+        glm::vec3(float(-std::sin(tilt)), 0.0f, float(std::cos(tilt))),
+        glm::vec3(float(std::sin(tilt)), 0.0f, float(std::cos(tilt)))};
+    const ExplicitCluster cluster = lighting::clusterOfSamples(positions, normals);
+    ASSERT_EQ(cluster.normalHalfAngle, 0.0f); // the float cone, narrower than the true one
+    lighting::LightSphere light;
+    light.centreView = light.positionView = {1.0f, 0.0f, -5.0f - 1e-4f};
+    light.radius = 2.0f;
+    const glm::dvec3 toLight = glm::dvec3(light.positionView) - glm::dvec3(positions[1]);
+    ASSERT_GT(glm::dot(glm::dvec3(normals[1]), toLight), 0.0); // it lights sample 1
+    const lighting::ClusterCone cone = lighting::backfaceClusterCone(cluster);
+    std::vector<uint32_t> list;
+    const std::vector<lighting::LightSphere> spheres = {light};
+    const std::vector<uint32_t> candidates = {0};
+    EXPECT_EQ(lighting::appendClusterLights(cluster, &cone, spheres, candidates, list), 0u);
+    EXPECT_EQ(list, std::vector<uint32_t>{0});
+}
+
 TEST(ExplicitClusters, KeysFollowThePapersSlices) {
     const ClusterKeying k = keying(0);
     // Slice k starts at near * (1 + 2 tan(theta) / S_y)^k.

@@ -2,7 +2,7 @@
 // identity against brute force (every contributing light among the lights each pixel evaluated,
 // tests/lighting/LightIdentity.h) and bitwise brute's image, at 10^2 and 10^4 lights on atrium
 // and on wall with lights behind it (where back-face culling must reject, and must not drop),
-// with and without normal clustering; the same result on 1 and 2 threads, bitwise, with the
+// with and without normal clustering; the same result on 1, 2 and 7 threads, bitwise, with the
 // same clusters and lists; the stage parameters stats.json records.
 #include <gtest/gtest.h>
 
@@ -11,6 +11,7 @@
 #include <string>
 #include <tuple>
 
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
 #include "lighting/PreparedScene.h"
@@ -87,24 +88,31 @@ INSTANTIATE_TEST_SUITE_P(
         return name;
     });
 
-TEST(ClusteredExplicit, SameResultOnOneAndTwoThreads) {
+// 1, 2 and 7 threads (global_control lifts TBB's cap at the core count, so 7 really splits the
+// tiles seven ways), each against 1 thread: images, counts, traces and the clusters' figures.
+TEST(ClusteredExplicit, SameResultOnOneTwoAndSevenThreads) {
     const Frame& f = frame("atrium", 1000);
+    tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, 7);
     for (const char* spec : {"clustered-explicit", "clustered-explicit:normals=3"}) {
-        lighting::StageResult results[2];
-        for (int i = 0; i < 2; ++i) {
-            tbb::task_arena arena(i + 1);
+        const int threads[] = {1, 2, 7};
+        lighting::StageResult results[3];
+        for (int i = 0; i < 3; ++i) {
+            tbb::task_arena arena(threads[i]);
             arena.execute([&] {
                 results[i].traceLights = true;
                 lighting::makeStage(spec)->shade(f.prepared->inputs, results[i]);
             });
         }
-        EXPECT_TRUE(stagecheck::bitwiseEqualImages(results[0], results[1])) << spec;
-        EXPECT_EQ(results[0].lightsEvaluated, results[1].lightsEvaluated) << spec;
-        EXPECT_EQ(results[0].lightTrace, results[1].lightTrace) << spec;
-        for (const char* key : {"unique_clusters", "cluster_light_pairs", "backface_rejected",
-                                "cluster_bytes", "simt_lane_slots"})
-            EXPECT_EQ(results[0].parameters.at(key), results[1].parameters.at(key))
-                << spec << " " << key;
+        for (int i = 1; i < 3; ++i) {
+            EXPECT_TRUE(stagecheck::bitwiseEqualImages(results[0], results[i]))
+                << spec << " on " << threads[i] << " threads";
+            EXPECT_EQ(results[0].lightsEvaluated, results[i].lightsEvaluated) << spec;
+            EXPECT_EQ(results[0].lightTrace, results[i].lightTrace) << spec;
+            for (const char* key : {"unique_clusters", "cluster_light_pairs", "backface_rejected",
+                                    "cluster_bytes", "simt_lane_slots"})
+                EXPECT_EQ(results[0].parameters.at(key), results[i].parameters.at(key))
+                    << spec << " " << key << " on " << threads[i] << " threads";
+        }
     }
 }
 
