@@ -55,8 +55,9 @@ struct StageInfo {
     bool ascendingLightOrder = true;
     std::vector<StageOption> options; // the option table (StageOptions.h), in listing order
     // Position in stageInfos() (ascending; unique among stages): today's order is reference 0,
-    // brute 10, ideal 20, deferred 30, light-indexed 40, clustered 50, tiled 60, tiled-backface
-    // 70, forward 80, forward-multipass 90, light-prepass 100, inferred 110, tiled-forward 120.
+    // brute 10, ideal 20, deferred 30, light-indexed 40, clustered 50, clustered-explicit 55, tiled
+    // 60, tiled-backface 70, forward 80, forward-multipass 90, light-prepass 100, inferred 110,
+    // tiled-forward 120.
     int listOrder = 0;
     // Multisampled frames (--msaa 2|4|8, MultisampleShading.h): empty when the stage shades them
     // through the fragment layers or natively; otherwise why it refuses them (`testbed list` shows

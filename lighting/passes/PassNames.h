@@ -20,6 +20,7 @@ inline constexpr const char* kShadowMaps = "shadow_maps";
 inline constexpr const char* kTransform = "transform"; // vertices to clip/view space (forward)
 inline constexpr const char* kPrepass = "prepass";     // depth-only pre-pass (forward)
 inline constexpr const char* kCull = "cull";           // light culling, tile / light lists
+inline constexpr const char* kClusters = "clusters";   // explicit clusters: keys, bounds
 inline constexpr const char* kAssign = "assign";       // clustered light assignment
 inline constexpr const char* kIndex = "index";         // light-indexed per-pixel lists
 inline constexpr const char* kShading = "shading";     // evaluating the lights
@@ -33,8 +34,8 @@ inline constexpr const char* kResolve = "resolve";
 inline constexpr const char* kPostAa = "post_aa";
 
 // The order passes run in within a frame; tables list passes this way, others after by name.
-inline constexpr std::array<std::string_view, 14> kPipelineOrder = {
-    kGBuffer, kExactSurface, kShadowMaps, kTransform, kPrepass, kCull,    kAssign,
+inline constexpr std::array<std::string_view, 15> kPipelineOrder = {
+    kGBuffer, kExactSurface, kShadowMaps, kTransform, kPrepass, kCull,    kClusters, kAssign,
     kIndex,   kShading,      kLighting,   kMaterial,  kBlend,   kResolve, kPostAa};
 
 } // namespace lighting::pass
