@@ -56,17 +56,59 @@ struct ZBinnedOptions {
     int tileSizePixels = 32;
     int binCount = 1024;
     ZBinSpacing spacing = ZBinSpacing::Uniform;
+    bool perPixelLists = false;
 };
 
 // The lists of a packet from the bins and the masks (see the file comment).
 class ZBinListSource final : public PacketListSource {
 public:
-    ZBinListSource(const TileGrid& grid, const ZBins& bins, const ZBinTileMasks& masks)
-        : mGrid(grid), mBins(bins), mMasks(masks) {}
+    // perPixel: each lane exactly its own bin's candidates (per-light lane masks); otherwise one
+    // list per packet and tile over the hull of the ranges of its lanes' bins (every lane walks
+    // it, as a GPU wave walks Drobot's wave-uniform range).
+    ZBinListSource(const TileGrid& grid, const ZBins& bins, const ZBinTileMasks& masks,
+                   bool perPixel)
+        : mGrid(grid), mBins(bins), mMasks(masks), mPerPixel(perPixel) {}
 
     void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
         Scratch& scratch = mScratch.local();
-        scratch.keys.clear();
+        // Lane bins: the nearest and the farthest lane's by search; when they differ and lists
+        // are per pixel, each lane's is the nearest's plus the boundaries in between its depth
+        // reaches (binOfDepth's own comparisons, as `clustered` finds slices).
+        float nearest = INFINITY, farthest = -INFINITY;
+        for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
+            const float depth = -packet.positionView[2][__builtin_ctz(lanes)];
+            nearest = std::min(nearest, depth);
+            farthest = std::max(farthest, depth);
+        }
+        const int nearBin = mBins.binOfDepth(nearest), farBin = mBins.binOfDepth(farthest);
+        const int firstTileX = packet.x0 / mGrid.tileSizePixels;
+        const int firstTileY = packet.y0 / mGrid.tileSizePixels;
+        const int lastX = std::min(packet.x0 + kernel::kPacketWidth, mGrid.widthPixels) - 1;
+        const int lastY = std::min(packet.y0 + kernel::kPacketHeight, mGrid.heightPixels) - 1;
+        if ((nearBin == farBin || !mPerPixel) && lastX / mGrid.tileSizePixels == firstTileX &&
+            lastY / mGrid.tileSizePixels == firstTileY) {
+            // One tile and one list (most packets): reused while the thread's next packets have
+            // the same tile and range.
+            const size_t tile = size_t(firstTileY) * size_t(mGrid.tileCountX) + size_t(firstTileX);
+            const ZBins::Range range = mBins.rangeOfBins(nearBin, farBin);
+            if (!(scratch.single && scratch.singleTile == tile &&
+                  scratch.singleRange.first == range.first &&
+                  scratch.singleRange.last == range.last)) {
+                scratch.lights.clear();
+                const TileLights& tileLights = lightsOfTile(scratch, tile);
+                for (size_t j = 0; j < tileLights.lights.size(); ++j)
+                    if (inRange(tileLights.positions[j], range))
+                        scratch.lights.push_back(tileLights.lights[j]);
+                scratch.single = true;
+                scratch.singleTile = tile;
+                scratch.singleRange = range;
+            }
+            lists.addTransient(packet.laneMask, scratch.lights);
+            return;
+        }
+        scratch.single = false;
+        scratch.lights.clear();
+        scratch.laneMasks.clear();
         int tileOfLane[kernel::kPacketLanes];
         int binOfLane[kernel::kPacketLanes];
         for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
@@ -74,7 +116,11 @@ public:
             const int x = packet.x0 + kernel::laneX(lane), y = packet.y0 + kernel::laneY(lane);
             tileOfLane[lane] =
                 (y / mGrid.tileSizePixels) * mGrid.tileCountX + x / mGrid.tileSizePixels;
-            binOfLane[lane] = mBins.binOfDepth(-packet.positionView[2][lane]);
+            const float depth = -packet.positionView[2][lane];
+            int bin = nearBin;
+            for (int k = nearBin + 1; k <= farBin; ++k)
+                bin += mBins.boundary(k) <= depth ? 1 : 0;
+            binOfLane[lane] = bin;
         }
         struct Group {
             uint32_t laneMask;
@@ -83,11 +129,10 @@ public:
         };
         Group groups[kernel::kPacketLanes];
         int groupCount = 0;
-        const std::span<const uint32_t> unbounded = mBins.unboundedLights();
         for (uint32_t remaining = packet.laneMask; remaining != 0;) {
             const int tile = tileOfLane[__builtin_ctz(remaining)];
             uint32_t groupMask = 0;
-            // The group's distinct bins, the lanes in each and their ranges.
+            // The group's distinct bins and the lanes in each.
             int binCount = 0;
             int bins[kernel::kPacketLanes];
             uint32_t binLanes[kernel::kPacketLanes];
@@ -106,44 +151,38 @@ public:
                 binLanes[k] |= 1u << lane;
             }
             remaining &= ~groupMask;
-            ZBins::Range ranges[kernel::kPacketLanes];
-            uint32_t first = UINT32_MAX, last = 0;
-            for (int k = 0; k < binCount; ++k) {
-                ranges[k] = mBins.range(bins[k]);
-                if (!ranges[k].empty()) {
-                    first = std::min(first, ranges[k].first);
-                    last = std::max(last, ranges[k].last);
-                }
-            }
-            const size_t begin = scratch.keys.size();
-            // Key: light index above, the lanes that evaluate it below; sorting the keys sorts
-            // by light index (each light once per group).
-            if (binCount == 1)
-                mMasks.forEachSetBit(size_t(tile), first, last, [&](uint32_t position) {
-                    scratch.keys.push_back(uint64_t(mBins.sortedLight(position)) << 16 | groupMask);
-                });
-            else
-                mMasks.forEachSetBit(size_t(tile), first, last, [&](uint32_t position) {
+            const TileLights& tileLights = lightsOfTile(scratch, size_t(tile));
+            const size_t begin = scratch.lights.size();
+            const bool perLane = mPerPixel && binCount > 1;
+            if (!perLane) {
+                // One list for the group: its one bin, or the hull of the bins from its nearest
+                // to its farthest.
+                const auto [lowBin, highBin] = std::minmax_element(bins, bins + binCount);
+                const ZBins::Range range = mBins.rangeOfBins(*lowBin, *highBin);
+                for (size_t j = 0; j < tileLights.lights.size(); ++j)
+                    if (inRange(tileLights.positions[j], range))
+                        scratch.lights.push_back(tileLights.lights[j]);
+            } else {
+                ZBins::Range ranges[kernel::kPacketLanes];
+                for (int k = 0; k < binCount; ++k)
+                    ranges[k] = mBins.range(bins[k]);
+                for (size_t j = 0; j < tileLights.lights.size(); ++j) {
                     uint32_t lanes = 0;
                     for (int k = 0; k < binCount; ++k)
-                        if (ranges[k].first <= position && position <= ranges[k].last)
+                        if (inRange(tileLights.positions[j], ranges[k]))
                             lanes |= binLanes[k];
-                    if (lanes != 0)
-                        scratch.keys.push_back(uint64_t(mBins.sortedLight(position)) << 16 | lanes);
-                });
-            for (uint32_t light : unbounded)
-                scratch.keys.push_back(uint64_t(light) << 16 | groupMask);
-            std::sort(scratch.keys.begin() + std::ptrdiff_t(begin), scratch.keys.end());
-            groups[groupCount++] = {groupMask, begin, scratch.keys.size(), binCount > 1};
+                    if (lanes != 0) {
+                        scratch.lights.push_back(tileLights.lights[j]);
+                        scratch.laneMasks.push_back(uint16_t(lanes));
+                    }
+                }
+            }
+            groups[groupCount++] = {groupMask, begin, scratch.lights.size(), perLane};
+            if (!perLane) // keep laneMasks aligned with lights
+                scratch.laneMasks.resize(scratch.lights.size(), uint16_t(groupMask));
         }
         // The lists, in storage that stays put until this packet is shaded (the next call on this
         // thread is for the next packet).
-        scratch.lights.resize(scratch.keys.size());
-        scratch.laneMasks.resize(scratch.keys.size());
-        for (size_t i = 0; i < scratch.keys.size(); ++i) {
-            scratch.lights[i] = uint32_t(scratch.keys[i] >> 16);
-            scratch.laneMasks[i] = uint16_t(scratch.keys[i] & 0xFFFFu);
-        }
         for (int g = 0; g < groupCount; ++g) {
             const Group& group = groups[g];
             const size_t count = group.end - group.begin;
@@ -159,14 +198,55 @@ public:
     }
 
 private:
+    // A tile's lights in ascending light index, each with its sorted position (UINT32_MAX for the
+    // unbounded lights, which every range takes): the tile's mask bits over its whole window,
+    // sorted once per thread and tile, so that a packet's list is a filter by range that is
+    // already in the order the kernel sums in.
+    struct TileLights {
+        size_t tile = SIZE_MAX;
+        std::vector<uint32_t> lights;
+        std::vector<uint32_t> positions;
+    };
     struct Scratch {
+        TileLights tileLights;
         std::vector<uint64_t> keys;
         std::vector<uint32_t> lights;
         std::vector<uint16_t> laneMasks;
+        // `lights` holds the one list of a one-tile packet with this tile and range.
+        bool single = false;
+        size_t singleTile = 0;
+        ZBins::Range singleRange;
     };
+
+    static bool inRange(uint32_t position, ZBins::Range range) {
+        return position == UINT32_MAX || (range.first <= position && position <= range.last);
+    }
+
+    const TileLights& lightsOfTile(Scratch& scratch, size_t tile) const {
+        TileLights& t = scratch.tileLights;
+        if (t.tile == tile)
+            return t;
+        scratch.keys.clear();
+        mMasks.forEachSetBit(tile, 0, UINT32_MAX, [&](uint32_t position) {
+            scratch.keys.push_back(uint64_t(mBins.sortedLight(position)) << 32 | position);
+        });
+        for (uint32_t light : mBins.unboundedLights())
+            scratch.keys.push_back(uint64_t(light) << 32 | UINT32_MAX);
+        std::sort(scratch.keys.begin(), scratch.keys.end());
+        t.lights.resize(scratch.keys.size());
+        t.positions.resize(scratch.keys.size());
+        for (size_t i = 0; i < scratch.keys.size(); ++i) {
+            t.lights[i] = uint32_t(scratch.keys[i] >> 32);
+            t.positions[i] = uint32_t(scratch.keys[i]);
+        }
+        t.tile = tile;
+        return t;
+    }
+
     const TileGrid& mGrid;
     const ZBins& mBins;
     const ZBinTileMasks& mMasks;
+    bool mPerPixel;
     mutable tbb::enumerable_thread_specific<Scratch> mScratch;
 };
 
@@ -213,7 +293,8 @@ public:
         assign.stop();
 
         PassTimer shading(result, pass::kShading);
-        accumulateLights(inputs, ZBinListSource(grid, mBins, mMasks), {}, result);
+        accumulateLights(inputs, ZBinListSource(grid, mBins, mMasks, mOptions.perPixelLists), {},
+                         result);
         shading.stop();
 
         if (mBlended.prepare(inputs))
@@ -222,6 +303,7 @@ public:
         result.parameters["tile"] = std::to_string(mOptions.tileSizePixels);
         result.parameters["bins"] = std::to_string(mOptions.binCount);
         result.parameters["spacing"] = mOptions.spacing == ZBinSpacing::Uniform ? "uniform" : "exp";
+        result.parameters["lists"] = mOptions.perPixelLists ? "pixel" : "packet";
         result.parameters["lights_after_vfc"] = std::to_string(candidates.size());
         result.parameters["vfc_culled"] = std::to_string(spheres.size() - candidates.size());
         result.parameters["binned_lights"] = std::to_string(mBins.binnedCount());
@@ -250,7 +332,11 @@ const StageRegistrar kRegistrar(
                  StageOption::integer("bins", 1024, 1, kMaxZBinCount, "z-bins"),
                  StageOption::choice("spacing", {"uniform", "exp"},
                                      "z-bin boundaries between the G-buffer's nearest and "
-                                     "farthest depth: linear or geometric")},
+                                     "farthest depth: linear or geometric"),
+                 StageOption::choice("lists", {"packet", "pixel"},
+                                     "packet: one list per packet and tile over the hull of its "
+                                     "lanes' bin ranges (Drobot's wave-uniform ranges); pixel: "
+                                     "each pixel exactly its own bin's lights (lane masks)")},
      .listOrder = 65},
     [](const StageOptions& table) {
         ZBinnedOptions options;
@@ -258,6 +344,7 @@ const StageRegistrar kRegistrar(
         options.binCount = table.integer("bins");
         options.spacing =
             table.text("spacing") == "uniform" ? ZBinSpacing::Uniform : ZBinSpacing::Exponential;
+        options.perPixelLists = table.text("lists") == "pixel";
         return std::make_unique<ZBinnedStage>(options);
     });
 

@@ -3,7 +3,8 @@
 // constant-overlap generator: bitwise `brute`'s image on the same ISA, every contributing light
 // among each pixel's evaluated lights (light identity, tests/lighting/LightIdentity.h), and each
 // pixel's evaluated lights exactly its candidates by definition (its tile's mask bits inside its
-// bin's range, plus the unbounded lights, ascending), from bins and masks rebuilt here; option
+// bin's range, or with the default lists=packet the hull of its packet's bins in its tile, plus
+// the unbounded lights, ascending), from bins and masks rebuilt here; option
 // variants (tile sizes that split packets, one bin, many bins, geometric bins); bitwise the same
 // on 1, 2 and 7 threads at 10^4 lights; passes and parameters.
 #include <gtest/gtest.h>
@@ -70,11 +71,13 @@ const Frame& frame(const Case& c) {
 }
 
 // Each pixel's candidates by the definition (the stage's assignment rebuilt here with its
-// defaults or the given ones): its tile's bits inside its bin's range, plus the unbounded lights,
-// ascending.
+// defaults or the given ones), ascending, plus the unbounded lights: with perPixel its tile's mask
+// bits inside its own bin's range; otherwise, per 4x4 packet and tile, the bits inside the hull of
+// the ranges of the bins from the nearest to the farthest of the packet's pixels in that tile.
 std::vector<std::vector<uint32_t>> candidatesByDefinition(const lighting::StageInputs& inputs,
                                                           int tileSize, int binCount,
-                                                          lighting::ZBinSpacing spacing) {
+                                                          lighting::ZBinSpacing spacing,
+                                                          bool perPixel) {
     const gbuffer::GBuffer& gb = *inputs.gbuffer;
     const lighting::TileGrid grid = lighting::TileGrid::make(gb.width(), gb.height(), tileSize);
     const std::vector<lighting::LightSphere> spheres =
@@ -94,18 +97,29 @@ std::vector<std::vector<uint32_t>> candidatesByDefinition(const lighting::StageI
     bins.build(candidates, nearDepth, farDepth, binCount, spacing);
     lighting::ZBinTileMasks masks;
     masks.build(grid, edges, bounds, candidates, bins);
-    std::vector<std::vector<uint32_t>> lists(size_t(gb.width()) * size_t(gb.height()));
-    for (int y = 0; y < gb.height(); ++y)
-        for (int x = 0; x < gb.width(); ++x) {
-            const size_t pixel = size_t(y) * size_t(gb.width()) + size_t(x);
+    const int width = gb.width(), height = gb.height();
+    auto tileOf = [&](int x, int y) {
+        return size_t(y / tileSize) * size_t(grid.tileCountX) + size_t(x / tileSize);
+    };
+    auto binOf = [&](int x, int y) { return bins.binOfDepth(-gb.decode(x, y).positionView.z); };
+    std::vector<std::vector<uint32_t>> lists(size_t(width) * size_t(height));
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = size_t(y) * size_t(width) + size_t(x);
             if (!gb.covered(pixel))
                 continue;
-            const float depth = -gb.decode(x, y).positionView.z;
-            const lighting::ZBins::Range r = bins.range(bins.binOfDepth(depth));
-            const size_t tile =
-                size_t(y / tileSize) * size_t(grid.tileCountX) + size_t(x / tileSize);
+            int lowBin = binOf(x, y), highBin = lowBin;
+            if (!perPixel) // the packet's pixels in the same tile
+                for (int py = y / 4 * 4; py < std::min(y / 4 * 4 + 4, height); ++py)
+                    for (int px = x / 4 * 4; px < std::min(x / 4 * 4 + 4, width); ++px)
+                        if (gb.covered(size_t(py) * size_t(width) + size_t(px)) &&
+                            tileOf(px, py) == tileOf(x, y)) {
+                            lowBin = std::min(lowBin, binOf(px, py));
+                            highBin = std::max(highBin, binOf(px, py));
+                        }
+            const lighting::ZBins::Range r = bins.rangeOfBins(lowBin, highBin);
             std::vector<uint32_t>& list = lists[pixel];
-            masks.forEachSetBit(tile, r.first, r.last, [&](uint32_t position) {
+            masks.forEachSetBit(tileOf(x, y), r.first, r.last, [&](uint32_t position) {
                 list.push_back(bins.sortedLight(position));
             });
             list.insert(list.end(), bins.unboundedLights().begin(), bins.unboundedLights().end());
@@ -119,29 +133,34 @@ class ZBinnedExact : public ::testing::TestWithParam<Case> {};
 TEST_P(ZBinnedExact, BitwiseBruteEveryContributingLightAndExactlyItsCandidates) {
     const Case& c = GetParam();
     const Frame& f = frame(c);
-    const std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage("zbinned");
-    const lighting::StageResult result = stagecheck::shadeTraced(*stage, f.prepared->inputs);
-    EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, f.brute)) << label(c);
-    EXPECT_TRUE(stagecheck::everyContributingLightEvaluated(result, f.contributing, true))
-        << label(c);
-    const std::vector<std::vector<uint32_t>> expected =
-        candidatesByDefinition(f.prepared->inputs, 32, 1024, lighting::ZBinSpacing::Uniform);
-    int failures = 0;
-    uint64_t evaluated = 0, contributing = 0;
-    for (size_t pixel = 0; pixel < expected.size(); ++pixel) {
-        evaluated += result.lightsEvaluated[pixel];
-        contributing += f.contributing.lightsOf(pixel).size();
-        if ((result.lightTrace[pixel] != expected[pixel] ||
-             result.lightsEvaluated[pixel] != expected[pixel].size()) &&
-            failures++ < 5)
-            ADD_FAILURE() << label(c) << ": pixel (" << pixel % kWidth << ", " << pixel / kWidth
-                          << ") evaluated " << result.lightsEvaluated[pixel] << " lights, "
-                          << expected[pixel].size() << " candidates by definition";
+    for (const bool perPixel : {false, true}) {
+        const std::string spec = perPixel ? "zbinned:lists=pixel" : "zbinned";
+        const std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage(spec);
+        const lighting::StageResult result = stagecheck::shadeTraced(*stage, f.prepared->inputs);
+        EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, f.brute)) << label(c) << " " << spec;
+        EXPECT_TRUE(stagecheck::everyContributingLightEvaluated(result, f.contributing, true))
+            << label(c) << " " << spec;
+        const std::vector<std::vector<uint32_t>> expected = candidatesByDefinition(
+            f.prepared->inputs, 32, 1024, lighting::ZBinSpacing::Uniform, perPixel);
+        int failures = 0;
+        uint64_t evaluated = 0, contributing = 0;
+        for (size_t pixel = 0; pixel < expected.size(); ++pixel) {
+            evaluated += result.lightsEvaluated[pixel];
+            contributing += f.contributing.lightsOf(pixel).size();
+            if ((result.lightTrace[pixel] != expected[pixel] ||
+                 result.lightsEvaluated[pixel] != expected[pixel].size()) &&
+                failures++ < 5)
+                ADD_FAILURE() << label(c) << " " << spec << ": pixel (" << pixel % kWidth << ", "
+                              << pixel / kWidth << ") evaluated " << result.lightsEvaluated[pixel]
+                              << " lights, " << expected[pixel].size()
+                              << " candidates by definition";
+        }
+        EXPECT_EQ(failures, 0);
+        EXPECT_GT(contributing, 0u) << label(c) << ": no light reaches the frame";
+        RecordProperty(
+            perPixel ? "culling_efficiency_pixel" : "culling_efficiency_packet",
+            std::to_string(double(contributing) / double(std::max<uint64_t>(evaluated, 1))));
     }
-    EXPECT_EQ(failures, 0);
-    EXPECT_GT(contributing, 0u) << label(c) << ": no light reaches the frame";
-    RecordProperty("culling_efficiency",
-                   std::to_string(double(contributing) / double(std::max<uint64_t>(evaluated, 1))));
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -157,7 +176,7 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& info) { return label(info.param); });
 
 // Tiles that are no multiple of 4 (packets across tiles), tiny and huge tiles, one bin (the
-// ranges are the tiles' whole windows), many bins (packets across bins, per-lane lane masks),
+// ranges are the tiles' whole windows), many bins (packets across bins), both list modes,
 // geometric bins: the same image, every contributing light, exactly the candidates.
 TEST(ZBinnedStage, EveryOptionVariantIsExact) {
     const Case c{"atrium", 2000, scenes::LightDensity::FixedRadius};
@@ -166,12 +185,17 @@ TEST(ZBinnedStage, EveryOptionVariantIsExact) {
         const char* spec;
         int tile, bins;
         lighting::ZBinSpacing spacing;
+        bool perPixel;
     };
     const Variant variants[] = {
-        {"zbinned:tile=13,bins=300", 13, 300, lighting::ZBinSpacing::Uniform},
-        {"zbinned:tile=4,bins=1", 4, 1, lighting::ZBinSpacing::Uniform},
-        {"zbinned:tile=128,bins=65536,spacing=exp", 128, 65536, lighting::ZBinSpacing::Exponential},
-        {"zbinned:tile=16,bins=64,spacing=exp", 16, 64, lighting::ZBinSpacing::Exponential},
+        {"zbinned:tile=13,bins=300", 13, 300, lighting::ZBinSpacing::Uniform, false},
+        {"zbinned:tile=13,bins=300,lists=pixel", 13, 300, lighting::ZBinSpacing::Uniform, true},
+        {"zbinned:tile=4,bins=1", 4, 1, lighting::ZBinSpacing::Uniform, false},
+        {"zbinned:tile=6,bins=1,lists=pixel", 6, 1, lighting::ZBinSpacing::Uniform, true},
+        {"zbinned:tile=128,bins=65536,spacing=exp", 128, 65536, lighting::ZBinSpacing::Exponential,
+         false},
+        {"zbinned:tile=16,bins=64,spacing=exp,lists=pixel", 16, 64,
+         lighting::ZBinSpacing::Exponential, true},
     };
     for (const Variant& v : variants) {
         const std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage(v.spec);
@@ -179,7 +203,8 @@ TEST(ZBinnedStage, EveryOptionVariantIsExact) {
         EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, f.brute)) << v.spec;
         EXPECT_TRUE(stagecheck::everyContributingLightEvaluated(result, f.contributing, true))
             << v.spec;
-        const auto expected = candidatesByDefinition(f.prepared->inputs, v.tile, v.bins, v.spacing);
+        const auto expected =
+            candidatesByDefinition(f.prepared->inputs, v.tile, v.bins, v.spacing, v.perPixel);
         int failures = 0;
         for (size_t pixel = 0; pixel < expected.size(); ++pixel)
             if (result.lightTrace[pixel] != expected[pixel] && failures++ < 3)
@@ -191,6 +216,7 @@ TEST(ZBinnedStage, EveryOptionVariantIsExact) {
         EXPECT_EQ(result.parameters.at("bins"), std::to_string(v.bins));
         EXPECT_EQ(result.parameters.at("spacing"),
                   v.spacing == lighting::ZBinSpacing::Uniform ? "uniform" : "exp");
+        EXPECT_EQ(result.parameters.at("lists"), v.perPixel ? "pixel" : "packet");
     }
 }
 
