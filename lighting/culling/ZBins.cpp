@@ -73,24 +73,24 @@ void ZBins::build(std::span<const CandidateLight> candidates, float nearDepthMet
     const size_t n = mKeys.size();
     mSortedLights.resize(n);
     mCandidateOf.resize(n);
+    // Each sorted light's bins (first > last: in none), read from its candidate once (in sorted
+    // order the candidates are visited at random; the chunks below then read these in order).
+    mBinsOf.resize(n);
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
         const uint32_t position = uint32_t(mKeys[i] & 0xFFFFFFFFu);
         mCandidateOf[i] = position;
-        mSortedLights[i] = candidates[position].index;
+        const CandidateLight& c = candidates[position];
+        mSortedLights[i] = c.index;
+        const float centreDepth = -c.centreView.z;
+        const float low = centreDepth - c.radius, high = centreDepth + c.radius;
+        // Wholly outside [near, far]: the comparisons of the tile depth test.
+        mBinsOf[i] = high < nearDepthMetres || low > farDepthMetres
+                         ? std::pair<int, int>(1, 0)
+                         : std::pair<int, int>(binOfDepth(low), binOfDepth(high));
     });
 
     // Bin ranges: per chunk of sorted lights the ranges of the bins it touches, then merged in
     // chunk order (min of firsts, max of lasts: the same for any split).
-    auto extentBins = [&](size_t i, int& firstBin, int& lastBin) {
-        const CandidateLight& c = candidates[mCandidateOf[i]];
-        const float centreDepth = -c.centreView.z;
-        const float low = centreDepth - c.radius, high = centreDepth + c.radius;
-        if (high < nearDepthMetres || low > farDepthMetres)
-            return false;
-        firstBin = binOfDepth(low);
-        lastBin = binOfDepth(high);
-        return true;
-    };
     const size_t chunkCount = (n + kLightsPerBinChunk - 1) / kLightsPerBinChunk;
     mChunkRanges.resize(chunkCount);
     mChunkFirstBin.assign(chunkCount, 0);
@@ -100,8 +100,8 @@ void ZBins::build(std::span<const CandidateLight> candidates, float nearDepthMet
                      end = std::min(n, begin + kLightsPerBinChunk);
         int lowest = binCount, highest = -1;
         for (size_t i = begin; i < end; ++i) {
-            int firstBin = 0, lastBin = 0;
-            if (extentBins(i, firstBin, lastBin)) {
+            const auto [firstBin, lastBin] = mBinsOf[i];
+            if (firstBin <= lastBin) {
                 lowest = std::min(lowest, firstBin);
                 highest = std::max(highest, lastBin);
                 ++chunkBinned[chunk];
@@ -111,9 +111,7 @@ void ZBins::build(std::span<const CandidateLight> candidates, float nearDepthMet
         local.assign(size_t(std::max(0, highest - lowest + 1)), Range{});
         mChunkFirstBin[chunk] = lowest;
         for (size_t i = begin; i < end; ++i) {
-            int firstBin = 0, lastBin = 0;
-            if (!extentBins(i, firstBin, lastBin))
-                continue;
+            const auto [firstBin, lastBin] = mBinsOf[i];
             for (int b = firstBin; b <= lastBin; ++b) {
                 Range& r = local[size_t(b - lowest)];
                 r = hull(r, {uint32_t(i), uint32_t(i)});

@@ -46,6 +46,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "lighting/culling/TileFrusta.h"
@@ -122,6 +123,7 @@ private:
     std::vector<uint32_t> mUnbounded;
     size_t mBinnedCount = 0;
     std::vector<uint64_t> mKeys;                  // build() scratch: depth key, position
+    std::vector<std::pair<int, int>> mBinsOf;     // build() scratch: bins of each sorted light
     std::vector<std::vector<Range>> mChunkRanges; // build() scratch: per chunk of lights
     std::vector<int> mChunkFirstBin;
 };

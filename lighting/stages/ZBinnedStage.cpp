@@ -8,15 +8,17 @@
 // Assignment ("assign" pass, as `clustered`'s): light spheres (LightBounds.h), view-frustum culling
 // and each light's tile column/row range (candidateLights, TileFrusta.h), the tiles' depth bounds
 // from the G-buffer's depth plane (computeTileDepthBounds), the sort and the bins between the
-// nearest and farthest covered depth, the masks over each covered tile's window of bins. Shading
-// ("shading" pass): accumulateLights (LightAccumulation.h) by 4x4 packets; per packet the lanes are
-// grouped by tile and each lane's bin found from its decoded depth, the group's words are walked
-// over the hull of its lanes' bin ranges, each set bit gives a light and the lanes whose own bin
-// range holds it (so every lane sums exactly its own candidates and lights.evaluated is the
-// per-pixel count, as in `clustered`), and the lights are sorted by light index: the kernel sums in
-// ascending light order (ShadingStage.h), so the image is bitwise `brute`'s on the same ISA. This
-// per-packet gathering is the stage's lookup cost, the z-binned counterpart of reading a cluster's
-// list, and is timed in the shading pass, as it runs in the shader on a GPU.
+// nearest and farthest covered depth, the masks over each covered tile's window of bins.
+// Shading ("shading" pass): accumulateLights (LightAccumulation.h) by 4x4 packets, lanes grouped by
+// tile. lists=packet: one list per group, the tile's bits inside the hull of the ranges of the bins
+// from its nearest to its farthest lane (Drobot's wave-uniform range: every lane walks it).
+// lists=pixel: each lane exactly its own bin's bits (per-light lane masks; lights.evaluated is then
+// the per-pixel candidate count, as in `clustered`). The kernel sums in ascending light index
+// (ShadingStage.h) and the bits come in depth order, so each thread keeps its current tile's bits
+// sorted by light index with their sorted positions (built once per thread and tile visit), and a
+// list is a filter of it by range: the image is bitwise `brute`'s on the same ISA. This gathering
+// is the stage's lookup cost, the z-binned counterpart of reading a cluster's list, and is timed in
+// the shading pass, as it runs in the shader on a GPU.
 //
 // Options (defaults first):
 //   tile=32          tile size in pixels (4..128): 920 tiles at 1280x720, which keeps the masks
@@ -24,6 +26,7 @@
 //   bins=1024        z-bins (1..65536)
 //   spacing=uniform|exp  bin boundaries linear in view depth (Drobot's) or geometric, between the
 //                    G-buffer's nearest and farthest covered depth
+//   lists=packet|pixel   (above)
 // Parameters: the options, lights_after_vfc, vfc_culled, binned_lights (bounded lights overlapping
 // the depth range), tile_light_pairs (mask bits set), mask_words, mask_bytes, bin_bytes,
 // sorted_bytes, zbin_near_m, zbin_far_m.
@@ -31,7 +34,8 @@
 // bins and masks from its own depth. Blended surfaces: the near-to-opaque tile lists of the tiled
 // stages (BlendedPass::shadeWithTileLists), as `tiled`.
 // Threads: the builds are deterministic (ZBins.h); each pixel is written by one task; per-packet
-// scratch is per thread and only ever read back by the packet that wrote it.
+// scratch is per thread (a thread shades one packet at a time, so a list stays put until its
+// packet is shaded).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
