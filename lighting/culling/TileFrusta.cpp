@@ -295,16 +295,12 @@ uint64_t appendTileLights(std::span<const CandidateLight> candidates, int tx, in
             list.push_back(c.index);
             continue;
         }
-        if (tx < c.columnMin || tx > c.columnMax || ty < c.rowMin || ty > c.rowMax)
+        if (!boundedCandidateTouchesTile(c, tx, ty, b, box))
             continue;
         const float centreDepth = -c.centreView.z;
-        const float low = centreDepth - c.radius, high = centreDepth + c.radius;
-        if (high < b.minDepthMetres || low > b.maxDepthMetres)
-            continue;
-        if (!sphereTouchesBox(c.centreView, c.radius, box.boxMin, box.boxMax))
-            continue;
-        if (options.depthMask &&
-            (depthRangeMask(low, high, b.minDepthMetres, b.maxDepthMetres) & b.depthMask) == 0)
+        if (options.depthMask && (depthRangeMask(centreDepth - c.radius, centreDepth + c.radius,
+                                                 b.minDepthMetres, b.maxDepthMetres) &
+                                  b.depthMask) == 0)
             continue;
         if (cone.enabled && lightBackFacesTile(box, cone, c.positionView)) {
             ++backfaceRejected;

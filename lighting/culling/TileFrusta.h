@@ -203,6 +203,21 @@ struct TileCullOptions {
     bool hierarchical = false;
 };
 
+// The basic test of one bounded candidate against covered tile (tx, ty) with bounds `b` and
+// frustum `box`: inside the tile's column/row range, the depth range, and the box
+// (sphereTouchesBox). What appendTileLights tests before its optional ones, and the per-tile test
+// of the z-binned masks (ZBins.h).
+inline bool boundedCandidateTouchesTile(const CandidateLight& c, int tx, int ty,
+                                        const TileSurfaceBounds& b, const TileBox& box) {
+    if (tx < c.columnMin || tx > c.columnMax || ty < c.rowMin || ty > c.rowMax)
+        return false;
+    const float centreDepth = -c.centreView.z;
+    const float low = centreDepth - c.radius, high = centreDepth + c.radius;
+    if (high < b.minDepthMetres || low > b.maxDepthMetres)
+        return false;
+    return sphereTouchesBox(c.centreView, c.radius, box.boxMin, box.boxMax);
+}
+
 // The per-tile light test: appends to `list`, in the candidates' (ascending) order, every
 // candidate that may touch covered tile (tx, ty) with bounds `b` and frustum `box`: unbounded
 // lights always; bounded ones when inside the tile's column/row range, the depth range, and the

@@ -74,6 +74,14 @@ public:
         if (laneMask != 0)
             mGroups[mCount++] = {laneMask, lights, lightLaneMasks, false};
     }
+    // As add(), for lists a source builds per packet in storage of its own that it rewrites for
+    // its next packet (z-binned): valid until this packet is shaded, so the SIMT model counts them
+    // at once instead of keeping the span for the rest of the warp (Group::scratch).
+    void addTransient(uint32_t laneMask, std::span<const uint32_t> lights,
+                      std::span<const uint16_t> lightLaneMasks = {}) {
+        if (laneMask != 0)
+            mGroups[mCount++] = {laneMask, lights, lightLaneMasks, true};
+    }
     // Groups the covered lanes of `packet` by the key lane -> keyOf(lane), whose equal values
     // mean the same list listOf(key); for per-tile or per-cluster lists.
     template <class KeyOf, class ListOf>
@@ -183,7 +191,8 @@ public:
         uint32_t laneMask = 0;
         std::span<const uint32_t> lights;
         std::span<const uint16_t> lightLaneMasks; // empty: every light on every lane of laneMask
-        bool scratch = false; // `lights` lives in the lists' scratch storage (until clear())
+        bool scratch = false; // `lights` lives in scratch storage (until clear() or the next
+                              // packet): addByKeyMerged's union, addTransient's lists
         // Whether lane `lane` of the group evaluates light lights[i].
         bool evaluates(int lane, size_t i) const {
             return (laneMask >> lane & 1u) &&

@@ -65,6 +65,7 @@ TEST(StageRegistry, ListsTodaysStagesInTheirFixedOrder) {
                                                "clustered",
                                                "clustered-explicit",
                                                "tiled",
+                                               "zbinned",
                                                "tiled-backface",
                                                "forward",
                                                "forward-multipass",
