@@ -296,11 +296,11 @@ def context_plots(report, jobs, groups, x_of, x_columns, x_label, y_column, y_la
         report.save(fig, "%s_%d" % (name, index + 1), plot_title, caption, "", kind)
 
 
-ASSIGNMENT_PASSES = ("cull", "assign", "index")
+ASSIGNMENT_PASSES = ("clusters", "cull", "assign", "index")
 
 
 def assignment_ms(job):
-    """The median time of the job's light-assignment passes (cull, assign, index), or None."""
+    """The median time of the job's light-assignment passes (clusters, cull, assign, index), or None."""
     times = [number(job.get("time_%s_median_ms" % p)) for p in ASSIGNMENT_PASSES]
     times = [t for t in times if t is not None]
     return sum(times) if times else None
@@ -383,7 +383,7 @@ def scaling_plots(report, jobs, groups):
         caption = ("Fixed: %s. Each point is the median over the jobs of that method and "
                    "light count; axes are log-log where the values span over 20x; slopes are "
                    "least-squares fits of log value against log lights from 10^3 lights up (1 = linear; N log N from 10^3 to 10^6 fits a slope of "
-                   "about 1.10). Assignment = cull + assign + index passes. Memory is the job "
+                   "about 1.10). Assignment = clusters + cull + assign + index passes (explicit clusters count their finding). Memory is the job "
                    "process's peak resident set (the whole render, reference excluded)."
                    % fixed)
         if slopes:
