@@ -382,9 +382,11 @@ def scaling_plots(report, jobs, groups):
         fixed = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)) or "nothing else"
         caption = ("Fixed: %s. Each point is the median over the jobs of that method and "
                    "light count; axes are log-log where the values span over 20x; slopes are "
-                   "least-squares fits of log value against log lights from 10^3 lights up (1 = linear; N log N from 10^3 to 10^6 fits a slope of "
-                   "about 1.10). Assignment = clusters + cull + assign + index passes (explicit clusters count their finding). Memory is the job "
-                   "process's peak resident set (the whole render, reference excluded)."
+                   "least-squares fits of log value against log lights from 10^3 lights up "
+                   "(1 = linear; N log N from 10^3 to 10^6 fits a slope of about 1.10). "
+                   "Assignment = clusters + cull + assign + index passes (explicit clusters "
+                   "count their finding). Memory is the job process's peak resident set (the "
+                   "whole render, reference excluded)."
                    % fixed)
         if slopes:
             caption += " Assignment slopes: %s." % "; ".join(slopes)
