@@ -233,6 +233,13 @@ def split_contexts(jobs, groups, x_of, x_columns, y_column):
     return contexts, context_columns, varying_context, covarying
 
 
+def context_title(title, context_columns, key, varying_context):
+    """A plot's title with the context settings that vary between its sibling plots."""
+    context = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)
+                        if c in varying_context)
+    return title + (" (%s)" % context if context else "")
+
+
 def context_plots(report, jobs, groups, x_of, x_columns, x_label, y_column, y_label, name, title,
                   kind):
     """y against x across groups: one plot per context (the grouping settings other than x's and
@@ -244,9 +251,7 @@ def context_plots(report, jobs, groups, x_of, x_columns, x_label, y_column, y_la
         return
     contexts, context_columns, varying_context, covarying = split
     for index, (key, members) in enumerate(sorted(contexts.items())):
-        context = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)
-                            if c in varying_context)
-        plot_title = title + (" (%s)" % context if context else "")
+        plot_title = context_title(title, context_columns, key, varying_context)
         series = {}
         for job in members:
             series.setdefault(method_label(job, groups["method_columns"]), {}).setdefault(
@@ -335,9 +340,7 @@ def scaling_plots(report, jobs, groups):
               ("peak resident memory (MiB)",
                lambda j: (number(j.get("peak_rss_bytes")) or 0) / 2**20 or None))
     for index, (key, members) in enumerate(sorted(contexts.items())):
-        context = ", ".join("%s %s" % (c, v) for c, v in zip(context_columns, key)
-                            if c in varying_context)
-        plot_title = title + (" (%s)" % context if context else "")
+        plot_title = context_title(title, context_columns, key, varying_context)
         series = {}
         for job in members:
             series.setdefault(method_label(job, groups["method_columns"]), []).append(job)
