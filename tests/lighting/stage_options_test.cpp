@@ -57,21 +57,12 @@ std::vector<std::string> refusedValues(const StageOption& option) {
 TEST(StageRegistry, ListsTodaysStagesInTheirFixedOrder) {
     // Also the guard that every stage file was linked: a registrar dropped by the static link
     // would shorten this list.
-    const std::vector<std::string> expected = {"reference",
-                                               "brute",
-                                               "ideal",
-                                               "deferred",
-                                               "light-indexed",
-                                               "clustered",
-                                               "clustered-explicit",
-                                               "tiled",
-                                               "zbinned",
-                                               "tiled-backface",
-                                               "forward",
-                                               "forward-multipass",
-                                               "light-prepass",
-                                               "inferred",
-                                               "tiled-forward"};
+    const std::vector<std::string> expected = {
+        "reference",          "brute",         "ideal",
+        "deferred",           "light-indexed", "clustered",
+        "clustered-explicit", "tiled",         "zbinned",
+        "tiled-backface",     "forward",       "forward-multipass",
+        "light-prepass",      "inferred",      "tiled-forward"};
     std::vector<std::string> names;
     for (const lighting::StageInfo& info : lighting::stageInfos())
         names.push_back(info.name);
