@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lighting/Oracle.h"
+#include "lighting/passes/KernelWork.h"
 #include "lighting/passes/PassNames.h"
 
 namespace lighting {
@@ -52,6 +53,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
         upper[size_t(k - 1)].traceLights = result.traceLights;
         stage.shade(prepared.layerInputs(k), upper[size_t(k - 1)]);
         addTimings(result.timingsMs, upper[size_t(k - 1)].timingsMs);
+        KernelWork::addRecorded(upper[size_t(k - 1)], result);
     }
     // Blended surfaces over the background samples of partially covered pixels.
     StageResult& background = mBackground;
@@ -65,6 +67,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
         frame.fragmentLayer = StageInputs::kBackgroundRun;
         stage.shade(frame, background);
         addTimings(result.timingsMs, background.timingsMs);
+        KernelWork::addRecorded(background, result);
     }
 
     PassTimer resolve(result, pass::kResolve);

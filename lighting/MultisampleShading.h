@@ -14,7 +14,10 @@
 // background run weighted by the background samples. lightsEvaluated adds every run's evaluations
 // (all of them were done); a stage-filled lightsOracle adds the layers' at the pixels where the
 // layer has a fragment. Passes of the same name are summed over the runs, in first-run order, and
-// "resolve" is appended. Parameters are the first run's, plus msaa_* counters.
+// "resolve" is appended. Parameters are the first run's, plus msaa_* counters, except the
+// kernel's work counters (simt_lane_slots and the packet counters, KernelWork::kCounterKeys),
+// which are summed over every run like the evaluations: simt_efficiency divides the layers' oracle
+// by the lane slots of every run.
 //
 // Which stages: every stage without a StageInfo::msaaRefusal (StageRegistry.h). A stage that
 // multisamples natively (ShadingStage::multisamplesNatively: the forward stages, which rasterize

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <iterator>
 #include <string>
 
 #include "lighting/ShadingStage.h"
@@ -47,11 +48,26 @@ struct KernelWork {
     void record(const kernel::KernelIsa& isa, int warpLanes, StageResult& result) const {
         result.parameters["isa"] = isa.name();
         result.parameters["simt_warp"] = std::to_string(warpLanes);
-        add(result, "simt_lane_slots", laneSlots);
-        add(result, "packet_groups", groups);
-        add(result, "packet_lights_skipped_at_range", skippedAtRange);
-        add(result, "packet_lights_skipped_at_cone_or_facing", skippedAtConeOrFacing);
-        add(result, "packet_lights_shaded", shaded);
+        const uint64_t values[] = {laneSlots, groups, skippedAtRange, skippedAtConeOrFacing,
+                                   shaded};
+        for (size_t k = 0; k < std::size(kCounterKeys); ++k)
+            add(result, kCounterKeys[k], values[k]);
+    }
+
+    // The counters record() writes, in its order: additive over a frame's kernel passes.
+    static constexpr const char* kCounterKeys[] = {
+        "simt_lane_slots", "packet_groups", "packet_lights_skipped_at_range",
+        "packet_lights_skipped_at_cone_or_facing", "packet_lights_shaded"};
+
+    // Adds another run's recorded counters to `result`'s (a multisampled frame's layer runs and
+    // background run, MultisampleShading.h: the frame's work is every run's). A counter `from`
+    // does not have is skipped.
+    static void addRecorded(const StageResult& from, StageResult& result) {
+        for (const char* key : kCounterKeys) {
+            const auto value = from.parameters.find(key);
+            if (value != from.parameters.end())
+                add(result, key, std::stoull(value->second));
+        }
     }
 
 private:
