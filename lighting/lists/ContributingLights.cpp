@@ -1,11 +1,19 @@
 #include "lighting/lists/ContributingLights.h"
 
+#include <algorithm>
+#include <numeric>
+
 #include <tbb/parallel_for.h>
+
+#include "lighting/culling/LightBounds.h"
+#include "lighting/lists/LightGrid.h"
 
 namespace lighting {
 
-void ContributingLights::build(const gbuffer::GBuffer& gb,
-                               const std::vector<LightInView<float>>& lights) {
+template <class Candidates>
+void ContributingLights::buildFrom(const gbuffer::GBuffer& gb,
+                                   const std::vector<LightInView<float>>& lights,
+                                   const Candidates& candidates) {
     mWidth = gb.width();
     mHeight = gb.height();
     const int width = mWidth;
@@ -15,6 +23,7 @@ void ContributingLights::build(const gbuffer::GBuffer& gb,
     // mCounts[pixel] (written by that row's task only); then concatenated in pixel order.
     tbb::parallel_for(0, mHeight, [&](int y) {
         std::vector<uint32_t>& row = mRowLists[size_t(y)];
+        std::vector<uint32_t> tested;
         row.clear();
         for (int x = 0; x < width; ++x) {
             gbuffer::Surface point;
@@ -22,13 +31,43 @@ void ContributingLights::build(const gbuffer::GBuffer& gb,
                 continue;
             const glm::vec3 toViewer = glm::normalize(-point.positionView);
             const size_t before = row.size();
-            for (uint32_t light = 0; light < lights.size(); ++light)
+            candidates(point.positionView, tested);
+            for (uint32_t light : tested)
                 if (contributes(evaluateLight(point, toViewer, lights[light])))
                     row.push_back(light);
             mCounts[size_t(y) * width + x] = uint32_t(row.size() - before);
         }
     });
     mLists.assign(mCounts, mRowLists);
+}
+
+void ContributingLights::build(const gbuffer::GBuffer& gb,
+                               const std::vector<LightInView<float>>& lights) {
+    const auto box = surfaceBox<gbuffer::Surface>(
+        gb.width(), gb.height(),
+        [&gb](int x, int y, gbuffer::Surface& s) { return gb.surfaceAt(x, y, s); });
+    LightGrid grid;
+    if (box)
+        grid.build(boundingSpheresView(lights), box->first, box->second);
+    // The grid's bounded candidates and the unbounded lights are each ascending and disjoint:
+    // merged, they are ascending, the order the lists (and `ideal`'s sums) need.
+    buildFrom(gb, lights, [&grid](glm::vec3 pointView, std::vector<uint32_t>& tested) {
+        const std::span<const uint32_t> bounded = grid.candidatesAt(pointView);
+        const std::span<const uint32_t> everywhere = grid.everywhere();
+        tested.resize(bounded.size() + everywhere.size());
+        std::merge(bounded.begin(), bounded.end(), everywhere.begin(), everywhere.end(),
+                   tested.begin());
+    });
+}
+
+void ContributingLights::buildBrute(const gbuffer::GBuffer& gb,
+                                    const std::vector<LightInView<float>>& lights) {
+    buildFrom(gb, lights, [&lights](glm::vec3, std::vector<uint32_t>& tested) {
+        if (tested.size() != lights.size()) {
+            tested.resize(lights.size());
+            std::iota(tested.begin(), tested.end(), 0u);
+        }
+    });
 }
 
 } // namespace lighting

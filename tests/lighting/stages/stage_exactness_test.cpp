@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <span>
 #include <stdexcept>
 
 #include <tbb/task_arena.h>
@@ -285,6 +286,28 @@ TEST(Oracle, GridCountsEqualBruteForceOnEveryScene) {
         SCOPED_TRACE(c.name);
         const PreparedCase& f = prepared(c);
         EXPECT_EQ(f.oracle, lighting::countContributingLightsBrute(f.prepared->inputs));
+    }
+}
+
+// ContributingLights (the lists `ideal` shades and the identity checks use) tests only the light
+// grid's candidates: the same lists, light by light and in the same order, as testing every
+// light, on every scene case (point, spot, directional and ambient lights; open and closed
+// scenes).
+TEST(ContributingLightLists, GridListsEqualBruteForceOnEveryScene) {
+    for (const SceneCase& c : kScenes) {
+        SCOPED_TRACE(c.name);
+        const PreparedCase& f = prepared(c);
+        const lighting::StageInputs& inputs = f.prepared->inputs;
+        lighting::ContributingLights grid, brute;
+        grid.build(*inputs.gbuffer, inputs.lights->lights);
+        brute.buildBrute(*inputs.gbuffer, inputs.lights->lights);
+        ASSERT_GT(brute.pairCount(), 0u);
+        ASSERT_EQ(grid.pairCount(), brute.pairCount());
+        for (size_t pixel = 0; pixel < size_t(kWidth) * kHeight; ++pixel) {
+            const std::span<const uint32_t> a = grid.lightsOf(pixel), b = brute.lightsOf(pixel);
+            ASSERT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end()))
+                << "pixel " << pixel % kWidth << "," << pixel / kWidth;
+        }
     }
 }
 
