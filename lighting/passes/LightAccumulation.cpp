@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "lighting/brdf/Brdf.h"
@@ -165,9 +166,16 @@ KernelWork walkWarps(int columns, int rows, int warpLanes, size_t lightCount, co
     const int warpHeight = warpLanes / kWarpWidth;
     const int warpRows = (rows + warpHeight - 1) / warpHeight;
     std::vector<KernelWork> workPerRow(static_cast<size_t>(warpRows));
+    // One union per thread, not per warp row: its stamps are lightCount words (4 MB at 10^6
+    // lights, which 180 warp rows of a 1280x720 frame would each allocate and clear). A union's
+    // state is reset by begin() and its warp stamp is unique per union, so which thread's union a
+    // row uses changes nothing. `shade` runs no parallel work of its own, so a thread never takes
+    // another row while its union is in use.
+    tbb::enumerable_thread_specific<WarpUnion> unions(
+        [lightCount] { return WarpUnion(lightCount); });
     tbb::parallel_for(0, warpRows, [&](int warpRow) {
         PacketScratch<Accumulator> scratch;
-        WarpUnion warpUnion(lightCount);
+        WarpUnion& warpUnion = unions.local();
         KernelWork rowWork;
         for (int wx = 0; wx < columns; wx += kWarpWidth) {
             warpUnion.begin();

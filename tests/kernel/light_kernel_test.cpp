@@ -318,7 +318,8 @@ TEST_P(LightKernelTest, HardCases) {
             Surface s = floor;
             s.specularPower = power;
             setLane(packet, 5, s);
-            const KernelLights lights({c.light});
+            const std::vector<lighting::LightInView<float>> one{c.light};
+            const KernelLights lights(one);
             const std::vector<uint32_t> list{0};
             PacketAccumulator vector;
             vector.clear();
@@ -364,7 +365,8 @@ TEST_P(LightKernelTest, ClosedFormSun) {
         sun.type = LightType::Directional;
         sun.directionView = {0.0f, -1.0f, 0.0f};
         sun.radiance = glm::vec3(2.0f);
-        const KernelLights lights({sun});
+        const std::vector<lighting::LightInView<float>> sunOnly{sun};
+        const KernelLights lights(sunOnly);
         const PacketAccumulator result = shade(isa, packet, kAllLanes, lights, {0});
         const double pi = 3.14159265358979323846;
         const double expected = 2.0 * (0.5 / pi + 0.25 * (double(power) + 8.0) / (8.0 * pi) *
