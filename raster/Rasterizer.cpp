@@ -420,4 +420,15 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
                 batch.pairTriangle.push_back(index);
 }
 
+void Rasterizer::clearTile(int tileIndex, int samples, float value, float* depth) const {
+    const int minX = (tileIndex % mTilesX) * kTileSize;
+    const int minY = (tileIndex / mTilesX) * kTileSize;
+    const int maxX = std::min(minX + kTileSize, mWidth);
+    const int maxY = std::min(minY + kTileSize, mHeight);
+    for (int y = minY; y < maxY; ++y) {
+        float* row = depth + (size_t(y) * size_t(mWidth) + size_t(minX)) * size_t(samples);
+        std::fill(row, row + size_t(maxX - minX) * size_t(samples), value);
+    }
+}
+
 } // namespace raster

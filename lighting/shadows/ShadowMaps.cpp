@@ -480,6 +480,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     state.cullMode = raster::CullMode::None;
     state.depthTest = raster::DepthTest::Greater;
     state.barycentrics = false;
+    state.clearDepth = 0.0f;
     // Per-thread rasterizers and clip buffers, taken over from the recycled maps (their bins and
     // buffers then cost no allocation and no page fault).
     maps.mScratch = recycled && recycled->mScratch ? std::move(recycled->mScratch)
@@ -509,8 +510,9 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         const glm::mat4& clipFromWorld = jobs[f].clipFromWorld;
         for (size_t i = 0; i < positions.size(); ++i)
             scratch.clip[i] = clipFromWorld * glm::vec4(positions[i], 1.0f);
+        // Cleared to 0 (nothing: the far plane) tile by tile inside the draw (clearDepth).
         face.depth = std::move(pooled[f]);
-        face.depth.assign(size_t(size) * size_t(size), 0.0f);
+        face.depth.resize(size_t(size) * size_t(size));
         scratch.rasterizer->draw(raster::TriangleList{scratch.clip, indices}, state,
                                  face.depth.data(), raster::DepthOnly{});
         faceMs[f] = milliseconds(faceStart);

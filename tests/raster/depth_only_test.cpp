@@ -2,12 +2,15 @@
 // random clip-space triangles (large and tiny, slivers, triangles crossing the near and far
 // planes and the guard band, shared edges of fans), with every depth test, depth writes on and
 // off, every cull mode, the depth buffer must be bitwise the same and the coverage counters
-// equal, for 1 and 2 threads.
+// equal, for 1 and 2 threads. The span loop's SIMD form (DepthSpan.h) against its scalar oracle,
+// and the in-draw clear (RasterState::clearDepth) against a clear before the draw.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -15,6 +18,7 @@
 #include <glm/glm.hpp>
 #include <tbb/task_arena.h>
 
+#include "raster/DepthSpan.h"
 #include "raster/Rasterizer.h"
 
 namespace {
@@ -129,6 +133,81 @@ TEST(DepthOnlyPath, DrawsWithoutADepthBufferCountLikeTheGenericPath) {
     b.draw(raster::TriangleList{mesh.positions, mesh.indices}, state, nullptr, raster::DepthOnly{});
     EXPECT_EQ(a.lastStats().samplesCovered, b.lastStats().samplesCovered);
     EXPECT_EQ(a.lastStats().samplesPassed, b.lastStats().samplesPassed);
+}
+
+// Random spans of 0 to 69 pixels at random offsets (the vector body and every tail length), planes
+// crossing 0 and 1 (the clamp), steep and flat, and NaN; stored depths random, equal to the
+// incoming ones, and NaN: the vector loop writes and counts bitwise what the scalar loop does.
+TEST(DepthSpan, VectorLoopIsBitwiseTheScalarLoop) {
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    int spans = 0, passedSomewhere = 0, failedSomewhere = 0;
+    for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
+                           DepthTest::Greater, DepthTest::GreaterEqual})
+        for (bool write : {true, false})
+            for (int trial = 0; trial < 400; ++trial) {
+                raster::DepthSpanArgs span;
+                span.lo = int(rng() % 40);
+                span.hi = span.lo + int(rng() % 70) - 1;
+                span.zStep = (unit(rng) - 0.5) * (trial % 3 == 0 ? 0.1 : 1e-4);
+                span.zRow = unit(rng) * 1.4 - 0.2 - span.zStep * span.lo;
+                if (trial % 50 == 7)
+                    span.zStep = std::numeric_limits<double>::quiet_NaN();
+                span.write = write;
+                std::vector<float> stored(128);
+                for (size_t i = 0; i < stored.size(); ++i) {
+                    const double z = span.zRow + span.zStep * double(i);
+                    stored[i] = i % 11 == 3  ? nan
+                                : i % 5 == 1 ? float(std::clamp(z, 0.0, 1.0)) // equal depths
+                                             : float(unit(rng));
+                }
+                std::vector<float> scalarRow = stored, vectorRow = stored;
+                span.row = scalarRow.data();
+                const uint64_t scalarPassed = raster::depthSpanScalar(test, span);
+                span.row = vectorRow.data();
+                const uint64_t vectorPassed = raster::depthSpan(test, span);
+                ASSERT_EQ(vectorPassed, scalarPassed) << "test " << int(test) << " trial " << trial;
+                ASSERT_EQ(0, std::memcmp(vectorRow.data(), scalarRow.data(),
+                                         scalarRow.size() * sizeof(float)))
+                    << "test " << int(test) << " trial " << trial;
+                passedSomewhere += scalarPassed > 0;
+                failedSomewhere += scalarPassed < uint64_t(std::max(0, span.hi - span.lo + 1));
+                ++spans;
+            }
+    EXPECT_EQ(spans, 4000);
+    EXPECT_GT(passedSomewhere, 1000);
+    EXPECT_GT(failedSomewhere, 1000);
+}
+
+// RasterState::clearDepth: each tile clears its own pixels (all samples) inside the draw; the
+// buffer, filled with garbage before, ends bitwise as with a clear before the draw, for 1 and 4
+// samples and 1 and 2 threads, including pixels no triangle covers.
+TEST(DepthOnlyPath, ClearInsideTheDrawEqualsAClearBefore) {
+    const Mesh mesh = randomMesh(23, 0); // the fan alone: the corners stay uncovered
+    for (int samples : {1, 4})
+        for (int threads : {1, 2}) {
+            raster::RasterState state;
+            state.depthTest = DepthTest::Greater;
+            state.cullMode = CullMode::None;
+            state.barycentrics = false;
+            state.samples = samples;
+            const int width = 301, height = 203;
+            const size_t size = size_t(width) * height * size_t(samples);
+            std::vector<float> before(size, 0.0f), inside(size, 0.75f);
+            for (size_t i = 0; i < size; i += 7)
+                inside[i] = std::numeric_limits<float>::quiet_NaN();
+            tbb::task_arena(threads).execute([&] {
+                raster::Rasterizer rasterizer(width, height);
+                const raster::TriangleList triangles{mesh.positions, mesh.indices};
+                rasterizer.draw(triangles, state, before.data(), raster::DepthOnly{});
+                state.clearDepth = 0.0f;
+                rasterizer.draw(triangles, state, inside.data(), raster::DepthOnly{});
+            });
+            EXPECT_EQ(0, std::memcmp(inside.data(), before.data(), size * sizeof(float)))
+                << samples << " samples, " << threads << " threads";
+            EXPECT_GT(std::count(before.begin(), before.end(), 0.0f), 1000) << "uncovered pixels";
+        }
 }
 
 } // namespace

@@ -1,0 +1,104 @@
+// The depth-only span loop per instruction set: hwy/foreach_target.h compiles this file once per
+// target Highway builds (the same policy as lighting/kernel/VectorTargets.cpp), and
+// HWY_DYNAMIC_DISPATCH calls the best one this CPU runs. See DepthSpan.h for the contract.
+#include "raster/DepthSpan.h"
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "raster/DepthSpan.cpp"
+#include <hwy/foreach_target.h> // must come before highway.h
+
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace raster::HWY_NAMESPACE {
+
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Depth in double lanes (the plane is double), tested and stored as float lanes of the same
+// count. The tail (fewer pixels than a vector) runs the scalar loop, so no load or store ever
+// leaves [lo, hi].
+template <DepthTest kTest> HWY_INLINE uint64_t spanLoop(const DepthSpanArgs& span) {
+    const hn::ScalableTag<double> dd;
+    const hn::Rebind<float, decltype(dd)> df;
+    const int lanes = int(hn::Lanes(dd));
+    const auto zero = hn::Zero(dd);
+    const auto one = hn::Set(dd, 1.0);
+    const auto zRow = hn::Set(dd, span.zRow);
+    const auto zStep = hn::Set(dd, span.zStep);
+    const auto advance = hn::Set(dd, double(lanes));
+    auto px = hn::Iota(dd, double(span.lo));
+    float* row = span.row;
+    uint64_t passed = 0;
+    int x = span.lo;
+    for (; x + lanes - 1 <= span.hi; x += lanes, px = hn::Add(px, advance)) {
+        auto z = hn::Add(zRow, hn::Mul(zStep, px));
+        // std::clamp(z, 0, 1): z < 0 ? 0 : (1 < z ? 1 : z), NaN kept.
+        z = hn::IfThenElse(hn::Lt(z, zero), zero, hn::IfThenElse(hn::Lt(one, z), one, z));
+        const auto depth = hn::DemoteTo(df, z);
+        const auto stored = hn::LoadU(df, row + x);
+        hn::Mask<decltype(df)> pass;
+        if constexpr (kTest == DepthTest::Always)
+            pass = hn::FirstN(df, size_t(lanes));
+        else if constexpr (kTest == DepthTest::Less)
+            pass = hn::Lt(depth, stored);
+        else if constexpr (kTest == DepthTest::LessEqual)
+            pass = hn::Le(depth, stored);
+        else if constexpr (kTest == DepthTest::Greater)
+            pass = hn::Gt(depth, stored);
+        else
+            pass = hn::Ge(depth, stored);
+        passed += hn::CountTrue(df, pass);
+        if (span.write)
+            hn::StoreU(hn::IfThenElse(pass, depth, stored), df, row + x);
+    }
+    DepthSpanArgs tail = span;
+    tail.lo = x;
+    return passed + detail::depthSpanScalarLoop<kTest>(tail);
+}
+
+uint64_t depthSpanVector(DepthTest test, const DepthSpanArgs& span) {
+    switch (test) {
+    case DepthTest::Always:
+        return spanLoop<DepthTest::Always>(span);
+    case DepthTest::Less:
+        return spanLoop<DepthTest::Less>(span);
+    case DepthTest::LessEqual:
+        return spanLoop<DepthTest::LessEqual>(span);
+    case DepthTest::Greater:
+        return spanLoop<DepthTest::Greater>(span);
+    case DepthTest::GreaterEqual:
+        return spanLoop<DepthTest::GreaterEqual>(span);
+    }
+    return 0;
+}
+
+} // namespace raster::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace raster {
+
+HWY_EXPORT(depthSpanVector);
+
+uint64_t depthSpan(DepthTest test, const DepthSpanArgs& span) {
+    return HWY_DYNAMIC_DISPATCH(depthSpanVector)(test, span);
+}
+
+uint64_t depthSpanScalar(DepthTest test, const DepthSpanArgs& span) {
+    switch (test) {
+    case DepthTest::Always:
+        return detail::depthSpanScalarLoop<DepthTest::Always>(span);
+    case DepthTest::Less:
+        return detail::depthSpanScalarLoop<DepthTest::Less>(span);
+    case DepthTest::LessEqual:
+        return detail::depthSpanScalarLoop<DepthTest::LessEqual>(span);
+    case DepthTest::Greater:
+        return detail::depthSpanScalarLoop<DepthTest::Greater>(span);
+    case DepthTest::GreaterEqual:
+        return detail::depthSpanScalarLoop<DepthTest::GreaterEqual>(span);
+    }
+    return 0;
+}
+
+} // namespace raster
+#endif // HWY_ONCE
