@@ -21,6 +21,8 @@ namespace lighting::shadows {
 
 inline constexpr uint32_t kNoShadow = ~0u;
 
+struct ShadowMapsView; // ShadowMapsView.h
+
 class ShadowLookup {
 public:
     virtual ~ShadowLookup() = default;
@@ -31,6 +33,10 @@ public:
     // a shadow returned by shadowOf: 0 = fully shadowed, 1 = fully lit.
     virtual float visibility(uint32_t shadow, const glm::vec3& positionView,
                              const glm::vec3& normalView) const = 0;
+    // The lookup as plain data (ShadowMapsView.h), for the kernel's vector lookup, which gives
+    // bitwise visibility()'s answers; null (the default): the kernel calls visibility() lane by
+    // lane. Called once per frame when the kernel's lights are built; O(1), thread-safe.
+    virtual const ShadowMapsView* view() const { return nullptr; }
 };
 
 // The reference's shadows: whether light `lightIndex` casts (the same lights as the stages'
