@@ -3,7 +3,10 @@
 // (lighting/kernel) multiplies a light's radiance at a lane by this fraction, on the scalar and
 // the vector path alike, so a stage shades shadows exactly as it shades light: every stage whose
 // shading goes through the kernel applies shadows the same way, with no second copy of the loop.
-// The shadow maps (ShadowMaps.h) implement it; tests implement it with analytic occluders.
+// The shadow maps (ShadowMaps.h) implement it, and hand the kernel their plain-data view too
+// (view(), ShadowMapsView.h), from which its vector path computes visibility() for a vector of
+// lanes at once, bitwise; tests implement it with analytic occluders (no view: the kernel then
+// calls visibility() lane by lane).
 // ExactShadowLookup is the reference's counterpart, in double: ray-traced visibility (RayShadows.h)
 // for the same shadow-casting lights, the ground truth the maps are measured against.
 //

@@ -32,6 +32,13 @@
 // Threading: render() runs in parallel under the caller's tbb::task_arena (per ShadowSchedule);
 // every face is written by one task only, so the maps are bitwise the same for any thread count.
 // A built ShadowMaps is immutable; visibility() and the accessors are thread-safe.
+//
+// Two lookups, one answer: visibility() here (scalar, the oracle) and the shading kernel's vector
+// lookup (lighting/kernel/VectorShadows-inl.h), which reads view() (ShadowMapsView.h: the same
+// matrices, planes, depth texels, settings and constants) and performs the same double operations
+// in the same order for 2 to 8 lanes at once, so its answers are bitwise visibility()'s
+// (tests/kernel/vector_shadows_test.cpp). A change to the lookup's arithmetic here must be made
+// there too; that test fails when they disagree on its random points and the cube's seams.
 #pragma once
 
 #include <cstddef>
