@@ -48,7 +48,8 @@ KernelLights::~KernelLights() {
 
 KernelLights::KernelLights(const std::vector<LightInView<float>>& lights,
                            const shadows::ShadowLookup* shadows)
-    : mSource(&lights), mRecords(takePooled(lights.size())), mShadows(shadows) {
+    : mSource(&lights), mRecords(takePooled(lights.size())), mShadows(shadows),
+      mShadowView(shadows ? shadows->view() : nullptr) {
     mRecords.resize(lights.size());
     // Lights in parallel (10^6 lights: 64 MB of records every frame), each record a function of
     // its light alone.

@@ -14,6 +14,7 @@
 
 #include "lighting/brdf/Brdf.h"
 #include "lighting/shadows/ShadowLookup.h"
+#include "lighting/shadows/ShadowMapsView.h"
 
 namespace lighting::kernel {
 
@@ -54,6 +55,9 @@ public:
     const KernelLight* records() const { return mRecords.data(); }
     const std::vector<LightInView<float>>& source() const { return *mSource; }
     const shadows::ShadowLookup* shadows() const { return mShadows; }
+    // shadows()->view(), asked once here: the vector kernel's plain-data lookup, or null (the
+    // kernel then calls shadows()->visibility() lane by lane).
+    const shadows::ShadowMapsView* shadowView() const { return mShadowView; }
     // The shadow of light `index` (records()[index].shadow), for the scalar path.
     uint32_t shadowOf(size_t index) const { return mRecords[index].shadow; }
 
@@ -66,6 +70,7 @@ private:
     // reuse changes no value.
     std::vector<KernelLight> mRecords;
     const shadows::ShadowLookup* mShadows = nullptr;
+    const shadows::ShadowMapsView* mShadowView = nullptr;
 };
 
 } // namespace lighting::kernel

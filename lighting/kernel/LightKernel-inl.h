@@ -55,6 +55,7 @@
 #include <hwy/highway.h>
 
 #include "lighting/kernel/VectorPow-inl.h"
+#include "lighting/kernel/VectorShadows-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace lighting::kernel::HWY_NAMESPACE {
@@ -305,16 +306,37 @@ HWY_INLINE void ambientRadiance(const KernelLight& light, const ShadingPacket& p
     }
 }
 
+// The vector lookup (VectorShadows-inl.h) for the lanes of chunk `chunk` whose bit is set in
+// `lanes` (bit 0 = the chunk's first lane); 1 at the others. Bitwise ShadowMaps::visibility.
+HWY_INLINE FloatVec vectorChunkVisibility(const shadows::ShadowMapsView& view, uint32_t shadow,
+                                          const ShadingPacket& packet, size_t chunk,
+                                          uint32_t lanes) {
+    const FloatTag d;
+    static_assert(kLanesPerVector % kShadowLanes == 0, "a float vector is whole double vectors");
+    HWY_ALIGN float visibility[kLanesPerVector];
+    constexpr uint32_t kHalfBits = (1u << kShadowLanes) - 1u;
+    for (size_t h = 0; h < kLanesPerVector; h += kShadowLanes)
+        hn::StoreU(shadowVisibilityLanes(view, shadow, packet, chunk * kLanesPerVector + h,
+                                         lanes >> h & kHalfBits),
+                   ShadowFloatTag(), visibility + h);
+    return hn::Load(d, visibility);
+}
+
 // The shadow factor of a shadowed light for one chunk: the lookup's visibility at the lanes of
 // `pass` (those whose radiance may be non-zero), 1 at the others (their radiance is +0 already).
-// The lookup is scalar, lane by lane, with the packet's float position and normal: the very calls
-// the scalar path makes, so the factor is bitwise the same on every path.
-HWY_INLINE FloatVec chunkVisibility(const shadows::ShadowLookup& lookup, uint32_t shadow,
+// With the lookup's plain-data view (ShadowMaps), the vector lookup, bitwise the scalar one;
+// without (a test's analytic lookup), the scalar lookup lane by lane with the packet's float
+// position and normal: the very calls the scalar path makes. Either way the factor is bitwise the
+// same on every path.
+HWY_INLINE FloatVec chunkVisibility(const shadows::ShadowLookup& lookup,
+                                    const shadows::ShadowMapsView* view, uint32_t shadow,
                                     const ShadingPacket& packet, size_t chunk, LaneMask pass) {
     const FloatTag d;
     uint8_t bits[8] = {};
     hn::StoreMaskBits(d, pass, bits);
     const uint32_t lanes = uint32_t(bits[0]) | uint32_t(bits[1]) << 8;
+    if (view)
+        return vectorChunkVisibility(*view, shadow, packet, chunk, lanes);
     HWY_ALIGN float visibility[kLanesPerVector];
     for (size_t i = 0; i < kLanesPerVector; ++i) {
         const size_t lane = chunk * kLanesPerVector + i;
@@ -339,7 +361,7 @@ HWY_INLINE void addShaded(const ShadeArgs& args, const KernelLight& light, size_
         return;
     }
     const FloatVec visibility =
-        chunkVisibility(*args.shadows, light.shadow, *args.packet, chunk, l.pass);
+        chunkVisibility(*args.shadows, args.shadowView, light.shadow, *args.packet, chunk, l.pass);
     FloatVec shadowed[3];
     for (int k = 0; k < 3; ++k)
         shadowed[k] = hn::Mul(radiance[k], visibility);
@@ -626,6 +648,16 @@ template <Models kModels> void shadeWithModels(const ShadeArgs& args) {
     } else {
         shadeLights<false, false, kModels>(args);
     }
+}
+
+// VectorFunctions::shadowVisibility: the vector lookup for every lane of a packet.
+void shadowVisibilityVector(const ShadowVisibilityArgs& args) {
+    const FloatTag d;
+    const uint32_t laneMask = args.laneMask & ((1u << kPacketLanes) - 1u);
+    for (size_t c = 0; c < kChunks; ++c)
+        hn::StoreU(vectorChunkVisibility(*args.view, args.shadow, *args.packet, c,
+                                         laneMask >> (c * kLanesPerVector)),
+                   d, args.visibility + c * kLanesPerVector);
 }
 
 void shadePacketVector(const ShadeArgs& args) {

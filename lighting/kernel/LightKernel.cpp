@@ -15,7 +15,7 @@ void shadePacket(const KernelIsa& isa, const ShadingPacket& packet, uint32_t lan
     }
     isa.vector()->shade(ShadeArgs{&packet, laneMask, lights.records(), lightIndices.data(),
                                   lightIndices.size(), &accumulator, countContributing, nullptr,
-                                  lights.shadows()});
+                                  lights.shadows(), lights.shadowView()});
 }
 
 } // namespace lighting::kernel
@@ -35,7 +35,7 @@ void shadePacket(const KernelIsa& isa, const ShadingPacket& packet, uint32_t lan
     }
     isa.vector()->shade(ShadeArgs{&packet, laneMask, lights.records(), lightIndices.data(),
                                   lightIndices.size(), &accumulator, countContributing,
-                                  lightLaneMasks.data(), lights.shadows()});
+                                  lightLaneMasks.data(), lights.shadows(), lights.shadowView()});
 }
 
 } // namespace lighting::kernel

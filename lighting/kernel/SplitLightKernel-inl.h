@@ -106,8 +106,8 @@ HWY_INLINE void splitShaded(const ShadeSplitArgs& args, const KernelLight& light
     // A shadowed light: all three terms times the shadow factor (addSplitLight's order: the
     // Blinn-Phong specular was decided by the unshadowed diffuse above).
     if (light.shadow != shadows::kNoShadow && args.shadows) {
-        const FloatVec visibility =
-            chunkVisibility(*args.shadows, light.shadow, *args.packet, chunk, l.pass);
+        const FloatVec visibility = chunkVisibility(*args.shadows, args.shadowView, light.shadow,
+                                                    *args.packet, chunk, l.pass);
         for (int k = 0; k < 3; ++k) {
             diffuse[k] = hn::Mul(diffuse[k], visibility);
             specular[k] = hn::Mul(specular[k], visibility);

@@ -26,7 +26,7 @@ void shadePacketSplit(const KernelIsa& isa, const ShadingPacket& packet, uint32_
     }
     isa.vector()->shadeSplit(ShadeSplitArgs{&packet, laneMask, lights.records(),
                                             lightIndices.data(), lightIndices.size(), &accumulator,
-                                            lights.shadows()});
+                                            lights.shadows(), lights.shadowView()});
 }
 
 } // namespace lighting::kernel

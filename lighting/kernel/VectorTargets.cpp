@@ -29,7 +29,7 @@ const VectorFunctions* vectorFunctions() {
     static const VectorFunctions functions{HWY_TARGET,           hwy::TargetName(HWY_TARGET),
                                            int(kLanesPerVector), &shadePacketVector,
                                            &decodePacketVector,  &powArrayVector,
-                                           &shadeSplitVector};
+                                           &shadeSplitVector,    &shadowVisibilityVector};
     return &functions;
 }
 

@@ -35,6 +35,9 @@ struct ShadeArgs {
     const uint16_t* lightLaneMasks = nullptr;
     // The lights' shadows (KernelLights::shadows()); null when no light casts one.
     const shadows::ShadowLookup* shadows = nullptr;
+    // Their plain-data view (KernelLights::shadowView()): when given, the shadow factor is the
+    // vector lookup's (VectorShadows-inl.h), else shadows->visibility() lane by lane.
+    const shadows::ShadowMapsView* shadowView = nullptr;
 };
 
 // shadePacketSplit's arguments (SplitLightKernel.h).
@@ -45,7 +48,17 @@ struct ShadeSplitArgs {
     const uint32_t* indices;
     size_t count;
     SplitPacketAccumulator* accumulator;
-    const shadows::ShadowLookup* shadows = nullptr; // as ShadeArgs::shadows
+    const shadows::ShadowLookup* shadows = nullptr;      // as ShadeArgs::shadows
+    const shadows::ShadowMapsView* shadowView = nullptr; // as ShadeArgs::shadowView
+};
+
+// shadowVisibility's arguments: the vector lookup alone, for tests and benchmarks.
+struct ShadowVisibilityArgs {
+    const shadows::ShadowMapsView* view;
+    uint32_t shadow;
+    const ShadingPacket* packet; // positionView and normalView are read
+    uint32_t laneMask;           // lanes to look up; the others get 1
+    float* visibility;           // kPacketLanes values
 };
 
 struct DecodeArgs {
@@ -65,6 +78,9 @@ struct VectorFunctions {
     // study of tests/kernel/vector_pow_test.cpp.
     void (*pow)(const float* x, const float* y, float* out, size_t count);
     void (*shadeSplit)(const ShadeSplitArgs&); // SplitLightKernel.h
+    // The shadow lookup the kernel makes for a shadowed light (VectorShadows-inl.h), for every
+    // lane of a packet: bitwise ShadowMaps::visibility. For tests and benchmarks.
+    void (*shadowVisibility)(const ShadowVisibilityArgs&);
 };
 
 // The compiled targets this CPU supports, narrowest to widest. Built once (thread-safe).

@@ -3,7 +3,10 @@
 // (lighting/kernel) multiplies a light's radiance at a lane by this fraction, on the scalar and
 // the vector path alike, so a stage shades shadows exactly as it shades light: every stage whose
 // shading goes through the kernel applies shadows the same way, with no second copy of the loop.
-// The shadow maps (ShadowMaps.h) implement it; tests implement it with analytic occluders.
+// The shadow maps (ShadowMaps.h) implement it, and hand the kernel their plain-data view too
+// (view(), ShadowMapsView.h), from which its vector path computes visibility() for a vector of
+// lanes at once, bitwise; tests implement it with analytic occluders (no view: the kernel then
+// calls visibility() lane by lane).
 // ExactShadowLookup is the reference's counterpart, in double: ray-traced visibility (RayShadows.h)
 // for the same shadow-casting lights, the ground truth the maps are measured against.
 //
@@ -21,6 +24,8 @@ namespace lighting::shadows {
 
 inline constexpr uint32_t kNoShadow = ~0u;
 
+struct ShadowMapsView; // ShadowMapsView.h
+
 class ShadowLookup {
 public:
     virtual ~ShadowLookup() = default;
@@ -31,6 +36,10 @@ public:
     // a shadow returned by shadowOf: 0 = fully shadowed, 1 = fully lit.
     virtual float visibility(uint32_t shadow, const glm::vec3& positionView,
                              const glm::vec3& normalView) const = 0;
+    // The lookup as plain data (ShadowMapsView.h), for the kernel's vector lookup, which gives
+    // bitwise visibility()'s answers; null (the default): the kernel calls visibility() lane by
+    // lane. Called once per frame when the kernel's lights are built; O(1), thread-safe.
+    virtual const ShadowMapsView* view() const { return nullptr; }
 };
 
 // The reference's shadows: whether light `lightIndex` casts (the same lights as the stages'

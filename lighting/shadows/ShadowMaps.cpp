@@ -93,27 +93,6 @@ glm::dmat4 orthographicReversed(double x0, double x1, double y0, double y1, doub
     return m;
 }
 
-// The 16-tap Poisson disk of radius 1 (a common fixed set), scaled by kPoissonRadiusTexels.
-constexpr double kPoissonRadiusTexels = 2.5;
-constexpr std::array<glm::dvec2, 16> kPoissonDisk = {{
-    {-0.94201624, -0.39906216},
-    {0.94558609, -0.76890725},
-    {-0.094184101, -0.92938870},
-    {0.34495938, 0.29387760},
-    {-0.91588581, 0.45771432},
-    {-0.81544232, -0.87912464},
-    {-0.38277543, 0.27676845},
-    {0.97484398, 0.75648379},
-    {0.44323325, -0.97511554},
-    {0.53742981, -0.47373420},
-    {-0.26496911, -0.41893023},
-    {0.79197514, 0.19090188},
-    {-0.24188840, 0.99706507},
-    {-0.81409955, 0.91437590},
-    {0.19984126, 0.78641367},
-    {0.14383161, -0.14100790},
-}};
-
 // Triangles a light's faces draw: either the scene's own buffers (directional lights) or the
 // corners of the triangles within a point or spot light's range, three per triangle.
 struct Casters {
@@ -207,6 +186,9 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             if (face.depth.capacity() > 0)
                 depthPool.push_back(std::move(face.depth));
         recycled->mFaces.clear();
+        recycled->mFaceViews.clear();
+        recycled->mShadowViews.clear();
+        recycled->mView = shadows::ShadowMapsView{};
     }
     maps.mSettings = settings;
     maps.mShadowOfLight.assign(scene.lights.size(), kNoShadow);
@@ -551,6 +533,44 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     }
     maps.mStats.faceCount = maps.mFaces.size();
     maps.mStats.renderMs = milliseconds(start);
+
+    // The plain-data view for the kernel's vector lookup: the same numbers visibility() reads.
+    for (const ShadowFace& face : maps.mFaces) {
+        shadows::ShadowFaceView faceView{};
+        for (int column = 0; column < 4; ++column)
+            for (int row = 0; row < 4; ++row)
+                faceView.lightClipFromView[column][row] = face.lightClipFromViewExact[column][row];
+        faceView.nearMetres = face.nearMetres;
+        faceView.farMetres = face.farMetres;
+        faceView.tanHalfFov = face.tanHalfFov;
+        faceView.extentMetres = face.extentMetres;
+        faceView.depth = face.empty ? nullptr : face.depth.data();
+        faceView.orthographic = face.orthographic;
+        faceView.empty = face.empty;
+        maps.mFaceViews.push_back(faceView);
+    }
+    for (const Shadow& shadow : maps.mShadows) {
+        shadows::ShadowView shadowView{};
+        shadowView.type = uint32_t(shadow.type);
+        shadowView.firstFace = uint32_t(shadow.firstFace);
+        shadowView.faceCount = uint32_t(shadow.faceCount);
+        for (int k = 0; k < 3; ++k)
+            shadowView.positionView[k] = shadow.positionView[k];
+        shadowView.cascadeFarDepthView = shadow.cascadeFarDepthView.data();
+        maps.mShadowViews.push_back(shadowView);
+    }
+    shadows::ShadowMapsView& mapsView = maps.mView;
+    mapsView.shadows = maps.mShadowViews.data();
+    mapsView.shadowCount = uint32_t(maps.mShadowViews.size());
+    mapsView.faces = maps.mFaceViews.data();
+    for (int column = 0; column < 3; ++column)
+        for (int row = 0; row < 3; ++row)
+            mapsView.worldFromViewRotation[column][row] = maps.mWorldFromViewRotation[column][row];
+    mapsView.mapSize = settings.mapSize;
+    mapsView.filter = settings.filter;
+    mapsView.biasConstant = settings.biasConstant;
+    mapsView.biasSlope = settings.biasSlope;
+    mapsView.normalOffset = settings.normalOffset;
     return maps;
 }
 
@@ -637,7 +657,7 @@ float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
     }
     // Outside the face's coverage: lit (a tolerance of 1e-9 of the face for points on a cube
     // face's edge, which the major axis assigns to this face).
-    const double tolerance = 1e-9 * sizeD;
+    const double tolerance = kFaceEdgeTolerance * sizeD;
     if (!(r.u >= -tolerance && r.u <= sizeD + tolerance && r.v >= -tolerance &&
           r.v <= sizeD + tolerance && r.depth >= face.nearMetres && r.depth <= face.farMetres))
         return 1.0f;
@@ -653,7 +673,7 @@ float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
         const double du1 = a.u - r.u, dv1 = a.v - r.v, dd1 = a.depth - r.depth;
         const double du2 = b.u - r.u, dv2 = b.v - r.v, dd2 = b.depth - r.depth;
         const double det = du1 * dv2 - dv1 * du2;
-        if (a.valid && b.valid && std::abs(det) > 1e-12) {
+        if (a.valid && b.valid && std::abs(det) > kMinReceiverPlaneDeterminant) {
             gradient = glm::dvec2(dd1 * dv2 - dv1 * dd2, du1 * dd2 - dd1 * du2) / det;
             tanTheta = glm::length(gradient) / texel;
         } else {
@@ -693,9 +713,9 @@ float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
         break;
     }
     case ShadowFilter::Poisson:
-        for (const glm::dvec2& offset : kPoissonDisk) {
-            litCount += lit(int(std::floor(r.u + kPoissonRadiusTexels * offset.x)),
-                            int(std::floor(r.v + kPoissonRadiusTexels * offset.y)));
+        for (const auto& offset : kPoissonDisk) {
+            litCount += lit(int(std::floor(r.u + kPoissonRadiusTexels * offset[0])),
+                            int(std::floor(r.v + kPoissonRadiusTexels * offset[1])));
             ++tapCount;
         }
         break;

@@ -32,6 +32,13 @@
 // Threading: render() runs in parallel under the caller's tbb::task_arena (per ShadowSchedule);
 // every face is written by one task only, so the maps are bitwise the same for any thread count.
 // A built ShadowMaps is immutable; visibility() and the accessors are thread-safe.
+//
+// Two lookups, one answer: visibility() here (scalar, the oracle) and the shading kernel's vector
+// lookup (lighting/kernel/VectorShadows-inl.h), which reads view() (ShadowMapsView.h: the same
+// matrices, planes, depth texels, settings and constants) and performs the same double operations
+// in the same order for 2 to 8 lanes at once, so its answers are bitwise visibility()'s
+// (tests/kernel/vector_shadows_test.cpp). A change to the lookup's arithmetic here must be made
+// there too; that test fails when they disagree on its random points and the cube's seams.
 #pragma once
 
 #include <cstddef>
@@ -45,6 +52,7 @@
 #include "gbuffer/visibility/CameraView.h"
 #include "gbuffer/visibility/SceneGeometry.h"
 #include "lighting/shadows/ShadowLookup.h"
+#include "lighting/shadows/ShadowMapsView.h"
 #include "lighting/shadows/ShadowSettings.h"
 #include "scenes/Scene.h"
 
@@ -61,9 +69,6 @@ inline constexpr double kMaxSpotHalfAngleDegrees = 80.0;
 inline constexpr int kFaceMarginTexels = 3;
 // The practical split scheme's weight of the logarithmic split (1 - lambda: uniform).
 inline constexpr double kCascadeLambda = 0.5;
-// tan(theta) of the slope bias and of the receiver plane is clamped here (84 degrees): beyond it
-// the tangent plane says nothing reliable about the depth a texel away.
-inline constexpr double kMaxBiasTan = 10.0;
 // The farthest texel centre a lookup reads from the receiver's projection, in texels: the
 // Poisson disk's radius (ShadowSettings.h; PCF 5x5 reaches 2).
 inline constexpr double kMaxTapDistanceTexels = 2.5;
@@ -112,6 +117,14 @@ class ShadowMaps final : public shadows::ShadowLookup {
 public:
     static constexpr uint32_t kNoShadow = shadows::kNoShadow;
 
+    ShadowMaps() = default;
+    // Move-only: the view (view()) points into the maps' own arrays, which a move carries along
+    // and a copy would not.
+    ShadowMaps(ShadowMaps&&) noexcept = default;
+    ShadowMaps& operator=(ShadowMaps&&) noexcept = default;
+    ShadowMaps(const ShadowMaps&) = delete;
+    ShadowMaps& operator=(const ShadowMaps&) = delete;
+
     // Renders every face of every chosen light. Parallel under the caller's task_arena; the
     // result is bitwise independent of the thread count. Cost: per light the triangles within
     // its range (spot, point) or all (directional), set up once per face; memory: mapSize^2
@@ -147,6 +160,9 @@ public:
     // few matrix products and 1 / 9 / 25 / 16 taps. Thread-safe.
     float visibility(uint32_t shadow, const glm::vec3& positionView,
                      const glm::vec3& normalView) const override;
+    // The maps as plain data for the kernel's vector lookup (ShadowMapsView.h), which is bitwise
+    // visibility(): it points into these maps. O(1).
+    const shadows::ShadowMapsView* view() const override { return &mView; }
 
     size_t shadowCount() const { return mShadows.size(); }
     const ShadowFace& face(size_t index) const { return mFaces[index]; }
@@ -181,6 +197,10 @@ private:
     std::vector<uint32_t> mShadowOfLight; // per scene light
     glm::dmat3 mWorldFromViewRotation{1.0};
     ShadowStats mStats;
+    // view(): filled at the end of render(); its arrays point into mShadows and mFaces.
+    std::vector<shadows::ShadowView> mShadowViews;
+    std::vector<shadows::ShadowFaceView> mFaceViews;
+    shadows::ShadowMapsView mView;
 };
 
 } // namespace lighting

@@ -3,6 +3,9 @@
 // Rasterizer per thread) or in sequence (the rasterizer's own tile parallelism). Reports ms per
 // render (manual time: mean; minimum and median beside it, as a shared machine inflates the
 // mean), faces, triangles drawn and bytes.
+// shadowLookup: the cost of one lookup in the same maps, the scalar ShadowMaps::visibility lane by
+// lane against the kernel's vector lookup (VectorShadows-inl.h, the dispatched target) a packet
+// of 16 lanes at a time, per filter, on one thread.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -10,7 +13,11 @@
 #include <string>
 #include <vector>
 
+#include <random>
+
 #include <tbb/task_arena.h>
+
+#include "lighting/kernel/VectorTargets.h"
 
 #include "gbuffer/visibility/CameraView.h"
 #include "gbuffer/visibility/SceneGeometry.h"
@@ -86,5 +93,99 @@ BENCHMARK(shadowMapRender)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
+
+// The atrium's maps (512^2, the filter of `filterIndex`: none, pcf3, pcf5, poisson) and packets of
+// receivers: each packet 16 points within 5 cm of a centre drawn uniformly in the ball of 0.9 x
+// the range of one casting light (a 4x4 pixel block's spread on a surface a few metres away),
+// one random unit normal per packet, the light's shadow beside it.
+struct LookupFrame {
+    lighting::ShadowMaps maps;
+    std::vector<lighting::kernel::ShadingPacket> packets;
+    std::vector<uint32_t> shadows; // per packet
+};
+
+const LookupFrame& lookupFrame(int filterIndex) {
+    static LookupFrame frames[4];
+    static bool built[4] = {};
+    LookupFrame& frame = frames[filterIndex];
+    if (built[filterIndex])
+        return frame;
+    built[filterIndex] = true;
+    const ShadowFrame& f = atrium();
+    lighting::ShadowSettings settings;
+    settings.mapSize = 512;
+    settings.filter = lighting::ShadowFilter(filterIndex);
+    frame.maps = lighting::ShadowMaps::render(f.scene, f.geometry, f.view, settings);
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    auto inBall = [&] {
+        glm::vec3 v;
+        do
+            v = {unit(random), unit(random), unit(random)};
+        while (glm::dot(v, v) > 1.0f);
+        return v;
+    };
+    constexpr size_t kPackets = 4096;
+    for (size_t i = 0; i < kPackets; ++i) {
+        const size_t lightIndex = f.scene.lights.size() * (random() % 1024) / 1024;
+        const uint32_t shadow = frame.maps.shadowOf(lightIndex);
+        if (shadow == lighting::ShadowMaps::kNoShadow) {
+            --i;
+            continue;
+        }
+        const scenes::Light& light = f.scene.lights[lightIndex];
+        const glm::vec3 centreWorld = light.positionWorld + 0.9f * light.rangeMetres * inBall();
+        const glm::vec3 centre(f.view.viewFromWorldExact * glm::dvec4(centreWorld, 1.0));
+        const glm::vec3 normal = glm::normalize(inBall() + glm::vec3(0.0f, 0.0f, 1e-3f));
+        lighting::kernel::ShadingPacket packet{};
+        for (size_t l = 0; l < lighting::kernel::kPacketLanes; ++l) {
+            const glm::vec3 p = centre + 0.05f * inBall();
+            for (int k = 0; k < 3; ++k) {
+                packet.positionView[k][l] = p[k];
+                packet.normalView[k][l] = normal[k];
+            }
+        }
+        frame.packets.push_back(packet);
+        frame.shadows.push_back(shadow);
+    }
+    return frame;
+}
+
+// range(0): 0 = scalar ShadowMaps::visibility per lane, 1 = the vector lookup per packet;
+// range(1): the filter (0 none, 1 pcf3, 2 pcf5, 3 poisson).
+void shadowLookup(benchmark::State& state) {
+    const LookupFrame& frame = lookupFrame(int(state.range(1)));
+    const bool vector = state.range(0) == 1;
+    const lighting::kernel::VectorFunctions* target = lighting::kernel::dispatchedVectorTarget();
+    state.SetLabel(std::string(vector ? target->name : "scalar") + ", " +
+                   lighting::formatShadowFilter(lighting::ShadowFilter(state.range(1))));
+    constexpr size_t kLanes = lighting::kernel::kPacketLanes;
+    float visibility[kLanes];
+    double sum = 0.0;
+    for (auto _ : state) {
+        for (size_t i = 0; i < frame.packets.size(); ++i) {
+            const lighting::kernel::ShadingPacket& packet = frame.packets[i];
+            if (vector) {
+                target->shadowVisibility(lighting::kernel::ShadowVisibilityArgs{
+                    frame.maps.view(), frame.shadows[i], &packet, 0xffffu, visibility});
+            } else {
+                for (size_t l = 0; l < kLanes; ++l)
+                    visibility[l] = frame.maps.visibility(
+                        frame.shadows[i],
+                        glm::vec3(packet.positionView[0][l], packet.positionView[1][l],
+                                  packet.positionView[2][l]),
+                        glm::vec3(packet.normalView[0][l], packet.normalView[1][l],
+                                  packet.normalView[2][l]));
+            }
+            for (float v : visibility)
+                sum += v;
+        }
+    }
+    benchmark::DoNotOptimize(sum);
+    // items_per_second: lookups per CPU second (1e9 / it = CPU ns per lookup; CPU time, because
+    // wall time on the shared machine includes other jobs' time slices).
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(frame.packets.size() * kLanes));
+}
+BENCHMARK(shadowLookup)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond);
 
 } // namespace
