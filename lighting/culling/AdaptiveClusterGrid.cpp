@@ -12,7 +12,9 @@ namespace {
 
 // Lights per assignment task: fixed, so the pair order never depends on the thread count.
 constexpr size_t kLightsPerBatch = 64;
-constexpr int kBlockPixels = 4; // depth min/max granularity: the smallest tile
+constexpr int kBlockPixels = 4;
+// assign()'s phase 2: lights fetched this far ahead of their use.
+constexpr size_t kPrefetchLights = 16; // depth min/max granularity: the smallest tile
 
 // x / depth (or -y / depth) of a screen edge, by unprojecting it at the near plane.
 glm::vec3 unprojectNdc(const gbuffer::CameraView& view, float ndcX, float ndcY) {
@@ -111,32 +113,39 @@ int AdaptiveClusterGrid::sliceOfDepth(float depthMetres) const {
 }
 
 size_t AdaptiveClusterGrid::placeClusters() {
-    size_t count = 0;
-    for (Tile& t : mTiles) {
-        if (t.depthLo > t.depthHi) {
-            t.s0 = 1;
-            t.s1 = 0;
-            continue;
-        }
-        t.s0 = int16_t(sliceOfDepth(t.depthLo));
-        t.s1 = int16_t(sliceOfDepth(t.depthHi));
-        t.base = uint32_t(std::min<size_t>(count, UINT32_MAX));
-        count += size_t(t.s1 - t.s0 + 1);
-    }
+    // Clusters numbered group by group (tiles row-major inside a group, then slices), so that
+    // each group's clusters are one range and assign() builds each group's lists alone.
     mGroups.assign(size_t(mGroupsX) * mGroupsY, Group{});
-    for (int ty = 0; ty < mTilesY; ++ty)
-        for (int tx = 0; tx < mTilesX; ++tx) {
-            const Tile& t = mTiles[tileOf(tx, ty)];
-            if (t.s0 > t.s1)
-                continue;
-            Group& g = mGroups[size_t(ty >> kGroupShift) * mGroupsX + (tx >> kGroupShift)];
-            if (g.depthLo > g.depthHi) {
-                g = {t.depthLo, t.depthHi};
-            } else {
-                g.depthLo = std::min(g.depthLo, t.depthLo);
-                g.depthHi = std::max(g.depthHi, t.depthHi);
-            }
+    size_t count = 0;
+    for (int gy = 0; gy < mGroupsY; ++gy)
+        for (int gx = 0; gx < mGroupsX; ++gx) {
+            Group& g = mGroups[size_t(gy) * mGroupsX + gx];
+            g.base = uint32_t(std::min<size_t>(count, UINT32_MAX));
+            for (int ty = gy << kGroupShift; ty < std::min(mTilesY, (gy + 1) << kGroupShift); ++ty)
+                for (int tx = gx << kGroupShift; tx < std::min(mTilesX, (gx + 1) << kGroupShift);
+                     ++tx) {
+                    Tile& t = mTiles[tileOf(tx, ty)];
+                    if (t.depthLo > t.depthHi) {
+                        t.s0 = 1;
+                        t.s1 = 0;
+                        continue;
+                    }
+                    t.s0 = int16_t(sliceOfDepth(t.depthLo));
+                    t.s1 = int16_t(sliceOfDepth(t.depthHi));
+                    t.base = uint32_t(std::min<size_t>(count, UINT32_MAX));
+                    count += size_t(t.s1 - t.s0 + 1);
+                    if (g.depthLo > g.depthHi) {
+                        g.depthLo = t.depthLo;
+                        g.depthHi = t.depthHi;
+                    } else {
+                        g.depthLo = std::min(g.depthLo, t.depthLo);
+                        g.depthHi = std::max(g.depthHi, t.depthHi);
+                    }
+                }
+            g.end = uint32_t(std::min<size_t>(count, UINT32_MAX));
         }
+    if (count >= UINT32_MAX)
+        throw std::length_error("AdaptiveClusterGrid: more than 2^32 - 1 clusters");
     return count;
 }
 
@@ -279,23 +288,34 @@ bool AdaptiveClusterGrid::build(const AdaptiveClusterOptions& options,
 }
 
 void AdaptiveClusterGrid::assign(std::span<const LightSphere> spheres) {
-    const size_t batchCount = (spheres.size() + kLightsPerBatch - 1) / kLightsPerBatch;
-    auto& batches = mBatchPairs;
-    batches.resize(batchCount);
     if (mClusterCount == 0) {
         mLists.assignFromPairs(1, {});
         return;
     }
+    const size_t lightCount = spheres.size();
+    const size_t groupCount = mGroups.size();
+    if (lightCount >= UINT32_MAX)
+        throw std::length_error("AdaptiveClusterGrid: more than 2^32 - 1 lights");
     const float nearDepth = mSliceDepth.front(), farDepth = mSliceDepth.back();
+
+    // Phase 1, per light (parallel over fixed batches): its candidate tiles and slices, and the
+    // groups it may reach (those whose depth range meets its own), as (group, light) pairs.
+    const size_t batchCount = (lightCount + kLightsPerBatch - 1) / kLightsPerBatch;
+    auto& batches = mBatchPairs;
+    batches.resize(batchCount);
+    mReach.resize(lightCount);
     tbb::parallel_for(size_t(0), batchCount, [&](size_t batch) {
         auto& pairs = batches[batch];
         pairs.clear();
-        const size_t end = std::min(spheres.size(), (batch + 1) * kLightsPerBatch);
+        const size_t end = std::min(lightCount, (batch + 1) * kLightsPerBatch);
         for (size_t light = batch * kLightsPerBatch; light < end; ++light) {
             const LightSphere& sphere = spheres[light];
+            LightReach& reach = mReach[light];
+            reach = LightReach{}; // no tile (column0 > column1)
             if (sphere.unbounded) {
-                for (size_t c = 0; c < mClusterCount; ++c)
-                    pairs.emplace_back(uint32_t(c), uint32_t(light));
+                for (size_t g = 0; g < groupCount; ++g)
+                    if (mGroups[g].base < mGroups[g].end)
+                        pairs.emplace_back(uint32_t(g), uint32_t(light));
                 continue;
             }
             const glm::vec3& c = sphere.centreView;
@@ -328,36 +348,90 @@ void AdaptiveClusterGrid::assign(std::span<const LightSphere> spheres) {
             if (row0 > row1)
                 continue;
             const float depthSlack = 2.0f * (kBoundSlack * depthHi + kBoundSlackMetres);
-            const float reachLo = depthLo - depthSlack, reachHi = depthHi + depthSlack;
-            const int slice0 = sliceOfDepth(reachLo), slice1 = sliceOfDepth(reachHi);
-            // Groups of tiles first: a light off the depth range of a whole patch of surface
-            // (in front of it, or hidden behind it) costs one test per group, not per tile.
+            reach = {int16_t(column0),
+                     int16_t(column1),
+                     int16_t(row0),
+                     int16_t(row1),
+                     int16_t(sliceOfDepth(depthLo - depthSlack)),
+                     int16_t(sliceOfDepth(depthHi + depthSlack)),
+                     depthLo - depthSlack,
+                     depthHi + depthSlack};
+            // A light off the depth range of a whole patch of surface (in front of it, or hidden
+            // behind it) costs one test per group, not one per tile.
             for (int gy = row0 >> kGroupShift; gy <= row1 >> kGroupShift; ++gy)
                 for (int gx = column0 >> kGroupShift; gx <= column1 >> kGroupShift; ++gx) {
-                    const Group& g = mGroups[size_t(gy) * mGroupsX + gx];
-                    if (!(g.depthHi >= reachLo && g.depthLo <= reachHi))
-                        continue;
-                    const int ty0 = std::max(row0, gy << kGroupShift);
-                    const int ty1 = std::min(row1, ((gy + 1) << kGroupShift) - 1);
-                    const int tx0 = std::max(column0, gx << kGroupShift);
-                    const int tx1 = std::min(column1, ((gx + 1) << kGroupShift) - 1);
-                    for (int ty = ty0; ty <= ty1; ++ty)
-                        for (int tx = tx0; tx <= tx1; ++tx) {
-                            const Tile& t = mTiles[tileOf(tx, ty)];
-                            if (t.s0 > t.s1 || t.depthHi < reachLo || t.depthLo > reachHi)
-                                continue;
-                            const int k1 = std::min<int>(slice1, t.s1);
-                            for (int k = std::max<int>(slice0, t.s0); k <= k1; ++k)
-                                if (sphereTouchesBox(sphere, clusterBox(tx, ty, k)))
-                                    pairs.emplace_back(t.base + uint32_t(k - t.s0),
-                                                       uint32_t(light));
-                        }
+                    const size_t g = size_t(gy) * mGroupsX + gx;
+                    if (mGroups[g].depthHi >= reach.depthLo && mGroups[g].depthLo <= reach.depthHi)
+                        pairs.emplace_back(uint32_t(g), uint32_t(light));
                 }
         }
     });
-    // Stable counting sort by cluster, batches in order: each list comes out ascending. The
-    // extra last list stays empty (tiles without clusters point at it).
-    mLists.assignFromPairs(mClusterCount + 1, batches);
+    // Each group's lights, ascending (a stable counting sort in batch order).
+    mGroupLights.assignFromPairs(groupCount, batches);
+
+    // Phase 2, per group (parallel): its lights in ascending order against its tiles and
+    // clusters; its clusters' lists built in its own chunk, so each list is ascending and written
+    // by one task.
+    mCounts.assign(mClusterCount + 1, 0u);
+    mGroupChunks.resize(groupCount);
+    tbb::parallel_for(size_t(0), groupCount, [&](size_t g) {
+        const Group& group = mGroups[g];
+        std::vector<uint32_t>& chunk = mGroupChunks[g];
+        chunk.clear();
+        if (group.base == group.end)
+            return;
+        const int gx = int(g % size_t(mGroupsX)), gy = int(g / size_t(mGroupsX));
+        const int tileX0 = gx << kGroupShift, tileY0 = gy << kGroupShift;
+        const int tileX1 = std::min(mTilesX, (gx + 1) << kGroupShift) - 1;
+        const int tileY1 = std::min(mTilesY, (gy + 1) << kGroupShift) - 1;
+        // (local cluster, light) pairs in light order, then a counting sort into the chunk.
+        std::vector<std::pair<uint32_t, uint32_t>> pairs;
+        const std::span<const uint32_t> lights = mGroupLights[g];
+        for (size_t i = 0; i < lights.size(); ++i) {
+            // The group's lights are scattered over the light list (10^6 spheres: 56 MB): fetch
+            // ahead, or each one costs a memory round trip (measured: half of this loop).
+            if (i + kPrefetchLights < lights.size()) {
+                const uint32_t ahead = lights[i + kPrefetchLights];
+                __builtin_prefetch(&spheres[ahead]);
+                __builtin_prefetch(reinterpret_cast<const char*>(&spheres[ahead]) + 48);
+                __builtin_prefetch(&mReach[ahead]);
+            }
+            const uint32_t light = lights[i];
+            const LightSphere& sphere = spheres[light];
+            if (sphere.unbounded) {
+                for (uint32_t cluster = group.base; cluster < group.end; ++cluster)
+                    pairs.emplace_back(cluster - group.base, light);
+                continue;
+            }
+            const LightReach& reach = mReach[light];
+            for (int ty = std::max<int>(reach.row0, tileY0),
+                     ty1 = std::min<int>(reach.row1, tileY1);
+                 ty <= ty1; ++ty)
+                for (int tx = std::max<int>(reach.column0, tileX0),
+                         tx1 = std::min<int>(reach.column1, tileX1);
+                     tx <= tx1; ++tx) {
+                    const Tile& t = mTiles[tileOf(tx, ty)];
+                    if (t.s0 > t.s1 || t.depthHi < reach.depthLo || t.depthLo > reach.depthHi)
+                        continue;
+                    const int k1 = std::min<int>(reach.slice1, t.s1);
+                    for (int k = std::max<int>(reach.slice0, t.s0); k <= k1; ++k)
+                        if (sphereTouchesBox(sphere, clusterBox(tx, ty, k)))
+                            pairs.emplace_back(t.base + uint32_t(k - t.s0) - group.base, light);
+                }
+        }
+        uint32_t* counts = mCounts.data() + group.base;
+        for (const auto& pair : pairs)
+            ++counts[pair.first];
+        std::vector<uint32_t> cursor(group.end - group.base);
+        for (size_t i = 1; i < cursor.size(); ++i)
+            cursor[i] = cursor[i - 1] + counts[i - 1];
+        chunk.resize(pairs.size());
+        for (const auto& pair : pairs)
+            chunk[cursor[pair.first]++] = pair.second;
+    });
+    // The groups' chunks concatenated are the lists in cluster order; the last list (tiles
+    // without clusters point at it) stays empty.
+    mLists.assign(mCounts, mGroupChunks);
 }
 
 size_t AdaptiveClusterGrid::memoryBytes() const {

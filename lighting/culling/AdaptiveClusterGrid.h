@@ -140,11 +140,18 @@ private:
         uint32_t base = 0;                    // first stored cluster
     };
     static_assert(sizeof(Tile) == 16, "tiles are read once per light and tile: keep them small");
-    static_assert(kMaxAdaptiveSlices <= INT16_MAX, "slice indices are int16 in Tile");
+    static_assert(kMaxAdaptiveSlices <= INT16_MAX && kMaxTilePixels >= 4,
+                  "slice and tile indices are int16 in Tile and LightReach");
     // A group of kGroupTiles x kGroupTiles tiles: the union of their depth ranges, so that a
     // light far in front of (or behind) a patch of surface is rejected once for the group.
     struct Group {
         float depthLo = 1.0f, depthHi = 0.0f; // empty when lo > hi
+        uint32_t base = 0, end = 0;           // its clusters [base, end): groups own ranges
+    };
+    // A light's candidate tiles and slices (assign(), phase 1), and its depth reach.
+    struct LightReach {
+        int16_t column0 = 1, column1 = 0, row0 = 0, row1 = 0, slice0 = 0, slice1 = 0;
+        float depthLo = 0.0f, depthHi = 0.0f;
     };
     static constexpr int kGroupShift = 3; // 8 x 8 tiles
     size_t tileOf(int tileX, int tileY) const { return size_t(tileY) * mTilesX + tileX; }
@@ -167,7 +174,13 @@ private:
     LightIndexLists mLists; // clusterCount + 1 lists (the last one empty)
     // build() scratch: per 4x4 pixel block the min/max covered NDC depth.
     std::vector<float> mBlockLo, mBlockHi;
-    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> mBatchPairs; // assign() scratch
+    // assign() scratch, kept across frames: per batch of lights its (group, light) pairs; per
+    // light its reach; per group its lights and its clusters' lists; per cluster its count.
+    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> mBatchPairs;
+    std::vector<LightReach> mReach;
+    LightIndexLists mGroupLights;
+    std::vector<std::vector<uint32_t>> mGroupChunks;
+    std::vector<uint32_t> mCounts;
 };
 
 } // namespace lighting
