@@ -10,11 +10,13 @@ namespace lighting {
 
 namespace {
 
-// Lights per assignment task: fixed, so the pair order never depends on the thread count.
+// The smallest chunk of lights of a phase-1 task (a task costs more than a few lights).
 constexpr size_t kLightsPerBatch = 64;
 constexpr int kBlockPixels = 4;
-// assign()'s phase 2: lights fetched this far ahead of their use.
-constexpr size_t kPrefetchLights = 16; // depth min/max granularity: the smallest tile
+// assign()'s phase 1 runs over at most this many chunks of lights (fixed by the light count, so
+// the record order never depends on the thread count): enough to balance 2..16 threads, few
+// enough that the chunk x group counters stay small (64 x 920 groups at 4-pixel tiles).
+constexpr size_t kMaxChunks = 64; // depth min/max granularity: the smallest tile
 
 // x / depth (or -y / depth) of a screen edge, by unprojecting it at the near plane.
 glm::vec3 unprojectNdc(const gbuffer::CameraView& view, float ndcX, float ndcY) {
@@ -298,24 +300,29 @@ void AdaptiveClusterGrid::assign(std::span<const LightSphere> spheres) {
         throw std::length_error("AdaptiveClusterGrid: more than 2^32 - 1 lights");
     const float nearDepth = mSliceDepth.front(), farDepth = mSliceDepth.back();
 
-    // Phase 1, per light (parallel over fixed batches): its candidate tiles and slices, and the
-    // groups it may reach (those whose depth range meets its own), as (group, light) pairs.
-    const size_t batchCount = (lightCount + kLightsPerBatch - 1) / kLightsPerBatch;
-    auto& batches = mBatchPairs;
-    batches.resize(batchCount);
-    mReach.resize(lightCount);
-    tbb::parallel_for(size_t(0), batchCount, [&](size_t batch) {
-        auto& pairs = batches[batch];
-        pairs.clear();
-        const size_t end = std::min(lightCount, (batch + 1) * kLightsPerBatch);
-        for (size_t light = batch * kLightsPerBatch; light < end; ++light) {
+    // Phase 1, per light (parallel over chunks fixed by the light count alone): its candidate
+    // tiles and slices, and the groups it may reach (those whose depth range meets its own), as
+    // (group, record) pairs in light order.
+    const size_t chunkSize = std::max(kLightsPerBatch, (lightCount + kMaxChunks - 1) / kMaxChunks);
+    const size_t chunkCount = (lightCount + chunkSize - 1) / chunkSize;
+    mChunkRecords.resize(chunkCount);
+    mChunkGroupStart.assign(chunkCount * groupCount, 0u);
+    tbb::parallel_for(size_t(0), chunkCount, [&](size_t chunk) {
+        auto& records = mChunkRecords[chunk];
+        records.clear();
+        uint32_t* groupCounts = mChunkGroupStart.data() + chunk * groupCount;
+        const size_t end = std::min(lightCount, (chunk + 1) * chunkSize);
+        for (size_t light = chunk * chunkSize; light < end; ++light) {
             const LightSphere& sphere = spheres[light];
-            LightReach& reach = mReach[light];
-            reach = LightReach{}; // no tile (column0 > column1)
+            LightRecord record;
+            record.light = uint32_t(light);
             if (sphere.unbounded) {
+                record.slice0 = -1;
                 for (size_t g = 0; g < groupCount; ++g)
-                    if (mGroups[g].base < mGroups[g].end)
-                        pairs.emplace_back(uint32_t(g), uint32_t(light));
+                    if (mGroups[g].base < mGroups[g].end) {
+                        records.emplace_back(uint32_t(g), record);
+                        ++groupCounts[g];
+                    }
                 continue;
             }
             const glm::vec3& c = sphere.centreView;
@@ -348,32 +355,58 @@ void AdaptiveClusterGrid::assign(std::span<const LightSphere> spheres) {
             if (row0 > row1)
                 continue;
             const float depthSlack = 2.0f * (kBoundSlack * depthHi + kBoundSlackMetres);
-            reach = {int16_t(column0),
-                     int16_t(column1),
-                     int16_t(row0),
-                     int16_t(row1),
-                     int16_t(sliceOfDepth(depthLo - depthSlack)),
-                     int16_t(sliceOfDepth(depthHi + depthSlack)),
-                     depthLo - depthSlack,
-                     depthHi + depthSlack};
+            record.centreView = c;
+            record.radius = r;
+            record.column0 = int16_t(column0);
+            record.column1 = int16_t(column1);
+            record.row0 = int16_t(row0);
+            record.row1 = int16_t(row1);
+            record.depthLo = depthLo - depthSlack;
+            record.depthHi = depthHi + depthSlack;
+            record.slice0 = int16_t(sliceOfDepth(record.depthLo));
+            record.slice1 = int16_t(sliceOfDepth(record.depthHi));
             // A light off the depth range of a whole patch of surface (in front of it, or hidden
             // behind it) costs one test per group, not one per tile.
             for (int gy = row0 >> kGroupShift; gy <= row1 >> kGroupShift; ++gy)
                 for (int gx = column0 >> kGroupShift; gx <= column1 >> kGroupShift; ++gx) {
                     const size_t g = size_t(gy) * mGroupsX + gx;
-                    if (mGroups[g].depthHi >= reach.depthLo && mGroups[g].depthLo <= reach.depthHi)
-                        pairs.emplace_back(uint32_t(g), uint32_t(light));
+                    if (mGroups[g].depthHi >= record.depthLo &&
+                        mGroups[g].depthLo <= record.depthHi) {
+                        records.emplace_back(uint32_t(g), record);
+                        ++groupCounts[g];
+                    }
                 }
         }
     });
-    // Each group's lights, ascending (a stable counting sort in batch order).
-    mGroupLights.assignFromPairs(groupCount, batches);
+    // The records in group order, chunks in order within a group (so lights ascend): counts to
+    // start positions (group-major), then each chunk scatters its own records (disjoint ranges).
+    mGroupStart.assign(groupCount + 1, 0u);
+    uint64_t total = 0;
+    for (size_t g = 0; g < groupCount; ++g) {
+        mGroupStart[g] = uint32_t(total);
+        for (size_t chunk = 0; chunk < chunkCount; ++chunk) {
+            uint32_t& slot = mChunkGroupStart[chunk * groupCount + g];
+            const uint32_t count = slot;
+            slot = uint32_t(total);
+            total += count;
+        }
+        if (total >= UINT32_MAX)
+            throw std::length_error("AdaptiveClusterGrid: more than 2^32 - 1 group records");
+    }
+    mGroupStart[groupCount] = uint32_t(total);
+    mGroupRecords.resize(size_t(total));
+    tbb::parallel_for(size_t(0), chunkCount, [&](size_t chunk) {
+        uint32_t* cursor = mChunkGroupStart.data() + chunk * groupCount;
+        for (const auto& [g, record] : mChunkRecords[chunk])
+            mGroupRecords[cursor[g]++] = record;
+    });
 
     // Phase 2, per group (parallel): its lights in ascending order against its tiles and
     // clusters; its clusters' lists built in its own chunk, so each list is ascending and written
     // by one task.
     mCounts.assign(mClusterCount + 1, 0u);
     mGroupChunks.resize(groupCount);
+    mGroupPairs.resize(groupCount);
     tbb::parallel_for(size_t(0), groupCount, [&](size_t g) {
         const Group& group = mGroups[g];
         std::vector<uint32_t>& chunk = mGroupChunks[g];
@@ -385,38 +418,31 @@ void AdaptiveClusterGrid::assign(std::span<const LightSphere> spheres) {
         const int tileX1 = std::min(mTilesX, (gx + 1) << kGroupShift) - 1;
         const int tileY1 = std::min(mTilesY, (gy + 1) << kGroupShift) - 1;
         // (local cluster, light) pairs in light order, then a counting sort into the chunk.
-        std::vector<std::pair<uint32_t, uint32_t>> pairs;
-        const std::span<const uint32_t> lights = mGroupLights[g];
-        for (size_t i = 0; i < lights.size(); ++i) {
-            // The group's lights are scattered over the light list (10^6 spheres: 56 MB): fetch
-            // ahead, or each one costs a memory round trip (measured: half of this loop).
-            if (i + kPrefetchLights < lights.size()) {
-                const uint32_t ahead = lights[i + kPrefetchLights];
-                __builtin_prefetch(&spheres[ahead]);
-                __builtin_prefetch(reinterpret_cast<const char*>(&spheres[ahead]) + 48);
-                __builtin_prefetch(&mReach[ahead]);
-            }
-            const uint32_t light = lights[i];
-            const LightSphere& sphere = spheres[light];
-            if (sphere.unbounded) {
+        std::vector<std::pair<uint32_t, uint32_t>>& pairs = mGroupPairs[g];
+        pairs.clear();
+        for (size_t i = mGroupStart[g]; i < mGroupStart[g + 1]; ++i) {
+            const LightRecord& record = mGroupRecords[i];
+            if (record.slice0 < 0) {
                 for (uint32_t cluster = group.base; cluster < group.end; ++cluster)
-                    pairs.emplace_back(cluster - group.base, light);
+                    pairs.emplace_back(cluster - group.base, record.light);
                 continue;
             }
-            const LightReach& reach = mReach[light];
-            for (int ty = std::max<int>(reach.row0, tileY0),
-                     ty1 = std::min<int>(reach.row1, tileY1);
+            for (int ty = std::max<int>(record.row0, tileY0),
+                     ty1 = std::min<int>(record.row1, tileY1);
                  ty <= ty1; ++ty)
-                for (int tx = std::max<int>(reach.column0, tileX0),
-                         tx1 = std::min<int>(reach.column1, tileX1);
+                for (int tx = std::max<int>(record.column0, tileX0),
+                         tx1 = std::min<int>(record.column1, tileX1);
                      tx <= tx1; ++tx) {
                     const Tile& t = mTiles[tileOf(tx, ty)];
-                    if (t.s0 > t.s1 || t.depthHi < reach.depthLo || t.depthLo > reach.depthHi)
+                    if (t.s0 > t.s1 || t.depthHi < record.depthLo || t.depthLo > record.depthHi)
                         continue;
-                    const int k1 = std::min<int>(reach.slice1, t.s1);
-                    for (int k = std::max<int>(reach.slice0, t.s0); k <= k1; ++k)
-                        if (sphereTouchesBox(sphere, clusterBox(tx, ty, k)))
-                            pairs.emplace_back(t.base + uint32_t(k - t.s0) - group.base, light);
+                    const int k1 = std::min<int>(record.slice1, t.s1);
+                    for (int k = std::max<int>(record.slice0, t.s0); k <= k1; ++k) {
+                        const ViewBox box = clusterBox(tx, ty, k);
+                        if (sphereTouchesBox(record.centreView, record.radius, box.lo, box.hi))
+                            pairs.emplace_back(t.base + uint32_t(k - t.s0) - group.base,
+                                               record.light);
+                    }
                 }
         }
         uint32_t* counts = mCounts.data() + group.base;
@@ -441,8 +467,8 @@ size_t AdaptiveClusterGrid::memoryBytes() const {
            (mBlockLo.capacity() + mBlockHi.capacity()) * sizeof(float) +
            (mLists.offsets().capacity() + mLists.indices().capacity()) * sizeof(uint32_t) + [&] {
                size_t bytes = 0;
-               for (const auto& pairs : mBatchPairs)
-                   bytes += pairs.capacity() * sizeof(pairs[0]);
+               for (const auto& records : mChunkRecords)
+                   bytes += records.capacity() * sizeof(records[0]);
                return bytes;
            }();
 }
