@@ -7,7 +7,10 @@
 // (ClusterListSource below).
 //
 // Options (defaults first):
-//   grid=24x12x32        tile columns x tile rows x depth slices (each 1..1024, <= 2^20 clusters)
+//   grid=24x12x32        tile columns x tile rows x depth slices (each 1..1024, <= 2^20 clusters);
+//                        or `adaptive`: the cluster size chosen per frame from the lights'
+//                        projected sizes, each tile storing only the slices its samples span
+//                        (culling/AdaptiveClusterGrid.h; options cells, max_clusters below)
 //   slices=exp|uniform   geometric (self-similar clusters) or linear slice boundaries between the
 //                        nearest and farthest view depth found in the G-buffer (a tighter range
 //                        than the camera's near/far planes, so no slice is wasted on empty space)
@@ -15,7 +18,11 @@
 //                        bvh: each cluster's box queries a light BVH (culling/LightBvh.h), the
 //                        lights found meet the same range and cluster tests (same lists)
 //   test=aabb|frustum    cluster test: sphere vs AABB, or AABB and the four side planes
-// Passes: "assign" (depth range, cluster bounds, light lists), "shading".
+//   (slices, assign and test apply to a fixed grid; giving one with grid=adaptive is an error)
+//   cells=2              grid=adaptive: clusters across a typical light's diameter, per axis
+//   max_clusters=1048576 grid=adaptive: stored clusters at most; the grid coarsens to fit
+//                        (cells and max_clusters with a fixed grid are an error)
+// Passes: "assign" (light spheres, depth range, cluster bounds, light lists), "shading".
 // Conventions: view space right-handed, -Z forward; a pixel's slice comes from the depth of its
 // decoded position by the same comparisons that define the slices, so it always lies in its
 // cluster (up to rounding, which the widened AABBs and spheres cover).
