@@ -18,16 +18,18 @@
 //                        bvh: each cluster's box queries a light BVH (culling/LightBvh.h), the
 //                        lights found meet the same range and cluster tests (same lists)
 //   test=aabb|frustum    cluster test: sphere vs AABB, or AABB and the four side planes
-//   (slices, assign and test apply to a fixed grid; giving one with grid=adaptive is an error)
+//   (slices, assign and test apply to a fixed grid; one given with grid=adaptive and a value
+//   other than its default is an error)
 //   cells=2              grid=adaptive: clusters across a typical light's diameter, per axis
 //   max_clusters=1048576 grid=adaptive: stored clusters at most; the grid coarsens to fit
-//                        (cells and max_clusters with a fixed grid are an error)
+//                        (cells or max_clusters off their defaults with a fixed grid: an error)
 // Passes: "assign" (light spheres, depth range, cluster bounds, light lists), "shading".
 // Conventions: view space right-handed, -Z forward; a pixel's slice comes from the depth of its
 // decoded position by the same comparisons that define the slices, so it always lies in its
 // cluster (up to rounding, which the widened AABBs and spheres cover).
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 
 #include <tbb/blocked_range.h>
@@ -310,8 +312,14 @@ const StageRegistrar kRegistrar(
         options.adaptive = table.text("grid") == "adaptive";
         const std::vector<std::string> fixedOnly = {"slices", "assign", "test"};
         const std::vector<std::string> adaptiveOnly = {"cells", "max_clusters"};
+        // An option of the other kind given with a value other than its default would be
+        // ignored: refused. Its default given explicitly changes nothing and is accepted (every
+        // option's default must parse on its own, tests/lighting/stage_options_test.cpp).
+        std::map<std::string, std::string> defaults;
+        for (const StageOption& option : clusteredOptionTable())
+            defaults[option.key] = option.defaultText;
         for (const std::string& key : options.adaptive ? fixedOnly : adaptiveOnly)
-            if (table.given(key))
+            if (table.given(key) && table.resolved().at(key) != defaults.at(key))
                 throw StageError("stage '" + table.stageName() + "': option " + key +
                                  (options.adaptive ? " applies to a fixed grid only"
                                                    : " applies to grid=adaptive only"));

@@ -192,7 +192,7 @@ TEST(ClusteredStage, RejectsBadOptions) {
                             "clustered:grid=adaptive,test=frustum",
                             "clustered:grid=adaptive,assign=bvh",
                             "clustered:grid=adaptive,slices=uniform",
-                            "clustered:cells=2",
+                            "clustered:cells=3",
                             "clustered:grid=24x12x32,max_clusters=100",
                             "clustered:grid=adaptive,cells=0",
                             "clustered:grid=adaptive,max_clusters=0",
@@ -203,6 +203,9 @@ TEST(ClusteredStage, RejectsBadOptions) {
     EXPECT_NO_THROW(lighting::makeStage("clustered:grid=64x32x64"));
     EXPECT_NO_THROW(lighting::makeStage("clustered:assign=bvh"));
     EXPECT_NO_THROW(lighting::makeStage("clustered:grid=adaptive,cells=3,max_clusters=1000"));
+    // An option of the other grid kind at its default value changes nothing: accepted.
+    EXPECT_NO_THROW(lighting::makeStage("clustered:grid=adaptive,test=aabb"));
+    EXPECT_NO_THROW(lighting::makeStage("clustered:cells=2"));
 }
 
 // ---- ClusterGrid alone ------------------------------------------------------------------------
