@@ -68,6 +68,8 @@ void AdaptiveClusterGrid::setGeometry(const gbuffer::CameraView& view, int tileP
     mTileShift = log2Floor(tilePixels);
     mTilesX = (mWidth + tilePixels - 1) / tilePixels;
     mTilesY = (mHeight + tilePixels - 1) / tilePixels;
+    if (mTilesX >= INT16_MAX || mTilesY >= INT16_MAX)
+        throw std::invalid_argument("AdaptiveClusterGrid: more than 32766 tiles across");
     mEdgeTanX.resize(mTilesX + 1);
     for (int j = 0; j <= mTilesX; ++j) {
         const int pixel = std::min(j * tilePixels, mWidth);
@@ -250,6 +252,10 @@ bool AdaptiveClusterGrid::build(const AdaptiveClusterOptions& options,
         sliceCount = int(std::clamp(slices, 1.0, double(kMaxAdaptiveSlices)));
     }
 
+    // Tile indices are int16 (Tile, LightRecord): tiles no smaller than a huge image needs.
+    while (tilePixels < kMaxTilePixels &&
+           std::max(width, height) / tilePixels >= int(INT16_MAX) - 1)
+        tilePixels *= 2;
     // Fit the budget: coarsen slices and tiles alternately (tile depth ranges per tile size).
     for (bool coarsenSlices = true;; coarsenSlices = !coarsenSlices) {
         setGeometry(view, tilePixels, sliceCount, nearDepth, farDepth);
