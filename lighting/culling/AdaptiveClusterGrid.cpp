@@ -11,7 +11,7 @@ namespace lighting {
 namespace {
 
 // The smallest chunk of lights of a phase-1 task (a task costs more than a few lights).
-constexpr size_t kLightsPerBatch = 64;
+constexpr size_t kMinChunkLights = 64;
 constexpr int kBlockPixels = 4;
 // assign()'s phase 1 runs over at most this many chunks of lights (fixed by the light count, so
 // the record order never depends on the thread count): enough to balance 2..16 threads, few
@@ -309,7 +309,7 @@ void AdaptiveClusterGrid::assign(std::span<const LightSphere> spheres) {
     // Phase 1, per light (parallel over chunks fixed by the light count alone): its candidate
     // tiles and slices, and the groups it may reach (those whose depth range meets its own), as
     // (group, record) pairs in light order.
-    const size_t chunkSize = std::max(kLightsPerBatch, (lightCount + kMaxChunks - 1) / kMaxChunks);
+    const size_t chunkSize = std::max(kMinChunkLights, (lightCount + kMaxChunks - 1) / kMaxChunks);
     const size_t chunkCount = (lightCount + chunkSize - 1) / chunkSize;
     mChunkRecords.resize(chunkCount);
     mChunkGroupStart.assign(chunkCount * groupCount, 0u);

@@ -56,7 +56,8 @@ namespace lighting {
 
 struct AdaptiveClusterOptions {
     // Clusters across a typical light's diameter, per axis: more tightens the lists (shading)
-    // and costs more pairs (assignment, about (cellsPerLight + 1)^3 clusters per light).
+    // and costs more assignment (about (cellsPerLight + 1)^2 tiles per light, and the slices of
+    // those whose samples it reaches).
     float cellsPerLight = 2.0f;
     // Stored clusters at most (4 bytes of list offset each; 2^20: 4 MiB); beyond it the grid
     // coarsens.
