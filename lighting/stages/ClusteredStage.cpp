@@ -7,7 +7,10 @@
 // (ClusterListSource below).
 //
 // Options (defaults first):
-//   grid=24x12x32        tile columns x tile rows x depth slices (each 1..1024, <= 2^20 clusters)
+//   grid=24x12x32        tile columns x tile rows x depth slices (each 1..1024, <= 2^20 clusters);
+//                        or `adaptive`: the cluster size chosen per frame from the lights'
+//                        projected sizes, each tile storing only the slices its samples span
+//                        (culling/AdaptiveClusterGrid.h; options cells, max_clusters below)
 //   slices=exp|uniform   geometric (self-similar clusters) or linear slice boundaries between the
 //                        nearest and farthest view depth found in the G-buffer (a tighter range
 //                        than the camera's near/far planes, so no slice is wasted on empty space)
@@ -15,12 +18,18 @@
 //                        bvh: each cluster's box queries a light BVH (culling/LightBvh.h), the
 //                        lights found meet the same range and cluster tests (same lists)
 //   test=aabb|frustum    cluster test: sphere vs AABB, or AABB and the four side planes
-// Passes: "assign" (depth range, cluster bounds, light lists), "shading".
+//   (slices, assign and test apply to a fixed grid; one given with grid=adaptive and a value
+//   other than its default is an error)
+//   cells=2              grid=adaptive: clusters across a typical light's diameter, per axis
+//   max_clusters=1048576 grid=adaptive: stored clusters at most; the grid coarsens to fit
+//                        (cells or max_clusters off their defaults with a fixed grid: an error)
+// Passes: "assign" (light spheres, depth range, cluster bounds, light lists), "shading".
 // Conventions: view space right-handed, -Z forward; a pixel's slice comes from the depth of its
 // decoded position by the same comparisons that define the slices, so it always lies in its
 // cluster (up to rounding, which the widened AABBs and spheres cover).
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 
 #include <tbb/blocked_range.h>
@@ -28,6 +37,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "lighting/StageRegistry.h"
+#include "lighting/culling/AdaptiveClusterGrid.h"
 #include "lighting/culling/ClusterGrid.h"
 #include "lighting/culling/LightBounds.h"
 #include "lighting/passes/LightAccumulation.h"
@@ -52,9 +62,10 @@ namespace {
 // - A packet across clusters gets the union of their lists with per-light lane masks
 //   (PacketLightLists::addByKeyMerged): a light in several of them costs one packet-wide
 //   evaluation, not one per cluster.
-class ClusterListSource final : public PacketListSource {
+// Grid: ClusterGrid or AdaptiveClusterGrid (the same queries).
+template <class Grid> class ClusterListSource final : public PacketListSource {
 public:
-    explicit ClusterListSource(const ClusterGrid& grid) : mGrid(grid) {}
+    explicit ClusterListSource(const Grid& grid) : mGrid(grid) {}
     void listsOf(const kernel::ShadingPacket& packet, PacketLightLists& lists) const override {
         float nearest = INFINITY, farthest = -INFINITY;
         for (uint32_t lanes = packet.laneMask; lanes != 0; lanes &= lanes - 1) {
@@ -94,20 +105,76 @@ public:
     }
 
 private:
-    const ClusterGrid& mGrid;
+    const Grid& mGrid;
+};
+
+// The stage's options: a fixed grid, or the density-adaptive grid (grid=adaptive).
+struct ClusteredOptions {
+    bool adaptive = false;
+    ClusterGridOptions fixed;
+    AdaptiveClusterOptions adaptiveGrid;
+    std::string cellsText; // the canonical text of the cells option, as recorded
 };
 
 class ClusteredStage final : public ShadingStage {
 public:
-    explicit ClusteredStage(const ClusterGridOptions& options) : mOptions(options) {}
+    explicit ClusteredStage(const ClusteredOptions& options) : mOptions(options) {}
     std::string name() const override { return "clustered"; }
     StageRequirements requirements() const override { return StageRequirements::wholeSurface(); }
 
     void shade(const StageInputs& inputs, StageResult& result) override {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
-        const int width = gb.width(), height = gb.height();
-        result.resize(width, height, false);
+        result.resize(gb.width(), gb.height(), false);
         PassTimer assign(result, pass::kAssign);
+        boundingSpheresView(*inputs.lights, mSpheres);
+        if (mOptions.adaptive)
+            shadeAdaptive(inputs, assign, result);
+        else
+            shadeFixed(inputs, assign, result);
+    }
+
+private:
+    void shadeAdaptive(const StageInputs& inputs, PassTimer& assign, StageResult& result) {
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
+        // Blended surfaces lie anywhere in front of the opaque depth, and over background: every
+        // tile then spans the whole view depth range so that their clusters exist.
+        const bool blended = mBlended.prepare(inputs);
+        AdaptiveClusterGrid& grid = mAdaptive;
+        const bool built = grid.build(mOptions.adaptiveGrid, gb, mSpheres, blended,
+                                      gb.view().nearMetres, gb.view().farMetres);
+        if (built)
+            grid.assign(mSpheres);
+        assign.stop();
+        PassTimer shading(result, pass::kShading);
+        if (built)
+            accumulateLights(inputs, ClusterListSource<AdaptiveClusterGrid>(grid), {}, result);
+        shading.stop();
+        if (blended)
+            mBlended.shade(
+                gb.depth(),
+                [&](int x, int y, const gbuffer::Surface& point, uint32_t) {
+                    return grid.lightsOf(
+                        grid.clusterIndex(grid.tileXOfPixel(x), grid.tileYOfPixel(y),
+                                          grid.sliceOfDepth(-point.positionView.z)));
+                },
+                result);
+        result.parameters["grid"] = "adaptive";
+        result.parameters["cells"] = mOptions.cellsText;
+        result.parameters["max_clusters"] = std::to_string(mOptions.adaptiveGrid.maxClusters);
+        result.parameters["adaptive_grid"] = built ? std::to_string(grid.tilesX()) + "x" +
+                                                         std::to_string(grid.tilesY()) + "x" +
+                                                         std::to_string(grid.slices())
+                                                   : "none";
+        result.parameters["tile_pixels"] = built ? std::to_string(grid.tilePixels()) : "0";
+        result.parameters["clusters"] = std::to_string(built ? grid.clusterCount() : 0);
+        result.parameters["cluster_bytes"] = std::to_string(grid.memoryBytes());
+        result.parameters["cluster_light_pairs"] = std::to_string(built ? grid.pairCount() : 0);
+    }
+
+    void shadeFixed(const StageInputs& inputs, PassTimer& assign, StageResult& result) {
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
+        const int width = gb.width(), height = gb.height();
+        const ClusterGridOptions& options = mOptions.fixed;
 
         // Nearest and farthest covered NDC depth (min/max: order-independent, so deterministic).
         const std::span<const float> depth = gb.depth();
@@ -143,16 +210,16 @@ public:
                 farDepth = std::max(farDepth, gb.view().farMetres);
             }
             if (!mGrid)
-                mGrid.emplace(mOptions, gb.view(), nearDepth, farDepth);
+                mGrid.emplace(options, gb.view(), nearDepth, farDepth);
             else
-                mGrid->build(mOptions, gb.view(), nearDepth, farDepth);
+                mGrid->build(options, gb.view(), nearDepth, farDepth);
             ClusterGrid& grid = *mGrid;
-            grid.assign(boundingSpheresView(*inputs.lights));
+            grid.assign(mSpheres);
             assign.stop();
             pairs = std::to_string(grid.pairCount());
 
             PassTimer shading(result, pass::kShading);
-            accumulateLights(inputs, ClusterListSource(grid), {}, result);
+            accumulateLights(inputs, ClusterListSource<ClusterGrid>(grid), {}, result);
             shading.stop();
             // Blended surfaces: each fragment with its own cluster's list.
             if (blended)
@@ -172,70 +239,104 @@ public:
                 mBlended.shadeWithEveryLight(depth, result);
         }
 
-        std::string grid = std::to_string(mOptions.tilesX);
+        std::string grid = std::to_string(options.tilesX);
         grid.append("x")
-            .append(std::to_string(mOptions.tilesY))
+            .append(std::to_string(options.tilesY))
             .append("x")
-            .append(std::to_string(mOptions.slices));
+            .append(std::to_string(options.slices));
         result.parameters["grid"] = grid;
         result.parameters["slices"] =
-            mOptions.spacing == SliceSpacing::Exponential ? "exp" : "uniform";
-        result.parameters["assign"] = mOptions.assign == AssignMethod::Walk     ? "walk"
-                                      : mOptions.assign == AssignMethod::Binary ? "binary"
-                                                                                : "bvh";
-        result.parameters["test"] = mOptions.test == ClusterTest::Aabb ? "aabb" : "frustum";
+            options.spacing == SliceSpacing::Exponential ? "exp" : "uniform";
+        result.parameters["assign"] = options.assign == AssignMethod::Walk     ? "walk"
+                                      : options.assign == AssignMethod::Binary ? "binary"
+                                                                               : "bvh";
+        result.parameters["test"] = options.test == ClusterTest::Aabb ? "aabb" : "frustum";
         result.parameters["cluster_light_pairs"] = pairs;
     }
 
-private:
-    ClusterGridOptions mOptions;
-    std::optional<ClusterGrid> mGrid; // reused across frames for its storage
-    BlendedPass mBlended;             // blended surfaces after the opaque pass (BlendedPass.h)
+    ClusteredOptions mOptions;
+    std::vector<LightSphere> mSpheres; // reused across frames (LightBounds.h)
+    std::optional<ClusterGrid> mGrid;  // reused across frames for its storage
+    AdaptiveClusterGrid mAdaptive;     // likewise
+    BlendedPass mBlended;              // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 std::vector<StageOption> clusteredOptionTable() {
     const ClusterGridOptions defaults;
+    const AdaptiveClusterOptions adaptiveDefaults;
     return {
         StageOption::text(
             "grid",
             std::to_string(defaults.tilesX) + "x" + std::to_string(defaults.tilesY) + "x" +
                 std::to_string(defaults.slices),
-            "XxYxZ with each of X, Y, Z in 1.." + std::to_string(kMaxClusterDimension) +
-                " and at most " + std::to_string(kMaxClusterCount) + " clusters",
+            "adaptive, or XxYxZ with each of X, Y, Z in 1.." +
+                std::to_string(kMaxClusterDimension) + " and at most " +
+                std::to_string(kMaxClusterCount) + " clusters",
             [](const std::string& value) -> std::optional<std::string> {
+                if (value == "adaptive")
+                    return value;
                 int x = 0, y = 0, z = 0;
                 if (!parseClusterGrid(value, x, y, z))
                     return std::nullopt;
                 return std::to_string(x) + "x" + std::to_string(y) + "x" + std::to_string(z);
             },
-            "tile columns x tile rows x depth slices"),
+            "tile columns x tile rows x depth slices; adaptive: cluster size from the lights' "
+            "projected sizes each frame, each tile only the slices its samples span "
+            "(culling/AdaptiveClusterGrid.h)"),
         StageOption::choice("slices", {"exp", "uniform"},
                             "slice boundaries between the G-buffer's nearest and farthest depth: "
-                            "geometric or linear"),
+                            "geometric or linear (fixed grid)"),
         StageOption::choice("assign", {"walk", "binary", "bvh"},
                             "per light, its cluster ranges by walking the planes or by binary "
-                            "search; or per cluster, its lights from a light BVH (same lists)"),
+                            "search; or per cluster, its lights from a light BVH (same lists; "
+                            "fixed grid)"),
         StageOption::choice("test", {"aabb", "frustum"},
-                            "cluster test: sphere vs AABB, or AABB and the four side planes")};
+                            "cluster test: sphere vs AABB, or AABB and the four side planes "
+                            "(fixed grid)"),
+        StageOption::number("cells", adaptiveDefaults.cellsPerLight, 0.25f, 16.0f, false,
+                            "grid=adaptive: clusters across a typical light's diameter per axis"),
+        StageOption::integer("max_clusters", int(adaptiveDefaults.maxClusters), 1, 1 << 24,
+                             "grid=adaptive: stored clusters at most (4 bytes each); the grid "
+                             "coarsens to fit")};
 }
 
 const StageRegistrar kRegistrar(
     {.name = "clustered",
-     .description = "implicit clusters: grid of screen tiles x depth slices, lights assigned per "
-                    "cluster AABB",
+     .description = "implicit clusters: grid of screen tiles x depth slices (fixed, or adaptive to "
+                    "the light density), lights assigned per cluster AABB",
      .kind = StageKind::Exact,
      .options = clusteredOptionTable(),
      .listOrder = 50},
     [](const StageOptions& table) {
-        ClusterGridOptions options;
-        parseClusterGrid(table.text("grid"), options.tilesX, options.tilesY, options.slices);
-        options.spacing =
+        ClusteredOptions options;
+        options.adaptive = table.text("grid") == "adaptive";
+        const std::vector<std::string> fixedOnly = {"slices", "assign", "test"};
+        const std::vector<std::string> adaptiveOnly = {"cells", "max_clusters"};
+        // An option of the other kind given with a value other than its default would be
+        // ignored: refused. Its default given explicitly changes nothing and is accepted (every
+        // option's default must parse on its own, tests/lighting/stage_options_test.cpp).
+        std::map<std::string, std::string> defaults;
+        for (const StageOption& option : clusteredOptionTable())
+            defaults[option.key] = option.defaultText;
+        for (const std::string& key : options.adaptive ? fixedOnly : adaptiveOnly)
+            if (table.given(key) && table.resolved().at(key) != defaults.at(key))
+                throw StageError("stage '" + table.stageName() + "': option " + key +
+                                 (options.adaptive ? " applies to a fixed grid only"
+                                                   : " applies to grid=adaptive only"));
+        if (!options.adaptive)
+            parseClusterGrid(table.text("grid"), options.fixed.tilesX, options.fixed.tilesY,
+                             options.fixed.slices);
+        options.fixed.spacing =
             table.text("slices") == "exp" ? SliceSpacing::Exponential : SliceSpacing::Uniform;
         const std::string assign = table.text("assign");
-        options.assign = assign == "walk"     ? AssignMethod::Walk
-                         : assign == "binary" ? AssignMethod::Binary
-                                              : AssignMethod::Bvh;
-        options.test = table.text("test") == "aabb" ? ClusterTest::Aabb : ClusterTest::Frustum;
+        options.fixed.assign = assign == "walk"     ? AssignMethod::Walk
+                               : assign == "binary" ? AssignMethod::Binary
+                                                    : AssignMethod::Bvh;
+        options.fixed.test =
+            table.text("test") == "aabb" ? ClusterTest::Aabb : ClusterTest::Frustum;
+        options.adaptiveGrid.cellsPerLight = table.number("cells");
+        options.adaptiveGrid.maxClusters = size_t(table.integer("max_clusters"));
+        options.cellsText = table.resolved().at("cells");
         return std::make_unique<ClusteredStage>(options);
     });
 

@@ -134,18 +134,78 @@ TEST(ClusteredStage, ReusedAcrossFramesEqualsFresh) {
     expectExact(spheres, second, "reused stage on spheres");
 }
 
+// grid=adaptive: exact against brute and the oracle over cluster densities, a budget that forces
+// coarsening, and constant-overlap lights (small, many) where the grid is finest.
+TEST(ClusteredStage, AdaptiveGridMatchesBrute) {
+    for (const char* scene : {"spheres", "atrium"}) {
+        const ClusterScene& f = prepared(scene, 120);
+        for (const char* options : {"cells=0.5", "cells=2", "cells=8", "cells=4,max_clusters=50"}) {
+            lighting::StageResult result;
+            const std::string spec = std::string("clustered:grid=adaptive,") + options;
+            lighting::makeStage(spec)->shade(f.inputs, result);
+            expectExact(f, result, std::string(scene) + " " + spec);
+            EXPECT_EQ(result.parameters.at("grid"), "adaptive");
+            EXPECT_GT(std::stoll(result.parameters.at("clusters")), 0);
+            if (std::string(options).find("max_clusters=50") != std::string::npos)
+                EXPECT_LE(std::stoll(result.parameters.at("clusters")), 50);
+        }
+    }
+    scenes::SceneRequest request;
+    request.lightCount = 3000;
+    request.seed = 7;
+    request.lightDensity = scenes::LightDensity::ConstantOverlap;
+    const ClusterScene dense(scenes::buildProceduralScene("atrium", request));
+    lighting::StageResult result;
+    lighting::makeStage("clustered:grid=adaptive")->shade(dense.inputs, result);
+    expectExact(dense, result, "atrium, 3000 constant-overlap lights, grid=adaptive");
+}
+
+TEST(ClusteredStage, AdaptiveGridIndependentOfThreadCount) {
+    const ClusterScene& f = prepared("atrium", 120);
+    lighting::StageResult one, two;
+    tbb::task_arena(1).execute(
+        [&] { lighting::makeStage("clustered:grid=adaptive,cells=4")->shade(f.inputs, one); });
+    tbb::task_arena(2).execute(
+        [&] { lighting::makeStage("clustered:grid=adaptive,cells=4")->shade(f.inputs, two); });
+    for (int ch = 0; ch < 3; ++ch)
+        EXPECT_EQ(one.radiance[ch], two.radiance[ch]);
+    EXPECT_EQ(one.lightsEvaluated, two.lightsEvaluated);
+    EXPECT_EQ(one.parameters.at("cluster_light_pairs"), two.parameters.at("cluster_light_pairs"));
+    EXPECT_EQ(one.parameters.at("adaptive_grid"), two.parameters.at("adaptive_grid"));
+}
+
 TEST(ClusteredStage, RejectsBadOptions) {
-    for (const char* bad :
-         {"clustered:grid=24x12", "clustered:grid=0x12x32", "clustered:grid=24x12x0",
-          "clustered:grid=100000x1x1", "clustered:grid=1024x1024x1024", "clustered:grid=24x12x32x",
-          "clustered:grid=abc", "clustered:grid=", "clustered:grid=-1x2x3",
-          "clustered:grid=24X12X32", "clustered:slices=log", "clustered:assign=octree",
-          "clustered:test=sphere", "clustered:tiles=16"})
+    for (const char* bad : {"clustered:grid=24x12",
+                            "clustered:grid=0x12x32",
+                            "clustered:grid=24x12x0",
+                            "clustered:grid=100000x1x1",
+                            "clustered:grid=1024x1024x1024",
+                            "clustered:grid=24x12x32x",
+                            "clustered:grid=abc",
+                            "clustered:grid=",
+                            "clustered:grid=-1x2x3",
+                            "clustered:grid=24X12X32",
+                            "clustered:slices=log",
+                            "clustered:assign=octree",
+                            "clustered:test=sphere",
+                            "clustered:tiles=16",
+                            "clustered:grid=adaptive,test=frustum",
+                            "clustered:grid=adaptive,assign=bvh",
+                            "clustered:grid=adaptive,slices=uniform",
+                            "clustered:cells=3",
+                            "clustered:grid=24x12x32,max_clusters=100",
+                            "clustered:grid=adaptive,cells=0",
+                            "clustered:grid=adaptive,max_clusters=0",
+                            "clustered:grid=Adaptive"})
         EXPECT_THROW(lighting::makeStage(bad), lighting::StageError) << bad;
     EXPECT_NO_THROW(
         lighting::makeStage("clustered:grid=1x1x1,slices=uniform,assign=binary,test=frustum"));
     EXPECT_NO_THROW(lighting::makeStage("clustered:grid=64x32x64"));
     EXPECT_NO_THROW(lighting::makeStage("clustered:assign=bvh"));
+    EXPECT_NO_THROW(lighting::makeStage("clustered:grid=adaptive,cells=3,max_clusters=1000"));
+    // An option of the other grid kind at its default value changes nothing: accepted.
+    EXPECT_NO_THROW(lighting::makeStage("clustered:grid=adaptive,test=aabb"));
+    EXPECT_NO_THROW(lighting::makeStage("clustered:cells=2"));
 }
 
 // ---- ClusterGrid alone ------------------------------------------------------------------------
