@@ -472,6 +472,10 @@ INSTANTIATE_TEST_SUITE_P(
                     o.shadows = "maps";
                     o.shadowFilter = "pcf7";
                 })},
+        BadCase{"shadow_point", with([](RenderOptions& o) {
+                    o.shadows = "maps";
+                    o.shadowPoint = "octahedral";
+                })},
         BadCase{"shadow_lights", with([](RenderOptions& o) {
                     o.shadows = "maps";
                     o.shadowLights = "-2";
