@@ -2,6 +2,7 @@
 // renders and the lookup. Conventions in ShadowMaps.h.
 #include "lighting/shadows/ShadowMaps.h"
 
+#include "lighting/shadows/CasterMaterials.h"
 #include "lighting/shadows/ShadowCasterSets.h"
 
 #include <algorithm>
@@ -554,6 +555,11 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     // Casters per light: point and spot lights draw the triangles of their casting set whose box
     // touches their range sphere (chunk boxes first), in triangle order; directional lights the
     // triangles of their casting set (everything when the set holds every instance).
+    // Triangles of materials that cast no shadow (CasterMaterials.h: blended, masked with a
+    // constant alpha below the cutoff) are left out, as the rays leave them out.
+    const std::vector<uint8_t> castingMaterial = shadows::castingMaterials(scene);
+    const bool everyMaterial = std::all_of(castingMaterial.begin(), castingMaterial.end(),
+                                           [](uint8_t casts) { return casts != 0; });
     std::vector<Casters> casters(maps.mShadows.size());
     tbb::parallel_for(size_t(0), maps.mShadows.size(), [&](size_t s) {
         const scenes::Light& light = scene.lights[maps.mShadows[s].lightIndex];
@@ -562,10 +568,11 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         const bool everyObject = inSet.empty() || std::all_of(inSet.begin(), inSet.end(),
                                                               [&](uint8_t in) { return in != 0; });
         auto excluded = [&](uint32_t t) {
-            return !everyObject && !inSet[geometry.triangleInstance[t]];
+            return (!everyObject && !inSet[geometry.triangleInstance[t]]) ||
+                   (!everyMaterial && !castingMaterial[geometry.triangleMaterial[t]]);
         };
         if (light.type == scenes::LightType::Directional) {
-            if (everyObject) {
+            if (everyObject && everyMaterial) {
                 set.whole = true;
                 return;
             }

@@ -21,6 +21,8 @@
 
 #include "gbuffer/visibility/CameraView.h"
 #include "gbuffer/visibility/SceneGeometry.h"
+#include "lighting/shadows/CasterMaterials.h"
+#include "lighting/shadows/RayVisibility.h"
 #include "lighting/shadows/ShadowMaps.h"
 #include "scenes/Scene.h"
 #include "scenes/mesh/MeshBuilder.h"
@@ -787,6 +789,55 @@ TEST(ShadowMaps, PerLightSettingsOverrideTheGlobalOnes) {
                          plain.visibility(light, s.world, s.normalWorld);
         EXPECT_GT(differing, 0) << "light " << light;
     }
+}
+
+// The casting policy by material (CasterMaterials.h), the same in maps and rays: under a sun
+// straight above, 1 m squares over the ground, opaque / blended (alpha 0.3) / masked with a
+// constant alpha 0.3 below its cutoff 0.5 / masked with 0.8 above it. The ground under each
+// square's centre (a 0.6 m grid inside it) is shadowed by the opaque and the masked-above
+// squares only, in the maps (filter none) and in the rays (RayVisibility with the policy).
+TEST(ShadowMaps, BlendedAndMaskedBelowCutoffCastNoShadowInMapsAndRays) {
+    TestScene t;
+    t.ground(4.0f);
+    struct Square {
+        scenes::AlphaMode mode;
+        float alpha;
+        bool casts;
+    };
+    const std::vector<Square> squares = {{scenes::AlphaMode::Opaque, 1.0f, true},
+                                         {scenes::AlphaMode::Blend, 0.3f, false},
+                                         {scenes::AlphaMode::Mask, 0.3f, false},
+                                         {scenes::AlphaMode::Mask, 0.8f, true}};
+    for (size_t i = 0; i < squares.size(); ++i) {
+        scenes::Material material;
+        material.alphaMode = squares[i].mode;
+        material.baseColorFactor.a = squares[i].alpha;
+        material.alphaCutoff = 0.5f;
+        t.scene.materials.push_back(material);
+        scenes::Mesh& mesh = t.newMesh();
+        const float x = -3.0f + 1.5f * float(i);
+        scenes::appendQuad(mesh, {x, 1.0f, 0.5f}, {1, 0, 0}, {0, 0, -1}, 1, 1);
+        mesh.material = uint32_t(t.scene.materials.size() - 1);
+    }
+    t.camera({0, 5, 6}, {0, 0, 0});
+    t.light(directionalLight({0.0f, -1.0f, 0.0f}));
+    const Frame frame(t.scene, noFilter());
+    const std::vector<uint8_t> casting = lighting::shadows::castingMaterials(t.scene);
+    EXPECT_EQ(casting, (std::vector<uint8_t>{1, 1, 0, 0, 1}));
+    const lighting::shadows::RayVisibility rays(frame.geometry, casting);
+    for (size_t i = 0; i < squares.size(); ++i) {
+        const double x = -3.0 + 1.5 * double(i) + 0.5;
+        int mapShadowed = 0, rayShadowed = 0, samples = 0;
+        for (const Sample& s : groundGrid(x - 0.3, x + 0.3, -0.3, 0.3, 10)) {
+            ++samples;
+            mapShadowed += frame.visibility(0, s.world, s.normalWorld) == 0.0f;
+            rayShadowed += rays.occludedDirectional(s.world, glm::dvec3(s.normalWorld),
+                                                    glm::dvec3(0.0, -1.0, 0.0));
+        }
+        EXPECT_EQ(mapShadowed, squares[i].casts ? samples : 0) << "square " << i;
+        EXPECT_EQ(rayShadowed, squares[i].casts ? samples : 0) << "square " << i;
+    }
+    EXPECT_EQ(rays.droppedTriangleCount(), 4u); // the two squares that cast nothing
 }
 
 TEST(ShadowSettings, FilterNamesRoundTrip) {
