@@ -15,6 +15,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scenes/LightShadow.h"
 #include "scenes/materials/Material.h"
 #include "scenes/materials/Texture.h"
 
@@ -98,6 +99,9 @@ struct Light {
     // Whether the light gets a shadow map (lighting/shadows): a JSON scene's "castsShadows", true
     // for every glTF punctual light. Ambient lights never cast, whatever this says.
     bool castsShadows = false;
+    // Its own shadow map settings, overriding the renderer's global ones (LightShadow.h: a JSON
+    // light's "shadow", which requires castsShadows); empty for every other source.
+    LightShadow shadow;
 };
 
 struct Scene {

@@ -32,6 +32,7 @@
 #include "experiments/sweep/SweepFile.h"
 #include "experiments/sweep/SweepRunner.h"
 #include "gbuffer/LayoutDerivation.h"
+#include "lighting/shadows/ShadowSettings.h"
 #include "scenes/input/ClosestName.h"
 
 namespace {
@@ -167,7 +168,8 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
         ->capture_default_str();
     render
         .add_option("--shadows", r.shadows,
-                    "off, or maps: shadow maps (spot: perspective, point: cube, directional: "
+                    "off, or maps: shadow maps (spot: perspective, point: cube or dual-paraboloid, "
+                    "directional: "
                     "cascades) looked up in the shading kernel by every stage; the reference "
                     "ray-traces the same lights (Embree). Casters: the scene's castsShadows "
                     "lights, or every light when it marks none")
@@ -177,6 +179,13 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
     render.add_option("--shadow-bias", r.shadowBias,
                       "CONSTANT,SLOPE depth bias (metres, texels); default 0.005,1.5");
     render.add_option("--shadow-filter", r.shadowFilter, "none, pcf3, pcf5 or poisson")
+        ->capture_default_str();
+    render
+        .add_option("--shadow-point", r.shadowPoint,
+                    "point lights' maps: cube (six faces) or dual-paraboloid (two faces, casters "
+                    "split to " +
+                        std::to_string(int(lighting::ShadowSettings{}.paraboloidMaxEdgeDegrees)) +
+                        "-degree edges)")
         ->capture_default_str();
     render
         .add_option("--shadow-lights", r.shadowLights,

@@ -70,26 +70,30 @@ double sceneBytes(const scenes::Scene& scene) {
 }
 
 // The shadow maps' bytes at most: the casting lights (ShadowMaps::chooseLights' rule) the budget
-// allows, those with the most faces first.
+// allows, those with the most bytes (faces times their own map size squared) first.
 double shadowMapBound(const scenes::Scene& scene, const lighting::ShadowSettings& settings) {
     const bool anyMarked = std::any_of(scene.lights.begin(), scene.lights.end(), [](const auto& l) {
         return l.castsShadows && l.type != scenes::LightType::Ambient;
     });
-    std::vector<int> faces;
+    std::vector<double> bytes;
     for (const scenes::Light& light : scene.lights) {
         if (light.type == scenes::LightType::Ambient || (anyMarked && !light.castsShadows))
             continue;
-        faces.push_back(light.type == scenes::LightType::Point         ? 6
-                        : light.type == scenes::LightType::Directional ? settings.cascades
-                                                                       : 1);
+        const int pointFaces =
+            settings.pointProjection == lighting::ShadowPointProjection::DualParaboloid ? 2 : 6;
+        const int faces = light.type == scenes::LightType::Point         ? pointFaces
+                          : light.type == scenes::LightType::Directional ? settings.cascades
+                                                                         : 1;
+        const double size = lighting::settingsForLight(settings, light.shadow).mapSize;
+        bytes.push_back(double(faces) * size * size * sizeof(float));
     }
-    std::sort(faces.begin(), faces.end(), std::greater<>());
-    if (settings.maxShadowLights >= 0 && faces.size() > size_t(settings.maxShadowLights))
-        faces.resize(size_t(settings.maxShadowLights));
-    double faceCount = 0.0;
-    for (int count : faces)
-        faceCount += count;
-    return faceCount * double(settings.mapSize) * double(settings.mapSize) * sizeof(float);
+    std::sort(bytes.begin(), bytes.end(), std::greater<>());
+    if (settings.maxShadowLights >= 0 && bytes.size() > size_t(settings.maxShadowLights))
+        bytes.resize(size_t(settings.maxShadowLights));
+    double total = 0.0;
+    for (double lightBytes : bytes)
+        total += lightBytes;
+    return total;
 }
 
 } // namespace
@@ -303,7 +307,8 @@ MemoryEstimate estimateRenderMemory(const RenderOptions& options, const scenes::
         const int runs = options.warmup + options.repetitions;
         const double maps = shadowMapBound(scene, *shadows) * (runs > 1 ? 2.0 : 1.0);
         add("shadow_maps", maps,
-            "casting lights' faces x " + std::to_string(shadows->mapSize) + "^2 x 4 bytes" +
+            "casting lights' faces x " + std::to_string(shadows->mapSize) +
+                "^2 (or the light's own size) x 4 bytes" +
                 (runs > 1 ? " x 2 (rendered again each run)" : ""));
     }
     if ((shadows && options.compareReference) || options.oracle == "visibility")

@@ -27,8 +27,9 @@
 //   reference      with --compare-reference: the double-precision reference, its frame and the
 //                  error and FLIP planes (more for a supersampled reference)
 //   post_aa        the filter's edge plane and scratch
-//   shadow_maps    an upper bound: the casting lights the budget allows, most faces first
-//                  (point 6, directional `cascades`, spot 1) x mapSize^2 floats, twice when the
+//   shadow_maps    an upper bound: the casting lights the budget allows, most bytes first
+//                  (point 6 or dual-paraboloid 2, directional `cascades`, spot 1) x the
+//                  light's own or the global mapSize^2 floats, twice when the
 //                  maps are rendered more than once (a repetition's maps are built before the
 //                  previous ones are freed)
 //   rays           Embree's BVH (~90 bytes a drawn triangle) for ray-traced shadows or the

@@ -219,7 +219,14 @@ nlohmann::json shadowsJson(const RenderRun& run) {
                           {"triangles_drawn", light.trianglesDrawn},
                           {"caster_objects", light.casterObjects},
                           {"light_in_frustum", light.lightInFrustum},
-                          {"render_ms", light.renderMs}});
+                          {"render_ms", light.renderMs},
+                          // The light's effective settings: the global ones below, with a
+                          // scene light's own "shadow" over them.
+                          {"map_size", light.settings.mapSize},
+                          {"bias_constant_m", light.settings.biasConstant},
+                          {"bias_slope_texels", light.settings.biasSlope},
+                          {"normal_offset_texels", light.settings.normalOffset},
+                          {"filter", lighting::formatShadowFilter(light.settings.filter)}});
     uint64_t casterObjects = 0;
     for (const lighting::ShadowLightStats& light : stats.lights)
         casterObjects += light.casterObjects;
@@ -230,6 +237,7 @@ nlohmann::json shadowsJson(const RenderRun& run) {
         {"bias_slope_texels", settings.biasSlope},
         {"normal_offset_texels", settings.normalOffset},
         {"filter", lighting::formatShadowFilter(settings.filter)},
+        {"point_projection", lighting::formatShadowPointProjection(settings.pointProjection)},
         {"cascades", settings.cascades},
         {"shadow_lights", run.options.shadowLights},
         {"casting_lights", stats.castingLightCount},

@@ -194,6 +194,12 @@ std::optional<lighting::ShadowSettings> shadowSettings(const RenderOptions& opti
         throw UsageError("--shadow-filter '" + options.shadowFilter + "' refused: must be " +
                          lighting::kShadowFilterNames);
     settings.filter = *filter;
+    const std::optional<lighting::ShadowPointProjection> point =
+        lighting::parseShadowPointProjection(options.shadowPoint);
+    if (!point)
+        throw UsageError("--shadow-point '" + options.shadowPoint + "' refused: must be " +
+                         lighting::kShadowPointProjectionNames);
+    settings.pointProjection = *point;
     if (options.shadowLights != "all") {
         const int count = parseNumber<int>("shadow-lights", options.shadowLights);
         if (count < 0)
@@ -265,6 +271,7 @@ std::vector<std::string> renderOptionKeys() {
             "shadow-map-size",
             "shadow-bias",
             "shadow-filter",
+            "shadow-point",
             "shadow-lights",
             "shadow-cascades",
             "shadow-caster-sets",
@@ -332,6 +339,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.shadowBias = value;
     else if (key == "shadow-filter")
         options.shadowFilter = value;
+    else if (key == "shadow-point")
+        options.shadowPoint = value;
     else if (key == "shadow-lights")
         options.shadowLights = value;
     else if (key == "shadow-cascades")

@@ -94,6 +94,7 @@ struct RenderOptions {
     int shadowMapSize = 1024;          // texels per face side (ShadowSettings::mapSize)
     std::string shadowBias;            // "CONSTANT,SLOPE" (metres, texels); "" = the defaults
     std::string shadowFilter = "pcf3"; // none | pcf3 | pcf5 | poisson
+    std::string shadowPoint = "cube";  // point lights' maps: cube | dual-paraboloid
     std::string shadowLights = "all";  // N or all
     int shadowCascades = 1;            // directional lights' cascades, 1..8
     // Shadow-casting sets (lighting/shadows/ShadowCasterSets.h): "on" draws into each light's
@@ -121,8 +122,8 @@ std::string lightsText(const RenderOptions& options);
 // Sets one option from text, by the name the CLI and sweep files use: scene, stage, lights,
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
 // alpha-to-coverage, reference-spp, layout, normals, normal-space, depth, position, view, brdf,
-// post-aa, oracle, shadows, shadow-map-size, shadow-bias, shadow-filter, shadow-lights,
-// shadow-cascades, shadow-caster-sets, max-memory (bytes, K/M/G/T suffixes) and
+// post-aa, oracle, shadows, shadow-map-size, shadow-bias, shadow-filter, shadow-point,
+// shadow-lights, shadow-cascades, shadow-caster-sets, max-memory (bytes, K/M/G/T suffixes) and
 // scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
 // throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or
 // scene added later is reachable without touching the runner.

@@ -134,6 +134,7 @@ std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys
                                                     "shadows",
                                                     "shadow-map-size",
                                                     "shadow-filter",
+                                                    "shadow-point",
                                                     "shadow-bias",
                                                     "shadow-lights",
                                                     "shadow-cascades",

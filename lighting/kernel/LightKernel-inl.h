@@ -325,7 +325,8 @@ HWY_INLINE FloatVec vectorChunkVisibility(const shadows::ShadowMapsView& view, u
 // The shadow factor of a shadowed light for one chunk: the lookup's visibility at the lanes of
 // `pass` (those whose radiance may be non-zero), 1 at the others (their radiance is +0 already).
 // With the lookup's plain-data view (ShadowMaps), the vector lookup, bitwise the scalar one;
-// without (a test's analytic lookup), the scalar lookup lane by lane with the packet's float
+// without (a test's analytic lookup) or for a shadow the view marks scalarOnly (dual-paraboloid
+// faces, per-light settings), the scalar lookup lane by lane with the packet's float
 // position and normal: the very calls the scalar path makes. Either way the factor is bitwise the
 // same on every path.
 HWY_INLINE FloatVec chunkVisibility(const shadows::ShadowLookup& lookup,
@@ -335,7 +336,7 @@ HWY_INLINE FloatVec chunkVisibility(const shadows::ShadowLookup& lookup,
     uint8_t bits[8] = {};
     hn::StoreMaskBits(d, pass, bits);
     const uint32_t lanes = uint32_t(bits[0]) | uint32_t(bits[1]) << 8;
-    if (view)
+    if (view && (shadow >= view->shadowCount || !view->shadows[shadow].scalarOnly))
         return vectorChunkVisibility(*view, shadow, packet, chunk, lanes);
     HWY_ALIGN float visibility[kLanesPerVector];
     for (size_t i = 0; i < kLanesPerVector; ++i) {

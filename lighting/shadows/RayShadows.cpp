@@ -1,5 +1,6 @@
 #include "lighting/shadows/RayShadows.h"
 
+#include "lighting/shadows/CasterMaterials.h"
 #include "lighting/shadows/ShadowMaps.h"
 
 namespace lighting::shadows {
@@ -13,7 +14,7 @@ RayShadows::RayShadows(const scenes::Scene& scene, const gbuffer::SceneGeometry&
 
 RayShadows::RayShadows(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
                        const gbuffer::CameraView& view, const std::vector<uint32_t>& castingLights)
-    : mRays(std::make_unique<RayVisibility>(geometry)),
+    : mRays(std::make_unique<RayVisibility>(geometry, castingMaterials(scene))),
       mWorldFromView(glm::inverse(view.viewFromWorldExact)),
       mWorldFromViewNormal(glm::dmat3(mWorldFromView)), mLights(scene.lights),
       mCasts(scene.lights.size(), false) {

@@ -82,7 +82,8 @@ void RayVisibility::SceneRelease::operator()(RTCSceneTy* scene) const {
     rtcReleaseScene(scene);
 }
 
-RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry) {
+RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry,
+                             std::span<const uint8_t> castingMaterial) {
     const auto start = std::chrono::steady_clock::now();
     const size_t vertexCount = geometry.positionWorldExact.size();
     const size_t sceneTriangleCount = geometry.indices.size() / 3;
@@ -105,6 +106,10 @@ RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry) {
     std::vector<uint32_t> kept;
     kept.reserve(geometry.indices.size());
     for (size_t t = 0; t < sceneTriangleCount; ++t) {
+        if (!castingMaterial.empty() && t < geometry.triangleMaterial.size() &&
+            geometry.triangleMaterial[t] < castingMaterial.size() &&
+            !castingMaterial[geometry.triangleMaterial[t]])
+            continue;
         std::array<glm::vec3, 3> corner;
         bool inRange = true;
         for (int i = 0; i < 3; ++i) {

@@ -3,9 +3,10 @@
 // libembree-dev): one BVH over every triangle, built once per scene, then "is anything between
 // this surface point and this light?" for any number of points and lights.
 //
-// Conventions: world space, metres. Every triangle is opaque and two-sided (materials are not
-// consulted: alpha-masked and blended surfaces cast full shadows). The query is the segment of
-// ShadowRay.h: the origin offset along the normal by a distance relative to the coordinates'
+// Conventions: world space, metres. Every triangle in the BVH is opaque and two-sided; given
+// the materials' casting flags (CasterMaterials.h), those of non-casting materials (blended,
+// masked below the cutoff) are not in it, and textured masks cast wholly. The query is the segment
+// of ShadowRay.h: the origin offset along the normal by a distance relative to the coordinates'
 // magnitude, the far end stopped as far short of the light; the exact oracle (ExactRayCast.h)
 // follows the same rule.
 //
@@ -54,7 +55,10 @@ public:
     // about 90 bytes per triangle (embreeBytes()). Throws std::runtime_error with Embree's
     // message when Embree fails (no device, out of memory), std::length_error beyond 2^32 - 1
     // vertices or triangles.
-    explicit RayVisibility(const gbuffer::SceneGeometry& geometry);
+    // castingMaterial, when not empty, has one flag per material (CasterMaterials.h): triangles
+    // of a material flagged 0 are left out (they cast no shadow), counted as dropped.
+    explicit RayVisibility(const gbuffer::SceneGeometry& geometry,
+                           std::span<const uint8_t> castingMaterial = {});
     ~RayVisibility();
     RayVisibility(const RayVisibility&) = delete;
     RayVisibility& operator=(const RayVisibility&) = delete;
@@ -76,7 +80,7 @@ public:
 
     // Triangles in the BVH (the scene's less the dropped ones).
     size_t triangleCount() const { return mTriangleCount; }
-    // Triangles left out as degenerate (see above).
+    // Triangles left out: degenerate (see above) or of a material that casts no shadow.
     size_t droppedTriangleCount() const { return mDroppedTriangleCount; }
     // Wall time of the constructor (filtering, conversion to float, BVH build).
     double buildMilliseconds() const { return mBuildMilliseconds; }

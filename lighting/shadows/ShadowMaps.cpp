@@ -2,6 +2,7 @@
 // renders and the lookup. Conventions in ShadowMaps.h.
 #include "lighting/shadows/ShadowMaps.h"
 
+#include "lighting/shadows/CasterMaterials.h"
 #include "lighting/shadows/ShadowCasterSets.h"
 
 #include <algorithm>
@@ -32,8 +33,12 @@ namespace lighting {
 // clip positions of the face being drawn.
 struct ShadowMaps::RenderScratch {
     struct Thread {
-        std::unique_ptr<raster::Rasterizer> rasterizer;
+        std::vector<std::unique_ptr<raster::Rasterizer>> rasterizers; // one per map size
         std::vector<glm::vec4> clip;
+        // Paraboloid faces: the casters in the face's light frame, clipped and split (three
+        // corners per triangle), and 0, 1, 2, ... to index them.
+        std::vector<glm::vec3> lightSpace;
+        std::vector<uint32_t> sequential;
     };
     tbb::enumerable_thread_specific<Thread> threads;
 };
@@ -102,16 +107,107 @@ struct Casters {
         return whole ? std::span<const glm::vec3>(geometry.positionWorld)
                      : std::span<const glm::vec3>(ownPositions);
     }
-    uint32_t triangleCount(const gbuffer::SceneGeometry& geometry) const {
-        return whole ? geometry.triangleCount() : uint32_t(ownPositions.size() / 3);
-    }
 };
 
 // What a face task needs beyond the ShadowFace it fills.
 struct FaceJob {
     size_t shadow = 0;
-    glm::mat4 clipFromWorld{1.0f};
+    glm::mat4 clipFromWorld{1.0f}; // paraboloid faces: the light frame from world
 };
+
+// Casters are split no finer than this fraction of the light's range (the angle rule alone
+// would never stop at an edge whose line passes through the light).
+constexpr double kMinParaboloidEdgeFraction = 1e-4;
+
+// One triangle of a paraboloid face, in the face's light frame (looking down -Z), appended to
+// `out` (three corners per triangle) after clipping to the face's hemisphere z <= 0 and splitting
+// every edge that spans more than the angle whose cosine is cosMaxEdge (and is longer than
+// minEdge). Every decision and new point depends only on the edge's two ends, in an order that
+// does not depend on which triangle asks (clip points from the lexicographically smaller end,
+// midpoints as 0.5 * (a + b)): triangles that share an edge split it alike, so no T-junction
+// opens a crack between them.
+void appendParaboloidCasters(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                             float cosMaxEdge, float minEdge, std::vector<glm::vec3>& out) {
+    auto lexLess = [](const glm::vec3& p, const glm::vec3& q) {
+        return p.x != q.x ? p.x < q.x : p.y != q.y ? p.y < q.y : p.z < q.z;
+    };
+    // Clip to z <= 0 (Sutherland-Hodgman against one plane: 0, 3 or 4 corners).
+    std::array<glm::vec3, 4> polygon;
+    int corners = 0;
+    const std::array<glm::vec3, 3> input = {a, b, c};
+    for (int i = 0; i < 3; ++i) {
+        const glm::vec3& p = input[size_t(i)];
+        const glm::vec3& q = input[size_t((i + 1) % 3)];
+        const bool pIn = p.z <= 0.0f, qIn = q.z <= 0.0f;
+        if (pIn)
+            polygon[size_t(corners++)] = p;
+        if (pIn != qIn) {
+            const glm::vec3& from = lexLess(p, q) ? p : q;
+            const glm::vec3& to = lexLess(p, q) ? q : p;
+            const float t = from.z / (from.z - to.z);
+            glm::vec3 x = from + t * (to - from);
+            x.z = 0.0f;
+            polygon[size_t(corners++)] = x;
+        }
+    }
+    if (corners < 3)
+        return;
+    auto splits = [&](const glm::vec3& p, const glm::vec3& q) {
+        const float lengths = glm::length(p) * glm::length(q);
+        return lengths > 0.0f && glm::dot(p, q) < cosMaxEdge * lengths &&
+               glm::length(q - p) > minEdge;
+    };
+    // Red-green refinement on an explicit stack: a triangle with k split edges becomes k + 1
+    // triangles, each split again until none of its edges splits.
+    std::vector<std::array<glm::vec3, 3>> stack;
+    stack.push_back({polygon[0], polygon[1], polygon[2]});
+    if (corners == 4)
+        stack.push_back({polygon[0], polygon[2], polygon[3]});
+    while (!stack.empty()) {
+        const std::array<glm::vec3, 3> t = stack.back();
+        stack.pop_back();
+        int first = -1, count = 0;
+        std::array<bool, 3> split{};
+        for (int e = 0; e < 3; ++e) {
+            split[size_t(e)] = cosMaxEdge < 1.0f && splits(t[size_t(e)], t[size_t((e + 1) % 3)]);
+            if (split[size_t(e)]) {
+                count += 1;
+                if (first < 0)
+                    first = e;
+            }
+        }
+        if (count == 0) {
+            out.insert(out.end(), t.begin(), t.end());
+            continue;
+        }
+        // Rotate so that edge 0 (t0 t1) splits; m_e is the midpoint of edge e (t_e t_{e+1}).
+        std::array<glm::vec3, 3> r;
+        std::array<bool, 3> s;
+        for (int k = 0; k < 3; ++k) {
+            r[size_t(k)] = t[size_t((first + k) % 3)];
+            s[size_t(k)] = split[size_t((first + k) % 3)];
+        }
+        const glm::vec3 m0 = 0.5f * (r[0] + r[1]), m1 = 0.5f * (r[1] + r[2]),
+                        m2 = 0.5f * (r[2] + r[0]);
+        if (count == 3) {
+            stack.push_back({r[0], m0, m2});
+            stack.push_back({m0, r[1], m1});
+            stack.push_back({m2, m1, r[2]});
+            stack.push_back({m0, m1, m2});
+        } else if (count == 1) {
+            stack.push_back({r[0], m0, r[2]});
+            stack.push_back({m0, r[1], r[2]});
+        } else if (s[1]) { // edges 0 and 1
+            stack.push_back({m0, r[1], m1});
+            stack.push_back({r[0], m0, m1});
+            stack.push_back({r[0], m1, r[2]});
+        } else { // edges 0 and 2
+            stack.push_back({r[0], m0, m2});
+            stack.push_back({m0, r[1], r[2]});
+            stack.push_back({m0, r[2], m2});
+        }
+    }
+}
 
 } // namespace
 
@@ -169,10 +265,13 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                               const gbuffer::CameraView& view, const ShadowSettings& settings,
                               ShadowMaps* recycled) {
     const auto start = Clock::now();
-    if (!(settings.mapSize >= 1 && settings.mapSize <= raster::kMaxViewportSize))
-        throw std::invalid_argument("shadow map size must be in [1, " +
-                                    std::to_string(raster::kMaxViewportSize) + "], got " +
-                                    std::to_string(settings.mapSize));
+    auto checkMapSize = [](int mapSize) {
+        if (!(mapSize >= 1 && mapSize <= raster::kMaxViewportSize))
+            throw std::invalid_argument("shadow map size must be in [1, " +
+                                        std::to_string(raster::kMaxViewportSize) + "], got " +
+                                        std::to_string(mapSize));
+    };
+    checkMapSize(settings.mapSize);
     if (!(settings.cascades >= 1 && settings.cascades <= 8))
         throw std::invalid_argument("shadow cascades must be in [1, 8], got " +
                                     std::to_string(settings.cascades));
@@ -195,11 +294,6 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     const glm::dmat4 worldFromView = glm::inverse(view.viewFromWorldExact);
     const glm::dmat4& viewFromWorld = view.viewFromWorldExact;
     maps.mWorldFromViewRotation = glm::dmat3(worldFromView);
-    const int size = settings.mapSize;
-    // Spot and cascade faces are widened so that their outer kFaceMarginTexels texels lie
-    // beyond the region they must cover (when the map is large enough to afford it).
-    const double marginScale =
-        size > 4 * kFaceMarginTexels ? double(size) / double(size - 2 * kFaceMarginTexels) : 1.0;
 
     // Chunk boxes and the geometry's bounds (the receivers and casters of the scene).
     const uint32_t triangleCount = geometry.triangleCount();
@@ -239,6 +333,19 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         maps.mFaces.push_back(std::move(face));
         jobs.push_back({shadow, glm::mat4(clipFromWorld)});
     };
+    // A paraboloid face (ShadowMaps.h): lightFromWorld its light frame.
+    auto addParaboloidFace = [&](size_t shadow, const glm::dmat4& lightFromWorld, double nearMetres,
+                                 double farMetres) {
+        ShadowFace face;
+        face.lightClipFromViewExact = lightFromWorld * worldFromView;
+        face.lightClipFromView = glm::mat4(face.lightClipFromViewExact);
+        face.paraboloid = true;
+        face.nearMetres = nearMetres;
+        face.farMetres = farMetres;
+        face.tanHalfFov = 2.0;
+        maps.mFaces.push_back(std::move(face));
+        jobs.push_back({shadow, glm::mat4(lightFromWorld)});
+    };
     auto addEmptyFace = [&](size_t shadow) {
         ShadowFace face;
         face.empty = true;
@@ -269,11 +376,31 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         shadow.lightIndex = lightIndex;
         shadow.type = light.type;
         shadow.firstFace = maps.mFaces.size();
+        // The light's own settings (a JSON light's "shadow") over the global ones.
+        shadow.settings = settingsForLight(settings, light.shadow);
+        checkMapSize(shadow.settings.mapSize);
+        const int size = shadow.settings.mapSize;
+        // Spot and cascade faces are widened so that their outer kFaceMarginTexels texels lie
+        // beyond the region they must cover (when the map is large enough to afford it).
+        const double marginScale = size > 4 * kFaceMarginTexels
+                                       ? double(size) / double(size - 2 * kFaceMarginTexels)
+                                       : 1.0;
         const size_t shadowIndex = maps.mShadows.size();
         const glm::dvec3 position(light.positionWorld);
         const double nearMetres = kNearFraction * light.rangeMetres;
         const double farMetres = light.rangeMetres;
-        if (light.type == scenes::LightType::Point) {
+        if (light.type == scenes::LightType::Point &&
+            settings.pointProjection == ShadowPointProjection::DualParaboloid) {
+            // Front (looking down world -Y, faceFor's first) and back.
+            for (const double sign : {-1.0, 1.0}) {
+                const glm::dvec3 forward(0.0, sign, 0.0);
+                addParaboloidFace(shadowIndex,
+                                  scenes::viewFromBasis(position, forward, upFor(forward)),
+                                  nearMetres, farMetres);
+            }
+            shadow.paraboloid = true;
+            shadow.positionView = glm::dvec3(viewFromWorld * glm::dvec4(position, 1.0));
+        } else if (light.type == scenes::LightType::Point) {
             // World axes: +X, -X, +Y, -Y, +Z, -Z (faceFor's order), each with an up vector
             // perpendicular to it.
             static constexpr std::array<std::array<double, 6>, 6> kCube = {{
@@ -362,6 +489,8 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             }
         }
         shadow.faceCount = maps.mFaces.size() - shadow.firstFace;
+        for (size_t f = shadow.firstFace; f < maps.mFaces.size(); ++f)
+            maps.mFaces[f].mapSize = size;
         maps.mShadowOfLight[lightIndex] = uint32_t(shadowIndex);
         maps.mShadows.push_back(std::move(shadow));
     }
@@ -387,13 +516,13 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                 const ShadowFace& face = maps.mFaces[f];
                 if (face.empty)
                     continue;
-                texelWorld = std::max(texelWorld,
-                                      face.orthographic
-                                          ? face.extentMetres / double(size)
-                                          : 2.0 * face.tanHalfFov * face.farMetres / double(size));
+                const double size = face.mapSize;
+                texelWorld = std::max(texelWorld, face.orthographic ? face.extentMetres / size
+                                                                    : 2.0 * face.tanHalfFov *
+                                                                          face.farMetres / size);
             }
             const double margin =
-                (kMaxTapDistanceTexels + 1.0 + double(settings.normalOffset)) * texelWorld;
+                (kMaxTapDistanceTexels + 1.0 + double(shadow.settings.normalOffset)) * texelWorld;
             const CasterVolume volume =
                 casterVolume(frustumCorners, scene.lights[shadow.lightIndex], sweepMetres);
             std::vector<uint8_t>& set = mayCast[s];
@@ -408,6 +537,11 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     // Casters per light: point and spot lights draw the triangles of their casting set whose box
     // touches their range sphere (chunk boxes first), in triangle order; directional lights the
     // triangles of their casting set (everything when the set holds every instance).
+    // Triangles of materials that cast no shadow (CasterMaterials.h: blended, masked with a
+    // constant alpha below the cutoff) are left out, as the rays leave them out.
+    const std::vector<uint8_t> castingMaterial = shadows::castingMaterials(scene);
+    const bool everyMaterial = std::all_of(castingMaterial.begin(), castingMaterial.end(),
+                                           [](uint8_t casts) { return casts != 0; });
     std::vector<Casters> casters(maps.mShadows.size());
     tbb::parallel_for(size_t(0), maps.mShadows.size(), [&](size_t s) {
         const scenes::Light& light = scene.lights[maps.mShadows[s].lightIndex];
@@ -416,10 +550,11 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         const bool everyObject = inSet.empty() || std::all_of(inSet.begin(), inSet.end(),
                                                               [&](uint8_t in) { return in != 0; });
         auto excluded = [&](uint32_t t) {
-            return !everyObject && !inSet[geometry.triangleInstance[t]];
+            return (!everyObject && !inSet[geometry.triangleInstance[t]]) ||
+                   (!everyMaterial && !castingMaterial[geometry.triangleMaterial[t]]);
         };
         if (light.type == scenes::LightType::Directional) {
-            if (everyObject) {
+            if (everyObject && everyMaterial) {
                 set.whole = true;
                 return;
             }
@@ -469,6 +604,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                                                    : std::make_shared<RenderScratch>();
     tbb::enumerable_thread_specific<RenderScratch::Thread>& scratches = maps.mScratch->threads;
     std::vector<double> faceMs(maps.mFaces.size(), 0.0);
+    std::vector<uint64_t> faceTriangles(maps.mFaces.size(), 0);
     std::vector<std::vector<float>> pooled(maps.mFaces.size());
     for (size_t f = 0; f < maps.mFaces.size() && !depthPool.empty(); ++f)
         if (!maps.mFaces[f].empty) {
@@ -481,22 +617,67 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             return;
         const auto faceStart = Clock::now();
         RenderScratch::Thread& scratch = scratches.local();
-        if (!scratch.rasterizer || scratch.rasterizer->width() != size)
-            scratch.rasterizer = std::make_unique<raster::Rasterizer>(size, size);
+        const int size = face.mapSize;
+        raster::Rasterizer* rasterizer = nullptr;
+        for (const std::unique_ptr<raster::Rasterizer>& candidate : scratch.rasterizers)
+            if (candidate->width() == size)
+                rasterizer = candidate.get();
+        if (!rasterizer) {
+            // Lights with their own map size: one rasterizer per size met, each kept.
+            scratch.rasterizers.push_back(std::make_unique<raster::Rasterizer>(size, size));
+            rasterizer = scratch.rasterizers.back().get();
+        }
         const Casters& set = casters[jobs[f].shadow];
         const std::span<const glm::vec3> positions = set.positions(geometry);
         const std::span<const uint32_t> indices =
             set.whole ? std::span<const uint32_t>(geometry.indices)
                       : std::span<const uint32_t>(sequentialIndices.data(), positions.size());
-        scratch.clip.resize(positions.size());
         const glm::mat4& clipFromWorld = jobs[f].clipFromWorld;
-        for (size_t i = 0; i < positions.size(); ++i)
-            scratch.clip[i] = clipFromWorld * glm::vec4(positions[i], 1.0f);
+        if (face.paraboloid) {
+            // Clipped and split in the light frame, then projected: x, y as they are and
+            // w = |l| - l.z, so that x / w is the paraboloid's coordinate; z / w the linear
+            // reversed depth (far - |l|) / (far - near).
+            const float cosMaxEdge = settings.paraboloidMaxEdgeDegrees > 0.0
+                                         ? float(std::cos(glm::radians(
+                                               std::min(settings.paraboloidMaxEdgeDegrees, 180.0))))
+                                         : 1.0f;
+            const float minEdge = float(kMinParaboloidEdgeFraction * face.farMetres);
+            scratch.lightSpace.clear();
+            const size_t cornerCount = indices.size();
+            for (size_t i = 0; i + 2 < cornerCount; i += 3) {
+                std::array<glm::vec3, 3> l;
+                for (size_t k = 0; k < 3; ++k)
+                    l[k] = glm::vec3(clipFromWorld * glm::vec4(positions[indices[i + k]], 1.0f));
+                appendParaboloidCasters(l[0], l[1], l[2], cosMaxEdge, minEdge, scratch.lightSpace);
+            }
+            const float nearM = float(face.nearMetres), farM = float(face.farMetres);
+            scratch.clip.resize(scratch.lightSpace.size());
+            for (size_t i = 0; i < scratch.lightSpace.size(); ++i) {
+                const glm::vec3& l = scratch.lightSpace[i];
+                const float distance = glm::length(l);
+                const float w = distance - l.z;
+                scratch.clip[i] = glm::vec4(l.x, l.y, w * (farM - distance) / (farM - nearM), w);
+            }
+            if (scratch.sequential.size() < scratch.clip.size()) {
+                scratch.sequential.resize(scratch.clip.size());
+                std::iota(scratch.sequential.begin(), scratch.sequential.end(), 0u);
+            }
+            faceTriangles[f] = scratch.clip.size() / 3;
+        } else {
+            scratch.clip.resize(positions.size());
+            for (size_t i = 0; i < positions.size(); ++i)
+                scratch.clip[i] = clipFromWorld * glm::vec4(positions[i], 1.0f);
+            faceTriangles[f] = indices.size() / 3;
+        }
+        const std::span<const uint32_t> drawIndices =
+            face.paraboloid
+                ? std::span<const uint32_t>(scratch.sequential.data(), scratch.clip.size())
+                : indices;
         // Cleared to 0 (nothing: the far plane) tile by tile inside the draw (clearDepth).
         face.depth = std::move(pooled[f]);
         face.depth.resize(size_t(size) * size_t(size));
-        scratch.rasterizer->draw(raster::TriangleList{scratch.clip, indices}, state,
-                                 face.depth.data(), raster::DepthOnly{});
+        rasterizer->draw(raster::TriangleList{scratch.clip, drawIndices}, state, face.depth.data(),
+                         raster::DepthOnly{});
         faceMs[f] = milliseconds(faceStart);
     };
     if (settings.schedule == ShadowSchedule::FacesInParallel) {
@@ -520,13 +701,13 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         lightStats.lightIndex = shadow.lightIndex;
         lightStats.type = shadow.type;
         lightStats.faceCount = shadow.faceCount;
+        lightStats.settings = shadow.settings;
         lightStats.casterObjects = useSets ? setStats[s].casterObjects : maps.mStats.objectCount;
         lightStats.lightInFrustum = setStats[s].lightInFrustum;
         for (size_t f = shadow.firstFace; f < shadow.firstFace + shadow.faceCount; ++f) {
             lightStats.bytes += maps.mFaces[f].depth.size() * kBytesPerTexel;
             lightStats.renderMs += faceMs[f];
-            if (!maps.mFaces[f].empty)
-                lightStats.trianglesDrawn += casters[s].triangleCount(geometry);
+            lightStats.trianglesDrawn += faceTriangles[f];
         }
         maps.mStats.totalBytes += lightStats.bytes;
         maps.mStats.lights.push_back(lightStats);
@@ -557,6 +738,11 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         for (int k = 0; k < 3; ++k)
             shadowView.positionView[k] = shadow.positionView[k];
         shadowView.cascadeFarDepthView = shadow.cascadeFarDepthView.data();
+        const ShadowSettings& own = shadow.settings;
+        shadowView.scalarOnly =
+            shadow.paraboloid || own.mapSize != settings.mapSize || own.filter != settings.filter ||
+            own.biasConstant != settings.biasConstant || own.biasSlope != settings.biasSlope ||
+            own.normalOffset != settings.normalOffset;
         maps.mShadowViews.push_back(shadowView);
     }
     shadows::ShadowMapsView& mapsView = maps.mView;
@@ -575,6 +761,11 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
 }
 
 size_t ShadowMaps::faceFor(const Shadow& shadow, const glm::dvec3& positionView) const {
+    if (shadow.type == scenes::LightType::Point && shadow.paraboloid) {
+        // The front face looks down world -Y (render's order).
+        const glm::dvec3 d = mWorldFromViewRotation * (positionView - shadow.positionView);
+        return shadow.firstFace + (d.y <= 0.0 ? 0 : 1);
+    }
     if (shadow.type == scenes::LightType::Point) {
         const glm::dvec3 d = mWorldFromViewRotation * (positionView - shadow.positionView);
         const glm::dvec3 a = glm::abs(d);
@@ -606,26 +797,39 @@ float ShadowMaps::visibility(uint32_t shadow, const glm::vec3& positionView,
     const size_t f = faceFor(mShadows[shadow], p);
     if (f == SIZE_MAX)
         return 1.0f;
-    const float v = faceVisibility(mFaces[f], p, n);
+    const float v = faceVisibility(mFaces[f], mShadows[shadow].settings, p, n);
     return std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 1.0f;
 }
 
-float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
-                                 const glm::dvec3& normalView) const {
+float ShadowMaps::faceVisibility(const ShadowFace& face, const ShadowSettings& settings,
+                                 glm::dvec3 p, const glm::dvec3& normalView) const {
     if (face.empty)
         return 1.0f;
-    const int size = mSettings.mapSize;
+    const int size = face.mapSize;
     const double sizeD = size;
     const glm::dmat4& m = face.lightClipFromViewExact;
-    // Texel coordinates (u right, v down, texel i covers [i, i+1)) and light-space depth.
+    // Texel coordinates (u right, v down, texel i covers [i, i+1)) and light-space depth
+    // (paraboloid: the distance to the light; cosAxis the cosine of the angle from the face's
+    // axis).
     struct Projected {
         double u, v, depth;
         bool valid;
+        double cosAxis;
     };
     auto project = [&](const glm::dvec3& q) {
         const glm::dvec4 c = m * glm::dvec4(q, 1.0);
-        Projected r{0.0, 0.0, 0.0, false};
-        if (face.orthographic) {
+        Projected r{0.0, 0.0, 0.0, false, 1.0};
+        if (face.paraboloid) {
+            const double distance = glm::length(glm::dvec3(c));
+            const double w = distance - c.z;
+            if (distance > 0.0 && w > 0.0) {
+                r.depth = distance;
+                r.u = (c.x / w * 0.5 + 0.5) * sizeD;
+                r.v = (0.5 - 0.5 * c.y / w) * sizeD;
+                r.cosAxis = -c.z / distance;
+                r.valid = true;
+            }
+        } else if (face.orthographic) {
             r.depth = face.farMetres - c.z * (face.farMetres - face.nearMetres);
             r.u = (c.x * 0.5 + 0.5) * sizeD;
             r.v = (0.5 - 0.5 * c.y) * sizeD;
@@ -638,9 +842,14 @@ float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
         }
         return r;
     };
-    // Side of one texel at light-space depth d, metres.
-    auto texelWorld = [&](double d) {
-        return face.orthographic ? face.extentMetres / sizeD : 2.0 * d * face.tanHalfFov / sizeD;
+    // Side of one texel at a projected point, metres. Paraboloid: the coordinate is
+    // tan(theta / 2) of the angle theta from the axis, d/dtheta = 1 / (1 + cos theta), so a texel
+    // (2 / mapSize of the coordinate) spans (2 / mapSize) (1 + cos theta) radians.
+    auto texelWorld = [&](const Projected& q) {
+        if (face.paraboloid)
+            return q.depth * 2.0 * (1.0 + q.cosAxis) / sizeD;
+        return face.orthographic ? face.extentMetres / sizeD
+                                 : 2.0 * q.depth * face.tanHalfFov / sizeD;
     };
 
     const double normalLength = glm::length(normalView);
@@ -649,8 +858,8 @@ float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
     Projected r = project(p);
     if (!r.valid)
         return 1.0f;
-    if (hasNormal && mSettings.normalOffset != 0.0f) {
-        p += n * (double(mSettings.normalOffset) * texelWorld(r.depth));
+    if (hasNormal && settings.normalOffset != 0.0f) {
+        p += n * (double(settings.normalOffset) * texelWorld(r));
         r = project(p);
         if (!r.valid)
             return 1.0f;
@@ -663,7 +872,7 @@ float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
         return 1.0f;
 
     // Receiver plane: depth change per texel along u and v, from two tangent directions.
-    const double texel = texelWorld(r.depth);
+    const double texel = texelWorld(r);
     glm::dvec2 gradient(0.0);
     double tanTheta = 0.0;
     if (hasNormal && texel > 0.0) {
@@ -685,28 +894,30 @@ float ShadowMaps::faceVisibility(const ShadowFace& face, glm::dvec3 p,
         }
     }
     const double bias =
-        double(mSettings.biasConstant) + double(mSettings.biasSlope) * texel * tanTheta;
+        double(settings.biasConstant) + double(settings.biasSlope) * texel * tanTheta;
 
-    // Stored depth -> light-space depth (reversed Z; 0 = nothing = the far plane).
+    // Stored depth -> light-space depth (reversed Z; 0 = nothing = the far plane; orthographic
+    // and paraboloid faces store it linearly).
     const double n0 = face.nearMetres, f0 = face.farMetres;
     const double a = -n0 / (f0 - n0), b = n0 * f0 / (f0 - n0);
     auto lit = [&](int ti, int tj) {
         ti = std::clamp(ti, 0, size - 1);
         tj = std::clamp(tj, 0, size - 1);
         const double stored = face.depth[size_t(tj) * size_t(size) + size_t(ti)];
-        const double occluder = face.orthographic ? f0 - stored * (f0 - n0) : b / (stored - a);
+        const double occluder =
+            face.orthographic || face.paraboloid ? f0 - stored * (f0 - n0) : b / (stored - a);
         const double receiver =
             r.depth + gradient.x * (ti + 0.5 - r.u) + gradient.y * (tj + 0.5 - r.v);
         return receiver - bias <= occluder ? 1 : 0;
     };
     const int i = int(std::floor(r.u)), j = int(std::floor(r.v));
     int litCount = 0, tapCount = 0;
-    switch (mSettings.filter) {
+    switch (settings.filter) {
     case ShadowFilter::None:
         return float(lit(i, j));
     case ShadowFilter::Pcf3:
     case ShadowFilter::Pcf5: {
-        const int radius = mSettings.filter == ShadowFilter::Pcf3 ? 1 : 2;
+        const int radius = settings.filter == ShadowFilter::Pcf3 ? 1 : 2;
         for (int dj = -radius; dj <= radius; ++dj)
             for (int di = -radius; di <= radius; ++di, ++tapCount)
                 litCount += lit(i + di, j + dj);

@@ -5,13 +5,27 @@
 // that can cast onto a visible receiver), and point and spot lights only the triangles within
 // their range. Which lights: every scene light with castsShadows that is not ambient; with a budget
 // (ShadowSettings::maxShadowLights = N >= 0) the N of them that matter most in view
-// (chooseLights). Per light, faces:
+// (chooseLights). Each light with its own settings (ShadowSettings.h settingsForLight: the global
+// ones, with a scene light's own map size, biases, filter and normal offset over them). Per
+// light, faces:
 //   spot         one perspective face along the axis, half-angle acos(spotOuterCos) plus a
 //                margin of kFaceMarginTexels (clamped at kMaxSpotHalfAngleDegrees), near =
 //                kNearFraction * range, far = range;
 //   point        a cube map: six 90-degree perspective faces along world +X, -X, +Y, -Y, +Z, -Z,
 //                near and far as for spot lights; a lookup takes the face of the major axis of
-//                the world-space direction from the light;
+//                the world-space direction from the light. Or (ShadowPointProjection::
+//                DualParaboloid) two paraboloid faces looking down world -Y (front) and +Y
+//                (back): a direction d (unit, in the face's light frame, the face looking down
+//                -Z) maps to (d.x, d.y) / (1 - d.z), its hemisphere to the disk inscribed in the
+//                face; depth is the distance to the light, stored linearly (1 = near, 0 = far).
+//                Each face draws its casters clipped to its hemisphere (the plane through the
+//                light) and split until every edge spans at most paraboloidMaxEdgeDegrees seen
+//                from the light: the rasterizer draws straight edges and interpolates depth
+//                linearly on screen, where the paraboloid maps straight edges to circular arcs
+//                and distance is not linear. An edge is split by its own length and angle only
+//                (the same decision in both triangles that share it), so the split mesh has no
+//                T-junctions and stays watertight. A lookup takes the face of the hemisphere of
+//                the direction from the light;
 //   directional  `cascades` orthographic faces, each fitted to its slice of the camera frustum
 //                clipped to the scene's geometry bounds (the visible receivers), in light space:
 //                x and y the intersection of the slice's and the scene's light-space boxes (plus
@@ -76,15 +90,21 @@ inline constexpr double kMaxTapDistanceTexels = 2.5;
 inline constexpr size_t kBytesPerTexel = sizeof(float);
 
 struct ShadowFace {
-    glm::mat4 lightClipFromView{1.0f};      // camera view -> face clip (reversed Z, 0 <= z <= w)
+    // Camera view -> face clip (reversed Z, 0 <= z <= w); paraboloid faces: camera view -> the
+    // face's light frame (looking down -Z), the projection after it is not a matrix (above).
+    glm::mat4 lightClipFromView{1.0f};
     glm::dmat4 lightClipFromViewExact{1.0}; // the same in double, what visibility() uses
     bool orthographic = false;
+    bool paraboloid = false;
     double nearMetres = 0.0; // light-space depth of the near and far planes
     double farMetres = 0.0;
     // Perspective: tan of the half field of view; orthographic: the box's larger side, metres.
+    // Paraboloid: 2, so that 2 * tanHalfFov * depth / mapSize is its widest texel (at the
+    // face's centre; at its rim a texel spans half that).
     double tanHalfFov = 0.0;
     double extentMetres = 0.0;
     bool empty = false;       // nothing to receive (a cascade outside the scene): lookups lit
+    int mapSize = 0;          // its light's (ShadowLightStats::settings.mapSize)
     std::vector<float> depth; // mapSize^2, row 0 at the top; empty when `empty`
 };
 
@@ -94,7 +114,12 @@ struct ShadowLightStats {
     scenes::LightType type = scenes::LightType::Point;
     size_t faceCount = 0;
     size_t bytes = 0;
-    uint64_t trianglesDrawn = 0; // triangles submitted over all faces, after the range cull
+    // The settings its maps were rendered and are looked up with: the global ones with the
+    // light's own (scenes::LightShadow) over them (settingsForLight).
+    ShadowSettings settings;
+    // Triangles submitted over all faces, after the range cull (dual-paraboloid faces: after
+    // clipping to the hemisphere and splitting, so what the rasterizer was given).
+    uint64_t trianglesDrawn = 0;
     // Its shadow-casting set (ShadowCasterSets.h): the instances drawn into its maps (every
     // instance with triangles when the sets are off), and O'Rorke's case.
     uint64_t casterObjects = 0;
@@ -128,7 +153,8 @@ public:
     // Renders every face of every chosen light. Parallel under the caller's task_arena; the
     // result is bitwise independent of the thread count. Cost: per light the triangles within
     // its range (spot, point) or all (directional), set up once per face; memory: mapSize^2
-    // floats per face. Throws std::invalid_argument for a mapSize outside [1, 16384] or
+    // floats per face. Throws std::invalid_argument for a mapSize (global or a light's own)
+    // outside [1, 16384] or
     // cascades outside [1, 8]. `recycled`, when given, is a previous frame's maps whose depth
     // buffers and rasterizers the new maps take over (it is left without faces): a frame then
     // pays no allocation or page fault for its maps, only their clear.
@@ -153,11 +179,11 @@ public:
     }
     // Fraction of the light reaching a receiver at positionView with normal normalView (camera
     // view space; the normal need not be unit, a zero normal disables the receiver plane and the
-    // slope bias) in [0, 1], 0 = fully shadowed, with the configured filter and bias
-    // (ShadowSettings.h). Points outside every face's coverage (beyond the range, outside a
-    // spot's cone or a cascade's box, closer than the near plane) are lit: the light's own
-    // falloff and cone decide there. Never NaN for finite input (non-finite input: 1). Cost: a
-    // few matrix products and 1 / 9 / 25 / 16 taps. Thread-safe.
+    // slope bias) in [0, 1], 0 = fully shadowed, with the light's filter and bias
+    // (ShadowSettings.h; the global ones unless the light has its own). Points outside every face's
+    // coverage (beyond the range, outside a spot's cone or a cascade's box, closer than the near
+    // plane) are lit: the light's own falloff and cone decide there. Never NaN for finite input
+    // (non-finite input: 1). Cost: a few matrix products and 1 / 9 / 25 / 16 taps. Thread-safe.
     float visibility(uint32_t shadow, const glm::vec3& positionView,
                      const glm::vec3& normalView) const override;
     // The maps as plain data for the kernel's vector lookup (ShadowMapsView.h), which is bitwise
@@ -171,6 +197,7 @@ public:
     size_t firstFace(uint32_t shadow) const { return mShadows[shadow].firstFace; }
     size_t faceCountOf(uint32_t shadow) const { return mShadows[shadow].faceCount; }
     const ShadowStats& stats() const { return mStats; }
+    // The global settings render() was given (each light's own: stats().lights[s].settings).
     const ShadowSettings& settings() const { return mSettings; }
 
 private:
@@ -179,14 +206,16 @@ private:
         scenes::LightType type = scenes::LightType::Point;
         size_t firstFace = 0;
         size_t faceCount = 0;
+        ShadowSettings settings;                 // the light's (settingsForLight)
+        bool paraboloid = false;                 // point lights: dual-paraboloid faces
         glm::dvec3 positionView{0.0};            // point lights: the cube's centre
         std::vector<double> cascadeFarDepthView; // directional: far split of each cascade
     };
 
     // The face of `shadow` that covers positionView (cube face, cascade), or SIZE_MAX.
     size_t faceFor(const Shadow& shadow, const glm::dvec3& positionView) const;
-    float faceVisibility(const ShadowFace& face, glm::dvec3 positionView,
-                         const glm::dvec3& normalView) const;
+    float faceVisibility(const ShadowFace& face, const ShadowSettings& settings,
+                         glm::dvec3 positionView, const glm::dvec3& normalView) const;
 
     struct RenderScratch; // per-thread rasterizers, handed from frame to frame (ShadowMaps.cpp)
 

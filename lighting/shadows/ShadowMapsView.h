@@ -60,6 +60,10 @@ struct ShadowView {
     uint32_t faceCount;
     double positionView[3];            // point lights: the cube's centre
     const double* cascadeFarDepthView; // directional: faceCount far splits, ascending
+    // The vector lookup does not handle this shadow: its faces are dual-paraboloid, or its light
+    // has settings of its own (scenes/LightShadow.h) that differ from the view's. The kernel then
+    // calls the scalar lookup lane by lane (the same answer, bitwise, as always).
+    bool scalarOnly;
 };
 
 struct ShadowMapsView {

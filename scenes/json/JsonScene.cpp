@@ -163,6 +163,7 @@ private:
     Camera camera(const Json& value, const std::string& field) const;
     void addViews(const Json& root, const std::optional<Camera>& objectCamera, Scene& scene) const;
     Light light(const Json& value, const std::string& field) const;
+    LightShadow lightShadow(const Json& value, const std::string& field) const;
     void applyMaterial(const Json& value, const std::string& field, Scene& scene) const;
     glm::vec4 colour(const Json& value, const std::string& field, bool alphaAllowed) const;
     void generateLights(const Json* generator, Scene& scene) const;
@@ -540,8 +541,8 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
         fail(field, "missing key 'type'");
     const std::string type = text(value["type"], fieldOf(field, "type"));
 
-    // Keys each type requires; color and intensity are optional for every type, castsShadows for
-    // every type but ambient.
+    // Keys each type requires; color and intensity are optional for every type, castsShadows and
+    // shadow for every type but ambient.
     Light light;
     std::vector<std::string> required;
     if (type == "point") {
@@ -562,7 +563,7 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
     std::vector<std::string> valid = required;
     valid.insert(valid.end(), {"type", "color", "intensity"});
     if (light.type != LightType::Ambient)
-        valid.push_back("castsShadows");
+        valid.insert(valid.end(), {"castsShadows", "shadow"});
     expectKeys(value, field, valid);
     for (const std::string& key : required)
         if (!member(value, key.c_str()))
@@ -589,6 +590,12 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
             fail(fieldOf(field, "castsShadows"), "expected true or false");
         light.castsShadows = casts->get<bool>();
     }
+    if (const Json* shadow = member(value, "shadow")) {
+        // Settings for maps the light would not get are an error, not silently unused.
+        if (!light.castsShadows)
+            fail(fieldOf(field, "shadow"), "needs \"castsShadows\": true on the light");
+        light.shadow = lightShadow(*shadow, fieldOf(field, "shadow"));
+    }
     if (light.type == LightType::Spot) {
         const float inner = number(value["innerConeDegrees"], fieldOf(field, "innerConeDegrees"));
         const float outer = number(value["outerConeDegrees"], fieldOf(field, "outerConeDegrees"));
@@ -601,6 +608,45 @@ Light JsonSceneReader::light(const Json& value, const std::string& field) const 
     if (const std::string problem = lightProblem(light); !problem.empty())
         fail(field, problem);
     return light;
+}
+
+// A light's "shadow": {"mapSize": N, "bias": [constant, slope], "filter": name, "normalOffset":
+// x}, every key optional, the names and ranges of the CLI's --shadow-map-size, --shadow-bias
+// and --shadow-filter (LightShadow.h).
+LightShadow JsonSceneReader::lightShadow(const Json& value, const std::string& field) const {
+    expectKeys(value, field, {"mapSize", "bias", "filter", "normalOffset"});
+    LightShadow shadow;
+    if (const Json* size = member(value, "mapSize")) {
+        if (!size->is_number_integer() || size->get<int64_t>() < kMinShadowMapSize ||
+            size->get<int64_t>() > kMaxShadowMapSize)
+            fail(fieldOf(field, "mapSize"),
+                 "expected an integer in [" + std::to_string(kMinShadowMapSize) + ", " +
+                     std::to_string(kMaxShadowMapSize) + "] (texels per face side)");
+        shadow.mapSize = int(size->get<int64_t>());
+    }
+    auto bounded = [&](const Json& number_, const std::string& name) {
+        const float result = number(number_, name);
+        if (!(result >= 0.0f && result <= kMaxShadowBias))
+            fail(name, "expected a number in [0, " + std::to_string(int(kMaxShadowBias)) + "]");
+        return result;
+    };
+    if (const Json* bias = member(value, "bias")) {
+        if (!bias->is_array() || bias->size() != 2)
+            fail(fieldOf(field, "bias"),
+                 "expected [constant, slope] (metres, texels), e.g. [0.005, 1.5]");
+        shadow.biasConstant = bounded((*bias)[0], fieldOf(field, "bias") + "[0]");
+        shadow.biasSlope = bounded((*bias)[1], fieldOf(field, "bias") + "[1]");
+    }
+    if (const Json* filter = member(value, "filter")) {
+        const std::string name = text(*filter, fieldOf(field, "filter"));
+        shadow.filter = parseShadowFilter(name);
+        if (!shadow.filter)
+            fail(fieldOf(field, "filter"),
+                 "unknown filter '" + name + "' (valid: " + std::string(kShadowFilterNames) + ")");
+    }
+    if (const Json* offset = member(value, "normalOffset"))
+        shadow.normalOffset = bounded(*offset, fieldOf(field, "normalOffset"));
+    return shadow;
 }
 
 // [r, g, b] or, with alphaAllowed, [r, g, b, a]: non-negative linear values (alpha at most 1).

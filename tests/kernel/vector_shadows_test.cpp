@@ -323,4 +323,26 @@ TEST(VectorShadows, SeamLanesSpanSeveralCubeFaces) {
     EXPECT_EQ(ties, 256);
 }
 
+// What the vector lookup does not model goes to the scalar lookup: dual-paraboloid faces and a
+// light's own settings (scenes::LightShadow) differing from the frame's. The kernel reads
+// ShadowView::scalarOnly (LightKernel-inl.h, chunkVisibility); cube maps and per-light settings
+// equal to the frame's stay on the vector path.
+TEST(VectorShadows, ParaboloidFacesAndOwnSettingsTakeTheScalarLookup) {
+    ShadowSettings cube;
+    cube.mapSize = 128;
+    EXPECT_FALSE(Frame(pointLight(), cube).maps.view()->shadows[0].scalarOnly);
+    ShadowSettings paraboloid = cube;
+    paraboloid.pointProjection = lighting::ShadowPointProjection::DualParaboloid;
+    EXPECT_TRUE(Frame(pointLight(), paraboloid).maps.view()->shadows[0].scalarOnly);
+    Light same = spotLight();
+    same.shadow.mapSize = cube.mapSize;
+    EXPECT_FALSE(Frame(same, cube).maps.view()->shadows[0].scalarOnly);
+    Light own = spotLight();
+    own.shadow.filter = ShadowFilter::Pcf5;
+    EXPECT_TRUE(Frame(own, cube).maps.view()->shadows[0].scalarOnly);
+    own.shadow = {};
+    own.shadow.mapSize = 64;
+    EXPECT_TRUE(Frame(own, cube).maps.view()->shadows[0].scalarOnly);
+}
+
 } // namespace

@@ -184,6 +184,55 @@ TEST(JsonScene, CastsShadowsIsReadPerLight) {
     expectJsonError(notBoolean, {"lights[0].castsShadows", "true or false"});
 }
 
+// A light's "shadow" (issue 29, per-light settings): every key read, absent keys left to the
+// global settings; the CLI's ranges and names; an error without "castsShadows": true, on an
+// ambient light, for an unknown key and for each malformed value, naming the field.
+TEST(JsonScene, LightShadowSettingsAreReadPerLight) {
+    auto point = [](json shadow, json casts = true) {
+        json light = {{"type", "point"}, {"position", {0, 1, 0}}, {"range", 2}};
+        if (!casts.is_null())
+            light["castsShadows"] = casts;
+        light["shadow"] = std::move(shadow);
+        return light;
+    };
+    json document = spheresOnly();
+    document["lights"] = {
+        point({{"mapSize", 256}, {"bias", {0.01, 2.5}}, {"filter", "pcf5"}, {"normalOffset", 1}}),
+        point({{"filter", "none"}}),
+        {{"type", "directional"}, {"direction", {0, -1, 0}}, {"castsShadows", true}}};
+    const Scene scene = loadJson(document);
+    ASSERT_EQ(scene.lights.size(), 3u);
+    const scenes::LightShadow& first = scene.lights[0].shadow;
+    EXPECT_EQ(first.mapSize, 256);
+    EXPECT_EQ(first.biasConstant, 0.01f);
+    EXPECT_EQ(first.biasSlope, 2.5f);
+    EXPECT_EQ(first.filter, scenes::ShadowFilter::Pcf5);
+    EXPECT_EQ(first.normalOffset, 1.0f);
+    const scenes::LightShadow& second = scene.lights[1].shadow;
+    EXPECT_EQ(second.filter, scenes::ShadowFilter::None);
+    EXPECT_FALSE(second.mapSize || second.biasConstant || second.biasSlope || second.normalOffset);
+    EXPECT_FALSE(scene.lights[2].shadow.any());
+
+    auto expectLightError = [&](const json& light, std::initializer_list<std::string> details) {
+        json bad = spheresOnly();
+        bad["lights"] = {light};
+        expectJsonError(bad, details);
+    };
+    expectLightError(point({{"filter", "pcf3"}}, nullptr), {"lights[0].shadow", "castsShadows"});
+    expectLightError(point({{"filter", "pcf3"}}, false), {"lights[0].shadow", "castsShadows"});
+    expectLightError({{"type", "ambient"}, {"shadow", {{"filter", "pcf3"}}}},
+                     {"lights[0]", "unknown key 'shadow'"});
+    expectLightError(point({{"size", 256}}), {"lights[0].shadow", "unknown key 'size'"});
+    expectLightError(point({{"mapSize", 8}}), {"lights[0].shadow.mapSize", "[16, 8192]"});
+    expectLightError(point({{"mapSize", 100000}}), {"lights[0].shadow.mapSize", "[16, 8192]"});
+    expectLightError(point({{"mapSize", 512.5}}), {"lights[0].shadow.mapSize", "integer"});
+    expectLightError(point({{"bias", 0.01}}), {"lights[0].shadow.bias", "[constant, slope]"});
+    expectLightError(point({{"bias", {0.01, -1}}}), {"lights[0].shadow.bias[1]", "[0, 100]"});
+    expectLightError(point({{"filter", "pcf7"}}), {"lights[0].shadow.filter", "'pcf7'", "poisson"});
+    expectLightError(point({{"normalOffset", "1"}}), {"lights[0].shadow.normalOffset", "number"});
+    expectLightError(point("pcf3"), {"lights[0].shadow", "expected an object"});
+}
+
 TEST(JsonScene, RelativeGltfPathAndDefaultCamera) {
     const fs::path directory = testDirectory();
     const json document = {
