@@ -99,44 +99,56 @@ std::vector<PassTiming> shadeRepetitions(RenderRun& run, lighting::ShadingStage&
     return passes;
 }
 
+// Whether the run's G-buffer holds every channel the BRDF reads (the forward stages' holds depth
+// alone: they shade while they rasterize).
+bool holdsTheShadedSurface(const RenderRun& run) {
+    const gbuffer::GBufferLayout& stored = run.prepared->gbuffer->layout();
+    return stored.provides(gbuffer::Channel::Normal) && stored.provides(gbuffer::Channel::Albedo) &&
+           stored.provides(gbuffer::Channel::Specular);
+}
+
+// The run's frame with a G-buffer that holds the surface the stage shades, for measurements that
+// decode it per pixel (the oracles, the shadow misclassification): the stage's own G-buffer when
+// it holds every channel the BRDF reads, else a lossless G-buffer of the same view, rendered now
+// (what the forward stages shade: float attributes, no encoding). Single-sample frames; the
+// lossless G-buffer lives as long as the struct.
+struct ShadedSurface {
+    lighting::StageInputs frame;
+    std::unique_ptr<gbuffer::GBuffer> lossless;
+};
+ShadedSurface shadedSurface(const RenderRun& run) {
+    ShadedSurface surface{run.prepared->inputs, nullptr};
+    if (!holdsTheShadedSurface(run)) {
+        surface.lossless = run.prepared->renderLosslessGBuffer();
+        surface.frame.gbuffer = surface.lossless.get();
+    }
+    return surface;
+}
+
 // The oracle counts lights on the surface the stage shades: its G-buffer when that holds every
 // channel the BRDF reads, else the lossless G-buffer (what forward stages shade).
 void countOracle(RenderRun& run) {
     if (run.options.oracle == "visibility") {
         // Every light's visibility by ray, on the surface the stage shades (checkOptions refuses
-        // multisampled frames): the G-buffer when it holds what the BRDF reads, else lossless.
+        // multisampled frames).
         const lighting::shadows::RayShadows everyLight(
             run.prepared->scene, run.prepared->geometry, run.prepared->view,
             lighting::shadows::RayShadows::everyLightCasts(run.prepared->scene));
-        const gbuffer::GBufferLayout& stored = run.prepared->gbuffer->layout();
-        if (stored.provides(gbuffer::Channel::Normal) &&
-            stored.provides(gbuffer::Channel::Albedo) &&
-            stored.provides(gbuffer::Channel::Specular)) {
-            run.oracle = lighting::countVisibleLights(run.prepared->inputs, everyLight);
-            return;
-        }
-        run.oracleFromLosslessGBuffer = true;
-        const std::unique_ptr<gbuffer::GBuffer> lossless = run.prepared->renderLosslessGBuffer();
-        lighting::StageInputs losslessFrame = run.prepared->inputs;
-        losslessFrame.gbuffer = lossless.get();
-        run.oracle = lighting::countVisibleLights(losslessFrame, everyLight);
+        const ShadedSurface surface = shadedSurface(run);
+        run.oracleFromLosslessGBuffer = surface.lossless != nullptr;
+        run.oracle = lighting::countVisibleLights(surface.frame, everyLight);
         return;
     }
     if (!run.result.lightsOracle.empty()) {
         run.oracle = run.result.lightsOracle;
         return;
     }
-    const lighting::StageInputs& frame = run.prepared->inputs;
-    const gbuffer::GBufferLayout& stored = run.prepared->gbuffer->layout();
-    const bool complete = stored.provides(gbuffer::Channel::Normal) &&
-                          stored.provides(gbuffer::Channel::Albedo) &&
-                          stored.provides(gbuffer::Channel::Specular);
     if (run.prepared->multisample) {
         // Summed over the fragment layers, as the stage's evaluations are; on the stored layers
         // (the count is then on the lossy surfaces, like a stage's) when they hold what the BRDF
         // reads, else (the forward stages, which read no channel) on the layers of a lossless
         // multisampled frame of the same view: one more multisampled G-buffer pass.
-        if (complete) {
+        if (holdsTheShadedSurface(run)) {
             run.oracle = lighting::countContributingLightsOverLayers(*run.prepared);
             return;
         }
@@ -152,15 +164,9 @@ void countOracle(RenderRun& run) {
         run.oracle = lighting::countContributingLightsOverLayers(lossless);
         return;
     }
-    if (complete) {
-        run.oracle = lighting::countContributingLights(frame);
-        return;
-    }
-    run.oracleFromLosslessGBuffer = true;
-    const std::unique_ptr<gbuffer::GBuffer> lossless = run.prepared->renderLosslessGBuffer();
-    lighting::StageInputs losslessFrame = frame;
-    losslessFrame.gbuffer = lossless.get();
-    run.oracle = lighting::countContributingLights(losslessFrame);
+    const ShadedSurface surface = shadedSurface(run);
+    run.oracleFromLosslessGBuffer = surface.lossless != nullptr;
+    run.oracle = lighting::countContributingLights(surface.frame);
 }
 
 // The reference image of the run: the given one; at 1 sample per pixel the stage's own image
@@ -283,9 +289,12 @@ RenderRun runRender(RenderPlan plan, const Progress& progress,
             fillReference(run, plan.stage->name(), givenReference, plan.shadows);
             referenceMs = millisecondsSince(start);
             if (plan.shadows && run.shadowMaps) {
+                // On the surface the stage shades, as the oracle: the forward stages' G-buffer
+                // holds depth alone, and its decoded normal would fail the facing test at random.
                 step("shadow misclassification (one ray per pixel and casting light)");
+                const ShadedSurface surface = shadedSurface(run);
                 run.shadowError = lighting::shadows::measureShadowError(
-                    run.prepared->inputs, rayShadows(run, *plan.shadows));
+                    surface.frame, rayShadows(run, *plan.shadows));
             }
             error = compareImages(run.result, run.reference);
             step("HDR-FLIP");

@@ -16,6 +16,10 @@ ShadowErrorCounts measureShadowError(const StageInputs& frame, const ExactShadow
     if (!frame.shadows)
         throw std::invalid_argument("measureShadowError: the frame has no shadow maps");
     const gbuffer::GBuffer& gbuffer = *frame.gbuffer;
+    // Without normals every pair's facing test and slope bias would read a made-up normal.
+    if (!gbuffer.layout().provides(gbuffer::Channel::Normal))
+        throw std::invalid_argument(
+            "measureShadowError: the G-buffer stores no normals (give it a lossless one)");
     const int width = frame.view->width, height = frame.view->height;
     const std::vector<LightInView<float>>& lights = frame.lights->lights;
     std::vector<uint32_t> casting;

@@ -31,7 +31,8 @@ struct ShadowErrorCounts {
     }
 };
 
-// frame: its G-buffer (decoded per pixel), its view-space lights and its shadow maps
+// frame: its G-buffer (decoded per pixel; must store normals: a forward stage's depth-only
+// G-buffer does not, measure on a lossless one), its view-space lights and its shadow maps
 // (frame.shadows, not null); truth: the same lights' exact visibility.
 ShadowErrorCounts measureShadowError(const StageInputs& frame, const ExactShadowLookup& truth);
 

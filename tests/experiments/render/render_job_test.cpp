@@ -378,6 +378,19 @@ TEST(RenderJob, ShadowMapsAreRenderedShadedAndMeasured) {
     EXPECT_LT(run.metrics.error->relativeRmse, 0.5 * plain.metrics.error->relativeRmse);
     EXPECT_FALSE(plain.shadowMaps);
     EXPECT_FALSE(plain.metrics.shadowMapBytes);
+
+    // A forward stage's G-buffer holds depth alone: its misclassification is measured on the
+    // surface it shades (lossless), not on a made-up normal (it was 38% on the atrium when read
+    // from the depth-only G-buffer), so it comes out as the same maps' on tiled's surface, to
+    // within the normal encoding's effect on the facing test and the slope bias.
+    RenderOptions forward = options;
+    forward.stage = "forward";
+    const RenderRun forwardRun = runRender(planRender(forward), {}, &run.reference);
+    ASSERT_TRUE(forwardRun.shadowError);
+    EXPECT_EQ(forwardRun.shadowError->pairs, run.shadowError->pairs);
+    EXPECT_NEAR(forwardRun.shadowError->misclassifiedFraction(),
+                run.shadowError->misclassifiedFraction(),
+                0.2 * run.shadowError->misclassifiedFraction() + 1e-4);
 }
 
 // `--oracle visibility`: at every pixel at most the unshadowed oracle's count, fewer in all on
