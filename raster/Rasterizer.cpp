@@ -39,13 +39,6 @@ float planeDistance(int plane, const glm::vec4& c, float guardX, float guardY) {
     }
 }
 
-// Which frustum planes (x, y within +-w, 0 <= z <= w) a clip position is outside of, one bit
-// each; no pixel centre can be covered when all three vertices share a bit.
-uint8_t frustumOutcode(const glm::vec4& c) {
-    return uint8_t((c.x > c.w) | (c.x < -c.w) << 1 | (c.y > c.w) << 2 | (c.y < -c.w) << 3 |
-                   (c.z < 0.0f) << 4 | (c.z > c.w) << 5);
-}
-
 bool isFinite(const glm::vec4& c) {
     return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w);
 }

@@ -96,6 +96,16 @@ inline bool isRasterSampleCount(int samples) {
 }
 
 enum class CullMode { None, Back, Front };
+
+// Which frustum planes (x, y within +-w, 0 <= z <= w) a clip position is outside of, one bit
+// each. The draw rejects a triangle whose three vertices share a bit (no pixel centre can be
+// covered) before any other work; a caller may drop such triangles itself (the shadow maps'
+// faces do) and get the same image. Comparisons with NaN are false: a non-finite position has
+// no bit here (the draw rejects it on its own).
+inline uint8_t frustumOutcode(const glm::vec4& c) {
+    return uint8_t((c.x > c.w) | (c.x < -c.w) << 1 | (c.y > c.w) << 2 | (c.y < -c.w) << 3 |
+                   (c.z < 0.0f) << 4 | (c.z > c.w) << 5);
+}
 // DepthTest: DepthSpan.h.
 
 struct RasterState {

@@ -35,6 +35,10 @@ struct ShadowMaps::RenderScratch {
     struct Thread {
         std::vector<std::unique_ptr<raster::Rasterizer>> rasterizers; // one per map size
         std::vector<glm::vec4> clip;
+        // Perspective and orthographic faces: the clip positions' frustum outcodes and the
+        // indices of the triangles the face keeps.
+        std::vector<uint8_t> outcodes;
+        std::vector<uint32_t> faceIndices;
         // Paraboloid faces: the casters in the face's light frame, clipped and split (three
         // corners per triangle), and 0, 1, 2, ... to index them.
         std::vector<glm::vec3> lightSpace;
@@ -663,16 +667,51 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                 std::iota(scratch.sequential.begin(), scratch.sequential.end(), 0u);
             }
             faceTriangles[f] = scratch.clip.size() / 3;
-        } else {
+        } else if (!settings.cullCastersPerFace) {
             scratch.clip.resize(positions.size());
             for (size_t i = 0; i < positions.size(); ++i)
                 scratch.clip[i] = clipFromWorld * glm::vec4(positions[i], 1.0f);
-            faceTriangles[f] = indices.size() / 3;
+            scratch.faceIndices.assign(indices.begin(), indices.end());
+        } else if (set.whole) {
+            // Shared vertices: each projected once, the triangles outside the face dropped from
+            // the index list.
+            scratch.clip.resize(positions.size());
+            scratch.outcodes.resize(positions.size());
+            for (size_t i = 0; i < positions.size(); ++i) {
+                scratch.clip[i] = clipFromWorld * glm::vec4(positions[i], 1.0f);
+                scratch.outcodes[i] = raster::frustumOutcode(scratch.clip[i]);
+            }
+            scratch.faceIndices.clear();
+            for (size_t i = 0; i + 2 < indices.size(); i += 3)
+                if (!(scratch.outcodes[indices[i]] & scratch.outcodes[indices[i + 1]] &
+                      scratch.outcodes[indices[i + 2]]))
+                    scratch.faceIndices.insert(scratch.faceIndices.end(), &indices[i],
+                                               &indices[i + 3]);
+        } else {
+            // Three corners per triangle: only the triangles inside the face are kept, so that
+            // the draw projects and sets up about a sixth of a cube map's casters per face.
+            scratch.clip.clear();
+            for (size_t i = 0; i + 2 < positions.size(); i += 3) {
+                const glm::vec4 corners[3] = {clipFromWorld * glm::vec4(positions[i], 1.0f),
+                                              clipFromWorld * glm::vec4(positions[i + 1], 1.0f),
+                                              clipFromWorld * glm::vec4(positions[i + 2], 1.0f)};
+                if (!(raster::frustumOutcode(corners[0]) & raster::frustumOutcode(corners[1]) &
+                      raster::frustumOutcode(corners[2])))
+                    scratch.clip.insert(scratch.clip.end(), corners, corners + 3);
+            }
+            scratch.faceIndices.assign(sequentialIndices.begin(),
+                                       sequentialIndices.begin() + scratch.clip.size());
         }
+        // The face's triangles: paraboloid faces their split pieces; perspective and orthographic
+        // faces those the face's frustum may hold (settings.cullCastersPerFace), by the draw's
+        // own trivial reject on the same clip positions (raster::frustumOutcode), so the map is
+        // bitwise the one the whole caster list draws, in a sixth of the set-up for a cube face.
         const std::span<const uint32_t> drawIndices =
             face.paraboloid
                 ? std::span<const uint32_t>(scratch.sequential.data(), scratch.clip.size())
-                : indices;
+                : std::span<const uint32_t>(scratch.faceIndices);
+        if (!face.paraboloid)
+            faceTriangles[f] = scratch.faceIndices.size() / 3;
         // Cleared to 0 (nothing: the far plane) tile by tile inside the draw (clearDepth).
         face.depth = std::move(pooled[f]);
         face.depth.resize(size_t(size) * size_t(size));

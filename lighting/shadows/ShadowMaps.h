@@ -117,8 +117,9 @@ struct ShadowLightStats {
     // The settings its maps were rendered and are looked up with: the global ones with the
     // light's own (scenes::LightShadow) over them (settingsForLight).
     ShadowSettings settings;
-    // Triangles submitted over all faces, after the range cull (dual-paraboloid faces: after
-    // clipping to the hemisphere and splitting, so what the rasterizer was given).
+    // Triangles the rasterizer was given over all faces: after the range cull and, with
+    // cullCastersPerFace, each face's frustum cull (dual-paraboloid faces: after clipping to
+    // the hemisphere and splitting).
     uint64_t trianglesDrawn = 0;
     // Its shadow-casting set (ShadowCasterSets.h): the instances drawn into its maps (every
     // instance with triangles when the sets are off), and O'Rorke's case.

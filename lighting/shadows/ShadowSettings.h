@@ -85,6 +85,10 @@ struct ShadowSettings {
     // onto a visible receiver. Off: every object in range (the brute force the sets are tested
     // against; the image is the same).
     bool casterSets = true;
+    // Each face draws only the casters its frustum may hold, chosen by the rasterizer's own
+    // trivial reject (raster::frustumOutcode) before the draw; the maps are bitwise the same.
+    // Off (tests, A/B): every face hands its light's whole caster list to the draw.
+    bool cullCastersPerFace = true;
 };
 
 // The names parseShadowPointProjection accepts, for error messages.

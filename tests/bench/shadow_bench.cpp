@@ -51,7 +51,9 @@ const ShadowFrame& atrium() {
 }
 
 // range(0): threads; range(1): 0 = faces in parallel, 1 = faces in sequence; range(2): 1 = each
-// frame takes over the last frame's depth buffers (what the runner does), 0 = fresh buffers.
+// frame takes over the last frame's depth buffers (what the runner does), 0 = fresh buffers;
+// range(3): 1 = each face drops the casters outside its frustum before the draw (the default),
+// 0 = every face hands its light's whole caster list to the rasterizer (the same maps).
 void shadowMapRender(benchmark::State& state) {
     const ShadowFrame& f = atrium();
     tbb::task_arena arena(int(state.range(0)));
@@ -59,8 +61,10 @@ void shadowMapRender(benchmark::State& state) {
     settings.mapSize = 512;
     settings.schedule = state.range(1) == 0 ? lighting::ShadowSchedule::FacesInParallel
                                             : lighting::ShadowSchedule::FacesInSequence;
+    settings.cullCastersPerFace = state.range(3) == 1;
     state.SetLabel(std::string(state.range(1) == 0 ? "faces in parallel" : "faces in sequence") +
-                   (state.range(2) == 1 ? ", buffers recycled" : ", fresh buffers"));
+                   (state.range(2) == 1 ? ", buffers recycled" : ", fresh buffers") +
+                   (state.range(3) == 1 ? ", per-face cull" : ", whole lists"));
     std::vector<double> renderMs;
     const bool recycleBuffers = state.range(2) == 1;
     lighting::ShadowStats stats;
@@ -89,7 +93,7 @@ void shadowMapRender(benchmark::State& state) {
     state.counters["MB"] = double(stats.totalBytes) / (1024.0 * 1024.0);
 }
 BENCHMARK(shadowMapRender)
-    ->ArgsProduct({{1, 2}, {0, 1}, {0, 1}})
+    ->ArgsProduct({{1, 2}, {0, 1}, {0, 1}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);

@@ -678,6 +678,41 @@ TEST(ShadowMaps, RenderIsBitwiseIndependentOfThreadsAndNeverNaN) {
     }
 }
 
+// Each face drops the casters outside its frustum before the draw (cullCastersPerFace): the maps
+// are bitwise the ones drawn from the whole caster lists, for the indexed lists (a directional
+// light with every object, sets off) and the per-light corner lists (sets on, point and spot),
+// and a cube face is given clearly fewer triangles than its light's whole list.
+TEST(ShadowMaps, PerFaceCasterCullGivesTheSameMaps) {
+    TestScene t;
+    t.ground(5.0f);
+    t.box({-0.5f, 0.0f, -0.5f}, {0.5f, 1.0f, 0.5f});
+    t.box({1.0f, 0.0f, 1.0f}, {1.5f, 2.0f, 1.5f});
+    t.box({-3.0f, 0.0f, 2.0f}, {-2.5f, 3.0f, 2.5f});
+    t.camera({0, 3, 6}, {0, 0, 0});
+    t.light(spotLight({0, 4, 0}, {0.2f, -1, 0}, 8.0f, 40.0f));
+    t.light(pointLight({-1.5f, 1.0f, 0.5f}, 5.0f));
+    t.light(directionalLight({0.3f, -1.0f, 0.2f}));
+    for (const bool sets : {false, true})
+        for (const int cascades : {1, 3}) {
+            SCOPED_TRACE(std::string("sets ") + (sets ? "on" : "off") + ", cascades " +
+                         std::to_string(cascades));
+            ShadowSettings settings;
+            settings.mapSize = 256;
+            settings.cascades = cascades;
+            settings.casterSets = sets;
+            ShadowSettings whole = settings;
+            whole.cullCastersPerFace = false;
+            const Frame culled(t.scene, settings), drawnWhole(t.scene, whole);
+            ASSERT_EQ(culled.maps.faceCount(), drawnWhole.maps.faceCount());
+            for (size_t f = 0; f < culled.maps.faceCount(); ++f)
+                EXPECT_EQ(culled.maps.face(f).depth, drawnWhole.maps.face(f).depth) << "face " << f;
+            const auto& point = culled.maps.stats().lights[1];
+            const auto& pointWhole = drawnWhole.maps.stats().lights[1];
+            EXPECT_EQ(point.faceCount, 6u);
+            EXPECT_LT(2 * point.trianglesDrawn, pointWhole.trianglesDrawn);
+        }
+}
+
 // The budget keeps the lights that matter most in view: brighter and nearer first, lights whose
 // support misses the view last, ambient and non-casting lights never.
 TEST(ShadowMaps, BudgetChoosesTheLightsThatMatterMostInView) {
