@@ -462,21 +462,24 @@ void scatterAccepted(Scene& scene, const PointLightScatter& scatter, int count, 
 // shadow-casting set is a small part of a scene of many objects (lighting/shadows/README.md).
 // Each object is its own instance of one of five shared meshes, standing on the floor, turned by
 // quarter turns (exact, so boxes stay axis-aligned). Heights and lengths 0.3-1.5 m.
-struct ClutterShape {
-    const char* name;
-    Aabb footprint; // object space, the object's bounds (y from 0)
-};
-
 constexpr float kClutterMaxHeight = 1.5f;
-// Where clutter stands: behind the wall along its length, and in front across the floor (from
-// the wall's face to 12 m in front of it, past the camera), never within kClutterGap of the wall,
-// of another object or of a light's centre, nor within kClutterCameraClearance of a camera's
+// Where clutter stands: behind the wall along its length (to 4.5 m behind it), in front along it
+// (the 4 m band the front lights fill) and across the floor in front (to 12 m in front of the
+// wall, past the camera); never within kClutterGap of the wall or of another object, nor within
+// kClutterLightClearance of a light's centre, nor within kClutterCameraClearance of a camera's
 // foot (an object there would hide most of its view).
 constexpr float kClutterAlongMax = kWallHalfLength - 0.5f;
 constexpr float kClutterBehindFar = -4.5f;
 constexpr float kClutterFrontFar = 12.0f;
-constexpr float kClutterBehindShare = 0.4f; // of the objects; the rest in front (a larger area)
+// Shares of the objects: behind the wall; in front along it (the band the front lights are in,
+// so that they have casters near them too); the rest across the floor in front.
+constexpr float kClutterBehindShare = 0.4f;
+constexpr float kClutterAlongWallShare = 0.3f;
+constexpr float kClutterAlongWallDepth = 4.0f;
 constexpr float kClutterGap = 0.15f;
+// How close a light's centre may come to an object (a light inside a crate would light nothing;
+// the front lights crowd the band along the wall, so a wider clearance would empty it).
+constexpr float kClutterLightClearance = 0.02f;
 constexpr float kClutterCameraClearance = 3.0f;
 
 void addWallClutter(Scene& scene, int count, uint64_t seed) {
@@ -520,10 +523,12 @@ void addWallClutter(Scene& scene, int count, uint64_t seed) {
                              " clutter objects without overlap");
         const uint32_t shape = std::min(uint32_t(uniform(0.0f, 5.0f)), 4u);
         const int quarterTurns = std::min(int(uniform(0.0f, 4.0f)), 3);
-        const bool behind = uniform(0.0f, 1.0f) < kClutterBehindShare;
+        const float side = uniform(0.0f, 1.0f);
         const float x = uniform(-kClutterAlongMax, kClutterAlongMax);
-        const float z = behind ? uniform(kClutterBehindFar, -kWallHalfThickness)
-                               : uniform(kWallFaceZ, kWallFaceZ + kClutterFrontFar);
+        const float z = side < kClutterBehindShare ? uniform(kClutterBehindFar, -kWallHalfThickness)
+                        : side < kClutterBehindShare + kClutterAlongWallShare
+                            ? uniform(kWallFaceZ, kWallFaceZ + kClutterAlongWallDepth)
+                            : uniform(kWallFaceZ, kWallFaceZ + kClutterFrontFar);
         const glm::mat4 worldFromObject = placeTurnedY({x, 0.0f, z}, quarterTurns);
         Aabb bounds;
         for (int k = 0; k < 8; ++k) {
@@ -554,9 +559,9 @@ void addWallClutter(Scene& scene, int count, uint64_t seed) {
         const bool holdsLight =
             std::any_of(scene.lights.begin(), scene.lights.end(), [&](const Light& light) {
                 const glm::vec3 p = light.positionWorld;
-                return p.x > bounds.min.x - kClutterGap && p.x < bounds.max.x + kClutterGap &&
-                       p.z > bounds.min.z - kClutterGap && p.z < bounds.max.z + kClutterGap &&
-                       p.y < bounds.max.y + kClutterGap;
+                const float c = kClutterLightClearance - 0.5f * kClutterGap;
+                return p.x > bounds.min.x - c && p.x < bounds.max.x + c && p.z > bounds.min.z - c &&
+                       p.z < bounds.max.z + c && p.y < bounds.max.y + kClutterLightClearance;
             });
         if (holdsLight)
             continue; // a light inside a crate lights nothing
