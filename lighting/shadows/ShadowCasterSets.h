@@ -31,7 +31,8 @@
 // monotonically), and a triangle's box lies inside its object's box (both are min/max of the
 // same float positions), so a triangle the cull draws is never in a dropped object. Without
 // this, every light's set holds every object of the hull however far from the light: on the
-// wall scene (all lights in view) that is nearly every object (lighting/shadows/README.md).
+// wall scene, whose lights are all in view, every object in view (57% of the objects with
+// clutter=200; 1-2% with the range test: lighting/shadows/README.md).
 //
 // Pure functions of their inputs; no state.
 #pragma once

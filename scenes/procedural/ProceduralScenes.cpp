@@ -157,9 +157,9 @@ std::vector<SceneOption> withAmbientAndSun(std::vector<SceneOption> specs, int d
     return specs;
 }
 
-// Most clutter objects wall accepts: 500 is one per 1.3 m^2 of the 640 m^2 they stand on, about
-// a third of it covered (the densest layout tested, beside 1000 lights); far denser, placing by
-// rejection without overlap would slow down and then fail.
+// Most clutter objects wall accepts: 500 is one per 1.3 m^2 of the 640 m^2 they stand on, with
+// about 30% of it covered (the densest layout tested, beside 1000 lights); far denser, placing
+// by rejection without overlap would slow down and then fail.
 constexpr int kMaxWallClutter = 500;
 
 // The option tables of the scenes, for a request of `lightCount` generated lights.
