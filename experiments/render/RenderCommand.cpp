@@ -247,6 +247,11 @@ nlohmann::json shadowsJson(const RenderRun& run) {
         {"objects", stats.objectCount},
         {"caster_objects_per_light",
          stats.lights.empty() ? 0.0 : double(casterObjects) / double(stats.lights.size())},
+        // The same as a fraction of the scene's objects (issue 29's target: <= 10% on average).
+        {"caster_objects_fraction",
+         stats.lights.empty() || stats.objectCount == 0
+             ? 0.0
+             : double(casterObjects) / (double(stats.lights.size()) * double(stats.objectCount))},
         {metric::kShadowMapBytes, stats.totalBytes},
         {"render_ms", stats.renderMs},
         {"per_light", lights}};

@@ -22,6 +22,18 @@ bool CasterVolume::mayContain(const scenes::Aabb& box, double margin) const {
     return true;
 }
 
+bool CasterVolume::mayCast(const scenes::Aabb& box, double margin) const {
+    if (!mayContain(box, margin))
+        return false;
+    return !rangeBounded || boxTouchesSphere(rangeCentre, rangeMetres, box);
+}
+
+bool boxTouchesSphere(const glm::dvec3& centre, double radius, const scenes::Aabb& box) {
+    const glm::dvec3 d = glm::max(
+        glm::max(glm::dvec3(box.min) - centre, centre - glm::dvec3(box.max)), glm::dvec3(0.0));
+    return glm::dot(d, d) <= radius * radius;
+}
+
 std::vector<glm::dvec3> frustumCornersWorld(const gbuffer::CameraView& view, double receiverNear,
                                             double receiverFar) {
     const glm::dmat4 worldFromView = glm::inverse(view.viewFromWorldExact);
@@ -87,6 +99,11 @@ bool insideAll(const std::vector<glm::dvec4>& planes, const glm::dvec3& p) {
 CasterVolume casterVolume(const std::vector<glm::dvec3>& frustumCorners, const scenes::Light& light,
                           double sweepMetres) {
     CasterVolume volume;
+    if (light.type == scenes::LightType::Point || light.type == scenes::LightType::Spot) {
+        volume.rangeBounded = true;
+        volume.rangeCentre = glm::dvec3(light.positionWorld);
+        volume.rangeMetres = light.rangeMetres;
+    }
     const std::vector<glm::dvec4> frustum = hullPlanes(frustumCorners);
     if (frustum.empty()) {
         volume.unbounded = true;

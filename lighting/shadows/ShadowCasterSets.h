@@ -22,6 +22,18 @@
 // receiver reads: the image is the same with and without the sets (tested against brute force,
 // tests/lighting/shadows/shadow_caster_sets_test.cpp).
 //
+// Within the light's range. A point or spot light's maps draw only the triangles whose box touches
+// its range sphere (ShadowMaps.cpp's range cull, with or without the sets), so an object whose
+// box misses the sphere has no triangle in any of its maps: leaving it out of the set changes
+// nothing drawn, exactly. Both tests are the one function boxTouchesSphere, and it is monotone
+// in the box (the distance from the centre to a box never grows as the box grows, in floating
+// point too: every step, the differences, the max with 0, the squares and their sum, rounds
+// monotonically), and a triangle's box lies inside its object's box (both are min/max of the
+// same float positions), so a triangle the cull draws is never in a dropped object. Without
+// this, every light's set holds every object of the hull however far from the light: on the
+// wall scene, whose lights are all in view, every object in view (57% of the objects with
+// clutter=200; 1-2% with the range test: lighting/shadows/README.md).
+//
 // Pure functions of their inputs; no state.
 #pragma once
 
@@ -41,11 +53,23 @@ struct CasterVolume {
     std::vector<glm::dvec4> planes; // (n, d)
     bool lightInFrustum = false;    // O'Rorke's case (the hull is then the frustum)
     bool unbounded = false;         // degenerate frustum: every object is kept
+    // Point and spot lights: the range sphere (file comment, "Within the light's range").
+    bool rangeBounded = false;
+    glm::dvec3 rangeCentre{0.0};
+    double rangeMetres = 0.0;
 
     // Whether `box` comes within `margin` metres of the volume (conservative: a box near a corner
     // of the volume but outside it may be kept; none inside is dropped).
     bool mayContain(const scenes::Aabb& box, double margin) const;
+    // Whether the light's maps may draw part of `box`: mayContain, and for point and spot lights
+    // the box touches the range sphere (no margin: the range cull that draws has none). The
+    // shadow-casting set is the objects for which this holds.
+    bool mayCast(const scenes::Aabb& box, double margin) const;
 };
+
+// Whether `box` comes within `radius` of `centre` (the maps' range cull and the sets' range test;
+// see the file comment for why they must be this one function).
+bool boxTouchesSphere(const glm::dvec3& centre, double radius, const scenes::Aabb& box);
 
 // The view frustum of `view` between view depths receiverNear and receiverFar, in world space
 // (8 corners: near then far, each (-x,-y), (+x,-y), (-x,+y), (+x,+y)).

@@ -59,12 +59,6 @@ double milliseconds(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-bool sphereTouchesAabb(const glm::dvec3& centre, double radius, const scenes::Aabb& box) {
-    const glm::dvec3 d = glm::max(
-        glm::max(glm::dvec3(box.min) - centre, centre - glm::dvec3(box.max)), glm::dvec3(0.0));
-    return glm::dot(d, d) <= radius * radius;
-}
-
 // A unit vector not parallel to `direction`: the world axis least aligned with it.
 glm::dvec3 upFor(const glm::dvec3& direction) {
     const glm::dvec3 a = glm::abs(direction);
@@ -502,7 +496,9 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     // Shadow-casting sets (ShadowCasterSets.h): per light, the instances that may cast onto a
     // visible receiver, kept within the reach of the filter's taps (the widest face texel of the
     // light times the largest tap distance, the normal offset and a texel centre's half
-    // diagonal). Without receivers in view, or with settings.casterSets off, every instance.
+    // diagonal), and for point and spot lights touching the range sphere (the range cull below,
+    // exactly: ShadowCasterSets.h). Without receivers in view, or with settings.casterSets off,
+    // every instance.
     const bool useSets = settings.casterSets && receiverFar > receiverNear && !sceneBounds.empty();
     const std::vector<scenes::Aabb> objectBounds = instanceBounds(geometry, scene.instances.size());
     const std::vector<glm::dvec3> frustumCorners =
@@ -532,7 +528,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             std::vector<uint8_t>& set = mayCast[s];
             set.resize(objectBounds.size());
             for (size_t i = 0; i < objectBounds.size(); ++i) {
-                set[i] = volume.mayContain(objectBounds[i], margin) ? 1 : 0;
+                set[i] = volume.mayCast(objectBounds[i], margin) ? 1 : 0;
                 setStats[s].casterObjects += set[i];
             }
             setStats[s].lightInFrustum = volume.lightInFrustum;
@@ -572,7 +568,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         const glm::dvec3 centre(light.positionWorld);
         const double radius = light.rangeMetres;
         for (uint32_t c = 0; c < chunkCount; ++c) {
-            if (!sphereTouchesAabb(centre, radius, chunkBounds[c]))
+            if (!boxTouchesSphere(centre, radius, chunkBounds[c]))
                 continue;
             const uint32_t end = std::min(triangleCount, (c + 1) * kTrianglesPerChunk);
             for (uint32_t t = c * kTrianglesPerChunk; t < end; ++t) {
@@ -581,7 +577,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                 scenes::Aabb box;
                 for (int k = 0; k < 3; ++k)
                     box.extend(geometry.positionWorld[geometry.indices[3 * t + k]]);
-                if (!sphereTouchesAabb(centre, radius, box))
+                if (!boxTouchesSphere(centre, radius, box))
                     continue;
                 for (int k = 0; k < 3; ++k)
                     set.ownPositions.push_back(geometry.positionWorld[geometry.indices[3 * t + k]]);

@@ -157,6 +157,11 @@ std::vector<SceneOption> withAmbientAndSun(std::vector<SceneOption> specs, int d
     return specs;
 }
 
+// Most clutter objects wall accepts: 500 is one per 1.3 m^2 of the 640 m^2 they stand on, with
+// about 30% of it covered (the densest layout tested, beside 1000 lights); far denser, placing
+// by rejection without overlap would slow down and then fail.
+constexpr int kMaxWallClutter = 500;
+
 // The option tables of the scenes, for a request of `lightCount` generated lights.
 std::vector<SceneOption> atriumOptions(int) {
     return withAmbientAndSun(
@@ -165,7 +170,10 @@ std::vector<SceneOption> atriumOptions(int) {
 }
 std::vector<SceneOption> wallOptions(int lightCount) {
     return withAmbientAndSun(
-        {{"behind", 0, 0, lightCount, "how many of the light count go behind the wall"}}, 0);
+        {{"behind", 0, 0, lightCount, "how many of the light count go behind the wall"},
+         {"clutter", 0, 0, kMaxWallClutter,
+          "street furniture objects (crates, benches, pillars, posts) on both sides"}},
+        0);
 }
 std::vector<SceneOption> glassOptions(int) {
     return withAmbientAndSun({}, 0);
@@ -451,6 +459,118 @@ void scatterAccepted(Scene& scene, const PointLightScatter& scatter, int count, 
     scene.generatedLightCount += count;
 }
 
+// Clutter: street furniture that gives every light casters near it, so that a light's
+// shadow-casting set is a small part of a scene of many objects (lighting/shadows/README.md).
+// Each object is its own instance of one of five shared meshes, standing on the floor, turned by
+// quarter turns (exact, so boxes stay axis-aligned). Heights and lengths 0.3-1.5 m.
+constexpr float kClutterMaxHeight = 1.5f;
+// Where clutter stands: behind the wall along its length (to 4.5 m behind it), in front along it
+// (the 4 m band the front lights fill) and across the floor in front (to 12 m in front of the
+// wall, past the camera); never within kClutterGap of the wall or of another object, nor within
+// kClutterLightClearance of a light's centre, nor within kClutterCameraClearance of a camera's
+// foot (an object there would hide most of its view).
+constexpr float kClutterAlongMax = kWallHalfLength - 0.5f;
+constexpr float kClutterBehindFar = -4.5f;
+constexpr float kClutterFrontFar = 12.0f;
+// Shares of the objects: behind the wall; in front along it (the band the front lights are in,
+// so that they have casters near them too); the rest across the floor in front.
+constexpr float kClutterBehindShare = 0.4f;
+constexpr float kClutterAlongWallShare = 0.3f;
+constexpr float kClutterAlongWallDepth = 4.0f;
+constexpr float kClutterGap = 0.15f;
+// How close a light's centre may come to an object (a light inside a crate would light nothing;
+// the front lights crowd the band along the wall, so a wider clearance would empty it).
+constexpr float kClutterLightClearance = 0.02f;
+constexpr float kClutterCameraClearance = 3.0f;
+
+void addWallClutter(Scene& scene, int count, uint64_t seed) {
+    if (count == 0)
+        return; // no materials or meshes either: the default scene is unchanged
+    const uint32_t wood = addMaterial(scene, "clutter-wood", {0.52f, 0.38f, 0.22f}, 0.04f, 12.0f);
+    const uint32_t metal = addMaterial(scene, "clutter-metal", {0.30f, 0.32f, 0.34f}, 0.4f, 96.0f);
+    const uint32_t stone = addMaterial(scene, "clutter-stone", {0.62f, 0.60f, 0.56f}, 0.06f, 20.0f);
+
+    std::vector<Aabb> footprints; // per mesh, object space
+    auto addBoxMesh = [&](const char* name, uint32_t material, const Aabb& box) {
+        appendBox(scene.meshes[addMesh(scene, name, material)], box, 0.5f);
+        footprints.push_back(box);
+    };
+    addBoxMesh("crate-small", wood, Aabb{{-0.25f, 0.0f, -0.25f}, {0.25f, 0.5f, 0.25f}});
+    addBoxMesh("crate-large", wood, Aabb{{-0.45f, 0.0f, -0.4f}, {0.45f, 0.8f, 0.4f}});
+    // A bench: seat and backrest as one closed box (1.5 m long, 0.45 m deep, 0.9 m high).
+    addBoxMesh("bench", wood, Aabb{{-0.75f, 0.0f, -0.225f}, {0.75f, 0.9f, 0.225f}});
+    addBoxMesh("pillar", stone, Aabb{{-0.2f, 0.0f, -0.2f}, {0.2f, kClutterMaxHeight, 0.2f}});
+    const uint32_t post = addMesh(scene, "post", metal);
+    appendCylinder(scene.meshes[post], glm::vec3(0.0f), 0.06f, 1.2f, 12, 3);
+    footprints.push_back(Aabb{{-0.06f, 0.0f, -0.06f}, {0.06f, 1.2f, 0.06f}});
+    const uint32_t firstMesh = uint32_t(scene.meshes.size() - footprints.size());
+
+    // Its own splitmix64 stream from the request's seed: the lights' streams stay untouched.
+    uint64_t state = seed ^ 0xC1A77E4C1A77E4ull;
+    auto uniform = [&state](float lo, float hi) {
+        uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+        z ^= z >> 31;
+        return lo + (hi - lo) * float(double(z >> 11) * 0x1.0p-53);
+    };
+    std::vector<Aabb> placed; // world bounds, grown by half the gap
+    // Rejection sampling; the cap turns a layout too crowded to place into an error, not a hang.
+    const int64_t maxCandidates = 200 * int64_t(count) + 1000;
+    int64_t candidates = 0;
+    while (int(placed.size()) < count) {
+        if (++candidates > maxCandidates)
+            throw SceneError(scene.name + ": cannot place " + std::to_string(count) +
+                             " clutter objects without overlap");
+        const uint32_t shape = std::min(uint32_t(uniform(0.0f, 5.0f)), 4u);
+        const int quarterTurns = std::min(int(uniform(0.0f, 4.0f)), 3);
+        const float side = uniform(0.0f, 1.0f);
+        const float x = uniform(-kClutterAlongMax, kClutterAlongMax);
+        const float z = side < kClutterBehindShare ? uniform(kClutterBehindFar, -kWallHalfThickness)
+                        : side < kClutterBehindShare + kClutterAlongWallShare
+                            ? uniform(kWallFaceZ, kWallFaceZ + kClutterAlongWallDepth)
+                            : uniform(kWallFaceZ, kWallFaceZ + kClutterFrontFar);
+        const glm::mat4 worldFromObject = placeTurnedY({x, 0.0f, z}, quarterTurns);
+        Aabb bounds;
+        for (int k = 0; k < 8; ++k) {
+            const Aabb& f = footprints[shape];
+            const glm::vec3 corner(k & 1 ? f.max.x : f.min.x, k & 2 ? f.max.y : f.min.y,
+                                   k & 4 ? f.max.z : f.min.z);
+            bounds.extend(glm::vec3(worldFromObject * glm::vec4(corner, 1.0f)));
+        }
+        const glm::vec3 halfGap(0.5f * kClutterGap, 0.0f, 0.5f * kClutterGap);
+        bounds.min -= halfGap;
+        bounds.max += halfGap;
+        auto overlaps = [&](const Aabb& other) {
+            return bounds.min.x < other.max.x && other.min.x < bounds.max.x &&
+                   bounds.min.z < other.max.z && other.min.z < bounds.max.z;
+        };
+        const Aabb wallZone{
+            {-kWallHalfLength, 0.0f, -kWallHalfThickness - 0.5f * kClutterGap},
+            {kWallHalfLength, kWallHeight, kWallHalfThickness + 0.5f * kClutterGap}};
+        if (overlaps(wallZone) || std::any_of(placed.begin(), placed.end(), overlaps))
+            continue;
+        const bool nearCamera =
+            std::any_of(scene.cameras.begin(), scene.cameras.end(), [&](const Camera& camera) {
+                const glm::vec2 toCamera(camera.positionWorld.x - x, camera.positionWorld.z - z);
+                return glm::length(toCamera) < kClutterCameraClearance;
+            });
+        if (nearCamera)
+            continue;
+        const bool holdsLight =
+            std::any_of(scene.lights.begin(), scene.lights.end(), [&](const Light& light) {
+                const glm::vec3 p = light.positionWorld;
+                const float c = kClutterLightClearance - 0.5f * kClutterGap;
+                return p.x > bounds.min.x - c && p.x < bounds.max.x + c && p.z > bounds.min.z - c &&
+                       p.z < bounds.max.z + c && p.y < bounds.max.y + kClutterLightClearance;
+            });
+        if (holdsLight)
+            continue; // a light inside a crate lights nothing
+        placed.push_back(bounds);
+        addInstance(scene, firstMesh + shape, worldFromObject);
+    }
+}
+
 Scene buildWall(const SceneRequest& request) {
     Scene scene;
     scene.name = "wall";
@@ -523,6 +643,8 @@ Scene buildWall(const SceneRequest& request) {
         makeCamera("wall-grazing", {-12.0f, 1.7f, 4.0f}, {6.0f, 2.5f, kWallFaceZ}, 100.0f));
     scene.cameras.push_back(makeCamera("wall-behind", {away, 2.5f, -kWallHalfThickness - away},
                                        {0.0f, 2.5f, -kWallHalfThickness}, 100.0f));
+    // After the lights and cameras, which it keeps clear of.
+    addWallClutter(scene, options.at("clutter"), request.seed);
     return scene;
 }
 

@@ -1,6 +1,7 @@
 // Built-in procedural scenes, registered by name, needing no file:
 //   atrium  (default) Sponza-like courtyard, >= 250k triangles, camera along the nave
-//   wall    long wall seen at an angle, lights on both sides ("behind=N" lights behind it)
+//   wall    long wall seen at an angle, lights on both sides ("behind=N" lights behind it),
+//           optionally "clutter=N" street-furniture objects on both sides (shadow-casting sets)
 //   spheres analytic spheres on a plane, for precision tests
 //   glass   alpha-tested (MASK) and overlapping blended (BLEND) panes, for transparency
 //   foliage alpha-masked leaf cards (about a texel per pixel), for alpha-to-coverage

@@ -591,6 +591,12 @@ TEST(RenderCommand, StatsRecordEachLightsShadowSettings) {
     EXPECT_EQ(point["bias_constant_m"], shadows["bias_constant_m"]);
     EXPECT_EQ(point["faces"], 2);
     EXPECT_EQ(point["bytes"], 2 * 64 * 64 * 4);
+    // The sets' size per light and as a fraction of the scene's objects.
+    const double perLight =
+        0.5 * (spot["caster_objects"].get<double>() + point["caster_objects"].get<double>());
+    EXPECT_DOUBLE_EQ(shadows["caster_objects_per_light"].get<double>(), perLight);
+    EXPECT_DOUBLE_EQ(shadows["caster_objects_fraction"].get<double>(),
+                     perLight / shadows["objects"].get<double>());
 }
 
 TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <numbers>
 #include <set>
@@ -816,6 +817,107 @@ TEST(Wall, BehindBeyondTheLightCountIsAnError) {
     const std::string message = errorOf("wall", requestWith({{"behind", "6"}}, 5));
     EXPECT_NE(message.find("behind='6'"), std::string::npos) << message;
     EXPECT_NE(message.find("0..5"), std::string::npos) << message;
+}
+
+bool sameBits(const glm::mat4& a, const glm::mat4& b) {
+    return std::memcmp(&a, &b, sizeof(glm::mat4)) == 0;
+}
+
+// World bounds of one instance's triangles.
+Aabb instanceBoundsWorld(const Scene& scene, const Instance& instance) {
+    Aabb bounds;
+    for (const glm::vec3& p : scene.meshes[instance.mesh].positions)
+        bounds.extend(transformPoint(instance.worldFromObject, p));
+    return bounds;
+}
+
+TEST(WallClutter, AddsExactlyNObjectsAndLeavesEverythingElseAsItWas) {
+    const Scene plain = buildProceduralScene("wall", requestWith({{"behind", "40"}}, 100));
+    const Scene cluttered =
+        buildProceduralScene("wall", requestWith({{"behind", "40"}, {"clutter", "200"}}, 100));
+    ASSERT_EQ(cluttered.instances.size(), plain.instances.size() + 200);
+    EXPECT_TRUE(sameLights(cluttered.lights, plain.lights));
+    ASSERT_EQ(cluttered.cameras.size(), plain.cameras.size());
+    for (size_t i = 0; i < plain.instances.size(); ++i) {
+        EXPECT_EQ(cluttered.instances[i].mesh, plain.instances[i].mesh);
+        EXPECT_TRUE(
+            sameBits(cluttered.instances[i].worldFromObject, plain.instances[i].worldFromObject));
+    }
+    // Each clutter object is its own instance of a shared mesh (five shapes).
+    std::set<uint32_t> meshes;
+    for (size_t i = plain.instances.size(); i < cluttered.instances.size(); ++i)
+        meshes.insert(cluttered.instances[i].mesh);
+    EXPECT_EQ(meshes.size(), 5u);
+    EXPECT_EQ(cluttered.meshes.size(), plain.meshes.size() + 5);
+    EXPECT_GE(*meshes.begin(), plain.meshes.size());
+    for (uint32_t mesh : meshes)
+        expectWellFormed(cluttered.meshes[mesh]);
+}
+
+TEST(WallClutter, IsDeterministicAndFollowsTheSeed) {
+    SceneRequest request = requestWith({{"clutter", "150"}}, 50);
+    request.seed = 5;
+    const Scene a = buildProceduralScene("wall", request);
+    const Scene b = buildProceduralScene("wall", request);
+    request.seed = 6;
+    const Scene c = buildProceduralScene("wall", request);
+    ASSERT_EQ(a.instances.size(), b.instances.size());
+    ASSERT_EQ(a.instances.size(), c.instances.size());
+    size_t moved = 0;
+    for (size_t i = 0; i < a.instances.size(); ++i) {
+        EXPECT_EQ(a.instances[i].mesh, b.instances[i].mesh);
+        EXPECT_TRUE(sameBits(a.instances[i].worldFromObject, b.instances[i].worldFromObject));
+        moved += !sameBits(a.instances[i].worldFromObject, c.instances[i].worldFromObject);
+    }
+    EXPECT_GT(moved, 140u) << "another seed places the clutter elsewhere";
+}
+
+TEST(WallClutter, StreetFurnitureOnBothSidesClearOfTheWallLightsAndEachOther) {
+    const int clutter = 500; // the option's maximum: the densest layout
+    const Scene scene = buildProceduralScene(
+        "wall", requestWith({{"behind", "500"}, {"clutter", std::to_string(clutter)}}, 1000));
+    const Aabb wall = instanceBoundsWorld(scene, scene.instances[0]);
+    std::vector<Aabb> boxes;
+    int behind = 0, inFront = 0, farInFront = 0;
+    for (size_t i = 2; i < scene.instances.size(); ++i) {
+        const Aabb box = instanceBoundsWorld(scene, scene.instances[i]);
+        const glm::vec3 size = box.size();
+        // Standing on the floor, street-furniture sized.
+        EXPECT_EQ(box.min.y, 0.0f);
+        const float largest = std::max({size.x, size.y, size.z});
+        EXPECT_GE(largest, 0.3f);
+        EXPECT_LE(largest, 1.5f + 1e-5f);
+        EXPECT_LE(std::abs(box.centre().x), 20.0f);
+        if (box.max.z < wall.min.z)
+            ++behind;
+        else if (box.min.z > wall.max.z)
+            ++inFront;
+        else
+            ADD_FAILURE() << "object " << i << " intersects the wall's slab";
+        farInFront += box.min.z > wall.max.z + 5.0f;
+        for (const Light& light : scene.lights) {
+            const glm::vec3 p = light.positionWorld;
+            const bool inside = p.x >= box.min.x && p.x <= box.max.x && p.y >= box.min.y &&
+                                p.y <= box.max.y && p.z >= box.min.z && p.z <= box.max.z;
+            EXPECT_FALSE(inside) << "a light inside object " << i;
+        }
+        for (const Aabb& other : boxes) {
+            const bool overlap = box.min.x < other.max.x && other.min.x < box.max.x &&
+                                 box.min.z < other.max.z && other.min.z < box.max.z;
+            EXPECT_FALSE(overlap) << "object " << i << " overlaps another";
+        }
+        boxes.push_back(box);
+    }
+    EXPECT_EQ(int(boxes.size()), clutter);
+    EXPECT_GT(behind, clutter / 5);
+    EXPECT_GT(inFront, clutter / 3);
+    EXPECT_GT(farInFront, clutter / 10) << "clutter also stands across the floor in front";
+}
+
+TEST(WallClutter, BeyondTheMaximumIsAnError) {
+    const std::string message = errorOf("wall", requestWith({{"clutter", "501"}}, 5));
+    EXPECT_NE(message.find("clutter='501'"), std::string::npos) << message;
+    EXPECT_NE(message.find("0..500"), std::string::npos) << message;
 }
 
 // ---------------------------------------------------------------------------------------------
