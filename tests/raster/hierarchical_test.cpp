@@ -224,7 +224,7 @@ std::vector<std::vector<float>> startDepths(const Mesh& mesh, DepthTest test) {
 }
 
 TEST(HierarchicalTraversal, BitwiseTheReferenceForEveryStateShadingAndThreadCount) {
-    const Mesh mesh = randomMesh(31, 3000);
+    const Mesh mesh = randomMesh(31, 1200);
     int cases = 0;
     uint64_t rejectedSomewhere = 0;
     for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
@@ -251,13 +251,13 @@ TEST(HierarchicalTraversal, BitwiseTheReferenceForEveryStateShadingAndThreadCoun
                                    name + ", " + std::to_string(threads) + " threads");
                         rejectedSomewhere += got.stats.samplesRejectedByHierarchicalDepth;
                     }
-                    EXPECT_GT(reference.stats.samplesCovered, 100000u) << name;
+                    EXPECT_GT(reference.stats.samplesCovered, 30000u) << name;
                     ++cases;
                 }
     }
     EXPECT_EQ(cases, 5 * 3 * 2 * 3);
     // Not vacuous: the hierarchical depth did reject pixels.
-    EXPECT_GT(rejectedSomewhere, 100000u);
+    EXPECT_GT(rejectedSomewhere, 10000u);
 }
 
 // The bound itself, on random planes and pixel rectangles, steep and flat, against every pixel's
