@@ -65,7 +65,6 @@
 #include <tbb/partitioner.h>
 
 #include "raster/DepthSpan.h"
-#include "raster/HierarchicalDepth.h"
 
 namespace raster {
 
@@ -170,10 +169,6 @@ struct RasterStats {
     uint64_t samplesCovered = 0;   // samples (pixels without multisampling) inside a triangle
     uint64_t samplesPassed = 0;    // passed the depth test and was not discarded
     uint64_t fragments = 0;        // fragment-function calls that kept their fragment
-    // Covered samples the hierarchical depth (HierarchicalDepth.h) rejected with their block,
-    // before their depth test: all of them would have failed it. Included in samplesCovered;
-    // zero with RasterState::referenceTraversal, with multisampling and without a depth test.
-    uint64_t samplesRejectedByHierarchicalDepth = 0;
 };
 
 // Where a draw's time goes (issue 31's breakdown), wall-clock milliseconds of its phases in the
@@ -227,10 +222,6 @@ struct SetupBarycentrics {
     bool swapped;
 };
 static_assert(kMaxViewportSize <= INT16_MAX, "pixel bounds are stored as int16_t");
-static_assert(kTileSize % HierarchicalDepth<DepthTest::Less>::kBlockSize == 0 &&
-                  kTileSize / HierarchicalDepth<DepthTest::Less>::kBlockSize <=
-                      HierarchicalDepth<DepthTest::Less>::kMaxBlocksPerSide,
-              "a tile is a whole number of hierarchical-depth blocks, as many as it holds");
 
 class Rasterizer {
 public:
@@ -446,7 +437,6 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
         mStats.samplesCovered += tile.stats.samplesCovered;
         mStats.samplesPassed += tile.stats.samplesPassed;
         mStats.fragments += tile.stats.fragments;
-        mStats.samplesRejectedByHierarchicalDepth += tile.stats.samplesRejectedByHierarchicalDepth;
     }
 }
 
@@ -483,11 +473,6 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
 
     // Counted in registers, stored once: a memory increment per sample costs measurably.
     uint64_t samplesCovered = 0, samplesPassed = 0;
-    // Covered samples that reached their depth test (the span path; the rest were rejected).
-    uint64_t samplesDrawn = 0;
-    HierarchicalDepth<kDepthTest> hierarchicalDepth(depth, mWidth, tileMinX, tileMinY, tileMaxX,
-                                                    tileMaxY);
-    const bool useHierarchicalDepth = depth && kDepthTest != DepthTest::Always;
     for (const Batch& batch : mBatches) {
         const uint32_t binEnd = batch.binOffsets[size_t(tileIndex) + 1];
         for (uint32_t item = batch.binOffsets[size_t(tileIndex)]; item < binEnd; ++item) {
@@ -523,11 +508,12 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
 
             const int64_t steps[3] = {stepX0, stepX1, stepX2};
             // A covered pixel: depth from the plane ((z0 + z2 py) + z1 px, px an exact double),
-            // depth test, fragment function, depth write. Returns whether the depth was written.
+            // depth test, fragment function, depth write.
             auto shadePixel = [&](int px, int py, double zRow, float* depthRow) {
+                ++samplesCovered;
                 const float z = float(std::clamp(zRow + t.z[1] * double(px), 0.0, 1.0));
                 if (depthRow && !detail::depthPasses<kDepthTest>(z, depthRow[px]))
-                    return false;
+                    return;
                 Fragment fragment;
                 fragment.x = px;
                 fragment.y = py;
@@ -539,7 +525,7 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                 if constexpr (kCanDiscard) {
                     // Discard (alpha test) before the depth write.
                     if (!detail::keepsAny(fragmentFn(fragment)))
-                        return false;
+                        return;
                     ++samplesPassed;
                     if (depthRow && state.depthWrite)
                         depthRow[px] = z;
@@ -549,7 +535,6 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                         depthRow[px] = z;
                     fragmentFn(fragment);
                 }
-                return depthRow && state.depthWrite;
             };
 
             if (state.referenceTraversal) {
@@ -567,7 +552,6 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                                 break;
                         } else {
                             spanStarted = true;
-                            ++samplesCovered;
                             shadePixel(px, py, zRow, depthRow);
                         }
                         w0 += stepX0;
@@ -581,85 +565,37 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                 continue;
             }
 
-            // Pixels [a, b] of row py, all covered and in blocks the hierarchical depth did not
-            // reject: returns how many depths were written.
-            auto drawRun = [&](int py, int a, int b) -> uint64_t {
-                samplesDrawn += uint64_t(b - a + 1);
+            for (int py = minY; py <= maxY; ++py) {
+                const int64_t values[3] = {row0 + bias0, row1 + bias1, row2 + bias2};
+                row0 += stepY0;
+                row1 += stepY1;
+                row2 += stepY2;
+                const detail::RowSpan k = detail::coveredSpan(values, steps, maxX - minX);
+                if (k.kLo > k.kHi)
+                    continue;
+                const int lo = minX + int(k.kLo), hi = minX + int(k.kHi);
                 const double zRow = t.z[0] + t.z[2] * py;
                 if constexpr (kDepthOnly) {
+                    samplesCovered += uint64_t(hi - lo + 1);
                     if (!depth) {
-                        samplesPassed += uint64_t(b - a + 1);
-                        return 0;
+                        samplesPassed += uint64_t(hi - lo + 1);
+                        continue;
                     }
                     DepthSpanArgs span;
                     span.row = depth + size_t(py) * mWidth;
-                    span.lo = a;
-                    span.hi = b;
+                    span.lo = lo;
+                    span.hi = hi;
                     span.zRow = zRow;
                     span.zStep = t.z[1];
                     span.write = state.depthWrite;
                     // Short spans stay inline: the dispatched call costs more than they do.
-                    const uint64_t passed = b - a < kShortSpan
-                                                ? detail::depthSpanScalarLoop<kDepthTest>(span)
-                                                : depthSpan(kDepthTest, span);
-                    samplesPassed += passed;
-                    return state.depthWrite ? passed : 0;
+                    samplesPassed += hi - lo < kShortSpan
+                                         ? detail::depthSpanScalarLoop<kDepthTest>(span)
+                                         : depthSpan(kDepthTest, span);
                 } else {
                     float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;
-                    uint64_t written = 0;
-                    for (int px = a; px <= b; ++px)
-                        written += shadePixel(px, py, zRow, depthRow);
-                    return written;
-                }
-            };
-
-            // Rows in block-row groups: the hierarchical depth decides once per group which of
-            // the triangle's blocks it rejects (a mask over block columns), then each row's span
-            // draws the runs of pixels in blocks that are not rejected, in the order the
-            // per-pixel traversal visits them.
-            for (int py = minY; py <= maxY;) {
-                const int blockRow = hierarchicalDepth.blockRowOf(py);
-                const int groupEnd = std::min(maxY, hierarchicalDepth.blockRowEnd(blockRow));
-                const uint32_t rejected =
-                    useHierarchicalDepth
-                        ? hierarchicalDepth.rejectedColumns(t.z, blockRow, minX, maxX, py, groupEnd)
-                        : 0u;
-                for (; py <= groupEnd; ++py) {
-                    const int64_t values[3] = {row0 + bias0, row1 + bias1, row2 + bias2};
-                    row0 += stepY0;
-                    row1 += stepY1;
-                    row2 += stepY2;
-                    const detail::RowSpan k = detail::coveredSpan(values, steps, maxX - minX);
-                    if (k.kLo > k.kHi)
-                        continue;
-                    const int lo = minX + int(k.kLo), hi = minX + int(k.kHi);
-                    samplesCovered += uint64_t(hi - lo + 1);
-                    if (rejected == 0) {
-                        const uint64_t written = drawRun(py, lo, hi);
-                        if (useHierarchicalDepth && written != 0)
-                            hierarchicalDepth.noteWrites(
-                                blockRow, hierarchicalDepth.blockColumnOf(lo),
-                                hierarchicalDepth.blockColumnOf(hi), written);
-                        continue;
-                    }
-                    const int lastColumn = hierarchicalDepth.blockColumnOf(hi);
-                    for (int px = lo; px <= hi;) {
-                        const int column = hierarchicalDepth.blockColumnOf(px);
-                        if (rejected >> column & 1u) {
-                            px = hierarchicalDepth.blockColumnEnd(column) + 1;
-                            continue;
-                        }
-                        int runLastColumn = column;
-                        while (runLastColumn < lastColumn &&
-                               !(rejected >> (runLastColumn + 1) & 1u))
-                            ++runLastColumn;
-                        const int runEnd =
-                            std::min(hi, hierarchicalDepth.blockColumnEnd(runLastColumn));
-                        const uint64_t written = drawRun(py, px, runEnd);
-                        if (written != 0)
-                            hierarchicalDepth.noteWrites(blockRow, column, runLastColumn, written);
-                        px = runEnd + 1;
-                    }
+                    for (int px = lo; px <= hi; ++px)
+                        shadePixel(px, py, zRow, depthRow);
                 }
             }
         }
@@ -667,8 +603,6 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     tileStats.samplesCovered = samplesCovered;
     tileStats.samplesPassed = samplesPassed;
     tileStats.fragments = samplesPassed;
-    if (!state.referenceTraversal)
-        tileStats.samplesRejectedByHierarchicalDepth = samplesCovered - samplesDrawn;
 }
 
 template <DepthTest kDepthTest, class FragmentFn>
