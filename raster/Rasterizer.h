@@ -298,8 +298,8 @@ private:
     template <DepthTest kDepthTest, class FragmentFn>
     void rasterizeTile(int tileIndex, const RasterState& state, float* depth,
                        FragmentFn& fragmentFn, RasterStats& tileStats) const;
-    // The same with state.samples > 1 (a separate loop: the one-sample path keeps its early span
-    // exit and per-pixel tests, which multisampling cannot use).
+    // The same with state.samples > 1 (a separate loop: the one-sample path finds each row's
+    // span by division, detail::coveredSpan, which per-sample coverage cannot use as it is).
     template <DepthTest kDepthTest, class FragmentFn>
     void rasterizeTileMultisample(int tileIndex, const RasterState& state, float* depth,
                                   FragmentFn& fragmentFn, RasterStats& tileStats) const;
