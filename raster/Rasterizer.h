@@ -123,6 +123,11 @@ struct RasterState {
     // the tile in cache for its triangles, where a clear before draw() streams the whole buffer
     // through memory once more (shadow maps: 96 faces of 1 MB per frame).
     std::optional<float> clearDepth;
+    // The oracle of the tests: when set, the one-sample traversal edge-tests every pixel of the
+    // triangle's bounding box in turn (no per-row span by division, no hierarchical depth, no
+    // depth-only span loop). The output is bitwise the same, fragments in the same order and
+    // the same statistics; only slower.
+    bool referenceTraversal = false;
 };
 
 // Triangles as indexed clip-space vertices; triangle t uses indices[3t .. 3t+2].
@@ -303,8 +308,8 @@ private:
     template <DepthTest kDepthTest, class FragmentFn>
     void rasterizeTile(int tileIndex, const RasterState& state, float* depth,
                        FragmentFn& fragmentFn, RasterStats& tileStats) const;
-    // The same with state.samples > 1 (a separate loop: the one-sample path keeps its early span
-    // exit and per-pixel tests, which multisampling cannot use).
+    // The same with state.samples > 1 (a separate loop: the one-sample path finds each row's
+    // span by division, detail::coveredSpan, which per-sample coverage cannot use as it is).
     template <DepthTest kDepthTest, class FragmentFn>
     void rasterizeTileMultisample(int tileIndex, const RasterState& state, float* depth,
                                   FragmentFn& fragmentFn, RasterStats& tileStats) const;
@@ -342,6 +347,37 @@ inline int64_t fillBias(int32_t ax, int32_t ay, int32_t bx, int32_t by) {
     int32_t dx = bx - ax, dy = by - ay;
     bool topLeft = dy < 0 || (dy == 0 && dx > 0);
     return topLeft ? 0 : -1;
+}
+
+// One row's covered pixels: pixel first + k, 0 <= k <= kMax, is covered when
+// value[e] + k * step[e] >= 0 for the three edges (value: the edge function at the row's first
+// pixel plus the fill bias, step: its change per pixel). The half-planes are convex, so the
+// covered k form one interval [kLo, kHi], found with at most one integer division per edge and
+// none for an edge that does not bound the interval inside [0, kMax] (most edges of a small
+// triangle's rows). Exact: the same integer tests as pixel by pixel. Empty when kLo > kHi.
+struct RowSpan {
+    int64_t kLo, kHi;
+};
+inline RowSpan coveredSpan(const int64_t value[3], const int64_t step[3], int64_t kMax) {
+    RowSpan span{0, kMax};
+    for (int e = 0; e < 3; ++e) {
+        const int64_t v = value[e], s = step[e];
+        if (s >= 0) {
+            if (v < 0) {
+                // Covered from ceil(-v / s) on; never when s == 0.
+                if (s == 0 || v + s * span.kHi < 0)
+                    return RowSpan{0, -1};
+                if (v + s * span.kLo < 0)
+                    span.kLo = (-v + s - 1) / s;
+            }
+        } else if (v < 0) {
+            return RowSpan{0, -1};
+        } else if (v + s * span.kHi < 0) {
+            // Covered up to floor(v / -s).
+            span.kHi = v / -s;
+        }
+    }
+    return span;
 }
 } // namespace detail
 
@@ -480,34 +516,76 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
             int64_t row1 = edge(x[2], y[2], x[0], y[0], px0, py0);
             int64_t row2 = edge(x[0], y[0], x[1], y[1], px0, py0);
 
-            if constexpr (kDepthOnly) {
-                const int64_t steps[3] = {stepX0, stepX1, stepX2};
-                const int64_t biases[3] = {bias0, bias1, bias2};
+            const int64_t steps[3] = {stepX0, stepX1, stepX2};
+            // A covered pixel: depth from the plane ((z0 + z2 py) + z1 px, px an exact double),
+            // depth test, fragment function, depth write.
+            auto shadePixel = [&](int px, int py, double zRow, float* depthRow) {
+                ++samplesCovered;
+                const float z = float(std::clamp(zRow + t.z[1] * double(px), 0.0, 1.0));
+                if (depthRow && !detail::depthPasses<kDepthTest>(z, depthRow[px]))
+                    return;
+                Fragment fragment;
+                fragment.x = px;
+                fragment.y = py;
+                fragment.depth = z;
+                if (state.barycentrics)
+                    fragment.barycentric = barycentricAt(batch, index, t, px, py);
+                fragment.triangle = t.triangle;
+                fragment.frontFacing = t.frontFacing;
+                if constexpr (kCanDiscard) {
+                    // Discard (alpha test) before the depth write.
+                    if (!detail::keepsAny(fragmentFn(fragment)))
+                        return;
+                    ++samplesPassed;
+                    if (depthRow && state.depthWrite)
+                        depthRow[px] = z;
+                } else {
+                    ++samplesPassed;
+                    if (depthRow && state.depthWrite)
+                        depthRow[px] = z;
+                    fragmentFn(fragment);
+                }
+            };
+
+            if (state.referenceTraversal) {
                 for (int py = minY; py <= maxY; ++py) {
-                    const int64_t rows[3] = {row0, row1, row2};
+                    int64_t w0 = row0, w1 = row1, w2 = row2;
+                    float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;
+                    const double zRow = t.z[0] + t.z[2] * py;
+                    // A triangle's samples in one row are contiguous (the intersection of three
+                    // half-planes is convex, biases included), so the row ends at its first
+                    // uncovered sample after a covered one.
+                    bool spanStarted = false;
+                    for (int px = minX; px <= maxX; ++px) {
+                        if (((w0 + bias0) | (w1 + bias1) | (w2 + bias2)) < 0) {
+                            if (spanStarted)
+                                break;
+                        } else {
+                            spanStarted = true;
+                            shadePixel(px, py, zRow, depthRow);
+                        }
+                        w0 += stepX0;
+                        w1 += stepX1;
+                        w2 += stepX2;
+                    }
                     row0 += stepY0;
                     row1 += stepY1;
                     row2 += stepY2;
-                    // Pixel minX + k is covered when rows[e] + biases[e] + k steps[e] >= 0 for
-                    // every edge: an interval of k, found by integer division.
-                    int64_t kLo = 0, kHi = maxX - minX;
-                    for (int e = 0; e < 3; ++e) {
-                        const int64_t v = rows[e] + biases[e], step = steps[e];
-                        if (step == 0) {
-                            if (v < 0)
-                                kHi = -1;
-                        } else if (step > 0) {
-                            if (v < 0)
-                                kLo = std::max(kLo, (-v + step - 1) / step);
-                        } else if (v < 0) {
-                            kHi = -1;
-                        } else {
-                            kHi = std::min(kHi, v / -step);
-                        }
-                    }
-                    if (kLo > kHi)
-                        continue;
-                    const int lo = minX + int(kLo), hi = minX + int(kHi);
+                }
+                continue;
+            }
+
+            for (int py = minY; py <= maxY; ++py) {
+                const int64_t values[3] = {row0 + bias0, row1 + bias1, row2 + bias2};
+                row0 += stepY0;
+                row1 += stepY1;
+                row2 += stepY2;
+                const detail::RowSpan k = detail::coveredSpan(values, steps, maxX - minX);
+                if (k.kLo > k.kHi)
+                    continue;
+                const int lo = minX + int(k.kLo), hi = minX + int(k.kHi);
+                const double zRow = t.z[0] + t.z[2] * py;
+                if constexpr (kDepthOnly) {
                     samplesCovered += uint64_t(hi - lo + 1);
                     if (!depth) {
                         samplesPassed += uint64_t(hi - lo + 1);
@@ -517,67 +595,18 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                     span.row = depth + size_t(py) * mWidth;
                     span.lo = lo;
                     span.hi = hi;
-                    span.zRow = t.z[0] + t.z[2] * py;
+                    span.zRow = zRow;
                     span.zStep = t.z[1];
                     span.write = state.depthWrite;
                     // Short spans stay inline: the dispatched call costs more than they do.
                     samplesPassed += hi - lo < kShortSpan
                                          ? detail::depthSpanScalarLoop<kDepthTest>(span)
                                          : depthSpan(kDepthTest, span);
+                } else {
+                    float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;
+                    for (int px = lo; px <= hi; ++px)
+                        shadePixel(px, py, zRow, depthRow);
                 }
-                continue;
-            }
-
-            for (int py = minY; py <= maxY; ++py) {
-                int64_t w0 = row0, w1 = row1, w2 = row2;
-                float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;
-                // Depth plane at (px, py) = (z0 + z2 py) + z1 px; px counts in double (exact).
-                const double zRow = t.z[0] + t.z[2] * py;
-                double pxDouble = minX;
-                // A triangle's samples in one row are contiguous (the intersection of three
-                // half-planes is convex, biases included), so the row ends at its first
-                // uncovered sample after a covered one.
-                bool spanStarted = false;
-                for (int px = minX; px <= maxX; ++px, pxDouble += 1.0) {
-                    if (((w0 + bias0) | (w1 + bias1) | (w2 + bias2)) < 0) {
-                        if (spanStarted)
-                            break;
-                    } else {
-                        spanStarted = true;
-                        ++samplesCovered;
-                        const float z = float(std::clamp(zRow + t.z[1] * pxDouble, 0.0, 1.0));
-                        bool pass = !depthRow || detail::depthPasses<kDepthTest>(z, depthRow[px]);
-                        if (pass) {
-                            Fragment fragment;
-                            fragment.x = px;
-                            fragment.y = py;
-                            fragment.depth = z;
-                            if (state.barycentrics)
-                                fragment.barycentric = barycentricAt(batch, index, t, px, py);
-                            fragment.triangle = t.triangle;
-                            fragment.frontFacing = t.frontFacing;
-                            if constexpr (kCanDiscard) {
-                                // Discard (alpha test) before the depth write.
-                                if (detail::keepsAny(fragmentFn(fragment))) {
-                                    ++samplesPassed;
-                                    if (depthRow && state.depthWrite)
-                                        depthRow[px] = z;
-                                }
-                            } else {
-                                ++samplesPassed;
-                                if (depthRow && state.depthWrite)
-                                    depthRow[px] = z;
-                                fragmentFn(fragment);
-                            }
-                        }
-                    }
-                    w0 += stepX0;
-                    w1 += stepX1;
-                    w2 += stepX2;
-                }
-                row0 += stepY0;
-                row1 += stepY1;
-                row2 += stepY2;
             }
         }
     }
