@@ -25,6 +25,23 @@ namespace scenes {
 
 namespace {
 
+// Uniform floats in [lo, hi) from a splitmix64 stream: the procedural scenes' own random numbers,
+// the same on every platform and standard library (std's distributions are not).
+class SplitMix64Uniform {
+public:
+    explicit SplitMix64Uniform(uint64_t seed) : mState(seed) {}
+    float operator()(float lo, float hi) {
+        uint64_t z = (mState += 0x9e3779b97f4a7c15ULL);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+        z ^= z >> 31;
+        return lo + (hi - lo) * float(double(z >> 11) * 0x1.0p-53);
+    }
+
+private:
+    uint64_t mState;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Options
 
@@ -506,14 +523,7 @@ void addWallClutter(Scene& scene, int count, uint64_t seed) {
     const uint32_t firstMesh = uint32_t(scene.meshes.size() - footprints.size());
 
     // Its own splitmix64 stream from the request's seed: the lights' streams stay untouched.
-    uint64_t state = seed ^ 0xC1A77E4C1A77E4ull;
-    auto uniform = [&state](float lo, float hi) {
-        uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-        z ^= z >> 31;
-        return lo + (hi - lo) * float(double(z >> 11) * 0x1.0p-53);
-    };
+    SplitMix64Uniform uniform(seed ^ 0xC1A77E4C1A77E4ull);
     std::vector<Aabb> placed; // world bounds, grown by half the gap
     // Rejection sampling; the cap turns a layout too crowded to place into an error, not a hang.
     const int64_t maxCandidates = 200 * int64_t(count) + 1000;
@@ -828,14 +838,7 @@ Scene buildFoliage(const SceneRequest& request) {
     const std::map<std::string, int> options =
         readOptions(scene.name, request, foliageOptions(request.lightCount.value_or(0)));
     // A fixed splitmix64 stream: the scene never depends on the request's seed (the lights do).
-    uint64_t state = 0xf011a6eULL;
-    auto uniform = [&state](float lo, float hi) {
-        uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-        z ^= z >> 31;
-        return lo + (hi - lo) * float(double(z >> 11) * 0x1.0p-53);
-    };
+    SplitMix64Uniform uniform(0xf011a6eULL);
 
     auto addQuadMesh = [&](const std::string& name, uint32_t material, const glm::vec3& corner,
                            const glm::vec3& edgeU, const glm::vec3& edgeV, int cells) {
