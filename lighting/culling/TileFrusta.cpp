@@ -106,6 +106,10 @@ std::vector<TileSurfaceBounds> boundsOfSamples(const TileGrid& grid,
 std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& gb,
                                                         const TileGrid& grid,
                                                         const TileBoundsOptions& options) {
+    // Without the normal cone only depth is read: from the depth plane, not a whole decoded
+    // surface (which a visibility buffer would fetch from its triangle). Bitwise the same range.
+    if (!options.normalCone)
+        return computeTileDepthBounds(gb.depthDecoder(), gb.depth(), grid, options.depthMask);
     return boundsOfSamples(grid, options,
                            [&gb](int x, int y, int, float& depthMetres, glm::vec3& normalView) {
                                if (!gb.covered(size_t(y) * gb.width() + x))
