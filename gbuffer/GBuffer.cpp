@@ -52,6 +52,10 @@ GBuffer::GBuffer(const GBufferLayout& layout, const CameraView& view)
     mWorldFromView = glm::transpose(view.viewFromWorldNormal);
     const size_t n = pixelCount();
     mDepth.assign(n, mClearDepth); // depth is always there: coverage and positions come from it
+    if (layout.visibilityBuffer) {
+        mVisibilityCodes.assign(n, VisibilityPass::kNoTriangle);
+        return; // every other channel is fetched from the triangle
+    }
     if (layout.hasNormals) {
         if (layout.normals.kind == NormalCodecKind::Float32)
             for (auto& plane : mNormal)
@@ -159,9 +163,38 @@ void GBuffer::writeEncoded(size_t pixel, const Surface& s) {
         mOcclusionPacked[pixel] = uint8_t(unorm8(s.occlusion));
 }
 
+void GBuffer::fetchSurfacesFrom(const VisibilityPass& pass) {
+    if (!mLayout.visibilityBuffer)
+        throw std::logic_error("G-buffer layout '" + mLayout.name +
+                               "' stores its attributes: it fetches no surface");
+    mSurfaceSource = &pass;
+    mSurfaceSourceFrame = pass.frame();
+}
+
+void GBuffer::checkSurfaceSource() const {
+    // A pass that has moved on to another frame would hand out another frame's triangles: wrong
+    // surfaces with no sign of it. One integer compare per decode keeps that loud.
+    if (!mSurfaceSource || mSurfaceSource->frame() != mSurfaceSourceFrame)
+        throw std::logic_error("visibility G-buffer decoded " +
+                               std::string(mSurfaceSource
+                                               ? "after its pass transformed another frame"
+                                               : "before the G-buffer pass filled it"));
+}
+
+Surface GBuffer::fetchedSurface(int x, int y) const {
+    checkSurfaceSource();
+    const uint32_t code = mVisibilityCodes[size_t(y) * size_t(width()) + size_t(x)];
+    return code == VisibilityPass::kNoTriangle ? Surface{} : mSurfaceSource->surfaceAt(code, x, y);
+}
+
 Surface GBuffer::decode(int x, int y) const {
     const CameraView& view = mDepthDecoder.view();
     const size_t pixel = size_t(y) * view.width + x;
+    if (mLayout.visibilityBuffer) {
+        Surface s = fetchedSurface(x, y);
+        s.positionView = mDepthDecoder.positionView(x, y, mDepth[pixel]);
+        return s;
+    }
     Surface s;
     s.positionView = mDepthDecoder.positionView(x, y, mDepth[pixel]);
     if (!mNormal[0].empty()) {

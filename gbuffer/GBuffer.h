@@ -16,6 +16,11 @@
 //   one 16-bit array when something decodes from the material table. Emission: three float planes
 //   or nothing (material index, none). The material model is not
 //   stored per pixel: it is the layout's constant or the material's (GBufferLayout.h).
+// - Visibility buffer (layout.visibilityBuffer): depth and one u32 plane of visibility codes, no
+//   attribute plane. decode() and emission() fetch the surface from the VisibilityPass that drew
+//   the codes (fetchSurfacesFrom, set by the G-buffer pass): bitwise the surface the G-buffer pass
+//   resolves into the lossless layouts' planes. That pass must outlive the reads and must not
+//   transform another frame before them (checked: std::logic_error).
 // View-space position is reconstructed from depth by the layout's DepthDecoder (DepthFormat.h:
 // inverse projection or view ray). Decoding is const and thread-safe; writing a pixel is safe
 // concurrently with writing other pixels.
@@ -31,6 +36,7 @@
 #include "gbuffer/Surface.h"
 #include "gbuffer/codecs/DepthFormat.h"
 #include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/VisibilityPass.h"
 
 namespace gbuffer {
 
@@ -114,6 +120,9 @@ public:
     // The emitted radiance of a covered pixel, decoded alone (decode() sets Surface::emissive
     // too): what the stages add once per pixel after their light sum.
     glm::vec3 emission(size_t pixel) const {
+        if (mLayout.visibilityBuffer)
+            return fetchedSurface(int(pixel % size_t(width())), int(pixel / size_t(width())))
+                .emissive;
         switch (mLayout.emission) {
         case EmissionEncoding::Float32:
             return {mEmission[0][pixel], mEmission[1][pixel], mEmission[2][pixel]};
@@ -134,6 +143,30 @@ public:
         return true;
     }
 
+    // The covered pixels x0 .. x0 + count - 1 of row y in order, visit(x, surface) for each:
+    // bitwise decode(x, y). For the visibility buffer, pixels of one triangle in the run share
+    // its fetched corners and row weights (VisibilityPass::RowSurfaces), the way the G-buffer
+    // pass resolves them, instead of fetching per pixel.
+    template <class Visit> void decodeRun(int x0, int count, int y, Visit&& visit) const {
+        const size_t row = size_t(y) * size_t(width());
+        if (!mLayout.visibilityBuffer) {
+            for (int x = x0; x < x0 + count; ++x)
+                if (covered(row + size_t(x)))
+                    visit(x, decode(x, y));
+            return;
+        }
+        checkSurfaceSource();
+        VisibilityPass::RowSurfaces surfaces(*mSurfaceSource, y);
+        for (int x = x0; x < x0 + count; ++x) {
+            const uint32_t code = mVisibilityCodes[row + size_t(x)];
+            if (code == VisibilityPass::kNoTriangle)
+                continue;
+            Surface s = surfaces.at(code, x);
+            s.positionView = mDepthDecoder.positionView(x, y, mDepth[row + size_t(x)]);
+            visit(x, s);
+        }
+    }
+
     // The working depth plane the G-buffer pass draws into: NDC depth in the view's convention,
     // the far plane's value where nothing was drawn.
     std::span<float> depthPlane() { return mDepth; }
@@ -152,7 +185,17 @@ public:
     }
     std::span<const float> occlusionPlane() const { return mOcclusion; }
 
+    // Visibility-buffer layouts (else empty): the codes the G-buffer pass stores (one per pixel,
+    // VisibilityPass::kNoTriangle for background) and the pass whose triangles they index.
+    std::span<uint32_t> visibilityCodePlane() { return mVisibilityCodes; }
+    std::span<const uint32_t> visibilityCodes() const { return mVisibilityCodes; }
+    void fetchSurfacesFrom(const VisibilityPass& pass);
+
 private:
+    // The surface of a covered pixel of a visibility-buffer layout, positionView left zero.
+    Surface fetchedSurface(int x, int y) const;
+    // Throws std::logic_error unless the visibility codes' pass still holds their frame.
+    void checkSurfaceSource() const;
     glm::vec3 viewRayOfPixel(size_t pixel) const;
     bool hasEncodedPlanes() const;
     // The planes Writer cannot store directly: normal codes, packed albedo, packed specular.
@@ -164,19 +207,22 @@ private:
         1.0f}; // for world-space normal codes (viewFromWorldNormal is a rotation)
     float mClearDepth;
     Plane<float> mDepth;
-    Plane<float> mNormal[3];                  // float32 normals
-    Plane<uint32_t> mNormalCode32;            // codes of up to 32 bits
-    Plane<uint64_t> mNormalCode64;            // longer codes (xyz:48)
-    Plane<float> mAlbedo[3];                  // f32
-    Plane<uint32_t> mAlbedoPacked;            // rgb8-srgb
-    Plane<float> mSpecular[2];                // f32
-    Plane<uint32_t> mSpecularPacked;          // unorm8+f16, unorm8+log8
-    Plane<float> mRoughnessMetallic[2];       // f32 roughness, metallic
-    Plane<uint16_t> mRoughnessMetallicPacked; // unorm8 roughness | unorm8 metallic << 8
-    Plane<float> mOcclusion;                  // f32 ambient occlusion
-    Plane<uint8_t> mOcclusionPacked;          // unorm8 ambient occlusion
-    Plane<float> mEmission[3];                // f32 emitted radiance
-    Plane<uint16_t> mMaterial;                // material index
+    Plane<float> mNormal[3];                        // float32 normals
+    Plane<uint32_t> mNormalCode32;                  // codes of up to 32 bits
+    Plane<uint64_t> mNormalCode64;                  // longer codes (xyz:48)
+    Plane<float> mAlbedo[3];                        // f32
+    Plane<uint32_t> mAlbedoPacked;                  // rgb8-srgb
+    Plane<float> mSpecular[2];                      // f32
+    Plane<uint32_t> mSpecularPacked;                // unorm8+f16, unorm8+log8
+    Plane<float> mRoughnessMetallic[2];             // f32 roughness, metallic
+    Plane<uint16_t> mRoughnessMetallicPacked;       // unorm8 roughness | unorm8 metallic << 8
+    Plane<float> mOcclusion;                        // f32 ambient occlusion
+    Plane<uint8_t> mOcclusionPacked;                // unorm8 ambient occlusion
+    Plane<float> mEmission[3];                      // f32 emitted radiance
+    Plane<uint16_t> mMaterial;                      // material index
+    Plane<uint32_t> mVisibilityCodes;               // visibility buffer: triangle + back-face bit
+    const VisibilityPass* mSurfaceSource = nullptr; // visibility buffer: what the codes index
+    uint64_t mSurfaceSourceFrame = 0;               // its frame() when the codes were stored
 };
 
 } // namespace gbuffer

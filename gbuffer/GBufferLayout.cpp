@@ -134,6 +134,10 @@ bool GBufferLayout::provides(Channel channel) const {
 std::vector<PlaneDesc> GBufferLayout::planes() const {
     std::vector<PlaneDesc> result;
     result.push_back({"Z", depth.text(), depth.bits(), "depth"});
+    if (visibilityBuffer) {
+        result.push_back({"triangle", "u32 visibility code", 32, "visibility"});
+        return result;
+    }
     if (hasNormals) {
         if (normals.kind == NormalCodecKind::Float32) {
             for (const char* name : {"N.X", "N.Y", "N.Z"})
@@ -258,6 +262,8 @@ std::string GBufferLayout::explain() const {
     for (Channel channel :
          {Channel::Normal, Channel::Albedo, Channel::Specular, Channel::Emission}) {
         const bool stored = [&] {
+            if (visibilityBuffer)
+                return false;
             for (const PlaneDesc& plane : planes())
                 if (plane.channel == channelName(channel))
                     return true;

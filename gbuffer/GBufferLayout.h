@@ -26,6 +26,14 @@
 // here reads (ambient occlusion, motion vectors, stencil...). They count in bytesPerPixel, so the
 // preset's size is the published one, but are never allocated.
 //
+// The visibility buffer (`visibilityBuffer`, preset "visibility"; Burns & Hunt, "The Visibility
+// Buffer", JCGT 2013) stores depth and the visible triangle's visibility code (32 bits) and no
+// attribute at all: every other channel is fetched from the triangle (its vertices interpolated at
+// the pixel centre, its material and textures read) where the stage decodes the pixel, so each
+// channel is exactly what the rasterizer computes (the lossless layouts' values) for 8 bytes per
+// pixel, and the cost moves from G-buffer bytes to fetches at shading time. The channel encodings
+// below then only say which channels the scene has (emission present or not); no plane is stored.
+//
 // Readers never touch planes: they call GBuffer::decode. Layouts are built by LayoutDerivation.h.
 #pragma once
 
@@ -117,6 +125,9 @@ struct GBufferLayout {
     // (e.g. occlusion textures without an ambient light): explain()'s "(no ... plane)" lines.
     std::vector<std::pair<std::string, std::string>> absentPlanes;
     std::vector<std::string> notes; // e.g. where a preset departs from its source
+    // Depth and the visibility code only; every other channel is fetched from the triangle where
+    // it is decoded (see the top of this file). The encodings above are then not stored.
+    bool visibilityBuffer = false;
 
     // Whether a reader can decode this channel (a `constant` channel can, with no plane).
     bool provides(Channel channel) const;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 namespace gbuffer {
@@ -20,6 +21,11 @@ GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geomet
 
 void GBufferPass::resolve(std::span<const uint32_t> codeSpan, GBuffer& target,
                           ExactSurface* exact) const {
+    if (target.layout().visibilityBuffer) {
+        storeCodes(codeSpan, target);
+        if (!exact)
+            return;
+    }
     const int width = target.width();
     const GBuffer::Writer sharedWriter = target.writer();
     const uint32_t* codes = codeSpan.data();
@@ -36,7 +42,7 @@ void GBufferPass::resolve(std::span<const uint32_t> codeSpan, GBuffer& target,
                 continue;
             }
             const Surface& surface = row.at(code, x);
-            writer.write(pixel, surface);
+            writer.write(pixel, surface); // no plane to write for the visibility buffer
             if (exact) {
                 exact->triangle[pixel] = VisibilityPass::triangleOf(code);
                 exact->backFacing[pixel] = VisibilityPass::backFaceOf(code) ? 1 : 0;
@@ -51,8 +57,21 @@ void GBufferPass::resolve(std::span<const uint32_t> codeSpan, GBuffer& target,
     });
 }
 
+void GBufferPass::storeCodes(std::span<const uint32_t> codes, GBuffer& target) const {
+    const std::span<uint32_t> stored = target.visibilityCodePlane();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, codes.size(), 65536), [&](const auto& range) {
+        std::copy(codes.begin() + range.begin(), codes.begin() + range.end(),
+                  stored.begin() + range.begin());
+    });
+    target.fetchSurfacesFrom(mVisibility);
+}
+
 void GBufferPass::resolveSparse(std::span<const uint32_t> codes, GBuffer& target,
                                 std::vector<uint8_t>& written) const {
+    if (target.layout().visibilityBuffer) {
+        storeCodes(codes, target);
+        return;
+    }
     const int width = target.width();
     const GBuffer::Writer sharedWriter = target.writer();
     tbb::parallel_for(0, target.height(), [&](int y) {

@@ -74,6 +74,9 @@ private:
     // Encodes the surfaces of `codes` (one per pixel) into `target`, whose depth plane holds
     // their depths already.
     void resolve(std::span<const uint32_t> codes, GBuffer& target, ExactSurface* exact) const;
+    // Visibility-buffer layouts: `codes` copied into the target, which then fetches its surfaces
+    // from this pass's visibility pass.
+    void storeCodes(std::span<const uint32_t> codes, GBuffer& target) const;
     // The same for an upper fragment layer (mostly background): surfaces where `codes` has one,
     // the background value where `written` says the last frame left a surface; `written` updated.
     void resolveSparse(std::span<const uint32_t> codes, GBuffer& target,

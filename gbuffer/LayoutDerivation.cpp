@@ -46,7 +46,8 @@ bool oneModel(const scenes::Scene& scene, const std::set<uint32_t>& used) {
 } // namespace
 
 std::vector<std::string> layoutPresetNames() {
-    return {"reference", "compact", "stalker", "clear-sky", "killzone2", "bf3", "thesis", "ue4"};
+    return {"reference", "compact", "stalker", "clear-sky", "killzone2",
+            "bf3",       "thesis",  "ue4",     "visibility"};
 }
 
 std::vector<MaterialConstants> materialTable(const scenes::Scene& scene) {
@@ -272,6 +273,30 @@ GBufferLayout presetLayout(const std::string& name, const scenes::Scene& scene) 
         addEmission(layout, scene, true);
         return layout;
     }
+    if (name == "visibility") {
+        // Which channels exist (emission or not, the material models) is the derived layout's
+        // answer for a stage that reads everything; nothing but depth and the code is stored.
+        layout = deriveLayout(scene, everything);
+        layout.name = "visibility";
+        layout.visibilityBuffer = true;
+        layout.reasons[Channel::Depth] =
+            "position is reconstructed from depth (float32, reversed Z); coverage too";
+        const std::string fetched =
+            "fetched from the visible triangle where the stage decodes the pixel (visibility "
+            "buffer: ";
+        layout.reasons[Channel::Normal] = fetched + "vertex normals interpolated at the pixel "
+                                                    "centre, normal map applied)";
+        layout.reasons[Channel::Albedo] = fetched + "material colour times its texture)";
+        layout.reasons[Channel::Specular] = fetched + "material parameters and textures)";
+        layout.reasons[Channel::Emission] = fetched + "material emission times its texture)";
+        layout.planeReasons["triangle"] =
+            "visible triangle index + back-face bit (Burns & Hunt 2013): every attribute is "
+            "fetched from it at shading time, exactly as the G-buffer pass computes it";
+        layout.notes.push_back("8 bytes per pixel whatever the materials; the cost moves to the "
+                               "stages, which interpolate each pixel's attributes every time they "
+                               "decode it");
+        return layout;
+    }
     if (name == "compact") {
         layout = deriveLayout(scene, everything);
         layout.name = "compact";
@@ -429,6 +454,10 @@ GBufferLayout makeLayout(const scenes::Scene& scene, const std::vector<Channel>&
                          const std::string& stageName, const LayoutRequest& request) {
     GBufferLayout layout = request.preset.empty() ? deriveLayout(scene, stageReads)
                                                   : presetLayout(request.preset, scene);
+    if (layout.visibilityBuffer && (request.normals || request.normalSpace))
+        throw std::invalid_argument(
+            "G-buffer layout 'visibility' stores no normals (they are interpolated from the "
+            "visible triangle where the stage shades): --normals and --normal-space do not apply");
     if (request.normals) {
         if (!reads(stageReads, Channel::Normal) && !layout.hasNormals) {
             layout.notes.push_back("stage '" + stageName +

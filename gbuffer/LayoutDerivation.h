@@ -22,9 +22,10 @@
 // The derived layout is lossless with respect to what the rasterizer computes: brute on it gives
 // bitwise the image of brute on `reference`. Lossy choices are opt-in (overrides, presets).
 //
-// Presets: reference, compact, and the thesis' historical layouts stalker, clear-sky, killzone2,
-// bf3, thesis (see presetLayout in the .cpp for each one's mapping and where it departs from the
-// published layout; the notes say so in --explain-layout).
+// Presets: reference, compact, the visibility buffer (depth + triangle code, every channel fetched
+// where it is decoded: GBufferLayout.h), and the thesis' historical layouts stalker, clear-sky,
+// killzone2, bf3, thesis, ue4 (see presetLayout in the .cpp for each one's mapping and where it
+// departs from the published layout; the notes say so in --explain-layout).
 #pragma once
 
 #include <optional>

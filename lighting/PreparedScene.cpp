@@ -78,6 +78,10 @@ std::unique_ptr<gbuffer::GBuffer> PreparedScene::renderLosslessGBuffer() {
                            scene),
         view);
     mPass->render(*mRasterizer, *lossless, nullptr);
+    // A visibility-buffer frame fetches its surfaces from the pass, which has just prepared
+    // another frame (the same view, but its reads check the frame): draw the frame's own again.
+    if (gbuffer->layout().visibilityBuffer)
+        mPass->render(*mRasterizer, *gbuffer, exact.get(), multisample.get());
     return lossless;
 }
 

@@ -17,6 +17,7 @@ void VisibilityPass::checkTriangleCount(const scenes::Scene& scene, const SceneG
 void VisibilityPass::transform(const scenes::Scene& scene, const SceneGeometry& geometry,
                                const CameraView& view, bool alphaToCoverage) {
     checkTriangleCount(scene, geometry);
+    ++mFrame;
     mScene = &scene;
     mGeometry = &geometry;
     mView = view;

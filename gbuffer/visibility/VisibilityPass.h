@@ -63,6 +63,9 @@ public:
     void transform(const scenes::Scene& scene, const SceneGeometry& geometry,
                    const CameraView& view, bool alphaToCoverage = false);
     const CameraView& view() const { return mView; }
+    // How many frames transform() has prepared: what a reader holding codes of an earlier frame
+    // checks (GBuffer's visibility layout).
+    uint64_t frame() const { return mFrame; }
     const SceneGeometry& geometry() const { return *mGeometry; }
     std::span<const glm::vec4> clipPositions() const { return mClipPositions; }
     // The scene's triangles in clip space, for draws after transform().
@@ -153,6 +156,7 @@ private:
     std::vector<float> mCentreDepths; // multisampled draws: per sample (centreDepths())
     int mSamples = 1;
     AlphaCoverage mAlpha;
+    uint64_t mFrame = 0;
 };
 
 // The surfaces of one pixel row, for loops over the visibility buffer (the G-buffer resolve, the

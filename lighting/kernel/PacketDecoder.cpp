@@ -59,7 +59,10 @@ void requirePlane(const void* plane, const char* name, const gbuffer::GBufferLay
 
 bool PacketDecoder::supports(const gbuffer::GBufferLayout& layout, std::string* why) {
     std::string reason;
-    if (!layout.hasNormals)
+    if (layout.visibilityBuffer)
+        reason = "the visibility buffer stores no attribute plane (surfaces are fetched from the "
+                 "triangle per pixel)";
+    else if (!layout.hasNormals)
         reason = "the layout stores no normals";
     else if (layout.normals.kind != gbuffer::NormalCodecKind::Float32)
         reason = "normals are stored as codes (only float32 normals are decoded by packets)";

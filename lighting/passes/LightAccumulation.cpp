@@ -67,13 +67,13 @@ void PacketPath::decode(int x0, int y0, kernel::ShadingPacket& packet) const {
         decoder->decode(isa, x0, y0, packet);
         return;
     }
+    // Row by row (lanes are row-major): a visibility buffer fetches each triangle once per row.
     packet.clear(x0, y0);
-    for (int lane = 0; lane < kPacketLanes; ++lane) {
-        const int x = x0 + kernel::laneX(lane), y = y0 + kernel::laneY(lane);
-        gbuffer::Surface s;
-        if (x < gbuffer.width() && y < gbuffer.height() && gbuffer.surfaceAt(x, y, s))
-            setLaneSurface(packet, lane, s);
-    }
+    const int count = std::min(kPacketWidth, gbuffer.width() - x0);
+    for (int row = 0; row < kPacketHeight && y0 + row < gbuffer.height(); ++row)
+        gbuffer.decodeRun(x0, count, y0 + row, [&](int x, const gbuffer::Surface& s) {
+            setLaneSurface(packet, row * kPacketWidth + (x - x0), s);
+        });
 }
 
 void PacketPath::record(StageResult& result) const {
