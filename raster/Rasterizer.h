@@ -56,6 +56,8 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -123,6 +125,16 @@ struct RasterState {
     // the tile in cache for its triangles, where a clear before draw() streams the whole buffer
     // through memory once more (shadow maps: 96 faces of 1 MB per frame).
     std::optional<float> clearDepth;
+    // With clearDepth, optional: one entry per tile (tileCountX() * tileCountY(), row-major) saying
+    // whether the tile of the depth buffer may hold anything but clearDepth, kept by the caller
+    // with its buffer (all 1 for a buffer of unknown content, all 0 for one filled with
+    // clearDepth). A tile marked 0 that no triangle is binned to is then left as it is instead of
+    // being cleared again, and each entry is rewritten to whether triangles were binned to its
+    // tile. The depth buffer is bitwise the one a full clear gives; the saving is the clear of
+    // empty tiles (shadow maps: about two thirds of the atrium's cube-face tiles hold no caster).
+    // The span's elements are written even though the state is const: it is the buffer's record,
+    // not a setting.
+    std::span<uint8_t> tilesNotClear;
     // The oracle of the tests: when set, the one-sample traversal edge-tests every pixel of the
     // triangle's bounding box in turn (no per-row span by division, no hierarchical depth, no
     // depth-only span loop). The output is bitwise the same, fragments in the same order and
@@ -241,7 +253,8 @@ public:
     int height() const { return mHeight; }
 
     // Rasterizes every triangle; depth (width*height*state.samples floats, row 0 = top) may be
-    // null for no depth test. Throws std::invalid_argument for an unsupported sample count. Cost:
+    // null for no depth test. Throws std::invalid_argument for an unsupported sample count or a
+    // state.tilesNotClear of the wrong size. Cost:
     // set-up O(triangles), traversal O(covered bounding-box pixels).
     template <class FragmentFn>
     void draw(const TriangleList& triangles, const RasterState& state, float* depth,
@@ -389,9 +402,25 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
     const auto traversalStart = std::chrono::steady_clock::now();
     const int tileCount = mTilesX * mTilesY;
     mTileStats.assign(size_t(tileCount), TileStats{});
+    const bool trackClearTiles = depth && state.clearDepth && !state.tilesNotClear.empty();
+    if (trackClearTiles && state.tilesNotClear.size() != size_t(tileCount))
+        throw std::invalid_argument("RasterState::tilesNotClear holds " +
+                                    std::to_string(state.tilesNotClear.size()) + " entries for " +
+                                    std::to_string(tileCount) + " tiles");
     auto rasterize = [&](int tile) {
-        if (depth && state.clearDepth)
+        if (trackClearTiles) {
+            bool binned = false;
+            for (const Batch& batch : mBatches)
+                binned |= batch.binOffsets[size_t(tile) + 1] > batch.binOffsets[size_t(tile)];
+            uint8_t& notClear = state.tilesNotClear[size_t(tile)];
+            if (binned || notClear)
+                clearTile(tile, state.samples, *state.clearDepth, depth);
+            notClear = binned ? 1 : 0;
+            if (!binned)
+                return; // nothing to draw; its statistics stay zero
+        } else if (depth && state.clearDepth) {
             clearTile(tile, state.samples, *state.clearDepth, depth);
+        }
         RasterStats& stats = mTileStats[size_t(tile)].stats;
         const bool multisample = state.samples > 1;
         switch (state.depthTest) {

@@ -55,6 +55,13 @@ using Clock = std::chrono::steady_clock;
 // before its triangles are (consecutive triangles of one mesh are close together).
 constexpr uint32_t kTrianglesPerChunk = 64;
 
+// A face's depth buffer and its record of which tiles are not clear (ShadowFace), handed from a
+// frame's maps to the next frame's.
+struct DepthBuffer {
+    std::vector<float> depth;
+    std::vector<uint8_t> tilesNotClear;
+};
+
 double milliseconds(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -276,12 +283,12 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
 
     ShadowMaps maps;
     // The depth buffers of a previous frame's maps, reused: a fresh face costs its page faults
-    // (the kernel zeroes every new page) on top of its clear.
-    std::vector<std::vector<float>> depthPool;
+    // (the kernel zeroes every new page) on top of its clear. Indexed by the previous face, so
+    // that a face takes over its own last buffer, whose drawn tiles are then mostly its own.
+    std::vector<DepthBuffer> depthPool;
     if (recycled) {
         for (ShadowFace& face : recycled->mFaces)
-            if (face.depth.capacity() > 0)
-                depthPool.push_back(std::move(face.depth));
+            depthPool.push_back({std::move(face.depth), std::move(face.tilesNotClear)});
         recycled->mFaces.clear();
         recycled->mFaceViews.clear();
         recycled->mShadowViews.clear();
@@ -500,7 +507,8 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     // exactly: ShadowCasterSets.h). Without receivers in view, or with settings.casterSets off,
     // every instance.
     const bool useSets = settings.casterSets && receiverFar > receiverNear && !sceneBounds.empty();
-    const std::vector<scenes::Aabb> objectBounds = instanceBounds(geometry, scene.instances.size());
+    const std::vector<scenes::Aabb> objectBounds =
+        instanceBoundsFromChunks(geometry, scene.instances.size(), chunkBounds, kTrianglesPerChunk);
     const std::vector<glm::dvec3> frustumCorners =
         useSets ? frustumCornersWorld(view, receiverNear, receiverFar) : std::vector<glm::dvec3>{};
     const double sweepMetres = 1.01 * double(glm::length(sceneBounds.size())) + 1.0;
@@ -605,9 +613,15 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     tbb::enumerable_thread_specific<RenderScratch::Thread>& scratches = maps.mScratch->threads;
     std::vector<double> faceMs(maps.mFaces.size(), 0.0);
     std::vector<uint64_t> faceTriangles(maps.mFaces.size(), 0);
-    std::vector<std::vector<float>> pooled(maps.mFaces.size());
+    // Face f takes the buffer of the previous frame's face f; faces beyond the previous count
+    // (or whose previous face had none) take what is left.
+    std::vector<DepthBuffer> pooled(maps.mFaces.size());
+    for (size_t f = 0; f < maps.mFaces.size() && f < depthPool.size(); ++f)
+        if (!maps.mFaces[f].empty)
+            pooled[f] = std::move(depthPool[f]);
+    std::erase_if(depthPool, [](const DepthBuffer& b) { return b.depth.capacity() == 0; });
     for (size_t f = 0; f < maps.mFaces.size() && !depthPool.empty(); ++f)
-        if (!maps.mFaces[f].empty) {
+        if (!maps.mFaces[f].empty && pooled[f].depth.capacity() == 0) {
             pooled[f] = std::move(depthPool.back());
             depthPool.pop_back();
         }
@@ -708,11 +722,21 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                 : std::span<const uint32_t>(scratch.faceIndices);
         if (!face.paraboloid)
             faceTriangles[f] = scratch.faceIndices.size() / 3;
-        // Cleared to 0 (nothing: the far plane) tile by tile inside the draw (clearDepth).
-        face.depth = std::move(pooled[f]);
-        face.depth.resize(size_t(size) * size_t(size));
-        rasterizer->draw(raster::TriangleList{scratch.clip, drawIndices}, state, face.depth.data(),
-                         raster::DepthOnly{});
+        // Cleared to 0 (nothing: the far plane) tile by tile inside the draw (clearDepth), only
+        // where the buffer is not clear already or casters are drawn (tilesNotClear). A buffer
+        // of another size is refilled: its tiles' record no longer describes it.
+        const size_t texels = size_t(size) * size_t(size);
+        const size_t tiles = size_t(rasterizer->tileCountX()) * size_t(rasterizer->tileCountY());
+        face.depth = std::move(pooled[f].depth);
+        face.tilesNotClear = std::move(pooled[f].tilesNotClear);
+        if (face.depth.size() != texels || face.tilesNotClear.size() != tiles) {
+            face.depth.assign(texels, 0.0f);
+            face.tilesNotClear.assign(tiles, 0);
+        }
+        raster::RasterState faceState = state;
+        faceState.tilesNotClear = face.tilesNotClear;
+        rasterizer->draw(raster::TriangleList{scratch.clip, drawIndices}, faceState,
+                         face.depth.data(), raster::DepthOnly{});
         faceMs[f] = milliseconds(faceStart);
     };
     if (settings.schedule == ShadowSchedule::FacesInParallel) {

@@ -106,6 +106,11 @@ struct ShadowFace {
     bool empty = false;       // nothing to receive (a cascade outside the scene): lookups lit
     int mapSize = 0;          // its light's (ShadowLightStats::settings.mapSize)
     std::vector<float> depth; // mapSize^2, row 0 at the top; empty when `empty`
+    // Per rasterizer tile of `depth` (raster::RasterState::tilesNotClear): whether casters were
+    // binned to it; 0 = the tile holds only 0 (far). It travels with the buffer to the next
+    // frame's maps (render's `recycled`), whose draw then clears only the tiles that are not
+    // already clear.
+    std::vector<uint8_t> tilesNotClear;
 };
 
 // Per shadow (one casting light).
@@ -157,8 +162,9 @@ public:
     // floats per face. Throws std::invalid_argument for a mapSize (global or a light's own)
     // outside [1, 16384] or
     // cascades outside [1, 8]. `recycled`, when given, is a previous frame's maps whose depth
-    // buffers and rasterizers the new maps take over (it is left without faces): a frame then
-    // pays no allocation or page fault for its maps, only their clear.
+    // buffers and rasterizers the new maps take over (it is left without faces), face i the
+    // buffer of its face i: a frame then pays no allocation or page fault for its maps, and
+    // clears only the tiles that either frame drew into.
     static ShadowMaps render(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
                              const gbuffer::CameraView& view, const ShadowSettings& settings,
                              ShadowMaps* recycled = nullptr);

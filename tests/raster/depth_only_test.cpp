@@ -3,7 +3,8 @@
 // planes and the guard band, shared edges of fans), with every depth test, depth writes on and
 // off, every cull mode, the depth buffer must be bitwise the same and the coverage counters
 // equal, for 1 and 2 threads. The span loop's SIMD form (DepthSpan.h) against its scalar oracle,
-// and the in-draw clear (RasterState::clearDepth) against a clear before the draw.
+// and the in-draw clear (RasterState::clearDepth) against a clear before the draw, with and
+// without the record of clear tiles (RasterState::tilesNotClear).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -208,6 +209,93 @@ TEST(DepthOnlyPath, ClearInsideTheDrawEqualsAClearBefore) {
                 << samples << " samples, " << threads << " threads";
             EXPECT_GT(std::count(before.begin(), before.end(), 0.0f), 1000) << "uncovered pixels";
         }
+}
+
+// RasterState::tilesNotClear: frame after frame into one buffer, with casters moving between
+// tiles (and a frame with none), the buffer is bitwise a full clear's after every draw, for 1
+// and 2 threads; a tile recorded clear that no triangle reaches is not written at all (its
+// sentinel survives: the clear really is skipped), and the record is rewritten to the tiles
+// triangles were binned to.
+TEST(DepthOnlyPath, ClearOnlyTilesNotClearEqualsAFullClear) {
+    const int width = 301, height = 203; // 3 x 2 tiles of 128, partial ones at the edges
+    // Small triangles around NDC centres: each lies within one tile.
+    auto trianglesAt = [](std::initializer_list<glm::vec2> centres) {
+        Mesh mesh;
+        for (const glm::vec2& c : centres) {
+            const uint32_t base = uint32_t(mesh.positions.size());
+            mesh.positions.insert(mesh.positions.end(), {glm::vec4(c.x - 0.1f, c.y - 0.1f, 0.3f, 1),
+                                                         glm::vec4(c.x + 0.1f, c.y - 0.1f, 0.5f, 1),
+                                                         glm::vec4(c.x, c.y + 0.1f, 0.4f, 1)});
+            mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
+        }
+        return mesh;
+    };
+    // NDC y up, row 0 at the top: (-0.6, 0.5) is in tile 0, (0.1, -0.5) in tile 4, (0.8, 0.5)
+    // in tile 2.
+    const std::vector<Mesh> frames = {
+        trianglesAt({{-0.6f, 0.5f}}), trianglesAt({{0.1f, -0.5f}, {0.8f, 0.5f}}), Mesh{},
+        trianglesAt({{-0.6f, 0.5f}, {0.1f, -0.5f}}), randomMesh(29, 40)};
+    for (int threads : {1, 2}) {
+        raster::RasterState state;
+        state.depthTest = DepthTest::Greater;
+        state.cullMode = CullMode::None;
+        state.barycentrics = false;
+        state.clearDepth = 0.0f;
+        std::vector<float> kept(size_t(width) * height, 0.0f);
+        std::vector<uint8_t> record(6, 0);
+        tbb::task_arena(threads).execute([&] {
+            raster::Rasterizer rasterizer(width, height);
+            ASSERT_EQ(rasterizer.tileCountX() * rasterizer.tileCountY(), 6);
+            for (size_t frame = 0; frame < frames.size(); ++frame) {
+                const raster::TriangleList triangles{frames[frame].positions,
+                                                     frames[frame].indices};
+                std::vector<float> full(kept.size(), 0.5f);
+                raster::RasterState fullState = state;
+                rasterizer.draw(triangles, fullState, full.data(), raster::DepthOnly{});
+                const std::vector<uint8_t> before = record;
+                // A sentinel in the last pixel of every tile recorded clear: it must survive
+                // exactly where no triangle is binned.
+                std::vector<size_t> sentinels;
+                for (int tile = 0; tile < 6; ++tile)
+                    if (!record[size_t(tile)]) {
+                        const int x = std::min((tile % 3) * 128 + 127, width - 1);
+                        const int y = std::min((tile / 3) * 128 + 127, height - 1);
+                        sentinels.push_back(size_t(y) * width + size_t(x));
+                    }
+                for (size_t i : sentinels)
+                    kept[i] = -1.0f;
+                raster::RasterState keptState = state;
+                keptState.tilesNotClear = record;
+                rasterizer.draw(triangles, keptState, kept.data(), raster::DepthOnly{});
+                for (int tile = 0; tile < 6; ++tile) {
+                    const int x0 = (tile % 3) * 128, y0 = (tile / 3) * 128;
+                    const size_t sentinel = size_t(std::min(y0 + 127, height - 1)) * width +
+                                            size_t(std::min(x0 + 127, width - 1));
+                    if (!before[size_t(tile)] && !record[size_t(tile)]) {
+                        EXPECT_EQ(kept[sentinel], -1.0f)
+                            << "frame " << frame << ", tile " << tile << " was cleared again";
+                        kept[sentinel] = 0.0f; // what the tile holds apart from the sentinel
+                    }
+                }
+                EXPECT_EQ(0, std::memcmp(kept.data(), full.data(), kept.size() * sizeof(float)))
+                    << "frame " << frame << ", " << threads << " threads";
+            }
+        });
+        // The last frame (random triangles over the whole screen) reaches every tile, the
+        // empty frame none.
+        EXPECT_EQ(record, std::vector<uint8_t>(6, 1));
+    }
+    // A record of the wrong size is refused.
+    raster::RasterState state;
+    state.clearDepth = 0.0f;
+    std::vector<uint8_t> record(5, 0);
+    state.tilesNotClear = record;
+    std::vector<float> depth(size_t(width) * height, 0.0f);
+    raster::Rasterizer rasterizer(width, height);
+    const Mesh mesh = trianglesAt({{0.0f, 0.0f}});
+    EXPECT_THROW(rasterizer.draw(raster::TriangleList{mesh.positions, mesh.indices}, state,
+                                 depth.data(), raster::DepthOnly{}),
+                 std::invalid_argument);
 }
 
 } // namespace

@@ -917,4 +917,44 @@ TEST(ShadowMaps, RecycledBuffersGiveTheSameMapsInTheSameMemory) {
     }
 }
 
+// Frames whose casters move between the faces' tiles (the lights move, a box appears, the map
+// size changes, a light is dropped) and that take over the last frame's buffers and their
+// record of drawn tiles (ShadowFace::tilesNotClear) give bitwise the maps a fresh render gives,
+// and the record is the fresh render's.
+TEST(ShadowMaps, RecycledBuffersStayExactWhenTheCastersMove) {
+    auto frameScene = [](int step) {
+        TestScene t;
+        t.ground(10.0f);
+        t.box({-1, 0, -4}, {1, 2, -3});
+        if (step % 2 == 1)
+            t.box({2, 0, -2}, {2.5f, 3, -1.5f});
+        t.camera({0, 2, 3}, {0, 0, -4});
+        t.light(pointLight({0.7f * float(step), 3, -2}, 10.0f));
+        if (step != 2)
+            t.light(spotLight({2, 4, float(step) - 1.0f}, {-0.3f, -1.0f, -0.5f}, 12.0f, 40.0f));
+        t.light(directionalLight({0.2f, -1.0f, -0.3f + 0.1f * float(step)}));
+        return t.scene;
+    };
+    ShadowMaps previous;
+    size_t clearTilesSeen = 0;
+    for (int step = 0; step < 5; ++step) {
+        ShadowSettings settings = noFilter();
+        settings.mapSize = step == 3 ? 384 : 256;
+        const Frame fresh(frameScene(step), settings);
+        ShadowMaps next =
+            ShadowMaps::render(fresh.scene, fresh.geometry, fresh.view, settings, &previous);
+        ASSERT_EQ(next.faceCount(), fresh.maps.faceCount()) << "step " << step;
+        for (size_t f = 0; f < next.faceCount(); ++f) {
+            EXPECT_EQ(next.face(f).depth, fresh.maps.face(f).depth)
+                << "step " << step << ", face " << f;
+            EXPECT_EQ(next.face(f).tilesNotClear, fresh.maps.face(f).tilesNotClear)
+                << "step " << step << ", face " << f;
+            clearTilesSeen += size_t(std::count(next.face(f).tilesNotClear.begin(),
+                                                next.face(f).tilesNotClear.end(), uint8_t(0)));
+        }
+        previous = std::move(next);
+    }
+    EXPECT_GT(clearTilesSeen, 0u) << "no face has an empty tile: the test exercises nothing";
+}
+
 } // namespace
