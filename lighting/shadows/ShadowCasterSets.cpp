@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace lighting {
 
@@ -135,6 +137,37 @@ std::vector<scenes::Aabb> instanceBounds(const gbuffer::SceneGeometry& geometry,
         scenes::Aabb& box = bounds[geometry.triangleInstance[t]];
         for (int k = 0; k < 3; ++k)
             box.extend(geometry.positionWorld[geometry.indices[3 * t + k]]);
+    }
+    return bounds;
+}
+
+std::vector<scenes::Aabb> instanceBoundsFromChunks(const gbuffer::SceneGeometry& geometry,
+                                                   size_t instanceCount,
+                                                   std::span<const scenes::Aabb> chunkBounds,
+                                                   uint32_t trianglesPerChunk) {
+    const uint32_t triangles = geometry.triangleCount();
+    if (trianglesPerChunk == 0 ||
+        chunkBounds.size() != (size_t(triangles) + trianglesPerChunk - 1) / trianglesPerChunk)
+        throw std::invalid_argument(
+            "instanceBoundsFromChunks: " + std::to_string(chunkBounds.size()) + " chunks of " +
+            std::to_string(trianglesPerChunk) + " for " + std::to_string(triangles) + " triangles");
+    std::vector<scenes::Aabb> bounds(instanceCount);
+    for (size_t c = 0; c < chunkBounds.size(); ++c) {
+        const uint32_t begin = uint32_t(c) * trianglesPerChunk;
+        const uint32_t end = std::min(triangles, begin + trianglesPerChunk);
+        const uint32_t instance = geometry.triangleInstance[begin];
+        bool oneInstance = true;
+        for (uint32_t t = begin + 1; t < end && oneInstance; ++t)
+            oneInstance = geometry.triangleInstance[t] == instance;
+        if (oneInstance) {
+            bounds[instance].extend(chunkBounds[c]);
+            continue;
+        }
+        for (uint32_t t = begin; t < end; ++t) {
+            scenes::Aabb& box = bounds[geometry.triangleInstance[t]];
+            for (int k = 0; k < 3; ++k)
+                box.extend(geometry.positionWorld[geometry.indices[3 * t + k]]);
+        }
     }
     return bounds;
 }

@@ -38,6 +38,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -84,5 +85,15 @@ CasterVolume casterVolume(const std::vector<glm::dvec3>& frustumCorners, const s
 // World-space bounds of every scene instance's triangles (empty boxes for instances without any).
 std::vector<scenes::Aabb> instanceBounds(const gbuffer::SceneGeometry& geometry,
                                          size_t instanceCount);
+// The same boxes, bitwise for finite positions (min and max are exact), from the bounds of
+// consecutive chunks of `trianglesPerChunk` triangles (chunkBounds[c] bounds triangles [c *
+// trianglesPerChunk, (c + 1) * trianglesPerChunk)), which the shadow maps compute anyway: a chunk
+// within one instance extends its instance's box once, a chunk that straddles instances triangle by
+// triangle. Reads the instance id of every triangle but the positions of straddling chunks
+// only; serial. Throws std::invalid_argument when chunkBounds does not cover the triangles.
+std::vector<scenes::Aabb> instanceBoundsFromChunks(const gbuffer::SceneGeometry& geometry,
+                                                   size_t instanceCount,
+                                                   std::span<const scenes::Aabb> chunkBounds,
+                                                   uint32_t trianglesPerChunk);
 
 } // namespace lighting

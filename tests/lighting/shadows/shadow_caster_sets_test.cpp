@@ -8,17 +8,21 @@
 //   objects (so the comparison is not vacuous).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <map>
 #include <memory>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gbuffer/visibility/CameraView.h"
+#include "gbuffer/visibility/SceneGeometry.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
 #include "lighting/shadows/ShadowCasterSets.h"
@@ -323,6 +327,47 @@ TEST(ShadowCasterSets, ClutteredWallSetsAreSmallAndTheImageIsTheSame) {
                               imageOn.radiance[c].size() * sizeof(float)),
                   0)
             << "channel " << c << ": the image with the sets differs from the one without";
+    }
+}
+
+} // namespace
+
+namespace {
+
+// instanceBoundsFromChunks (what the shadow maps use) against instanceBounds, triangle by
+// triangle: bitwise the same boxes on every procedural scene, for chunks of one triangle, of a
+// size that straddles instances often (7), the maps' 64 and one chunk holding everything; a
+// chunk list that does not cover the triangles is refused.
+TEST(ShadowCasterSets, InstanceBoundsFromChunksAreTheTriangleBounds) {
+    for (const std::string& name : scenes::proceduralSceneNames()) {
+        scenes::SceneRequest request;
+        request.lightCount = 4;
+        const scenes::Scene scene = scenes::buildProceduralScene(name, request);
+        const gbuffer::SceneGeometry geometry = gbuffer::SceneGeometry::build(scene);
+        const std::vector<scenes::Aabb> expected =
+            lighting::instanceBounds(geometry, scene.instances.size());
+        const uint32_t triangles = geometry.triangleCount();
+        for (uint32_t perChunk : {1u, 7u, 64u, std::max(triangles, 1u)}) {
+            std::vector<scenes::Aabb> chunks((triangles + perChunk - 1) / perChunk);
+            for (uint32_t t = 0; t < triangles; ++t)
+                for (int k = 0; k < 3; ++k)
+                    chunks[t / perChunk].extend(
+                        geometry.positionWorld[geometry.indices[3 * t + k]]);
+            const std::vector<scenes::Aabb> derived = lighting::instanceBoundsFromChunks(
+                geometry, scene.instances.size(), chunks, perChunk);
+            ASSERT_EQ(derived.size(), expected.size());
+            for (size_t i = 0; i < expected.size(); ++i) {
+                EXPECT_EQ(0, std::memcmp(&derived[i], &expected[i], sizeof(scenes::Aabb)))
+                    << name << ", chunks of " << perChunk << ", instance " << i;
+            }
+        }
+        if (triangles > 1) {
+            const std::vector<scenes::Aabb> tooFew(1);
+            EXPECT_THROW(
+                lighting::instanceBoundsFromChunks(geometry, scene.instances.size(), tooFew, 1),
+                std::invalid_argument)
+                << name;
+        }
     }
 }
 
