@@ -21,16 +21,14 @@
 
 #include "raster/DepthSpan.h"
 #include "raster/Rasterizer.h"
+#include "tests/raster/TestMeshes.h"
 
 namespace {
 
 using raster::CullMode;
 using raster::DepthTest;
 
-struct Mesh {
-    std::vector<glm::vec4> positions;
-    std::vector<uint32_t> indices;
-};
+using raster_test::Mesh;
 
 // Random triangles in clip space: mostly on screen, some huge or crossing z = 0 / z = w, some
 // sub-pixel, and a fan whose triangles share edges.
@@ -57,16 +55,7 @@ Mesh randomMesh(uint32_t seed, int count) {
         mesh.positions.insert(mesh.positions.end(), {a, b, c});
         mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
     }
-    // A fan of 64 triangles around a point: shared edges, each pixel covered once.
-    const uint32_t centre = uint32_t(mesh.positions.size());
-    mesh.positions.emplace_back(0.1f, -0.05f, 0.4f, 1.0f);
-    for (int k = 0; k <= 64; ++k) {
-        const float angle = float(k) / 64.0f * 6.2831853f;
-        mesh.positions.emplace_back(0.7f * std::cos(angle), 0.7f * std::sin(angle),
-                                    0.3f + 0.2f * unit(rng), 1.0f);
-    }
-    for (uint32_t k = 0; k < 64; ++k)
-        mesh.indices.insert(mesh.indices.end(), {centre, centre + 1 + k, centre + 2 + k});
+    raster_test::appendFan(mesh, rng);
     return mesh;
 }
 

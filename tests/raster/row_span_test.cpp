@@ -26,6 +26,7 @@
 #include <tbb/task_arena.h>
 
 #include "raster/Rasterizer.h"
+#include "tests/raster/TestMeshes.h"
 
 namespace {
 
@@ -34,10 +35,7 @@ using raster::DepthTest;
 
 constexpr int kWidth = 301, kHeight = 203; // several tiles, partial ones at the edges
 
-struct Mesh {
-    std::vector<glm::vec4> positions;
-    std::vector<uint32_t> indices;
-};
+using raster_test::Mesh;
 
 // Random clip-space triangles of seven kinds, in an order that puts big occluders before smaller
 // triangles behind them and in front of them.
@@ -108,16 +106,7 @@ Mesh randomMesh(uint32_t seed, int count) {
         }
         }
     }
-    // A fan of 64 triangles around a point: shared edges, each pixel covered once.
-    const uint32_t centre = uint32_t(mesh.positions.size());
-    mesh.positions.emplace_back(0.1f, -0.05f, 0.4f, 1.0f);
-    for (int k = 0; k <= 64; ++k) {
-        const float angle = float(k) / 64.0f * 6.2831853f;
-        mesh.positions.emplace_back(0.7f * std::cos(angle), 0.7f * std::sin(angle),
-                                    0.3f + 0.2f * unit(rng), 1.0f);
-    }
-    for (uint32_t k = 0; k < 64; ++k)
-        mesh.indices.insert(mesh.indices.end(), {centre, centre + 1 + k, centre + 2 + k});
+    raster_test::appendFan(mesh, rng);
     return mesh;
 }
 
