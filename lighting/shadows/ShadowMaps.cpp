@@ -108,56 +108,11 @@ glm::dmat4 orthographicReversed(double x0, double x1, double y0, double y1, doub
 struct Casters {
     std::vector<glm::vec3> ownPositions;
     bool whole = false;
-    // Cube-mapped point lights with cullCastersPerFace: instead of ownPositions, the corners of
-    // the triangles each face (kCube's order) may hold, by cubeFacesOutside: a face's draw then
-    // projects about a sixth of the light's casters instead of all of them.
-    bool perCubeFace = false;
-    std::array<std::vector<glm::vec3>, 6> cubeFacePositions;
     std::span<const glm::vec3> positions(const gbuffer::SceneGeometry& geometry) const {
         return whole ? std::span<const glm::vec3>(geometry.positionWorld)
                      : std::span<const glm::vec3>(ownPositions);
     }
 };
-
-// The cube faces (kCube's order: +X, -X, +Y, -Y, +Z, -Z) whose frustum a triangle with corners
-// p[0..2] certainly misses, one bit per face, for a cube centred at `centre` (90-degree faces on
-// the world axes). Face (axis a, sign s) has depth s * d[a] and the side planes
-// +-d[b] = depth, +-d[c] = depth (b, c the other axes), d = p - centre; the triangle misses it
-// when its three corners lie beyond one side plane by more than `margin`, 1e-5 of the
-// coordinates' magnitude plus 1e-5 m. The face's draw tests the same planes on float clip
-// positions (raster::frustumOutcode), whose error is about 1e-7 of that magnitude: so every
-// triangle rejected here the draw's own trivial reject would reject, and the face draws the
-// same triangles in the same order (the maps bitwise the same,
-// ShadowMaps.PerFaceCasterCullGivesTheSameMaps). Near and far are left to the draw.
-uint32_t cubeFacesOutside(const glm::vec3 (&p)[3], const glm::dvec3& centre) {
-    const double centreMagnitude =
-        std::max({std::abs(centre.x), std::abs(centre.y), std::abs(centre.z)});
-    uint32_t outsideAll = 0xFFFFFFu; // 4 side planes x 6 faces
-    for (const glm::vec3& corner : p) {
-        const glm::dvec3 d = glm::dvec3(corner) - centre;
-        const double margin =
-            1e-5 * (std::max({std::abs(double(corner.x)), std::abs(double(corner.y)),
-                              std::abs(double(corner.z))}) +
-                    centreMagnitude + 1.0);
-        uint32_t outside = 0;
-        for (int axis = 0; axis < 3; ++axis) {
-            const double b = d[(axis + 1) % 3], c = d[(axis + 2) % 3];
-            for (int negative = 0; negative < 2; ++negative) {
-                const double depth = negative ? -d[axis] : d[axis];
-                const int face = 2 * axis + negative;
-                outside |= uint32_t(b - depth > margin) << (4 * face) |
-                           uint32_t(-b - depth > margin) << (4 * face + 1) |
-                           uint32_t(c - depth > margin) << (4 * face + 2) |
-                           uint32_t(-c - depth > margin) << (4 * face + 3);
-            }
-        }
-        outsideAll &= outside;
-    }
-    uint32_t faces = 0;
-    for (int face = 0; face < 6; ++face)
-        faces |= uint32_t(((outsideAll >> (4 * face)) & 0xFu) != 0) << face;
-    return faces;
-}
 
 // What a face task needs beyond the ShadowFace it fills.
 struct FaceJob {
@@ -620,8 +575,6 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         }
         const glm::dvec3 centre(light.positionWorld);
         const double radius = light.rangeMetres;
-        set.perCubeFace = light.type == scenes::LightType::Point && !maps.mShadows[s].paraboloid &&
-                          settings.cullCastersPerFace;
         for (uint32_t c = 0; c < chunkCount; ++c) {
             if (!boxTouchesSphere(centre, radius, chunkBounds[c]))
                 continue;
@@ -634,28 +587,15 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                     box.extend(geometry.positionWorld[geometry.indices[3 * t + k]]);
                 if (!boxTouchesSphere(centre, radius, box))
                     continue;
-                const glm::vec3 corners[3] = {geometry.positionWorld[geometry.indices[3 * t]],
-                                              geometry.positionWorld[geometry.indices[3 * t + 1]],
-                                              geometry.positionWorld[geometry.indices[3 * t + 2]]};
-                if (!set.perCubeFace) {
-                    set.ownPositions.insert(set.ownPositions.end(), corners, corners + 3);
-                    continue;
-                }
-                const uint32_t outside = cubeFacesOutside(corners, centre);
-                for (int face = 0; face < 6; ++face)
-                    if (!(outside >> face & 1u))
-                        set.cubeFacePositions[size_t(face)].insert(
-                            set.cubeFacePositions[size_t(face)].end(), corners, corners + 3);
+                for (int k = 0; k < 3; ++k)
+                    set.ownPositions.push_back(geometry.positionWorld[geometry.indices[3 * t + k]]);
             }
         }
     });
     size_t maxCorners = 0;
-    for (const Casters& set : casters) {
+    for (const Casters& set : casters)
         if (!set.whole)
             maxCorners = std::max(maxCorners, set.ownPositions.size());
-        for (const std::vector<glm::vec3>& face : set.cubeFacePositions)
-            maxCorners = std::max(maxCorners, face.size());
-    }
     std::vector<uint32_t> sequentialIndices(maxCorners);
     std::iota(sequentialIndices.begin(), sequentialIndices.end(), 0u);
 
@@ -702,11 +642,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             rasterizer = scratch.rasterizers.back().get();
         }
         const Casters& set = casters[jobs[f].shadow];
-        const std::span<const glm::vec3> positions =
-            set.perCubeFace
-                ? std::span<const glm::vec3>(
-                      set.cubeFacePositions[f - maps.mShadows[jobs[f].shadow].firstFace])
-                : set.positions(geometry);
+        const std::span<const glm::vec3> positions = set.positions(geometry);
         const std::span<const uint32_t> indices =
             set.whole ? std::span<const uint32_t>(geometry.indices)
                       : std::span<const uint32_t>(sequentialIndices.data(), positions.size());

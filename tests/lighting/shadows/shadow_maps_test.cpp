@@ -14,7 +14,6 @@
 #include <functional>
 #include <limits>
 #include <numbers>
-#include <random>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -956,72 +955,6 @@ TEST(ShadowMaps, RecycledBuffersStayExactWhenTheCastersMove) {
         previous = std::move(next);
     }
     EXPECT_GT(clearTilesSeen, 0u) << "no face has an empty tile: the test exercises nothing";
-}
-
-} // namespace
-
-namespace {
-
-// The cube faces' light-space pre-cull (ShadowMaps.cpp, cubeFacesOutside) keeps every triangle
-// the draw's own trivial reject keeps: around a point light, triangles with corners on the
-// faces' diagonal planes (|lateral| = depth, where two faces meet), straddling them by a hair,
-// at the cube's corners, and random ones give bitwise the maps that whole lists give, and the
-// same triangle counts, with the light at the origin and far from it (larger rounding).
-TEST(ShadowMaps, CubeFacePreCullKeepsEveryTriangleTheDrawKeeps) {
-    for (const glm::vec3 lightPosition :
-         {glm::vec3(0.0f, 0.0f, 0.0f), glm::vec3(317.3f, 2.9f, -1049.1f)}) {
-        TestScene t;
-        t.ground(6.0f, lightPosition.y - 2.5f, lightPosition.x, lightPosition.z);
-        scenes::Mesh& soup = t.newMesh();
-        std::mt19937 rng(7);
-        std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-        auto add = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c) {
-            const uint32_t base = uint32_t(soup.positions.size());
-            for (const glm::vec3& p : {a, b, c}) {
-                soup.positions.push_back(lightPosition + p);
-                soup.normals.emplace_back(0.0f, 1.0f, 0.0f);
-            }
-            soup.indices.insert(soup.indices.end(), {base, base + 1, base + 2});
-        };
-        for (int i = 0; i < 400; ++i) {
-            // Corners on a diagonal plane of a random face pair, |lateral| = depth exactly or
-            // off by a few ulps, at 0.5-4 m.
-            const float depth = 0.5f + 1.75f * (unit(rng) + 1.0f);
-            const float hair = float(i % 5 - 2) * 1e-6f * depth;
-            const int axis = i % 3;
-            glm::vec3 p[3];
-            for (glm::vec3& q : p) {
-                q = glm::vec3(unit(rng), unit(rng), unit(rng)) * depth;
-                q[axis] = (i % 2 ? -1.0f : 1.0f) * depth;
-                q[(axis + 1) % 3] = (i % 4 < 2 ? 1.0f : -1.0f) * (depth + hair);
-            }
-            add(p[0], p[1], p[2]);
-            // Random small and large triangles anywhere within the range.
-            const glm::vec3 centre(unit(rng) * 4.0f, unit(rng) * 4.0f, unit(rng) * 4.0f);
-            const float size = i % 2 ? 0.05f : 1.5f;
-            add(centre, centre + size * glm::vec3(unit(rng), unit(rng), unit(rng)),
-                centre + size * glm::vec3(unit(rng), unit(rng), unit(rng)));
-        }
-        // A triangle through a cube corner (three faces meet).
-        add(glm::vec3(2.0f, 2.0f, 2.0f), glm::vec3(2.0f, 1.0f, 2.1f), glm::vec3(1.0f, 2.0f, 2.0f));
-        t.camera(lightPosition + glm::vec3(0.0f, 3.0f, 8.0f), lightPosition);
-        t.light(pointLight(lightPosition, 8.0f));
-        ShadowSettings settings;
-        settings.mapSize = 256;
-        settings.casterSets = false;
-        ShadowSettings whole = settings;
-        whole.cullCastersPerFace = false;
-        const Frame culled(t.scene, settings), drawnWhole(t.scene, whole);
-        ASSERT_EQ(culled.maps.faceCount(), 6u);
-        ASSERT_EQ(drawnWhole.maps.faceCount(), 6u);
-        for (size_t f = 0; f < 6; ++f)
-            EXPECT_EQ(culled.maps.face(f).depth, drawnWhole.maps.face(f).depth)
-                << "face " << f << ", light at " << lightPosition.x;
-        // Each face drew only what its frustum may hold, yet no face lost one (the draw's
-        // trivial reject on the whole list keeps the same triangles).
-        EXPECT_LT(culled.maps.stats().lights[0].trianglesDrawn,
-                  drawnWhole.maps.stats().lights[0].trianglesDrawn);
-    }
 }
 
 } // namespace
