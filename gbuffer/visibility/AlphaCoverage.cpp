@@ -1,5 +1,6 @@
 #include "gbuffer/visibility/AlphaCoverage.h"
 
+#include "gbuffer/visibility/MaterialAlpha.h"
 #include "gbuffer/visibility/TriangleCorners.h"
 
 namespace gbuffer {
@@ -55,13 +56,7 @@ float AlphaCoverage::alphaAt(const scenes::Scene& scene, const SceneGeometry& ge
         b = glm::vec3(1.0f);
         sum = 3.0f;
     }
-    const glm::vec3 weights = b * (1.0f / sum);
-    const scenes::TextureMapping& mapping = material.baseColorMapping;
-    const bool second = mapping.texCoord == 1 && !geometry.uv1.empty();
-    const std::vector<glm::vec2>& uvs = second ? geometry.uv1 : geometry.uv;
-    const glm::vec2 uv = raster::interpolate(uvs[index[0]], uvs[index[1]], uvs[index[2]], weights);
-    return material.baseColorFactor.a *
-           scene.textures[size_t(material.baseColorTexture)].sample(mapping.apply(uv)).a;
+    return baseColorAlpha(scene, geometry, triangle, b * (1.0f / sum));
 }
 
 } // namespace gbuffer
