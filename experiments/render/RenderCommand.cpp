@@ -256,9 +256,11 @@ nlohmann::json shadowsJson(const RenderRun& run) {
         {"render_ms", stats.renderMs},
         {"per_light", lights}};
     if (run.rayShadows)
-        shadows["ray_bvh"] = {{"triangles", run.rayShadows->rays().triangleCount()},
-                              {"build_ms", run.rayShadows->rays().buildMilliseconds()},
-                              {"bytes", run.rayShadows->rays().embreeBytes()}};
+        shadows["ray_bvh"] = {
+            {"triangles", run.rayShadows->rays().triangleCount()},
+            {"alpha_tested_triangles", run.rayShadows->rays().alphaTestedTriangleCount()},
+            {"build_ms", run.rayShadows->rays().buildMilliseconds()},
+            {"bytes", run.rayShadows->rays().embreeBytes()}};
     if (run.shadowError) {
         const lighting::shadows::ShadowErrorCounts& error = *run.shadowError;
         const double pairs = double(std::max<uint64_t>(error.pairs, 1));

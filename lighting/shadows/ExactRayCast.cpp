@@ -112,36 +112,48 @@ double finiteLength(const gbuffer::SceneGeometry& geometry, const glm::dvec3& or
 
 } // namespace
 
-bool segmentHitsTriangleExact(const ShadowSegment& segment, const glm::dvec3& a,
-                              const glm::dvec3& b, const glm::dvec3& c) {
+std::optional<glm::dvec3> segmentHitWeightsExact(const ShadowSegment& segment, const glm::dvec3& a,
+                                                 const glm::dvec3& b, const glm::dvec3& c) {
     if (!(segment.lengthWorld > 0.0))
-        return false;
+        return std::nullopt;
     const glm::dvec3 edge1 = b - a;
     const glm::dvec3 edge2 = c - a;
     const glm::dvec3 p = glm::cross(segment.directionWorld, edge2);
     const double determinant = glm::dot(edge1, p);
     if (determinant == 0.0 || !std::isfinite(determinant))
-        return false; // parallel to the plane (or degenerate): no crossing point
+        return std::nullopt; // parallel to the plane (or degenerate): no crossing point
     const double inverse = 1.0 / determinant;
     const glm::dvec3 s = segment.originWorld - a;
     const double u = glm::dot(s, p) * inverse;
     if (!(u >= 0.0 && u <= 1.0))
-        return false;
+        return std::nullopt;
     const glm::dvec3 q = glm::cross(s, edge1);
     const double v = glm::dot(segment.directionWorld, q) * inverse;
     if (!(v >= 0.0 && u + v <= 1.0))
-        return false;
+        return std::nullopt;
     const double t = glm::dot(edge2, q) * inverse;
-    return t > 0.0 && t < segment.lengthWorld;
+    if (!(t > 0.0 && t < segment.lengthWorld))
+        return std::nullopt;
+    return glm::dvec3(1.0 - u - v, u, v);
 }
 
-bool segmentBlockedExact(const gbuffer::SceneGeometry& geometry, const ShadowRay& ray) {
+bool segmentHitsTriangleExact(const ShadowSegment& segment, const glm::dvec3& a,
+                              const glm::dvec3& b, const glm::dvec3& c) {
+    return segmentHitWeightsExact(segment, a, b, c).has_value();
+}
+
+bool segmentBlockedExact(const gbuffer::SceneGeometry& geometry, const ShadowRay& ray,
+                         const CasterAlphaTest* alphaTest) {
     const ShadowSegment segment = shadowSegment(ray);
     if (!(segment.lengthWorld > 0.0))
         return false;
     for (size_t t = 0; t < geometry.indices.size() / 3; ++t) {
         const auto corner = corners(geometry, t);
-        if (corner && segmentHitsTriangleExact(segment, (*corner)[0], (*corner)[1], (*corner)[2]))
+        if (!corner)
+            continue;
+        const auto weights =
+            segmentHitWeightsExact(segment, (*corner)[0], (*corner)[1], (*corner)[2]);
+        if (weights && (!alphaTest || alphaTest->casts(uint32_t(t), glm::vec3(*weights))))
             return true;
     }
     return false;

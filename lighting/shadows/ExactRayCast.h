@@ -6,26 +6,35 @@
 //
 // Conventions: as ShadowRay.h. Triangles are two-sided; a hit on an edge or a vertex counts
 // (barycentrics >= 0, inclusive, as Embree's watertight test), the segment is open at both ends
-// (0 < t < length). Degenerate triangles (zero area in double, non-finite vertices, indices out of
-// range) never block. All functions are pure and thread-safe.
+// (0 < t < length). With a CasterAlphaTest, a hit on an alpha-tested triangle blocks only where
+// its alpha passes at the hit's barycentrics (CasterMaterials.h). Degenerate triangles (zero area
+// in double, non-finite vertices, indices out of range) never block. All functions are pure and
+// thread-safe.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include <glm/glm.hpp>
 
 #include "gbuffer/visibility/SceneGeometry.h"
+#include "lighting/shadows/CasterMaterials.h"
 #include "lighting/shadows/ShadowRay.h"
 
 namespace lighting::shadows {
 
-// True when triangle (a, b, c) meets the open segment (Moeller-Trumbore in double).
+// Where triangle (a, b, c) meets the open segment (Moeller-Trumbore in double): the weights of
+// a, b, c at the crossing point, or nothing when they do not meet.
+std::optional<glm::dvec3> segmentHitWeightsExact(const ShadowSegment& segment, const glm::dvec3& a,
+                                                 const glm::dvec3& b, const glm::dvec3& c);
+// True when triangle (a, b, c) meets the open segment.
 bool segmentHitsTriangleExact(const ShadowSegment& segment, const glm::dvec3& a,
                               const glm::dvec3& b, const glm::dvec3& c);
 
 // True when any triangle of `geometry` blocks `ray`'s segment: the oracle of
-// RayVisibility::occluded.
-bool segmentBlockedExact(const gbuffer::SceneGeometry& geometry, const ShadowRay& ray);
+// RayVisibility::occluded. With `alphaTest`, alpha-tested triangles block only where they cast.
+bool segmentBlockedExact(const gbuffer::SceneGeometry& geometry, const ShadowRay& ray,
+                         const CasterAlphaTest* alphaTest = nullptr);
 bool segmentBlockedExact(const gbuffer::SceneGeometry& geometry, const glm::dvec3& surfaceWorld,
                          const glm::dvec3& normalWorld, const glm::dvec3& lightWorld);
 bool directionBlockedExact(const gbuffer::SceneGeometry& geometry, const glm::dvec3& surfaceWorld,

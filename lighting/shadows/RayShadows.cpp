@@ -1,6 +1,5 @@
 #include "lighting/shadows/RayShadows.h"
 
-#include "lighting/shadows/CasterMaterials.h"
 #include "lighting/shadows/ShadowMaps.h"
 
 namespace lighting::shadows {
@@ -14,7 +13,7 @@ RayShadows::RayShadows(const scenes::Scene& scene, const gbuffer::SceneGeometry&
 
 RayShadows::RayShadows(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
                        const gbuffer::CameraView& view, const std::vector<uint32_t>& castingLights)
-    : mRays(std::make_unique<RayVisibility>(geometry, castingMaterials(scene))),
+    : mRays(std::make_unique<RayVisibility>(scene, geometry)),
       mWorldFromView(glm::inverse(view.viewFromWorldExact)),
       mWorldFromViewNormal(glm::dmat3(mWorldFromView)), mLights(scene.lights),
       mCasts(scene.lights.size(), false) {

@@ -8,7 +8,8 @@
 // the ray is traced in world space through the inverse of the view's exact matrix. A view
 // jittered by a sub-pixel offset (the supersampled reference) has the same viewFromWorld, so
 // one RayShadows serves every sub-frame. Visibility is 0 or 1 (a point light has no area).
-// Immutable after construction; visibility() is thread-safe.
+// `scene` and `geometry` must outlive it (the rays' filter of alpha-tested casters reads their
+// uvs and textures). Immutable after construction; visibility() is thread-safe.
 #pragma once
 
 #include <memory>

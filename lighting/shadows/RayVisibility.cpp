@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -13,6 +14,8 @@
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "lighting/shadows/CasterMaterials.h"
 
 namespace lighting::shadows {
 
@@ -82,8 +85,47 @@ void RayVisibility::SceneRelease::operator()(RTCSceneTy* scene) const {
     rtcReleaseScene(scene);
 }
 
+struct RayAlphaFilter {
+    CasterAlphaTest test;
+    std::vector<uint32_t> sceneTriangle; // per primitive of the filtered geometry
+};
+
+namespace {
+
+// Embree's occlusion filter of the alpha-tested geometry: a hit where the caster's alpha does not
+// pass is rejected (valid = 0), and the traversal goes on to the next hit.
+void alphaTestedHit(const RTCFilterFunctionNArguments* args) {
+    const auto* filter = static_cast<const RayAlphaFilter*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1)
+            continue;
+        const unsigned primitive = RTCHitN_primID(args->hit, args->N, i);
+        const float u = RTCHitN_u(args->hit, args->N, i);
+        const float v = RTCHitN_v(args->hit, args->N, i);
+        if (!filter->test.casts(filter->sceneTriangle[primitive], glm::vec3(1.0f - u - v, u, v)))
+            args->valid[i] = 0;
+    }
+}
+
+} // namespace
+
 RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry,
                              std::span<const uint8_t> castingMaterial) {
+    build(geometry, castingMaterial, nullptr);
+}
+
+RayVisibility::RayVisibility(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry) {
+    const CasterAlphaTest alphaTest(scene, geometry);
+    build(geometry, castingMaterials(scene), alphaTest.any() ? &alphaTest : nullptr);
+}
+
+size_t RayVisibility::alphaTestedTriangleCount() const {
+    return mAlphaFilter ? mAlphaFilter->sceneTriangle.size() : 0;
+}
+
+void RayVisibility::build(const gbuffer::SceneGeometry& geometry,
+                          std::span<const uint8_t> castingMaterial,
+                          const CasterAlphaTest* alphaTest) {
     const auto start = std::chrono::steady_clock::now();
     const size_t vertexCount = geometry.positionWorldExact.size();
     const size_t sceneTriangleCount = geometry.indices.size() / 3;
@@ -101,10 +143,13 @@ RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry,
     std::atomic<int64_t> embreeBytes{0};
     rtcSetDeviceMemoryMonitorFunction(device, countBytes, &embreeBytes);
 
-    // The triangles Embree can use, as float vertex indices (vertices are shared, unfiltered:
-    // Embree reads only the ones the kept triangles name).
+    // The triangles Embree can use: the opaque ones as float vertex indices (vertices are shared,
+    // unfiltered: Embree reads only the ones the kept triangles name), the alpha-tested ones with
+    // three corners each in their own geometry, whose filter maps a primitive to its triangle.
     std::vector<uint32_t> kept;
     kept.reserve(geometry.indices.size());
+    std::vector<glm::vec3> testedCorners;
+    std::vector<uint32_t> testedTriangle;
     for (size_t t = 0; t < sceneTriangleCount; ++t) {
         if (!castingMaterial.empty() && t < geometry.triangleMaterial.size() &&
             geometry.triangleMaterial[t] < castingMaterial.size() &&
@@ -120,10 +165,15 @@ RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry,
         }
         if (!inRange || !usable(corner))
             continue;
+        if (alphaTest && alphaTest->tested(uint32_t(t))) {
+            testedCorners.insert(testedCorners.end(), corner.begin(), corner.end());
+            testedTriangle.push_back(uint32_t(t));
+            continue;
+        }
         kept.insert(kept.end(), geometry.indices.begin() + 3 * t,
                     geometry.indices.begin() + 3 * t + 3);
     }
-    mTriangleCount = kept.size() / 3;
+    mTriangleCount = kept.size() / 3 + testedTriangle.size();
     mDroppedTriangleCount = sceneTriangleCount - mTriangleCount;
 
     mScene.reset(rtcNewScene(device));
@@ -131,33 +181,51 @@ RayVisibility::RayVisibility(const gbuffer::SceneGeometry& geometry,
     RTCScene scene = mScene.get();
     rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-    if (mTriangleCount > 0) {
+    // One triangle geometry of `vertices` (float3) and `triangles` index triples, in buffers
+    // Embree allocates itself, with the padding its vector loads need past the last vertex.
+    auto attach = [&](size_t vertexTotal, auto vertexAt, std::span<const uint32_t> triangles,
+                      RTCFilterFunctionN occludedFilter, void* userData) {
         RTCGeometry mesh = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         throwOnError(device, log, "rtcNewGeometry");
         rtcSetGeometryBuildQuality(mesh, RTC_BUILD_QUALITY_HIGH);
-        // Buffers Embree allocates itself, with the padding its vector loads need past the last
-        // vertex.
         auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            mesh, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertexCount));
+            mesh, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertexTotal));
         auto* indices = static_cast<uint32_t*>(
             rtcSetNewGeometryBuffer(mesh, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                    3 * sizeof(uint32_t), mTriangleCount));
+                                    3 * sizeof(uint32_t), triangles.size() / 3));
         if (!vertices || !indices) {
             rtcReleaseGeometry(mesh);
             throwOnError(device, log, "rtcSetNewGeometryBuffer");
             throw std::runtime_error("RayVisibility: Embree gave no geometry buffer");
         }
-        for (size_t v = 0; v < vertexCount; ++v) {
-            const glm::vec3 p(geometry.positionWorldExact[v]);
+        for (size_t v = 0; v < vertexTotal; ++v) {
+            const glm::vec3 p = vertexAt(v);
             vertices[3 * v + 0] = p.x;
             vertices[3 * v + 1] = p.y;
             vertices[3 * v + 2] = p.z;
         }
-        std::copy(kept.begin(), kept.end(), indices);
+        std::copy(triangles.begin(), triangles.end(), indices);
+        if (occludedFilter) {
+            rtcSetGeometryUserData(mesh, userData);
+            rtcSetGeometryOccludedFilterFunction(mesh, occludedFilter);
+        }
         rtcCommitGeometry(mesh);
         rtcAttachGeometry(scene, mesh);
         rtcReleaseGeometry(mesh); // the scene holds it now
         throwOnError(device, log, "rtcAttachGeometry");
+    };
+    if (!kept.empty())
+        attach(
+            vertexCount, [&](size_t v) { return glm::vec3(geometry.positionWorldExact[v]); }, kept,
+            nullptr, nullptr);
+    if (!testedTriangle.empty()) {
+        mAlphaFilter =
+            std::make_unique<RayAlphaFilter>(RayAlphaFilter{*alphaTest, std::move(testedTriangle)});
+        std::vector<uint32_t> sequential(testedCorners.size());
+        std::iota(sequential.begin(), sequential.end(), 0u);
+        attach(
+            testedCorners.size(), [&](size_t v) { return testedCorners[v]; }, sequential,
+            alphaTestedHit, mAlphaFilter.get());
     }
     rtcCommitScene(scene);
     throwOnError(device, log, "rtcCommitScene");

@@ -3,9 +3,12 @@
 // libembree-dev): one BVH over every triangle, built once per scene, then "is anything between
 // this surface point and this light?" for any number of points and lights.
 //
-// Conventions: world space, metres. Every triangle in the BVH is opaque and two-sided; given
-// the materials' casting flags (CasterMaterials.h), those of non-casting materials (blended,
-// masked below the cutoff) are not in it, and textured masks cast wholly. The query is the segment
+// Conventions: world space, metres. Every triangle in the BVH is two-sided; given the materials'
+// casting policy (CasterMaterials.h), those of non-casting materials (blended, masked below the
+// cutoff) are not in it. Built from a scene, the triangles of alpha-tested materials (textured
+// masks) are a second Embree geometry whose occlusion filter tests the alpha at each hit's
+// barycentrics (CasterAlphaTest), so a hit in a cut-out's hole does not block; built from casting
+// flags alone, every triangle in the BVH is opaque. The query is the segment
 // of ShadowRay.h: the origin offset along the normal by a distance relative to the coordinates'
 // magnitude, the far end stopped as far short of the light; the exact oracle (ExactRayCast.h)
 // follows the same rule.
@@ -45,7 +48,15 @@
 struct RTCDeviceTy;
 struct RTCSceneTy;
 
+namespace scenes {
+struct Scene;
+}
+
 namespace lighting::shadows {
+
+class CasterAlphaTest;
+struct RayAlphaFilter; // what the occlusion filter of alpha-tested casters reads
+                       // (RayVisibility.cpp)
 
 class RayVisibility {
 public:
@@ -59,6 +70,10 @@ public:
     // of a material flagged 0 are left out (they cast no shadow), counted as dropped.
     explicit RayVisibility(const gbuffer::SceneGeometry& geometry,
                            std::span<const uint8_t> castingMaterial = {});
+    // The scene's casters by its materials' policy (castingMaterials), the alpha-tested ones
+    // filtered per hit: `scene` and `geometry` must outlive the object when the scene has
+    // alpha-tested materials (the filter reads their uvs and textures).
+    RayVisibility(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry);
     ~RayVisibility();
     RayVisibility(const RayVisibility&) = delete;
     RayVisibility& operator=(const RayVisibility&) = delete;
@@ -80,6 +95,8 @@ public:
 
     // Triangles in the BVH (the scene's less the dropped ones).
     size_t triangleCount() const { return mTriangleCount; }
+    // Of those, the alpha-tested ones (in the filtered geometry).
+    size_t alphaTestedTriangleCount() const;
     // Triangles left out: degenerate (see above) or of a material that casts no shadow.
     size_t droppedTriangleCount() const { return mDroppedTriangleCount; }
     // Wall time of the constructor (filtering, conversion to float, BVH build).
@@ -96,7 +113,12 @@ private:
         void operator()(RTCSceneTy* scene) const;
     };
 
-    // Declared in this order so that the scene is released before its device.
+    void build(const gbuffer::SceneGeometry& geometry, std::span<const uint8_t> castingMaterial,
+               const CasterAlphaTest* alphaTest);
+
+    // Declared in this order so that the scene is released before its device, and both before
+    // the filter's data.
+    std::unique_ptr<RayAlphaFilter> mAlphaFilter;
     std::unique_ptr<RTCDeviceTy, DeviceRelease> mDevice;
     std::unique_ptr<RTCSceneTy, SceneRelease> mScene;
     size_t mTriangleCount = 0;

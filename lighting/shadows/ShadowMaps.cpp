@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <span>
@@ -43,6 +44,12 @@ struct ShadowMaps::RenderScratch {
         // corners per triangle), and 0, 1, 2, ... to index them.
         std::vector<glm::vec3> lightSpace;
         std::vector<uint32_t> sequential;
+        // The alpha-tested casters of the face: clip positions and uvs per corner (a paraboloid
+        // piece's corners lie inside its scene triangle), the material per triangle.
+        std::vector<glm::vec4> testedClip;
+        std::vector<glm::vec2> testedUv;
+        std::vector<uint32_t> testedMaterial;
+        std::vector<glm::vec3> testedLightSpace, testedWeights; // one triangle's pieces
     };
     tbb::enumerable_thread_specific<Thread> threads;
 };
@@ -104,10 +111,13 @@ glm::dmat4 orthographicReversed(double x0, double x1, double y0, double y1, doub
 }
 
 // Triangles a light's faces draw: either the scene's own buffers (directional lights) or the
-// corners of the triangles within a point or spot light's range, three per triangle.
+// corners of the triangles within a point or spot light's range, three per triangle; and apart,
+// the alpha-tested ones (CasterMaterials.h), three corners and the scene's triangle index each.
 struct Casters {
     std::vector<glm::vec3> ownPositions;
     bool whole = false;
+    std::vector<glm::vec3> testedPositions;
+    std::vector<uint32_t> testedTriangles;
     std::span<const glm::vec3> positions(const gbuffer::SceneGeometry& geometry) const {
         return whole ? std::span<const glm::vec3>(geometry.positionWorld)
                      : std::span<const glm::vec3>(ownPositions);
@@ -131,31 +141,46 @@ constexpr double kMinParaboloidEdgeFraction = 1e-4;
 // does not depend on which triangle asks (clip points from the lexicographically smaller end,
 // midpoints as 0.5 * (a + b)): triangles that share an edge split it alike, so no T-junction
 // opens a crack between them.
-void appendParaboloidCasters(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
-                             float cosMaxEdge, float minEdge, std::vector<glm::vec3>& out) {
+//
+// weightsOut, when given, receives each output corner's weights of the input corners (the
+// corners' own weights are `weights`, lerped along with the positions), so that an alpha-tested
+// caster's pieces find their uv; the positions do not depend on it.
+void appendParaboloidCasters(const std::array<glm::vec3, 3>& corners,
+                             const std::array<glm::vec3, 3>& weights, float cosMaxEdge,
+                             float minEdge, std::vector<glm::vec3>& out,
+                             std::vector<glm::vec3>* weightsOut) {
+    struct Corner {
+        glm::vec3 p; // light frame
+        glm::vec3 w; // weights of the input triangle's corners
+    };
     auto lexLess = [](const glm::vec3& p, const glm::vec3& q) {
         return p.x != q.x ? p.x < q.x : p.y != q.y ? p.y < q.y : p.z < q.z;
     };
+    auto midpoint = [](const Corner& p, const Corner& q) {
+        return Corner{0.5f * (p.p + q.p), 0.5f * (p.w + q.w)};
+    };
     // Clip to z <= 0 (Sutherland-Hodgman against one plane: 0, 3 or 4 corners).
-    std::array<glm::vec3, 4> polygon;
-    int corners = 0;
-    const std::array<glm::vec3, 3> input = {a, b, c};
+    std::array<Corner, 4> polygon;
+    int count = 0;
+    const std::array<Corner, 3> input = {Corner{corners[0], weights[0]},
+                                         Corner{corners[1], weights[1]},
+                                         Corner{corners[2], weights[2]}};
     for (int i = 0; i < 3; ++i) {
-        const glm::vec3& p = input[size_t(i)];
-        const glm::vec3& q = input[size_t((i + 1) % 3)];
-        const bool pIn = p.z <= 0.0f, qIn = q.z <= 0.0f;
+        const Corner& p = input[size_t(i)];
+        const Corner& q = input[size_t((i + 1) % 3)];
+        const bool pIn = p.p.z <= 0.0f, qIn = q.p.z <= 0.0f;
         if (pIn)
-            polygon[size_t(corners++)] = p;
+            polygon[size_t(count++)] = p;
         if (pIn != qIn) {
-            const glm::vec3& from = lexLess(p, q) ? p : q;
-            const glm::vec3& to = lexLess(p, q) ? q : p;
-            const float t = from.z / (from.z - to.z);
-            glm::vec3 x = from + t * (to - from);
-            x.z = 0.0f;
-            polygon[size_t(corners++)] = x;
+            const Corner& from = lexLess(p.p, q.p) ? p : q;
+            const Corner& to = lexLess(p.p, q.p) ? q : p;
+            const float t = from.p.z / (from.p.z - to.p.z);
+            Corner x{from.p + t * (to.p - from.p), from.w + t * (to.w - from.w)};
+            x.p.z = 0.0f;
+            polygon[size_t(count++)] = x;
         }
     }
-    if (corners < 3)
+    if (count < 3)
         return;
     auto splits = [&](const glm::vec3& p, const glm::vec3& q) {
         const float lengths = glm::length(p) * glm::length(q);
@@ -164,42 +189,47 @@ void appendParaboloidCasters(const glm::vec3& a, const glm::vec3& b, const glm::
     };
     // Red-green refinement on an explicit stack: a triangle with k split edges becomes k + 1
     // triangles, each split again until none of its edges splits.
-    std::vector<std::array<glm::vec3, 3>> stack;
+    std::vector<std::array<Corner, 3>> stack;
     stack.push_back({polygon[0], polygon[1], polygon[2]});
-    if (corners == 4)
+    if (count == 4)
         stack.push_back({polygon[0], polygon[2], polygon[3]});
     while (!stack.empty()) {
-        const std::array<glm::vec3, 3> t = stack.back();
+        const std::array<Corner, 3> t = stack.back();
         stack.pop_back();
-        int first = -1, count = 0;
+        int first = -1, splitCount = 0;
         std::array<bool, 3> split{};
         for (int e = 0; e < 3; ++e) {
-            split[size_t(e)] = cosMaxEdge < 1.0f && splits(t[size_t(e)], t[size_t((e + 1) % 3)]);
+            split[size_t(e)] =
+                cosMaxEdge < 1.0f && splits(t[size_t(e)].p, t[size_t((e + 1) % 3)].p);
             if (split[size_t(e)]) {
-                count += 1;
+                splitCount += 1;
                 if (first < 0)
                     first = e;
             }
         }
-        if (count == 0) {
-            out.insert(out.end(), t.begin(), t.end());
+        if (splitCount == 0) {
+            for (const Corner& corner : t) {
+                out.push_back(corner.p);
+                if (weightsOut)
+                    weightsOut->push_back(corner.w);
+            }
             continue;
         }
         // Rotate so that edge 0 (t0 t1) splits; m_e is the midpoint of edge e (t_e t_{e+1}).
-        std::array<glm::vec3, 3> r;
+        std::array<Corner, 3> r;
         std::array<bool, 3> s;
         for (int k = 0; k < 3; ++k) {
             r[size_t(k)] = t[size_t((first + k) % 3)];
             s[size_t(k)] = split[size_t((first + k) % 3)];
         }
-        const glm::vec3 m0 = 0.5f * (r[0] + r[1]), m1 = 0.5f * (r[1] + r[2]),
-                        m2 = 0.5f * (r[2] + r[0]);
-        if (count == 3) {
+        const Corner m0 = midpoint(r[0], r[1]), m1 = midpoint(r[1], r[2]),
+                     m2 = midpoint(r[2], r[0]);
+        if (splitCount == 3) {
             stack.push_back({r[0], m0, m2});
             stack.push_back({m0, r[1], m1});
             stack.push_back({m2, m1, r[2]});
             stack.push_back({m0, m1, m2});
-        } else if (count == 1) {
+        } else if (splitCount == 1) {
             stack.push_back({r[0], m0, r[2]});
             stack.push_back({m0, r[1], r[2]});
         } else if (s[1]) { // edges 0 and 1
@@ -546,8 +576,10 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     // touches their range sphere (chunk boxes first), in triangle order; directional lights the
     // triangles of their casting set (everything when the set holds every instance).
     // Triangles of materials that cast no shadow (CasterMaterials.h: blended, masked with a
-    // constant alpha below the cutoff) are left out, as the rays leave them out.
+    // constant alpha below the cutoff) are left out, as the rays leave them out; alpha-tested ones
+    // are kept apart, for the faces' second, alpha-testing draw.
     const std::vector<uint8_t> castingMaterial = shadows::castingMaterials(scene);
+    const shadows::CasterAlphaTest alphaTest(scene, geometry);
     const bool everyMaterial = std::all_of(castingMaterial.begin(), castingMaterial.end(),
                                            [](uint8_t casts) { return casts != 0; });
     std::vector<Casters> casters(maps.mShadows.size());
@@ -561,16 +593,22 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             return (!everyObject && !inSet[geometry.triangleInstance[t]]) ||
                    (!everyMaterial && !castingMaterial[geometry.triangleMaterial[t]]);
         };
+        auto add = [&](uint32_t t) {
+            const bool tested = alphaTest.tested(t);
+            for (int k = 0; k < 3; ++k)
+                (tested ? set.testedPositions : set.ownPositions)
+                    .push_back(geometry.positionWorld[geometry.indices[3 * t + k]]);
+            if (tested)
+                set.testedTriangles.push_back(t);
+        };
         if (light.type == scenes::LightType::Directional) {
-            if (everyObject && everyMaterial) {
+            if (everyObject && everyMaterial && !alphaTest.any()) {
                 set.whole = true;
                 return;
             }
             for (uint32_t t = 0; t < triangleCount; ++t)
                 if (!excluded(t))
-                    for (int k = 0; k < 3; ++k)
-                        set.ownPositions.push_back(
-                            geometry.positionWorld[geometry.indices[3 * t + k]]);
+                    add(t);
             return;
         }
         const glm::dvec3 centre(light.positionWorld);
@@ -587,8 +625,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                     box.extend(geometry.positionWorld[geometry.indices[3 * t + k]]);
                 if (!boxTouchesSphere(centre, radius, box))
                     continue;
-                for (int k = 0; k < 3; ++k)
-                    set.ownPositions.push_back(geometry.positionWorld[geometry.indices[3 * t + k]]);
+                add(t);
             }
         }
     });
@@ -647,31 +684,36 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             set.whole ? std::span<const uint32_t>(geometry.indices)
                       : std::span<const uint32_t>(sequentialIndices.data(), positions.size());
         const glm::mat4& clipFromWorld = jobs[f].clipFromWorld;
+        // Paraboloid faces: clipped and split in the light frame, then projected: x, y as they
+        // are and w = |l| - l.z, so that x / w is the paraboloid's coordinate; z / w the linear
+        // reversed depth (far - |l|) / (far - near).
+        const float cosMaxEdge =
+            settings.paraboloidMaxEdgeDegrees > 0.0
+                ? float(std::cos(glm::radians(std::min(settings.paraboloidMaxEdgeDegrees, 180.0))))
+                : 1.0f;
+        const float minEdge = float(kMinParaboloidEdgeFraction * face.farMetres);
+        const float nearM = float(face.nearMetres), farM = float(face.farMetres);
+        auto paraboloidClip = [&](const glm::vec3& l) {
+            const float distance = glm::length(l);
+            const float w = distance - l.z;
+            return glm::vec4(l.x, l.y, w * (farM - distance) / (farM - nearM), w);
+        };
+        constexpr std::array<glm::vec3, 3> kCornerWeights = {
+            glm::vec3(1.0f, 0.0f, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 0.0f, 1.0f)};
+        auto lightFrame = [&](const glm::vec3& world) {
+            return glm::vec3(clipFromWorld * glm::vec4(world, 1.0f));
+        };
         if (face.paraboloid) {
-            // Clipped and split in the light frame, then projected: x, y as they are and
-            // w = |l| - l.z, so that x / w is the paraboloid's coordinate; z / w the linear
-            // reversed depth (far - |l|) / (far - near).
-            const float cosMaxEdge = settings.paraboloidMaxEdgeDegrees > 0.0
-                                         ? float(std::cos(glm::radians(
-                                               std::min(settings.paraboloidMaxEdgeDegrees, 180.0))))
-                                         : 1.0f;
-            const float minEdge = float(kMinParaboloidEdgeFraction * face.farMetres);
             scratch.lightSpace.clear();
             const size_t cornerCount = indices.size();
-            for (size_t i = 0; i + 2 < cornerCount; i += 3) {
-                std::array<glm::vec3, 3> l;
-                for (size_t k = 0; k < 3; ++k)
-                    l[k] = glm::vec3(clipFromWorld * glm::vec4(positions[indices[i + k]], 1.0f));
-                appendParaboloidCasters(l[0], l[1], l[2], cosMaxEdge, minEdge, scratch.lightSpace);
-            }
-            const float nearM = float(face.nearMetres), farM = float(face.farMetres);
+            for (size_t i = 0; i + 2 < cornerCount; i += 3)
+                appendParaboloidCasters(
+                    {lightFrame(positions[indices[i]]), lightFrame(positions[indices[i + 1]]),
+                     lightFrame(positions[indices[i + 2]])},
+                    kCornerWeights, cosMaxEdge, minEdge, scratch.lightSpace, nullptr);
             scratch.clip.resize(scratch.lightSpace.size());
-            for (size_t i = 0; i < scratch.lightSpace.size(); ++i) {
-                const glm::vec3& l = scratch.lightSpace[i];
-                const float distance = glm::length(l);
-                const float w = distance - l.z;
-                scratch.clip[i] = glm::vec4(l.x, l.y, w * (farM - distance) / (farM - nearM), w);
-            }
+            for (size_t i = 0; i < scratch.lightSpace.size(); ++i)
+                scratch.clip[i] = paraboloidClip(scratch.lightSpace[i]);
             if (scratch.sequential.size() < scratch.clip.size()) {
                 scratch.sequential.resize(scratch.clip.size());
                 std::iota(scratch.sequential.begin(), scratch.sequential.end(), 0u);
@@ -737,6 +779,99 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         faceState.tilesNotClear = face.tilesNotClear;
         rasterizer->draw(raster::TriangleList{scratch.clip, drawIndices}, faceState,
                          face.depth.data(), raster::DepthOnly{});
+        if (!set.testedTriangles.empty()) {
+            // The alpha-tested casters, drawn after the others into the same buffer (the depth
+            // test keeps the nearest whatever the order): each corner carries its uv (a
+            // paraboloid piece's from its weights of its scene triangle's corners), the fragment
+            // interpolates it with its perspective-correct barycentrics, and the texel keeps the
+            // fragment only where the material's alpha passes there (CasterAlphaTest, the rays'
+            // test). A paraboloid piece's barycentrics are perspective-correct for its clip w,
+            // not for the paraboloid's nonlinear projection: within the split's angle, about a
+            // texel.
+            scratch.testedClip.clear();
+            scratch.testedUv.clear();
+            scratch.testedMaterial.clear();
+            for (size_t t = 0; t < set.testedTriangles.size(); ++t) {
+                const uint32_t triangle = set.testedTriangles[t];
+                const uint32_t material = geometry.triangleMaterial[triangle];
+                const glm::vec3* corner = &set.testedPositions[3 * t];
+                if (face.paraboloid) {
+                    scratch.testedLightSpace.clear();
+                    scratch.testedWeights.clear();
+                    appendParaboloidCasters(
+                        {lightFrame(corner[0]), lightFrame(corner[1]), lightFrame(corner[2])},
+                        kCornerWeights, cosMaxEdge, minEdge, scratch.testedLightSpace,
+                        &scratch.testedWeights);
+                    for (size_t k = 0; k < scratch.testedLightSpace.size(); ++k) {
+                        scratch.testedClip.push_back(paraboloidClip(scratch.testedLightSpace[k]));
+                        scratch.testedUv.push_back(
+                            alphaTest.uvAt(triangle, scratch.testedWeights[k]));
+                    }
+                    scratch.testedMaterial.insert(scratch.testedMaterial.end(),
+                                                  scratch.testedLightSpace.size() / 3, material);
+                    continue;
+                }
+                const glm::vec4 clip[3] = {clipFromWorld * glm::vec4(corner[0], 1.0f),
+                                           clipFromWorld * glm::vec4(corner[1], 1.0f),
+                                           clipFromWorld * glm::vec4(corner[2], 1.0f)};
+                if (raster::frustumOutcode(clip[0]) & raster::frustumOutcode(clip[1]) &
+                    raster::frustumOutcode(clip[2]))
+                    continue;
+                scratch.testedClip.insert(scratch.testedClip.end(), clip, clip + 3);
+                for (const glm::vec3& weights : kCornerWeights)
+                    scratch.testedUv.push_back(alphaTest.uvAt(triangle, weights));
+                scratch.testedMaterial.push_back(material);
+            }
+            if (scratch.sequential.size() < scratch.testedClip.size()) {
+                scratch.sequential.resize(scratch.testedClip.size());
+                std::iota(scratch.sequential.begin(), scratch.sequential.end(), 0u);
+            }
+            raster::RasterState testedState = state;
+            testedState.barycentrics = true;
+            testedState.clearDepth.reset(); // the first draw cleared
+            const std::vector<glm::vec2>& uv = scratch.testedUv;
+            const std::vector<uint32_t>& materialOf = scratch.testedMaterial;
+            rasterizer->draw(
+                raster::TriangleList{scratch.testedClip,
+                                     std::span<const uint32_t>(scratch.sequential.data(),
+                                                               scratch.testedClip.size())},
+                testedState, face.depth.data(), [&](const raster::Fragment& fragment) {
+                    const size_t i = 3 * size_t(fragment.triangle);
+                    return alphaTest.castsAtUv(
+                        materialOf[fragment.triangle],
+                        raster::interpolate(uv[i], uv[i + 1], uv[i + 2], fragment.barycentric));
+                });
+            faceTriangles[f] += scratch.testedMaterial.size();
+            // The tiles record only the first draw's bins: the tiles the tested triangles' screen
+            // boxes touch (a pixel's margin for the snapping) may now hold depth too, all of them
+            // when a corner is not in front of the projection (w <= 0: no finite box).
+            const int tilesX = rasterizer->tileCountX(), tilesY = rasterizer->tileCountY();
+            for (size_t i = 0; i + 2 < scratch.testedClip.size(); i += 3) {
+                glm::vec2 low(std::numeric_limits<float>::max()), high(-low);
+                bool finite = true;
+                for (size_t k = 0; k < 3; ++k) {
+                    const glm::vec4& c = scratch.testedClip[i + k];
+                    finite = finite && c.w > 0.0f;
+                    const glm::vec2 pixel((c.x / c.w * 0.5f + 0.5f) * float(size),
+                                          (0.5f - c.y / c.w * 0.5f) * float(size));
+                    low = glm::min(low, pixel);
+                    high = glm::max(high, pixel);
+                }
+                finite = finite && std::isfinite(low.x) && std::isfinite(low.y) &&
+                         std::isfinite(high.x) && std::isfinite(high.y);
+                auto tileOf = [](float pixel, int tiles) {
+                    return int(std::clamp(std::floor(pixel / float(raster::kTileSize)), 0.0f,
+                                          float(tiles - 1)));
+                };
+                const int x0 = finite ? tileOf(low.x - 1.0f, tilesX) : 0;
+                const int x1 = finite ? tileOf(high.x + 1.0f, tilesX) : tilesX - 1;
+                const int y0 = finite ? tileOf(low.y - 1.0f, tilesY) : 0;
+                const int y1 = finite ? tileOf(high.y + 1.0f, tilesY) : tilesY - 1;
+                for (int ty = y0; ty <= y1; ++ty)
+                    for (int tx = x0; tx <= x1; ++tx)
+                        face.tilesNotClear[size_t(ty) * size_t(tilesX) + size_t(tx)] = 1;
+            }
+        }
         faceMs[f] = milliseconds(faceStart);
     };
     if (settings.schedule == ShadowSchedule::FacesInParallel) {

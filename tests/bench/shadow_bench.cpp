@@ -98,6 +98,58 @@ BENCHMARK(shadowMapRender)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
 
+// Alpha-tested casters (CasterMaterials.h): `foliage` (12 leaf cards of a textured Mask
+// material, 664 triangles) with 16 generated point lights (seed 1) and its sun casting, cube maps
+// of 512^2 (97 faces), buffers recycled, faces in parallel. range(0): threads; range(1): 1 = the
+// cards alpha-tested per texel (what the testbed renders), 0 = the same scene with the cards'
+// material made Opaque (the depth-only span path): the test's cost is the difference.
+const ShadowFrame& foliage(bool alphaTested) {
+    auto make = [](bool opaqueCards) {
+        ShadowFrame f;
+        f.scene = bench::proceduralScene("foliage", 16);
+        for (scenes::Material& material : f.scene.materials)
+            if (opaqueCards && material.alphaMode == scenes::AlphaMode::Mask)
+                material.alphaMode = scenes::AlphaMode::Opaque;
+        f.geometry = gbuffer::SceneGeometry::build(f.scene);
+        f.view = gbuffer::CameraView::fromCamera(f.scene.cameras[0], bench::kWidth, bench::kHeight);
+        return f;
+    };
+    static const ShadowFrame frames[2] = {make(true), make(false)};
+    return frames[alphaTested ? 1 : 0];
+}
+
+void shadowMapRenderAlphaTested(benchmark::State& state) {
+    const ShadowFrame& f = foliage(state.range(1) == 1);
+    tbb::task_arena arena(int(state.range(0)));
+    lighting::ShadowSettings settings;
+    settings.mapSize = 512;
+    state.SetLabel(state.range(1) == 1 ? "cards alpha-tested" : "cards opaque");
+    std::vector<double> renderMs;
+    lighting::ShadowStats stats;
+    lighting::ShadowMaps previous;
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        arena.execute([&] {
+            previous =
+                lighting::ShadowMaps::render(f.scene, f.geometry, f.view, settings, &previous);
+            stats = previous.stats();
+        });
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        state.SetIterationTime(seconds);
+        renderMs.push_back(seconds * 1e3);
+    }
+    std::sort(renderMs.begin(), renderMs.end());
+    state.counters["render_ms_min"] = renderMs.front();
+    state.counters["render_ms_median"] = renderMs[renderMs.size() / 2];
+    state.counters["faces"] = double(stats.faceCount);
+}
+BENCHMARK(shadowMapRenderAlphaTested)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
+
 // The atrium's maps (512^2, the filter of `filterIndex`: none, pcf3, pcf5, poisson) and packets of
 // receivers: each packet 16 points within 5 cm of a centre drawn uniformly in the ball of 0.9 x
 // the range of one casting light (a 4x4 pixel block's spread on a surface a few metres away),

@@ -56,10 +56,11 @@ const SceneCase kScenes[] = {
     // kernel (BlendedPass), the reference composites them with the rays. Last: the every-stage
     // suite below leaves it out (its approximate stages' blended paths are their own study).
     // Its panes and its ghost pane (masked, alpha below the cutoff) cast no shadow
-    // (CasterMaterials.h): the box, the fence and the walls shadow 2.0% of the pairs, so the
-    // pcf3 penumbrae along their edges weigh more against the unshadowed error (measured 0.27
-    // against 1.18: 23%).
-    {"glass_sun", "glass", 24, {{"sun", "1"}}, 0.3, 0.015},
+    // (CasterMaterials.h), and the fence's cut-out stripes cast only where their alpha passes:
+    // the box, the fence and the walls shadow 1.5% of the pairs, so the pcf3 penumbrae along
+    // their edges weigh more against the unshadowed error (measured 0.277 against 0.792: 35%;
+    // before the fence was alpha-tested per texel, 0.27 against 1.18 and 2.0% of the pairs).
+    {"glass_sun", "glass", 24, {{"sun", "1"}}, 0.45, 0.012},
 };
 constexpr int kEveryStageScenes = 2;
 

@@ -22,6 +22,7 @@
 #include "gbuffer/visibility/CameraView.h"
 #include "gbuffer/visibility/SceneGeometry.h"
 #include "lighting/shadows/CasterMaterials.h"
+#include "lighting/shadows/ExactRayCast.h"
 #include "lighting/shadows/RayVisibility.h"
 #include "lighting/shadows/ShadowMaps.h"
 #include "scenes/Scene.h"
@@ -875,6 +876,117 @@ TEST(ShadowMaps, BlendedAndMaskedBelowCutoffCastNoShadowInMapsAndRays) {
     EXPECT_EQ(rays.droppedTriangleCount(), 4u); // the two squares that cast nothing
 }
 
+// A cut-out (a textured Mask material: a 4x4 checker of alpha 0 and 1) over a ground plane casts
+// only where its alpha passes, in every kind of map and in the rays (Embree's filter and the exact
+// oracle alike). The receivers are the points whose rays to the light pass through the centres of
+// the texture's texels, where the bilinear alpha is the texel's own (0 or 1): half must be
+// shadowed, half lit. Before the per-texel test, every one was shadowed.
+// A quad corner + s * edgeU + t * edgeV cut out by a 4x4 checker of alpha 0 and 1 (a textured
+// Mask material, cutoff 0.5, added to the scene with its texture); returns the texture.
+scenes::Texture addCheckerCutOut(TestScene& t, const glm::vec3& corner, const glm::vec3& edgeU,
+                                 const glm::vec3& edgeV) {
+    scenes::Texture checker;
+    checker.name = "checker";
+    checker.width = checker.height = 4;
+    for (int r = 0; r < 4; ++r)
+        for (int i = 0; i < 4; ++i)
+            checker.rgba8.insert(checker.rgba8.end(),
+                                 {200, 200, 200, uint8_t((i + r) % 2 == 0 ? 255 : 0)});
+    t.scene.textures.push_back(checker);
+    scenes::Material cutOut;
+    cutOut.alphaMode = scenes::AlphaMode::Mask;
+    cutOut.alphaCutoff = 0.5f;
+    cutOut.baseColorTexture = int(t.scene.textures.size() - 1);
+    t.scene.materials.push_back(cutOut);
+    scenes::Mesh& quad = t.newMesh();
+    scenes::appendQuad(quad, corner, edgeU, edgeV, 1, 1);
+    quad.material = uint32_t(t.scene.materials.size() - 1);
+    return checker;
+}
+
+TEST(ShadowMaps, AlphaTestedCastersCastOnlyWhereTheirAlphaPasses) {
+    TestScene t;
+    t.ground(6.0f);
+    // uv.x = (x + 1) / 2, uv.y = (z + 1) / 2 (MeshBuilder: uv.x along edgeU, uv.y falling along
+    // edgeV), facing +Y, two triangles.
+    const scenes::Texture checker = addCheckerCutOut(t, {-1.0f, 1.0f, 1.0f}, {2, 0, 0}, {0, 0, -2});
+    t.camera({0, 5, 6}, {0, 0, 0});
+    t.light(directionalLight({0.0f, -1.0f, 0.0f}));
+    t.light(spotLight({0.2f, 4.0f, 0.1f}, {0, -1, 0}, 12.0f, 50.0f));
+    t.light(pointLight({-0.3f, 4.0f, 0.2f}, 12.0f));
+
+    // The receivers: under texel (i, r)'s centre, seen from light `light`.
+    struct Receiver {
+        glm::dvec3 ground;
+        bool shadowed;
+    };
+    auto receivers = [&](const Light& light) {
+        std::vector<Receiver> out;
+        for (int r = 0; r < 4; ++r)
+            for (int i = 0; i < 4; ++i) {
+                const glm::vec2 uv((i + 0.5f) / 4.0f, (r + 0.5f) / 4.0f);
+                const glm::dvec3 centre(2.0 * uv.x - 1.0, 1.0, 2.0 * uv.y - 1.0);
+                const glm::dvec3 from = light.type == LightType::Directional
+                                            ? centre - 10.0 * glm::dvec3(light.directionWorld)
+                                            : glm::dvec3(light.positionWorld);
+                const glm::dvec3 ground = from + (centre - from) * (from.y / (from.y - 1.0));
+                out.push_back({ground, checker.sample(uv).a >= 0.5f});
+            }
+        return out;
+    };
+    ShadowSettings settings = noFilter(512);
+    for (const lighting::ShadowPointProjection projection :
+         {lighting::ShadowPointProjection::Cube, lighting::ShadowPointProjection::DualParaboloid}) {
+        SCOPED_TRACE(lighting::formatShadowPointProjection(projection));
+        settings.pointProjection = projection;
+        const Frame frame(t.scene, settings);
+        const lighting::shadows::RayVisibility rays(frame.scene, frame.geometry);
+        EXPECT_EQ(rays.alphaTestedTriangleCount(), 2u);
+        const lighting::shadows::CasterAlphaTest alphaTest(frame.scene, frame.geometry);
+        for (size_t l = 0; l < t.scene.lights.size(); ++l) {
+            const Light& light = t.scene.lights[l];
+            int shadowedTruth = 0;
+            for (const Receiver& receiver : receivers(light)) {
+                SCOPED_TRACE(testing::Message() << "light " << l << " at (" << receiver.ground.x
+                                                << ", " << receiver.ground.z << ")");
+                const glm::dvec3 up(0.0, 1.0, 0.0);
+                const lighting::shadows::ShadowRay ray =
+                    light.type == LightType::Directional
+                        ? lighting::shadows::ShadowRay::directional(
+                              receiver.ground, up, glm::dvec3(light.directionWorld))
+                        : lighting::shadows::ShadowRay::toPoint(receiver.ground, up,
+                                                                glm::dvec3(light.positionWorld));
+                shadowedTruth += receiver.shadowed;
+                EXPECT_EQ(lighting::shadows::segmentBlockedExact(frame.geometry, ray, &alphaTest),
+                          receiver.shadowed);
+                EXPECT_EQ(lighting::shadows::segmentBlockedExact(frame.geometry, ray),
+                          true); // without the test, the holes block
+                EXPECT_EQ(rays.occluded(ray), receiver.shadowed);
+                std::vector<lighting::shadows::ShadowRay> packet(16, ray);
+                std::vector<uint8_t> answers(packet.size());
+                rays.occluded(packet, answers);
+                EXPECT_EQ(std::count(answers.begin(), answers.end(), uint8_t(1)),
+                          receiver.shadowed ? 16 : 0);
+                EXPECT_EQ(frame.visibility(l, receiver.ground, glm::vec3(up)) == 0.0f,
+                          receiver.shadowed);
+            }
+            EXPECT_EQ(shadowedTruth, 8);
+        }
+        // The second, alpha-testing draw keeps the maps bitwise independent of the threads.
+        auto depthWith = [&](int threads) {
+            tbb::task_arena arena(threads);
+            return arena.execute([&] {
+                const Frame again(t.scene, settings);
+                std::vector<std::vector<float>> depth;
+                for (size_t f = 0; f < again.maps.faceCount(); ++f)
+                    depth.push_back(again.maps.face(f).depth);
+                return depth;
+            });
+        };
+        EXPECT_EQ(depthWith(1), depthWith(2));
+    }
+}
+
 TEST(ShadowSettings, FilterNamesRoundTrip) {
     for (ShadowFilter filter :
          {ShadowFilter::None, ShadowFilter::Pcf3, ShadowFilter::Pcf5, ShadowFilter::Poisson})
@@ -955,6 +1067,38 @@ TEST(ShadowMaps, RecycledBuffersStayExactWhenTheCastersMove) {
         previous = std::move(next);
     }
     EXPECT_GT(clearTilesSeen, 0u) << "no face has an empty tile: the test exercises nothing";
+}
+
+// The same with an alpha-tested cut-out that moves from frame to frame (its second draw's tiles
+// must be recorded, or a recycled buffer keeps its old depth there), for cube and paraboloid
+// point maps, a spot light and a sun.
+TEST(ShadowMaps, RecycledBuffersStayExactWhenAlphaTestedCastersMove) {
+    for (const lighting::ShadowPointProjection projection :
+         {lighting::ShadowPointProjection::Cube, lighting::ShadowPointProjection::DualParaboloid}) {
+        SCOPED_TRACE(lighting::formatShadowPointProjection(projection));
+        ShadowMaps previous;
+        for (int step = 0; step < 4; ++step) {
+            // No ground: the cut-out's tiles hold nothing else, so only its own record clears them.
+            TestScene t;
+            t.box({-1, 0, -4}, {1, 2, -3});
+            const float x = step % 2 == 0 ? -3.0f : 2.0f;
+            addCheckerCutOut(t, {x, 1.0f, 0.0f}, {1.0f, 0, 0}, {0, 0, -1.0f});
+            t.camera({0, 2, 3}, {0, 0, -4});
+            t.light(pointLight({0.0f, 3.0f, -1.0f}, 10.0f));
+            t.light(spotLight({0.5f, 4.0f, -0.5f}, {0.0f, -1.0f, -0.2f}, 12.0f, 60.0f));
+            t.light(directionalLight({0.2f, -1.0f, -0.3f}));
+            ShadowSettings settings = noFilter(256);
+            settings.pointProjection = projection;
+            const Frame fresh(t.scene, settings);
+            ShadowMaps next =
+                ShadowMaps::render(fresh.scene, fresh.geometry, fresh.view, settings, &previous);
+            ASSERT_EQ(next.faceCount(), fresh.maps.faceCount()) << "step " << step;
+            for (size_t f = 0; f < next.faceCount(); ++f)
+                EXPECT_EQ(next.face(f).depth, fresh.maps.face(f).depth)
+                    << "step " << step << ", face " << f;
+            previous = std::move(next);
+        }
+    }
 }
 
 } // namespace
