@@ -50,30 +50,21 @@ const ShadowFrame& atrium() {
     return frame;
 }
 
-// range(0): threads; range(1): 0 = faces in parallel, 1 = faces in sequence; range(2): 1 = each
-// frame takes over the last frame's depth buffers (what the runner does), 0 = fresh buffers;
-// range(3): 1 = each face drops the casters outside its frustum before the draw (the default),
-// 0 = every face hands its light's whole caster list to the rasterizer (the same maps).
-void shadowMapRender(benchmark::State& state) {
-    const ShadowFrame& f = atrium();
-    tbb::task_arena arena(int(state.range(0)));
-    lighting::ShadowSettings settings;
-    settings.mapSize = 512;
-    settings.schedule = state.range(1) == 0 ? lighting::ShadowSchedule::FacesInParallel
-                                            : lighting::ShadowSchedule::FacesInSequence;
-    settings.cullCastersPerFace = state.range(3) == 1;
-    state.SetLabel(std::string(state.range(1) == 0 ? "faces in parallel" : "faces in sequence") +
-                   (state.range(2) == 1 ? ", buffers recycled" : ", fresh buffers") +
-                   (state.range(3) == 1 ? ", per-face cull" : ", whole lists"));
+// Renders `f`'s maps once per benchmark iteration under `threads` (each frame taking over the
+// last frame's buffers when `recycle`), timed by hand; sets the counters render_ms_min,
+// render_ms_median and faces, and returns the last frame's statistics.
+lighting::ShadowStats timeRenders(benchmark::State& state, const ShadowFrame& f,
+                                  const lighting::ShadowSettings& settings, int threads,
+                                  bool recycle) {
+    tbb::task_arena arena(threads);
     std::vector<double> renderMs;
-    const bool recycleBuffers = state.range(2) == 1;
     lighting::ShadowStats stats;
     lighting::ShadowMaps previous; // the last frame's, whose buffers a frame may take over
     for (auto _ : state) {
         const auto start = std::chrono::steady_clock::now();
         arena.execute([&] {
             previous = lighting::ShadowMaps::render(f.scene, f.geometry, f.view, settings,
-                                                    recycleBuffers ? &previous : nullptr);
+                                                    recycle ? &previous : nullptr);
             stats = previous.stats();
         });
         const double seconds =
@@ -82,12 +73,31 @@ void shadowMapRender(benchmark::State& state) {
         renderMs.push_back(seconds * 1e3);
     }
     std::sort(renderMs.begin(), renderMs.end());
-    uint64_t triangles = 0;
-    for (const lighting::ShadowLightStats& light : stats.lights)
-        triangles += light.trianglesDrawn;
     state.counters["render_ms_min"] = renderMs.front();
     state.counters["render_ms_median"] = renderMs[renderMs.size() / 2];
     state.counters["faces"] = double(stats.faceCount);
+    return stats;
+}
+
+// range(0): threads; range(1): 0 = faces in parallel, 1 = faces in sequence; range(2): 1 = each
+// frame takes over the last frame's depth buffers (what the runner does), 0 = fresh buffers;
+// range(3): 1 = each face drops the casters outside its frustum before the draw (the default),
+// 0 = every face hands its light's whole caster list to the rasterizer (the same maps).
+void shadowMapRender(benchmark::State& state) {
+    const ShadowFrame& f = atrium();
+    lighting::ShadowSettings settings;
+    settings.mapSize = 512;
+    settings.schedule = state.range(1) == 0 ? lighting::ShadowSchedule::FacesInParallel
+                                            : lighting::ShadowSchedule::FacesInSequence;
+    settings.cullCastersPerFace = state.range(3) == 1;
+    state.SetLabel(std::string(state.range(1) == 0 ? "faces in parallel" : "faces in sequence") +
+                   (state.range(2) == 1 ? ", buffers recycled" : ", fresh buffers") +
+                   (state.range(3) == 1 ? ", per-face cull" : ", whole lists"));
+    const lighting::ShadowStats stats =
+        timeRenders(state, f, settings, int(state.range(0)), state.range(2) == 1);
+    uint64_t triangles = 0;
+    for (const lighting::ShadowLightStats& light : stats.lights)
+        triangles += light.trianglesDrawn;
     state.counters["triangles_drawn"] = double(triangles);
     state.counters["scene_triangles"] = double(f.geometry.triangleCount());
     state.counters["MB"] = double(stats.totalBytes) / (1024.0 * 1024.0);
@@ -120,29 +130,10 @@ const ShadowFrame& foliage(bool alphaTested) {
 
 void shadowMapRenderAlphaTested(benchmark::State& state) {
     const ShadowFrame& f = foliage(state.range(1) == 1);
-    tbb::task_arena arena(int(state.range(0)));
     lighting::ShadowSettings settings;
     settings.mapSize = 512;
     state.SetLabel(state.range(1) == 1 ? "cards alpha-tested" : "cards opaque");
-    std::vector<double> renderMs;
-    lighting::ShadowStats stats;
-    lighting::ShadowMaps previous;
-    for (auto _ : state) {
-        const auto start = std::chrono::steady_clock::now();
-        arena.execute([&] {
-            previous =
-                lighting::ShadowMaps::render(f.scene, f.geometry, f.view, settings, &previous);
-            stats = previous.stats();
-        });
-        const double seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        state.SetIterationTime(seconds);
-        renderMs.push_back(seconds * 1e3);
-    }
-    std::sort(renderMs.begin(), renderMs.end());
-    state.counters["render_ms_min"] = renderMs.front();
-    state.counters["render_ms_median"] = renderMs[renderMs.size() / 2];
-    state.counters["faces"] = double(stats.faceCount);
+    timeRenders(state, f, settings, int(state.range(0)), true);
 }
 BENCHMARK(shadowMapRenderAlphaTested)
     ->ArgsProduct({{1, 2}, {0, 1}})
