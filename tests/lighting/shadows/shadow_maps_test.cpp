@@ -134,6 +134,19 @@ struct Frame {
     }
 };
 
+// Every face's depth of `scene`'s maps, rendered in an arena of `threads`.
+std::vector<std::vector<float>> mapsDepth(const scenes::Scene& scene,
+                                          const ShadowSettings& settings, int threads) {
+    tbb::task_arena arena(threads);
+    return arena.execute([&] {
+        const Frame frame(scene, settings);
+        std::vector<std::vector<float>> depth;
+        for (size_t f = 0; f < frame.maps.faceCount(); ++f)
+            depth.push_back(frame.maps.face(f).depth);
+        return depth;
+    });
+}
+
 // ---- the brute-force oracle -----------------------------------------------------------------
 
 // Moller-Trumbore: the ray origin + t dir hits the triangle for some t in (tMin, tMax).
@@ -642,16 +655,9 @@ TEST(ShadowMaps, RenderIsBitwiseIndependentOfThreadsAndNeverNaN) {
         settings.cascades = 3;
         settings.pointProjection = projection;
         auto renderWith = [&](int threads, lighting::ShadowSchedule schedule) {
-            tbb::task_arena arena(threads);
             ShadowSettings s = settings;
             s.schedule = schedule;
-            return arena.execute([&] {
-                const Frame frame(t.scene, s);
-                std::vector<std::vector<float>> depth;
-                for (size_t f = 0; f < frame.maps.faceCount(); ++f)
-                    depth.push_back(frame.maps.face(f).depth);
-                return depth;
-            });
+            return mapsDepth(t.scene, s, threads);
         };
         const auto reference = renderWith(1, lighting::ShadowSchedule::FacesInParallel);
         EXPECT_EQ(reference.size(), 1u + pointFaces + 3u);
@@ -973,17 +979,7 @@ TEST(ShadowMaps, AlphaTestedCastersCastOnlyWhereTheirAlphaPasses) {
             EXPECT_EQ(shadowedTruth, 8);
         }
         // The second, alpha-testing draw keeps the maps bitwise independent of the threads.
-        auto depthWith = [&](int threads) {
-            tbb::task_arena arena(threads);
-            return arena.execute([&] {
-                const Frame again(t.scene, settings);
-                std::vector<std::vector<float>> depth;
-                for (size_t f = 0; f < again.maps.faceCount(); ++f)
-                    depth.push_back(again.maps.face(f).depth);
-                return depth;
-            });
-        };
-        EXPECT_EQ(depthWith(1), depthWith(2));
+        EXPECT_EQ(mapsDepth(t.scene, settings, 1), mapsDepth(t.scene, settings, 2));
     }
 }
 
