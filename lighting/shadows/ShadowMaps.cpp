@@ -244,6 +244,39 @@ void appendParaboloidCasters(const std::array<glm::vec3, 3>& corners,
     }
 }
 
+// Marks 1 in `tilesNotClear` (row-major, tilesX x tilesY tiles of raster::kTileSize) every tile
+// the screen box of a triangle of `clip` (three corners each, a size x size viewport) touches,
+// with a pixel's margin for the rasterizer's snapping; every tile when a corner is not in front
+// of the projection (w <= 0: no finite box).
+void markTilesTouched(std::span<const glm::vec4> clip, int size, int tilesX, int tilesY,
+                      std::span<uint8_t> tilesNotClear) {
+    auto tileOf = [](float pixel, int tiles) {
+        return int(
+            std::clamp(std::floor(pixel / float(raster::kTileSize)), 0.0f, float(tiles - 1)));
+    };
+    for (size_t i = 0; i + 2 < clip.size(); i += 3) {
+        glm::vec2 low(std::numeric_limits<float>::max()), high(-low);
+        bool finite = true;
+        for (size_t k = 0; k < 3; ++k) {
+            const glm::vec4& c = clip[i + k];
+            finite = finite && c.w > 0.0f;
+            const glm::vec2 pixel((c.x / c.w * 0.5f + 0.5f) * float(size),
+                                  (0.5f - c.y / c.w * 0.5f) * float(size));
+            low = glm::min(low, pixel);
+            high = glm::max(high, pixel);
+        }
+        finite = finite && std::isfinite(low.x) && std::isfinite(low.y) && std::isfinite(high.x) &&
+                 std::isfinite(high.y);
+        const int x0 = finite ? tileOf(low.x - 1.0f, tilesX) : 0;
+        const int x1 = finite ? tileOf(high.x + 1.0f, tilesX) : tilesX - 1;
+        const int y0 = finite ? tileOf(low.y - 1.0f, tilesY) : 0;
+        const int y1 = finite ? tileOf(high.y + 1.0f, tilesY) : tilesY - 1;
+        for (int ty = y0; ty <= y1; ++ty)
+            for (int tx = x0; tx <= x1; ++tx)
+                tilesNotClear[size_t(ty) * size_t(tilesX) + size_t(tx)] = 1;
+    }
+}
+
 } // namespace
 
 std::vector<uint32_t> ShadowMaps::chooseLights(const std::vector<scenes::Light>& lights,
@@ -842,35 +875,10 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                         raster::interpolate(uv[i], uv[i + 1], uv[i + 2], fragment.barycentric));
                 });
             faceTriangles[f] += scratch.testedMaterial.size();
-            // The tiles record only the first draw's bins: the tiles the tested triangles' screen
-            // boxes touch (a pixel's margin for the snapping) may now hold depth too, all of them
-            // when a corner is not in front of the projection (w <= 0: no finite box).
-            const int tilesX = rasterizer->tileCountX(), tilesY = rasterizer->tileCountY();
-            for (size_t i = 0; i + 2 < scratch.testedClip.size(); i += 3) {
-                glm::vec2 low(std::numeric_limits<float>::max()), high(-low);
-                bool finite = true;
-                for (size_t k = 0; k < 3; ++k) {
-                    const glm::vec4& c = scratch.testedClip[i + k];
-                    finite = finite && c.w > 0.0f;
-                    const glm::vec2 pixel((c.x / c.w * 0.5f + 0.5f) * float(size),
-                                          (0.5f - c.y / c.w * 0.5f) * float(size));
-                    low = glm::min(low, pixel);
-                    high = glm::max(high, pixel);
-                }
-                finite = finite && std::isfinite(low.x) && std::isfinite(low.y) &&
-                         std::isfinite(high.x) && std::isfinite(high.y);
-                auto tileOf = [](float pixel, int tiles) {
-                    return int(std::clamp(std::floor(pixel / float(raster::kTileSize)), 0.0f,
-                                          float(tiles - 1)));
-                };
-                const int x0 = finite ? tileOf(low.x - 1.0f, tilesX) : 0;
-                const int x1 = finite ? tileOf(high.x + 1.0f, tilesX) : tilesX - 1;
-                const int y0 = finite ? tileOf(low.y - 1.0f, tilesY) : 0;
-                const int y1 = finite ? tileOf(high.y + 1.0f, tilesY) : tilesY - 1;
-                for (int ty = y0; ty <= y1; ++ty)
-                    for (int tx = x0; tx <= x1; ++tx)
-                        face.tilesNotClear[size_t(ty) * size_t(tilesX) + size_t(tx)] = 1;
-            }
+            // The tiles record only the first draw's bins: the tested triangles' tiles may now
+            // hold depth too.
+            markTilesTouched(scratch.testedClip, size, rasterizer->tileCountX(),
+                             rasterizer->tileCountY(), face.tilesNotClear);
         }
         faceMs[f] = milliseconds(faceStart);
     };
