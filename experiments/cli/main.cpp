@@ -188,6 +188,11 @@ void addRenderOptions(CLI::App& render, experiments::RenderCommandOptions& optio
                         "-degree edges)")
         ->capture_default_str();
     render
+        .add_option("--shadow-depth-format", r.shadowDepthFormat,
+                    "float32 (the rasterizer's depth) or unorm16 (16-bit linear depth, half the "
+                    "bytes, rounded towards the far plane)")
+        ->capture_default_str();
+    render
         .add_option("--shadow-lights", r.shadowLights,
                     "N or all: the casting lights that get maps (the N that matter most in view)")
         ->capture_default_str();

@@ -13,6 +13,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "experiments/render/RenderPlan.h"
 #include "lighting/SupersampledReference.h"
 #include "scenes/procedural/ProceduralScenes.h"
 
@@ -85,7 +86,8 @@ double shadowMapBound(const scenes::Scene& scene, const lighting::ShadowSettings
                           : light.type == scenes::LightType::Directional ? settings.cascades
                                                                          : 1;
         const double size = lighting::settingsForLight(settings, light.shadow).mapSize;
-        bytes.push_back(double(faces) * size * size * sizeof(float));
+        bytes.push_back(double(faces) * size * size *
+                        double(lighting::shadowBytesPerTexel(settings.depthFormat)));
     }
     std::sort(bytes.begin(), bytes.end(), std::greater<>());
     if (settings.maxShadowLights >= 0 && bytes.size() > size_t(settings.maxShadowLights))
@@ -306,10 +308,23 @@ MemoryEstimate estimateRenderMemory(const RenderOptions& options, const scenes::
     if (shadows) {
         const int runs = options.warmup + options.repetitions;
         const double maps = shadowMapBound(scene, *shadows) * (runs > 1 ? 2.0 : 1.0);
+        const size_t texelBytes = lighting::shadowBytesPerTexel(shadows->depthFormat);
         add("shadow_maps", maps,
             "casting lights' faces x " + std::to_string(shadows->mapSize) +
-                "^2 (or the light's own size) x 4 bytes" +
+                "^2 (or the light's own size) x " + std::to_string(texelBytes) + " bytes" +
                 (runs > 1 ? " x 2 (rendered again each run)" : ""));
+        if (shadows->depthFormat == lighting::ShadowDepthFormat::Unorm16) {
+            // Unorm16 faces are drawn in float, into one buffer per thread and map size.
+            int largest = shadows->mapSize;
+            for (const scenes::Light& light : scene.lights)
+                largest =
+                    std::max(largest, lighting::settingsForLight(*shadows, light.shadow).mapSize);
+            const int threads = effectiveThreads(options.threads);
+            add("shadow_draw_buffers",
+                double(threads) * double(largest) * double(largest) * sizeof(float),
+                std::to_string(threads) + " threads x " + std::to_string(largest) +
+                    "^2 x 4 bytes (unorm16 faces drawn in float)");
+        }
     }
     if ((shadows && options.compareReference) || options.oracle == "visibility")
         add("rays", drawnTriangles * kRayBytesPerTriangle,

@@ -238,6 +238,7 @@ nlohmann::json shadowsJson(const RenderRun& run) {
         {"normal_offset_texels", settings.normalOffset},
         {"filter", lighting::formatShadowFilter(settings.filter)},
         {"point_projection", lighting::formatShadowPointProjection(settings.pointProjection)},
+        {"depth_format", lighting::formatShadowDepthFormat(settings.depthFormat)},
         {"cascades", settings.cascades},
         {"shadow_lights", run.options.shadowLights},
         {"casting_lights", stats.castingLightCount},

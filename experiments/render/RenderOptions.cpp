@@ -200,6 +200,12 @@ std::optional<lighting::ShadowSettings> shadowSettings(const RenderOptions& opti
         throw UsageError("--shadow-point '" + options.shadowPoint + "' refused: must be " +
                          lighting::kShadowPointProjectionNames);
     settings.pointProjection = *point;
+    const std::optional<lighting::ShadowDepthFormat> depthFormat =
+        lighting::parseShadowDepthFormat(options.shadowDepthFormat);
+    if (!depthFormat)
+        throw UsageError("--shadow-depth-format '" + options.shadowDepthFormat +
+                         "' refused: must be " + lighting::kShadowDepthFormatNames);
+    settings.depthFormat = *depthFormat;
     if (options.shadowLights != "all") {
         const int count = parseNumber<int>("shadow-lights", options.shadowLights);
         if (count < 0)
@@ -272,6 +278,7 @@ std::vector<std::string> renderOptionKeys() {
             "shadow-bias",
             "shadow-filter",
             "shadow-point",
+            "shadow-depth-format",
             "shadow-lights",
             "shadow-cascades",
             "shadow-caster-sets",
@@ -341,6 +348,8 @@ void setRenderOption(RenderOptions& options, const std::string& key, const std::
         options.shadowFilter = value;
     else if (key == "shadow-point")
         options.shadowPoint = value;
+    else if (key == "shadow-depth-format")
+        options.shadowDepthFormat = value;
     else if (key == "shadow-lights")
         options.shadowLights = value;
     else if (key == "shadow-cascades")

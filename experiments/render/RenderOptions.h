@@ -95,8 +95,9 @@ struct RenderOptions {
     std::string shadowBias;            // "CONSTANT,SLOPE" (metres, texels); "" = the defaults
     std::string shadowFilter = "pcf3"; // none | pcf3 | pcf5 | poisson
     std::string shadowPoint = "cube";  // point lights' maps: cube | dual-paraboloid
-    std::string shadowLights = "all";  // N or all
-    int shadowCascades = 1;            // directional lights' cascades, 1..8
+    std::string shadowDepthFormat = "float32"; // float32 | unorm16 (ShadowDepthFormat)
+    std::string shadowLights = "all";          // N or all
+    int shadowCascades = 1;                    // directional lights' cascades, 1..8
     // Shadow-casting sets (lighting/shadows/ShadowCasterSets.h): "on" draws into each light's
     // maps only the objects that can cast onto a visible receiver; "off" every object in range.
     std::string shadowCasterSets = "on";
@@ -123,10 +124,10 @@ std::string lightsText(const RenderOptions& options);
 // seed, width, height, resolution (WxH), threads, isa, simt-warp, msaa, complex-detect,
 // alpha-to-coverage, reference-spp, layout, normals, normal-space, depth, position, view, brdf,
 // post-aa, oracle, shadows, shadow-map-size, shadow-bias, shadow-filter, shadow-point,
-// shadow-lights, shadow-cascades, shadow-caster-sets, max-memory (bytes, K/M/G/T suffixes) and
-// scene-option.KEY. Values are checked later by validate(); a malformed number or an unknown key
-// throws UsageError naming it. The sweep runner goes through this, so every stage, encoding or
-// scene added later is reachable without touching the runner.
+// shadow-depth-format, shadow-lights, shadow-cascades, shadow-caster-sets, max-memory (bytes,
+// K/M/G/T suffixes) and scene-option.KEY. Values are checked later by validate(); a malformed
+// number or an unknown key throws UsageError naming it. The sweep runner goes through this, so
+// every stage, encoding or scene added later is reachable without touching the runner.
 void setRenderOption(RenderOptions& options, const std::string& key, const std::string& value);
 // The keys setRenderOption accepts (scene-option.KEY listed once as "scene-option.<key>").
 std::vector<std::string> renderOptionKeys();

@@ -135,6 +135,7 @@ std::vector<std::string> axisColumns(const std::vector<std::string>& settingKeys
                                                     "shadow-map-size",
                                                     "shadow-filter",
                                                     "shadow-point",
+                                                    "shadow-depth-format",
                                                     "shadow-bias",
                                                     "shadow-lights",
                                                     "shadow-cascades",

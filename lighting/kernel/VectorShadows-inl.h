@@ -228,10 +228,22 @@ HWY_INLINE ShadowDouble shadowFaceLitCount(const shadows::ShadowMapsView& view,
         ti = hn::Min(hn::Max(ti, hn::Zero(di)), lastTexel);
         tj = hn::Min(hn::Max(tj, hn::Zero(di)), lastTexel);
         const ShadowIndex index = hn::Add(hn::Mul(tj, rowStride), ti);
-        const ShadowDouble stored = hn::PromoteTo(d, hn::GatherIndex(df, face.depth, index));
-        const ShadowDouble occluder =
-            face.orthographic ? hn::Sub(hn::Set(d, f0), hn::Mul(stored, hn::Set(d, f0 - n0)))
-                              : hn::Div(hn::Set(d, planeB), hn::Sub(stored, hn::Set(d, planeA)));
+        ShadowDouble occluder;
+        if (face.packedDepth) {
+            // unorm16Texel: the word of texel k / 2, shifted right by 16 (k & 1), low 16 bits.
+            const ShadowIndex word = hn::GatherIndex(
+                di, reinterpret_cast<const int32_t*>(face.packedDepth), hn::ShiftRight<1>(index));
+            const ShadowIndex shift = hn::ShiftLeft<4>(hn::And(index, hn::Set(di, 1)));
+            const ShadowDouble stored =
+                hn::PromoteTo(d, hn::And(hn::Shr(word, shift), hn::Set(di, 0xFFFF)));
+            occluder = hn::Sub(hn::Set(d, f0), hn::Mul(hn::Div(stored, hn::Set(d, kUnorm16Max)),
+                                                       hn::Set(d, f0 - n0)));
+        } else {
+            const ShadowDouble stored = hn::PromoteTo(d, hn::GatherIndex(df, face.depth, index));
+            occluder = face.orthographic
+                           ? hn::Sub(hn::Set(d, f0), hn::Mul(stored, hn::Set(d, f0 - n0)))
+                           : hn::Div(hn::Set(d, planeB), hn::Sub(stored, hn::Set(d, planeA)));
+        }
         const ShadowDouble receiver = hn::Add(
             hn::Add(r.depth,
                     hn::Mul(gradientU, hn::Sub(hn::Add(hn::PromoteTo(d, ti), texelCentre), r.u))),

@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -35,6 +37,11 @@ namespace lighting {
 struct ShadowMaps::RenderScratch {
     struct Thread {
         std::vector<std::unique_ptr<raster::Rasterizer>> rasterizers; // one per map size
+        // Per rasterizer (the same index): the float buffer Unorm16 faces of its size are drawn
+        // into before packUnorm16, with its own record of the tiles that are not clear (the
+        // next face this thread draws at that size then clears only those).
+        std::vector<std::vector<float>> unormTargets;
+        std::vector<std::vector<uint8_t>> unormTargetTiles;
         std::vector<glm::vec4> clip;
         // Perspective and orthographic faces: the clip positions' frustum outcodes and the
         // indices of the triangles the face keeps.
@@ -67,7 +74,59 @@ constexpr uint32_t kTrianglesPerChunk = 64;
 struct DepthBuffer {
     std::vector<float> depth;
     std::vector<uint8_t> tilesNotClear;
+    std::vector<uint32_t> packed; // Unorm16 faces' texels
 };
+
+// A Unorm16 face's texels from the float depth its draw wrote (ShadowSettings.h): the linear
+// depth (far - distance) / (far - near), rounded down (towards the far plane) to a multiple of
+// 1 / 65535, two texels per word (ShadowMapsView.h unorm16Texel: texel k in the half of word
+// k / 2 that a little-endian machine stores at byte 2 k, so the texels are written as an array of
+// 16-bit values). Perspective faces' reversed-Z depth z is a distance n f / (n + z (f - n)) (the
+// lookup's b / (z - a)); orthographic and paraboloid faces store the linear depth already.
+// Computed in float (a rounding of the linear depth, ~6e-8, against a step of 1.5e-5: at most a
+// step lower at a step's boundary, the same on every machine); 0 (nothing) stays 0. A tile the
+// draw's record says is clear (drawnTiles, raster::kTileSize) is zeroed without reading, and only
+// when `packedTiles` (the record of `packed`, which may be a previous frame's) says it is not
+// zero already: the clear two thirds of a cube map then cost no memory traffic. `packed` and
+// `packedTiles` must be sized for the face.
+void packUnorm16(const ShadowFace& face, std::span<const float> depth,
+                 std::span<const uint8_t> drawnTiles, std::span<uint32_t> packed,
+                 std::span<uint8_t> packedTiles) {
+    static_assert(std::endian::native == std::endian::little,
+                  "unorm16Texel's packing is written as 16-bit values in memory order");
+    const float n = float(face.nearMetres), f = float(face.farMetres);
+    const bool linear = face.orthographic || face.paraboloid;
+    const float scale = float(kUnorm16Max);
+    const float nf = n * f, range = f - n;
+    const size_t size = size_t(face.mapSize);
+    const size_t tilesX = (size + raster::kTileSize - 1) / raster::kTileSize;
+    unsigned char* bytes = reinterpret_cast<unsigned char*>(packed.data());
+    uint16_t row[raster::kTileSize];
+    for (size_t y = 0; y < size; ++y)
+        for (size_t x0 = 0; x0 < size; x0 += raster::kTileSize) {
+            const size_t count = std::min(size_t(raster::kTileSize), size - x0);
+            const size_t k0 = y * size + x0;
+            const size_t tile = (y / raster::kTileSize) * tilesX + x0 / raster::kTileSize;
+            if (!drawnTiles[tile]) {
+                if (packedTiles[tile])
+                    std::memset(bytes + 2 * k0, 0, 2 * count);
+                continue;
+            }
+            // Two loops without a branch inside, so that the compiler puts them on SIMD lanes.
+            const float* z = depth.data() + k0;
+            if (linear) {
+                for (size_t i = 0; i < count; ++i)
+                    row[i] = uint16_t(int32_t(std::clamp(z[i] * scale, 0.0f, scale)));
+            } else {
+                for (size_t i = 0; i < count; ++i) {
+                    const float steps = (f - nf / (n + z[i] * range)) / range * scale;
+                    row[i] = uint16_t(int32_t(std::clamp(steps, 0.0f, scale)));
+                }
+            }
+            std::memcpy(bytes + 2 * k0, row, 2 * count);
+        }
+    std::copy(drawnTiles.begin(), drawnTiles.end(), packedTiles.begin());
+}
 
 double milliseconds(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -351,7 +410,8 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     std::vector<DepthBuffer> depthPool;
     if (recycled) {
         for (ShadowFace& face : recycled->mFaces)
-            depthPool.push_back({std::move(face.depth), std::move(face.tilesNotClear)});
+            depthPool.push_back({std::move(face.depth), std::move(face.tilesNotClear),
+                                 std::move(face.packedDepth)});
         recycled->mFaces.clear();
         recycled->mFaceViews.clear();
         recycled->mShadowViews.clear();
@@ -557,8 +617,10 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             }
         }
         shadow.faceCount = maps.mFaces.size() - shadow.firstFace;
-        for (size_t f = shadow.firstFace; f < maps.mFaces.size(); ++f)
+        for (size_t f = shadow.firstFace; f < maps.mFaces.size(); ++f) {
             maps.mFaces[f].mapSize = size;
+            maps.mFaces[f].depthFormat = settings.depthFormat;
+        }
         maps.mShadowOfLight[lightIndex] = uint32_t(shadowIndex);
         maps.mShadows.push_back(std::move(shadow));
     }
@@ -689,9 +751,12 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     for (size_t f = 0; f < maps.mFaces.size() && f < depthPool.size(); ++f)
         if (!maps.mFaces[f].empty)
             pooled[f] = std::move(depthPool[f]);
-    std::erase_if(depthPool, [](const DepthBuffer& b) { return b.depth.capacity() == 0; });
+    auto unused = [](const DepthBuffer& b) {
+        return b.depth.capacity() == 0 && b.packed.capacity() == 0;
+    };
+    std::erase_if(depthPool, unused);
     for (size_t f = 0; f < maps.mFaces.size() && !depthPool.empty(); ++f)
-        if (!maps.mFaces[f].empty && pooled[f].depth.capacity() == 0) {
+        if (!maps.mFaces[f].empty && unused(pooled[f])) {
             pooled[f] = std::move(depthPool.back());
             depthPool.pop_back();
         }
@@ -702,15 +767,17 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         const auto faceStart = Clock::now();
         RenderScratch::Thread& scratch = scratches.local();
         const int size = face.mapSize;
-        raster::Rasterizer* rasterizer = nullptr;
-        for (const std::unique_ptr<raster::Rasterizer>& candidate : scratch.rasterizers)
-            if (candidate->width() == size)
-                rasterizer = candidate.get();
-        if (!rasterizer) {
+        size_t rasterizerIndex = 0;
+        while (rasterizerIndex < scratch.rasterizers.size() &&
+               scratch.rasterizers[rasterizerIndex]->width() != size)
+            ++rasterizerIndex;
+        if (rasterizerIndex == scratch.rasterizers.size()) {
             // Lights with their own map size: one rasterizer per size met, each kept.
             scratch.rasterizers.push_back(std::make_unique<raster::Rasterizer>(size, size));
-            rasterizer = scratch.rasterizers.back().get();
+            scratch.unormTargets.emplace_back();
+            scratch.unormTargetTiles.emplace_back();
         }
+        raster::Rasterizer* rasterizer = scratch.rasterizers[rasterizerIndex].get();
         const Casters& set = casters[jobs[f].shadow];
         const std::span<const glm::vec3> positions = set.positions(geometry);
         const std::span<const uint32_t> indices =
@@ -799,19 +866,35 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             faceTriangles[f] = scratch.faceIndices.size() / 3;
         // Cleared to 0 (nothing: the far plane) tile by tile inside the draw (clearDepth), only
         // where the buffer is not clear already or casters are drawn (tilesNotClear). A buffer
-        // of another size is refilled: its tiles' record no longer describes it.
+        // of another size is refilled: its tiles' record no longer describes it. Float32 faces
+        // draw into their own buffer, Unorm16 faces into the thread's float buffer of their
+        // size, packed after the draws.
         const size_t texels = size_t(size) * size_t(size);
         const size_t tiles = size_t(rasterizer->tileCountX()) * size_t(rasterizer->tileCountY());
-        face.depth = std::move(pooled[f].depth);
+        const bool unorm16 = face.depthFormat == ShadowDepthFormat::Unorm16;
+        std::vector<float>& target = unorm16 ? scratch.unormTargets[rasterizerIndex] : face.depth;
+        std::vector<uint8_t>& targetTiles =
+            unorm16 ? scratch.unormTargetTiles[rasterizerIndex] : face.tilesNotClear;
         face.tilesNotClear = std::move(pooled[f].tilesNotClear);
-        if (face.depth.size() != texels || face.tilesNotClear.size() != tiles) {
-            face.depth.assign(texels, 0.0f);
-            face.tilesNotClear.assign(tiles, 0);
+        if (unorm16) {
+            // The packed texels keep their own record of the tiles that are not zero.
+            face.packedDepth = std::move(pooled[f].packed);
+            const size_t words = (texels + 1) / 2;
+            if (face.packedDepth.size() != words || face.tilesNotClear.size() != tiles) {
+                face.packedDepth.assign(words, 0u);
+                face.tilesNotClear.assign(tiles, 0);
+            }
+        } else {
+            face.depth = std::move(pooled[f].depth);
+        }
+        if (target.size() != texels || targetTiles.size() != tiles) {
+            target.assign(texels, 0.0f);
+            targetTiles.assign(tiles, 0);
         }
         raster::RasterState faceState = state;
-        faceState.tilesNotClear = face.tilesNotClear;
-        rasterizer->draw(raster::TriangleList{scratch.clip, drawIndices}, faceState,
-                         face.depth.data(), raster::DepthOnly{});
+        faceState.tilesNotClear = targetTiles;
+        rasterizer->draw(raster::TriangleList{scratch.clip, drawIndices}, faceState, target.data(),
+                         raster::DepthOnly{});
         if (!set.testedTriangles.empty()) {
             // The alpha-tested casters, drawn after the others into the same buffer (the depth
             // test keeps the nearest whatever the order): each corner carries its uv (a
@@ -868,7 +951,7 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
                 raster::TriangleList{scratch.testedClip,
                                      std::span<const uint32_t>(scratch.sequential.data(),
                                                                scratch.testedClip.size())},
-                testedState, face.depth.data(), [&](const raster::Fragment& fragment) {
+                testedState, target.data(), [&](const raster::Fragment& fragment) {
                     const size_t i = 3 * size_t(fragment.triangle);
                     return alphaTest.castsAtUv(
                         materialOf[fragment.triangle],
@@ -878,8 +961,10 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             // The tiles record only the first draw's bins: the tested triangles' tiles may now
             // hold depth too.
             markTilesTouched(scratch.testedClip, size, rasterizer->tileCountX(),
-                             rasterizer->tileCountY(), face.tilesNotClear);
+                             rasterizer->tileCountY(), targetTiles);
         }
+        if (unorm16)
+            packUnorm16(face, target, targetTiles, face.packedDepth, face.tilesNotClear);
         faceMs[f] = milliseconds(faceStart);
     };
     if (settings.schedule == ShadowSchedule::FacesInParallel) {
@@ -907,7 +992,8 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         lightStats.casterObjects = useSets ? setStats[s].casterObjects : maps.mStats.objectCount;
         lightStats.lightInFrustum = setStats[s].lightInFrustum;
         for (size_t f = shadow.firstFace; f < shadow.firstFace + shadow.faceCount; ++f) {
-            lightStats.bytes += maps.mFaces[f].depth.size() * kBytesPerTexel;
+            lightStats.bytes += maps.mFaces[f].depth.size() * sizeof(float) +
+                                maps.mFaces[f].packedDepth.size() * sizeof(uint32_t);
             lightStats.renderMs += faceMs[f];
             lightStats.trianglesDrawn += faceTriangles[f];
         }
@@ -927,7 +1013,9 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         faceView.farMetres = face.farMetres;
         faceView.tanHalfFov = face.tanHalfFov;
         faceView.extentMetres = face.extentMetres;
-        faceView.depth = face.empty ? nullptr : face.depth.data();
+        faceView.depth = face.empty || face.depth.empty() ? nullptr : face.depth.data();
+        faceView.packedDepth =
+            face.empty || face.packedDepth.empty() ? nullptr : face.packedDepth.data();
         faceView.orthographic = face.orthographic;
         faceView.empty = face.empty;
         maps.mFaceViews.push_back(faceView);
@@ -1102,12 +1190,20 @@ float ShadowMaps::faceVisibility(const ShadowFace& face, const ShadowSettings& s
     // and paraboloid faces store it linearly).
     const double n0 = face.nearMetres, f0 = face.farMetres;
     const double a = -n0 / (f0 - n0), b = n0 * f0 / (f0 - n0);
+    const bool unorm16 = face.depthFormat == ShadowDepthFormat::Unorm16;
     auto lit = [&](int ti, int tj) {
         ti = std::clamp(ti, 0, size - 1);
         tj = std::clamp(tj, 0, size - 1);
-        const double stored = face.depth[size_t(tj) * size_t(size) + size_t(ti)];
-        const double occluder =
-            face.orthographic || face.paraboloid ? f0 - stored * (f0 - n0) : b / (stored - a);
+        const size_t k = size_t(tj) * size_t(size) + size_t(ti);
+        double occluder;
+        if (unorm16) {
+            const double stored = double(shadows::unorm16Texel(face.packedDepth.data(), k));
+            occluder = f0 - stored / kUnorm16Max * (f0 - n0);
+        } else {
+            const double stored = face.depth[k];
+            occluder =
+                face.orthographic || face.paraboloid ? f0 - stored * (f0 - n0) : b / (stored - a);
+        }
         const double receiver =
             r.depth + gradient.x * (ti + 0.5 - r.u) + gradient.y * (tj + 0.5 - r.v);
         return receiver - bias <= occluder ? 1 : 0;

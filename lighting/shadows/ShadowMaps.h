@@ -37,7 +37,8 @@
 //
 // Conventions: each face is a right-handed light view (looking down its -Z) with a zero-to-one
 // reversed-Z projection (1 = near plane, 0 = far plane / nothing; orthographic depth is linear,
-// perspective float depth keeps ~1e-7 relative precision); the depth texture is mapSize^2 floats,
+// perspective float depth keeps ~1e-7 relative precision); the depth texture is mapSize^2 floats
+// (ShadowDepthFormat::Unorm16: 16-bit linear depth, the same 1 = near, 0 = far, ShadowSettings.h),
 // row 0 at the top (the rasterizer's screen convention, y down). No face culling (CullMode::None):
 // both sides of a caster write, so open meshes (a single quad, a leaf) cast and the bias model
 // does not depend on which side faces the light. lightClipFromView maps CAMERA VIEW space (the
@@ -89,8 +90,6 @@ inline constexpr double kCascadeLambda = 0.5;
 // The farthest texel centre a lookup reads from the receiver's projection, in texels: the
 // Poisson disk's radius (ShadowSettings.h; PCF 5x5 reaches 2).
 inline constexpr double kMaxTapDistanceTexels = 2.5;
-// A face's cost: mapSize^2 floats.
-inline constexpr size_t kBytesPerTexel = sizeof(float);
 
 struct ShadowFace {
     // Camera view -> face clip (reversed Z, 0 <= z <= w); paraboloid faces: camera view -> the
@@ -106,13 +105,20 @@ struct ShadowFace {
     // face's centre; at its rim a texel spans half that).
     double tanHalfFov = 0.0;
     double extentMetres = 0.0;
-    bool empty = false;       // nothing to receive (a cascade outside the scene): lookups lit
-    int mapSize = 0;          // its light's (ShadowLightStats::settings.mapSize)
-    std::vector<float> depth; // mapSize^2, row 0 at the top; empty when `empty`
+    bool empty = false; // nothing to receive (a cascade outside the scene): lookups lit
+    int mapSize = 0;    // its light's (ShadowLightStats::settings.mapSize)
+    ShadowDepthFormat depthFormat = ShadowDepthFormat::Float32;
+    // Float32 faces: mapSize^2, row 0 at the top; empty when `empty` and for Unorm16 faces.
+    std::vector<float> depth;
+    // Unorm16 faces: mapSize^2 texels (row 0 at the top) packed two per word, texel k in
+    // shadows::unorm16Texel(packedDepth.data(), k); else empty.
+    std::vector<uint32_t> packedDepth;
     // Per rasterizer tile of `depth` (raster::RasterState::tilesNotClear): whether casters were
     // binned to it; 0 = the tile holds only 0 (far). It travels with the buffer to the next
     // frame's maps (render's `recycled`), whose draw then clears only the tiles that are not
-    // already clear.
+    // already clear. Unorm16 faces are drawn into a per-thread float buffer, which keeps its
+    // own record; theirs is packedDepth's (0 = the tile's texels are all 0), so that packing
+    // rewrites a clear tile only where a previous frame left depth in it.
     std::vector<uint8_t> tilesNotClear;
 };
 
@@ -162,12 +168,12 @@ public:
     // Renders every face of every chosen light. Parallel under the caller's task_arena; the
     // result is bitwise independent of the thread count. Cost: per light the triangles within
     // its range (spot, point) or all (directional), set up once per face; memory: mapSize^2
-    // floats per face. Throws std::invalid_argument for a mapSize (global or a light's own)
-    // outside [1, 16384] or
-    // cascades outside [1, 8]. `recycled`, when given, is a previous frame's maps whose depth
-    // buffers and rasterizers the new maps take over (it is left without faces), face i the
-    // buffer of its face i: a frame then pays no allocation or page fault for its maps, and
-    // clears only the tiles that either frame drew into.
+    // texels of the depth format per face (plus, for Unorm16, one float buffer per thread and
+    // map size, kept in the scratch). Throws std::invalid_argument for a mapSize (global or a
+    // light's own) outside [1, 16384] or cascades outside [1, 8]. `recycled`, when given, is a
+    // previous frame's maps whose depth buffers and rasterizers the new maps take over (it is left
+    // without faces), face i the buffer of its face i: a frame then pays no allocation or page
+    // fault for its maps, and clears only the tiles that either frame drew into.
     static ShadowMaps render(const scenes::Scene& scene, const gbuffer::SceneGeometry& geometry,
                              const gbuffer::CameraView& view, const ShadowSettings& settings,
                              ShadowMaps* recycled = nullptr);

@@ -38,7 +38,17 @@ inline constexpr double kPoissonDisk[kPoissonTapCount][2] = {
     {0.14383161, -0.14100790},
 };
 
+// Unorm16 faces (ShadowDepthFormat): a texel's 16 bits over this are its linear depth, 0 = the
+// far plane, 1 = the near plane.
+inline constexpr double kUnorm16Max = 65535.0;
+
 namespace shadows {
+
+// Texel k of a Unorm16 face: bits [16 (k & 1), 16 (k & 1) + 16) of word k / 2 (the vector lookup
+// gathers the word and shifts the same way).
+inline uint32_t unorm16Texel(const uint32_t* packed, size_t k) {
+    return (packed[k >> 1] >> ((k & 1u) * 16u)) & 0xFFFFu;
+}
 
 // One face (ShadowFace in ShadowMaps.h).
 struct ShadowFaceView {
@@ -48,7 +58,9 @@ struct ShadowFaceView {
     double farMetres;
     double tanHalfFov;   // perspective faces
     double extentMetres; // orthographic faces
-    const float* depth;  // mapSize^2 floats; null when empty
+    const float* depth;  // Float32 faces: mapSize^2 floats; else null (and when empty)
+    // Unorm16 faces: mapSize^2 texels packed two per word (unorm16Texel); else null.
+    const uint32_t* packedDepth;
     bool orthographic;
     bool empty; // nothing to receive: every lookup is lit
 };

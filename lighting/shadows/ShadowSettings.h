@@ -16,6 +16,7 @@
 // ShadowMaps renders and looks up each light with settingsForLight(global, light.shadow).
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string_view>
 
@@ -47,9 +48,43 @@ enum class ShadowSchedule { FacesInParallel, FacesInSequence };
 // paraboloidMaxEdgeDegrees as seen from the light (ShadowMaps.h says what that costs).
 enum class ShadowPointProjection { Cube, DualParaboloid };
 
+// What a face's depth texels are stored as. Float32: the rasterizer's reversed-Z depth as it
+// writes it (perspective: ~1e-7 relative precision at every distance). Unorm16: the distance
+// along the face's axis, linear between its near and far planes, in 16 bits (half the bytes and
+// half the lookup's memory traffic; a step of (far - near) / 65535: 0.05 mm for a 3.5 m point
+// light, 15 mm over a 1 km cascade). Perspective depth is not stored as 16 bits as it is: reversed
+// Z in unorm leaves a point light's far half a few hundred steps. Each texel is rounded towards
+// the far plane, so an occluder is never stored nearer than it is: quantisation can move a
+// shadow's start back by up to one step (peter-panning) but cannot make a surface shadow itself.
+// The face is drawn in float (a per-thread buffer) and converted after its draw.
+enum class ShadowDepthFormat { Float32, Unorm16 };
+
+// The names parseShadowDepthFormat accepts, for error messages.
+inline constexpr const char* kShadowDepthFormatNames = "float32|unorm16";
+
+// "float32", "unorm16" (the CLI and sweep names); nullopt for anything else.
+inline std::optional<ShadowDepthFormat> parseShadowDepthFormat(std::string_view name) {
+    if (name == "float32")
+        return ShadowDepthFormat::Float32;
+    if (name == "unorm16")
+        return ShadowDepthFormat::Unorm16;
+    return std::nullopt;
+}
+
+inline const char* formatShadowDepthFormat(ShadowDepthFormat format) {
+    return format == ShadowDepthFormat::Unorm16 ? "unorm16" : "float32";
+}
+
+// Bytes one texel costs in a face of this format (a face's array: ShadowMaps.h).
+inline constexpr size_t shadowBytesPerTexel(ShadowDepthFormat format) {
+    return format == ShadowDepthFormat::Unorm16 ? 2 : 4;
+}
+
 struct ShadowSettings {
-    // Side of every shadow map face in texels (a face is mapSize^2 floats).
+    // Side of every shadow map face in texels (a face is mapSize^2 texels of depthFormat).
     int mapSize = 1024;
+    // Of every light's faces (no light overrides it).
+    ShadowDepthFormat depthFormat = ShadowDepthFormat::Float32;
     // Constant depth bias, metres. Covers the float depth of the map (reversed-Z perspective:
     // ~1e-7 relative; orthographic: ~1e-7 of the map's depth range, 1e-4 m over 1 km) and the
     // difference between the float render transform and the double lookup transform. 5 mm lets

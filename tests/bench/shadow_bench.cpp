@@ -108,6 +108,25 @@ BENCHMARK(shadowMapRender)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
 
+// The depth format (ShadowSettings.h ShadowDepthFormat) on atrium's 16 casting point lights at
+// 512^2, buffers recycled, faces in parallel, per-face cull. range(0): threads; range(1): 0 =
+// float32, 1 = unorm16 (drawn into the thread's float buffer, then packed: the packing's cost).
+void shadowMapRenderDepthFormat(benchmark::State& state) {
+    const ShadowFrame& f = atrium();
+    lighting::ShadowSettings settings;
+    settings.mapSize = 512;
+    settings.depthFormat = state.range(1) == 1 ? lighting::ShadowDepthFormat::Unorm16
+                                               : lighting::ShadowDepthFormat::Float32;
+    state.SetLabel(lighting::formatShadowDepthFormat(settings.depthFormat));
+    const lighting::ShadowStats stats = timeRenders(state, f, settings, int(state.range(0)), true);
+    state.counters["MB"] = double(stats.totalBytes) / (1024.0 * 1024.0);
+}
+BENCHMARK(shadowMapRenderDepthFormat)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
+
 // Alpha-tested casters (CasterMaterials.h): `foliage` (12 leaf cards of a textured Mask
 // material, 664 triangles) with 16 generated point lights (seed 1) and its sun casting, cube maps
 // of 512^2 (97 faces), buffers recycled, faces in parallel. range(0): threads; range(1): 1 = the
@@ -151,17 +170,19 @@ struct LookupFrame {
     std::vector<uint32_t> shadows; // per packet
 };
 
-const LookupFrame& lookupFrame(int filterIndex) {
-    static LookupFrame frames[4];
-    static bool built[4] = {};
-    LookupFrame& frame = frames[filterIndex];
-    if (built[filterIndex])
+const LookupFrame& lookupFrame(int filterIndex, int formatIndex) {
+    static LookupFrame frames[4][2];
+    static bool built[4][2] = {};
+    LookupFrame& frame = frames[filterIndex][formatIndex];
+    if (built[filterIndex][formatIndex])
         return frame;
-    built[filterIndex] = true;
+    built[filterIndex][formatIndex] = true;
     const ShadowFrame& f = atrium();
     lighting::ShadowSettings settings;
     settings.mapSize = 512;
     settings.filter = lighting::ShadowFilter(filterIndex);
+    settings.depthFormat = formatIndex == 1 ? lighting::ShadowDepthFormat::Unorm16
+                                            : lighting::ShadowDepthFormat::Float32;
     frame.maps = lighting::ShadowMaps::render(f.scene, f.geometry, f.view, settings);
     std::mt19937 random(7);
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
@@ -199,13 +220,15 @@ const LookupFrame& lookupFrame(int filterIndex) {
 }
 
 // range(0): 0 = scalar ShadowMaps::visibility per lane, 1 = the vector lookup per packet;
-// range(1): the filter (0 none, 1 pcf3, 2 pcf5, 3 poisson).
+// range(1): the filter (0 none, 1 pcf3, 2 pcf5, 3 poisson); range(2): the depth format (0
+// float32, 1 unorm16).
 void shadowLookup(benchmark::State& state) {
-    const LookupFrame& frame = lookupFrame(int(state.range(1)));
+    const LookupFrame& frame = lookupFrame(int(state.range(1)), int(state.range(2)));
     const bool vector = state.range(0) == 1;
     const lighting::kernel::VectorFunctions* target = lighting::kernel::dispatchedVectorTarget();
     state.SetLabel(std::string(vector ? target->name : "scalar") + ", " +
-                   lighting::formatShadowFilter(lighting::ShadowFilter(state.range(1))));
+                   lighting::formatShadowFilter(lighting::ShadowFilter(state.range(1))) + ", " +
+                   (state.range(2) == 1 ? "unorm16" : "float32"));
     constexpr size_t kLanes = lighting::kernel::kPacketLanes;
     float visibility[kLanes];
     double sum = 0.0;
@@ -233,6 +256,6 @@ void shadowLookup(benchmark::State& state) {
     // wall time on the shared machine includes other jobs' time slices).
     state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(frame.packets.size() * kLanes));
 }
-BENCHMARK(shadowLookup)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond);
+BENCHMARK(shadowLookup)->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 } // namespace

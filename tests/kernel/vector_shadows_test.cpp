@@ -270,32 +270,37 @@ class VectorShadows : public ::testing::TestWithParam<LightCase> {};
 
 TEST_P(VectorShadows, EqualTheScalarLookupBitwiseOnEveryTarget) {
     const LightCase& c = GetParam();
-    for (ShadowFilter filter : kFilters)
-        for (float normalOffset : {0.0f, 1.5f}) {
-            ShadowSettings settings;
-            settings.mapSize = 256;
-            settings.filter = filter;
-            settings.normalOffset = normalOffset;
-            settings.cascades = c.cascades;
-            const Frame frame(c.light, settings);
-            ASSERT_EQ(frame.maps.shadowCount(), 1u);
-            const std::string label = std::string(c.name) + " " +
-                                      lighting::formatShadowFilter(filter) + " normal offset " +
-                                      std::to_string(normalOffset);
-            std::mt19937 random(1234);
-            const Tally tally =
-                compareAllTargets(frame.maps, randomLanes(random, 4096), random, label);
-            // Not two constant answers: shadowed, lit and (with a filter) partly lit lanes.
-            EXPECT_GT(tally.shadowed, tally.compared / 50) << label;
-            EXPECT_GT(tally.lit, tally.compared / 10) << label;
-            if (filter != ShadowFilter::None)
-                EXPECT_GT(tally.partial, tally.compared / 200) << label;
-            if (c.light.type == LightType::Point) {
-                const Tally seams = compareAllTargets(frame.maps, seamLanes(random, 2048), random,
-                                                      label + " seams");
-                EXPECT_GT(seams.shadowed + seams.partial, 0u) << label;
+    for (const lighting::ShadowDepthFormat format :
+         {lighting::ShadowDepthFormat::Float32, lighting::ShadowDepthFormat::Unorm16})
+        for (ShadowFilter filter : kFilters)
+            for (float normalOffset : {0.0f, 1.5f}) {
+                ShadowSettings settings;
+                // Unorm16: an odd size, so that texels sit in both halves of a word on every row.
+                settings.mapSize = format == lighting::ShadowDepthFormat::Unorm16 ? 255 : 256;
+                settings.filter = filter;
+                settings.normalOffset = normalOffset;
+                settings.cascades = c.cascades;
+                settings.depthFormat = format;
+                const Frame frame(c.light, settings);
+                ASSERT_EQ(frame.maps.shadowCount(), 1u);
+                const std::string label = std::string(c.name) + " " +
+                                          lighting::formatShadowDepthFormat(format) + " " +
+                                          lighting::formatShadowFilter(filter) + " normal offset " +
+                                          std::to_string(normalOffset);
+                std::mt19937 random(1234);
+                const Tally tally =
+                    compareAllTargets(frame.maps, randomLanes(random, 4096), random, label);
+                // Not two constant answers: shadowed, lit and (with a filter) partly lit lanes.
+                EXPECT_GT(tally.shadowed, tally.compared / 50) << label;
+                EXPECT_GT(tally.lit, tally.compared / 10) << label;
+                if (filter != ShadowFilter::None)
+                    EXPECT_GT(tally.partial, tally.compared / 200) << label;
+                if (c.light.type == LightType::Point) {
+                    const Tally seams = compareAllTargets(frame.maps, seamLanes(random, 2048),
+                                                          random, label + " seams");
+                    EXPECT_GT(seams.shadowed + seams.partial, 0u) << label;
+                }
             }
-        }
 }
 
 INSTANTIATE_TEST_SUITE_P(Lights, VectorShadows,

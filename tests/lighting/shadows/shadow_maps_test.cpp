@@ -30,6 +30,7 @@
 
 namespace {
 
+using lighting::ShadowDepthFormat;
 using lighting::ShadowFilter;
 using lighting::ShadowMaps;
 using lighting::ShadowSettings;
@@ -144,6 +145,22 @@ std::vector<std::vector<float>> mapsDepth(const scenes::Scene& scene,
         for (size_t f = 0; f < frame.maps.faceCount(); ++f)
             depth.push_back(frame.maps.face(f).depth);
         return depth;
+    });
+}
+
+const ShadowDepthFormat kDepthFormats[] = {ShadowDepthFormat::Float32, ShadowDepthFormat::Unorm16};
+
+// Every face's packed Unorm16 texels (ShadowFace::packedDepth), rendered in an arena of
+// `threads`.
+std::vector<std::vector<uint32_t>> mapsPackedDepth(const scenes::Scene& scene,
+                                                   const ShadowSettings& settings, int threads) {
+    tbb::task_arena arena(threads);
+    return arena.execute([&] {
+        const Frame frame(scene, settings);
+        std::vector<std::vector<uint32_t>> packed;
+        for (size_t f = 0; f < frame.maps.faceCount(); ++f)
+            packed.push_back(frame.maps.face(f).packedDepth);
+        return packed;
     });
 }
 
@@ -487,61 +504,67 @@ TEST(ShadowMaps, DualParaboloidHasNoSeamGaps) {
 // ~1 m, so only its bulk: >= 50% of the truly shadowed samples) and with 4 cascades (>= 90%,
 // mismatch below 5% of the samples around the caster).
 TEST(ShadowMaps, DirectionalOverKilometrePlaneFindsShadowNearCamera) {
-    for (int cascades : {1, 4}) {
-        TestScene t;
-        t.ground(500.0f, 0.0f, 0.0f, 0.0f, 8);
-        t.box({-1.0f, 0.0f, -13.0f}, {1.0f, 3.0f, -11.0f});
-        t.camera({0, 1.7f, 0}, {0, 0.5f, -20}, 2000.0f);
-        t.light(directionalLight({0.4f, -1.0f, 0.3f}));
-        ShadowSettings settings = noFilter();
-        settings.cascades = cascades;
-        const Frame frame(t.scene, settings);
-        EXPECT_EQ(frame.maps.faceCount(), size_t(cascades));
-        std::vector<Sample> samples;
-        for (const Sample& s : groundGrid(-4, 6, -16, -6, 50))
-            if (frame.inView(s.world) &&
-                !(s.world.x > -1.0 && s.world.x < 1.0 && s.world.z > -13.0 && s.world.z < -11.0))
-                samples.push_back(s);
-        const Comparison c = compare(frame, 0, samples);
-        ASSERT_GT(c.shadowedTruth, 100);
-        const double found = double(c.shadowedBoth) / c.shadowedTruth;
-        EXPECT_GE(found, cascades == 1 ? 0.5 : 0.9) << cascades << " cascades";
-        if (cascades > 1) {
-            EXPECT_LT(c.fraction(), 0.05) << c.mismatched << " of " << c.samples;
+    for (const ShadowDepthFormat format : kDepthFormats)
+        for (int cascades : {1, 4}) {
+            SCOPED_TRACE(lighting::formatShadowDepthFormat(format));
+            TestScene t;
+            t.ground(500.0f, 0.0f, 0.0f, 0.0f, 8);
+            t.box({-1.0f, 0.0f, -13.0f}, {1.0f, 3.0f, -11.0f});
+            t.camera({0, 1.7f, 0}, {0, 0.5f, -20}, 2000.0f);
+            t.light(directionalLight({0.4f, -1.0f, 0.3f}));
+            ShadowSettings settings = noFilter();
+            settings.cascades = cascades;
+            settings.depthFormat = format;
+            const Frame frame(t.scene, settings);
+            EXPECT_EQ(frame.maps.faceCount(), size_t(cascades));
+            std::vector<Sample> samples;
+            for (const Sample& s : groundGrid(-4, 6, -16, -6, 50))
+                if (frame.inView(s.world) && !(s.world.x > -1.0 && s.world.x < 1.0 &&
+                                               s.world.z > -13.0 && s.world.z < -11.0))
+                    samples.push_back(s);
+            const Comparison c = compare(frame, 0, samples);
+            ASSERT_GT(c.shadowedTruth, 100);
+            const double found = double(c.shadowedBoth) / c.shadowedTruth;
+            EXPECT_GE(found, cascades == 1 ? 0.5 : 0.9) << cascades << " cascades";
+            if (cascades > 1) {
+                EXPECT_LT(c.fraction(), 0.05) << c.mismatched << " of " << c.samples;
+            }
         }
-    }
 }
 
 // Acne: a plane lit 80 degrees from its normal (a sun and a spot) shadows no sample of itself
 // with the default bias and every filter.
 TEST(ShadowMaps, GrazingLightCausesNoAcneWithDefaultBias) {
     const double angle = glm::radians(80.0);
-    for (ShadowFilter filter :
-         {ShadowFilter::None, ShadowFilter::Pcf3, ShadowFilter::Pcf5, ShadowFilter::Poisson}) {
-        TestScene t;
-        t.ground(10.0f);
-        t.camera({0, 4, 6}, {0, 0, -2});
-        t.light(directionalLight({float(std::sin(angle)), float(-std::cos(angle)), 0.0f}));
-        // A spot 1 m above the plane, its axis 80 degrees from the normal, at 5.7 m.
-        t.light(spotLight({-5.67f, 1.0f, -2.0f},
-                          {float(std::sin(angle)), float(-std::cos(angle)), 0}, 20.0f, 10.0f));
-        ShadowSettings settings;
-        settings.filter = filter;
-        const Frame frame(t.scene, settings);
-        int shadowedSun = 0, shadowedSpot = 0, spotSamples = 0;
-        for (const Sample& s : groundGrid(-6, 6, -8, 4, 60)) {
-            if (!frame.inView(s.world))
-                continue;
-            shadowedSun += frame.visibility(0, s.world, s.normalWorld) < 1.0f;
-            if (!withinCone(t.scene.lights[1], {s}).empty()) {
-                ++spotSamples;
-                shadowedSpot += frame.visibility(1, s.world, s.normalWorld) < 1.0f;
+    for (const ShadowDepthFormat format : kDepthFormats)
+        for (ShadowFilter filter :
+             {ShadowFilter::None, ShadowFilter::Pcf3, ShadowFilter::Pcf5, ShadowFilter::Poisson}) {
+            SCOPED_TRACE(lighting::formatShadowDepthFormat(format));
+            TestScene t;
+            t.ground(10.0f);
+            t.camera({0, 4, 6}, {0, 0, -2});
+            t.light(directionalLight({float(std::sin(angle)), float(-std::cos(angle)), 0.0f}));
+            // A spot 1 m above the plane, its axis 80 degrees from the normal, at 5.7 m.
+            t.light(spotLight({-5.67f, 1.0f, -2.0f},
+                              {float(std::sin(angle)), float(-std::cos(angle)), 0}, 20.0f, 10.0f));
+            ShadowSettings settings;
+            settings.filter = filter;
+            settings.depthFormat = format;
+            const Frame frame(t.scene, settings);
+            int shadowedSun = 0, shadowedSpot = 0, spotSamples = 0;
+            for (const Sample& s : groundGrid(-6, 6, -8, 4, 60)) {
+                if (!frame.inView(s.world))
+                    continue;
+                shadowedSun += frame.visibility(0, s.world, s.normalWorld) < 1.0f;
+                if (!withinCone(t.scene.lights[1], {s}).empty()) {
+                    ++spotSamples;
+                    shadowedSpot += frame.visibility(1, s.world, s.normalWorld) < 1.0f;
+                }
             }
+            EXPECT_EQ(shadowedSun, 0) << lighting::formatShadowFilter(filter);
+            EXPECT_GT(spotSamples, 20);
+            EXPECT_EQ(shadowedSpot, 0) << lighting::formatShadowFilter(filter);
         }
-        EXPECT_EQ(shadowedSun, 0) << lighting::formatShadowFilter(filter);
-        EXPECT_GT(spotSamples, 20);
-        EXPECT_EQ(shadowedSpot, 0) << lighting::formatShadowFilter(filter);
-    }
 }
 
 // Peter-panning: a 1 m box standing on the ground, a sun 45 degrees from the vertical. Along the
@@ -550,32 +573,36 @@ TEST(ShadowMaps, GrazingLightCausesNoAcneWithDefaultBias) {
 // a texel or two (texels of ~5 mm here).
 constexpr double kContactGap = 0.02; // metres
 TEST(ShadowMaps, ContactShadowStartsWithinSmallGap) {
-    for (ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf3}) {
-        TestScene t;
-        t.ground(3.0f);
-        t.box({-0.5f, 0.0f, -0.5f}, {0.5f, 1.0f, 0.5f});
-        t.camera({0, 3, 4}, {0.5f, 0, 0});
-        t.light(directionalLight({1.0f, -1.0f, 0.0f}));
-        ShadowSettings settings;
-        settings.filter = filter;
-        const Frame frame(t.scene, settings);
-        // Measured gap: the first sample (1 mm steps) from the face that is fully shadowed.
-        double gap = -1.0;
-        for (int k = 0; k < 200 && gap < 0.0; ++k) {
-            const double x = 0.5 + 0.001 * (k + 0.5);
-            if (frame.visibility(0, {x, 0.0, 0.0}, {0, 1, 0}) == 0.0f)
-                gap = x - 0.5;
+    for (const ShadowDepthFormat format : kDepthFormats)
+        for (ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf3}) {
+            SCOPED_TRACE(lighting::formatShadowDepthFormat(format));
+            TestScene t;
+            t.ground(3.0f);
+            t.box({-0.5f, 0.0f, -0.5f}, {0.5f, 1.0f, 0.5f});
+            t.camera({0, 3, 4}, {0.5f, 0, 0});
+            t.light(directionalLight({1.0f, -1.0f, 0.0f}));
+            ShadowSettings settings;
+            settings.filter = filter;
+            settings.depthFormat = format;
+            const Frame frame(t.scene, settings);
+            // Measured gap: the first sample (1 mm steps) from the face that is fully shadowed.
+            double gap = -1.0;
+            for (int k = 0; k < 200 && gap < 0.0; ++k) {
+                const double x = 0.5 + 0.001 * (k + 0.5);
+                if (frame.visibility(0, {x, 0.0, 0.0}, {0, 1, 0}) == 0.0f)
+                    gap = x - 0.5;
+            }
+            std::printf("  %s, %s: contact shadow from %.1f mm beyond the box\n",
+                        lighting::formatShadowDepthFormat(format),
+                        lighting::formatShadowFilter(filter), gap * 1e3);
+            EXPECT_GE(gap, 0.0) << "no contact shadow";
+            EXPECT_LE(gap, kContactGap) << lighting::formatShadowFilter(filter);
+            // ... and it stays shadowed to the end of the shadow (minus the filter's reach).
+            int lit = 0;
+            for (double x = 0.5 + kContactGap; x < 1.45; x += 0.01)
+                lit += frame.visibility(0, {x, 0.0, 0.0}, {0, 1, 0}) > 0.0f;
+            EXPECT_EQ(lit, 0) << lighting::formatShadowFilter(filter);
         }
-        std::printf("  %s: contact shadow from %.1f mm beyond the box\n",
-                    lighting::formatShadowFilter(filter), gap * 1e3);
-        EXPECT_GE(gap, 0.0) << "no contact shadow";
-        EXPECT_LE(gap, kContactGap) << lighting::formatShadowFilter(filter);
-        // ... and it stays shadowed to the end of the shadow (minus the filter's reach).
-        int lit = 0;
-        for (double x = 0.5 + kContactGap; x < 1.45; x += 0.01)
-            lit += frame.visibility(0, {x, 0.0, 0.0}, {0, 1, 0}) > 0.0f;
-        EXPECT_EQ(lit, 0) << lighting::formatShadowFilter(filter);
-    }
 }
 
 // A 1 cm pole, 2 m tall, at mapSize 2048 (texels of ~3 mm): the centre line of its shadow on
@@ -683,6 +710,86 @@ TEST(ShadowMaps, RenderIsBitwiseIndependentOfThreadsAndNeverNaN) {
         nonFinite += !(frame.visibility(0, {0, 4, 0}, {0, 1, 0}) >= 0.0f);
         EXPECT_EQ(nonFinite, 0);
     }
+}
+
+// ShadowDepthFormat::Unorm16: every texel is the float map's depth made linear ((far - distance)
+// / (far - near)) and rounded down to a multiple of 1 / 65535, so that no occluder is stored
+// nearer than it is (a float rounding may land a step lower at a step's boundary, never higher);
+// nothing stays 0. Spot, cube and dual-paraboloid point and 3-cascade directional faces of an
+// odd size (the last word holds one texel), half the bytes, bitwise the same for 1 and 2
+// threads and both schedules.
+TEST(ShadowMaps, Unorm16TexelsAreTheFloatDepthRoundedTowardsTheFarPlane) {
+    TestScene t;
+    t.ground(5.0f);
+    t.box({-0.5f, 0.0f, -0.5f}, {0.5f, 1.0f, 0.5f});
+    t.box({1.0f, 0.0f, 1.0f}, {1.5f, 2.0f, 1.5f});
+    t.camera({0, 3, 6}, {0, 0, 0});
+    t.light(spotLight({0, 4, 0}, {0.2f, -1, 0}, 8.0f, 40.0f));
+    t.light(pointLight({-1.5f, 1.0f, 0.5f}, 5.0f));
+    t.light(directionalLight({0.3f, -1.0f, 0.2f}));
+    constexpr int kSize = 255;
+    for (const lighting::ShadowPointProjection projection :
+         {lighting::ShadowPointProjection::Cube, lighting::ShadowPointProjection::DualParaboloid}) {
+        SCOPED_TRACE(lighting::formatShadowPointProjection(projection));
+        ShadowSettings settings;
+        settings.mapSize = kSize;
+        settings.cascades = 3;
+        settings.pointProjection = projection;
+        const Frame floats(t.scene, settings);
+        settings.depthFormat = ShadowDepthFormat::Unorm16;
+        const Frame unorm(t.scene, settings);
+        ASSERT_EQ(unorm.maps.faceCount(), floats.maps.faceCount());
+        size_t covered = 0, exact = 0, wordsTotal = 0;
+        for (size_t f = 0; f < unorm.maps.faceCount(); ++f) {
+            const lighting::ShadowFace& face = unorm.maps.face(f);
+            const lighting::ShadowFace& reference = floats.maps.face(f);
+            ASSERT_EQ(face.empty, reference.empty);
+            if (face.empty)
+                continue;
+            EXPECT_TRUE(face.depth.empty());
+            ASSERT_EQ(face.packedDepth.size(), (size_t(kSize) * kSize + 1) / 2);
+            wordsTotal += face.packedDepth.size();
+            const double n = reference.nearMetres, far = reference.farMetres;
+            for (size_t k = 0; k < size_t(kSize) * kSize; ++k) {
+                const double z = reference.depth[k];
+                const uint32_t u = lighting::shadows::unorm16Texel(face.packedDepth.data(), k);
+                if (z == 0.0) {
+                    EXPECT_EQ(u, 0u) << "face " << f << " texel " << k;
+                    continue;
+                }
+                ++covered;
+                const double linear = reference.orthographic || reference.paraboloid
+                                          ? z
+                                          : (far - n * far / (n + z * (far - n))) / (far - n);
+                const double steps = linear * lighting::kUnorm16Max;
+                EXPECT_LE(double(u), steps + 1e-2) << "face " << f << " texel " << k;
+                EXPECT_GE(double(u), std::floor(steps) - 1.0) << "face " << f << " texel " << k;
+                exact += double(u) == std::floor(steps);
+            }
+        }
+        EXPECT_GT(covered, size_t(kSize) * kSize) << "the maps hold almost nothing";
+        EXPECT_GE(double(exact), 0.99 * double(covered)) << exact << " of " << covered;
+        EXPECT_EQ(unorm.maps.stats().totalBytes, wordsTotal * sizeof(uint32_t));
+        EXPECT_LT(unorm.maps.stats().totalBytes, floats.maps.stats().totalBytes / 2 + 64);
+
+        const auto reference = mapsPackedDepth(t.scene, settings, 1);
+        EXPECT_EQ(mapsPackedDepth(t.scene, settings, 2), reference);
+        settings.schedule = lighting::ShadowSchedule::FacesInSequence;
+        EXPECT_EQ(mapsPackedDepth(t.scene, settings, 2), reference);
+    }
+}
+
+// The closed room's pillar (compareClosedRoomWithPillar) with 16-bit maps: the shadow against
+// the rays is as good as the float maps' (a step of 0.15 mm for the light's 10 m range, far
+// below the 5 mm bias).
+TEST(ShadowMaps, Unorm16MapsMatchTheRaysAsWellAsFloatMaps) {
+    ShadowSettings settings = noFilter();
+    const Comparison floats = compareClosedRoomWithPillar(settings);
+    settings.depthFormat = ShadowDepthFormat::Unorm16;
+    const Comparison unorm = compareClosedRoomWithPillar(settings);
+    EXPECT_GT(unorm.shadowedTruth, 100);
+    EXPECT_LE(unorm.mismatched, floats.mismatched + unorm.samples / 500)
+        << unorm.mismatched << " vs " << floats.mismatched << " of " << unorm.samples;
 }
 
 // Each face drops the casters outside its frustum before the draw (cullCastersPerFace): the maps
@@ -1026,13 +1133,15 @@ TEST(ShadowMaps, RecycledBuffersGiveTheSameMapsInTheSameMemory) {
 }
 
 // Frames whose casters move between the faces' tiles (the lights move, a box appears, the map
-// size changes, a light is dropped) and that take over the last frame's buffers and their
-// record of drawn tiles (ShadowFace::tilesNotClear) give bitwise the maps a fresh render gives,
-// and the record is the fresh render's.
+// size changes, a light is dropped, the ground goes) and that take over the last frame's buffers
+// and their record of drawn tiles (ShadowFace::tilesNotClear) give bitwise the maps a fresh
+// render gives, and the record is the fresh render's; with both depth formats (Unorm16: the
+// packed texels' record, and the per-thread float buffers shared by the faces of a size).
 TEST(ShadowMaps, RecycledBuffersStayExactWhenTheCastersMove) {
     auto frameScene = [](int step) {
         TestScene t;
-        t.ground(10.0f);
+        if (step != 5)
+            t.ground(10.0f);
         t.box({-1, 0, -4}, {1, 2, -3});
         if (step % 2 == 1)
             t.box({2, 0, -2}, {2.5f, 3, -1.5f});
@@ -1043,24 +1152,41 @@ TEST(ShadowMaps, RecycledBuffersStayExactWhenTheCastersMove) {
         t.light(directionalLight({0.2f, -1.0f, -0.3f + 0.1f * float(step)}));
         return t.scene;
     };
-    ShadowMaps previous;
     size_t clearTilesSeen = 0;
-    for (int step = 0; step < 5; ++step) {
-        ShadowSettings settings = noFilter();
-        settings.mapSize = step == 3 ? 384 : 256;
-        const Frame fresh(frameScene(step), settings);
-        ShadowMaps next =
-            ShadowMaps::render(fresh.scene, fresh.geometry, fresh.view, settings, &previous);
-        ASSERT_EQ(next.faceCount(), fresh.maps.faceCount()) << "step " << step;
-        for (size_t f = 0; f < next.faceCount(); ++f) {
-            EXPECT_EQ(next.face(f).depth, fresh.maps.face(f).depth)
-                << "step " << step << ", face " << f;
-            EXPECT_EQ(next.face(f).tilesNotClear, fresh.maps.face(f).tilesNotClear)
-                << "step " << step << ", face " << f;
-            clearTilesSeen += size_t(std::count(next.face(f).tilesNotClear.begin(),
-                                                next.face(f).tilesNotClear.end(), uint8_t(0)));
+    for (const ShadowDepthFormat format : kDepthFormats) {
+        SCOPED_TRACE(lighting::formatShadowDepthFormat(format));
+        ShadowMaps previous;
+        // Tiles that held depth in the last frame's buffer and must be cleared in this one's.
+        size_t tilesEmptied = 0;
+        std::vector<std::vector<uint8_t>> lastRecords; // per face of the last frame
+        for (int step = 0; step < 6; ++step) {
+            ShadowSettings settings = noFilter();
+            settings.mapSize = step == 3 ? 384 : 256;
+            settings.depthFormat = format;
+            const Frame fresh(frameScene(step), settings);
+            ShadowMaps next =
+                ShadowMaps::render(fresh.scene, fresh.geometry, fresh.view, settings, &previous);
+            ASSERT_EQ(next.faceCount(), fresh.maps.faceCount()) << "step " << step;
+            for (size_t f = 0; f < next.faceCount(); ++f) {
+                EXPECT_EQ(next.face(f).depth, fresh.maps.face(f).depth)
+                    << "step " << step << ", face " << f;
+                EXPECT_EQ(next.face(f).packedDepth, fresh.maps.face(f).packedDepth)
+                    << "step " << step << ", face " << f;
+                EXPECT_EQ(next.face(f).tilesNotClear, fresh.maps.face(f).tilesNotClear)
+                    << "step " << step << ", face " << f;
+                clearTilesSeen += size_t(std::count(next.face(f).tilesNotClear.begin(),
+                                                    next.face(f).tilesNotClear.end(), uint8_t(0)));
+                if (f < lastRecords.size() &&
+                    lastRecords[f].size() == next.face(f).tilesNotClear.size())
+                    for (size_t k = 0; k < lastRecords[f].size(); ++k)
+                        tilesEmptied += lastRecords[f][k] && !next.face(f).tilesNotClear[k];
+            }
+            lastRecords.clear();
+            for (size_t f = 0; f < next.faceCount(); ++f)
+                lastRecords.push_back(next.face(f).tilesNotClear);
+            previous = std::move(next);
         }
-        previous = std::move(next);
+        EXPECT_GT(tilesEmptied, 0u) << "no tile is emptied: the test exercises nothing";
     }
     EXPECT_GT(clearTilesSeen, 0u) << "no face has an empty tile: the test exercises nothing";
 }
