@@ -489,6 +489,10 @@ INSTANTIATE_TEST_SUITE_P(
                     o.shadows = "maps";
                     o.shadowPoint = "octahedral";
                 })},
+        BadCase{"shadow_depth_format", with([](RenderOptions& o) {
+                    o.shadows = "maps";
+                    o.shadowDepthFormat = "unorm24";
+                })},
         BadCase{"shadow_lights", with([](RenderOptions& o) {
                     o.shadows = "maps";
                     o.shadowLights = "-2";
@@ -540,63 +544,74 @@ TEST(RenderCommand, StatsRecordTheStagesResolvedOptions) {
 // reports the settings its maps were rendered and looked up with, the light's own where it has
 // them and the global flags' elsewhere; the maps' bytes follow each light's own size.
 TEST(RenderCommand, StatsRecordEachLightsShadowSettings) {
-    const std::filesystem::path folder =
-        std::filesystem::path(::testing::TempDir()) / "render_light_shadow";
-    std::filesystem::remove_all(folder);
-    std::filesystem::create_directories(folder);
-    const nlohmann::json scene = {
-        {"objects", {{{"procedural", "spheres"}}}},
-        {"lights",
-         {{{"type", "spot"},
-           {"position", {0, 6, 0}},
-           {"direction", {0, -1, 0}},
-           {"range", 20},
-           {"innerConeDegrees", 30},
-           {"outerConeDegrees", 40},
-           {"castsShadows", true},
-           {"shadow",
-            {{"mapSize", 128}, {"bias", {0.02, 3}}, {"filter", "pcf5"}, {"normalOffset", 0.5}}}},
-          {{"type", "point"}, {"position", {2, 3, 1}}, {"range", 15}, {"castsShadows", true}}}}};
-    std::ofstream(folder / "scene.json") << scene.dump(2);
-    experiments::RenderCommandOptions options;
-    options.render.scene = (folder / "scene.json").string();
-    options.render.stage = "brute";
-    options.render.width = 96;
-    options.render.height = 64;
-    options.render.shadows = "maps";
-    options.render.shadowMapSize = 64;
-    options.render.shadowFilter = "poisson";
-    options.render.shadowPoint = "dual-paraboloid";
-    options.out = folder / "out";
-    testing::internal::CaptureStdout();
-    ASSERT_EQ(experiments::runRenderCommand(options), 0);
-    testing::internal::GetCapturedStdout();
-    std::ifstream statsFile(folder / "out" / "stats.json");
-    const nlohmann::json stats = nlohmann::json::parse(statsFile);
-    const nlohmann::json& shadows = stats["shadows"];
-    EXPECT_EQ(shadows["map_size"], 64);
-    EXPECT_EQ(shadows["filter"], "poisson");
-    EXPECT_EQ(shadows["point_projection"], "dual-paraboloid");
-    ASSERT_EQ(shadows["per_light"].size(), 2u);
-    const nlohmann::json& spot = shadows["per_light"][0];
-    EXPECT_EQ(spot["map_size"], 128);
-    EXPECT_EQ(spot["filter"], "pcf5");
-    EXPECT_FLOAT_EQ(spot["bias_constant_m"].get<float>(), 0.02f);
-    EXPECT_FLOAT_EQ(spot["bias_slope_texels"].get<float>(), 3.0f);
-    EXPECT_FLOAT_EQ(spot["normal_offset_texels"].get<float>(), 0.5f);
-    EXPECT_EQ(spot["bytes"], 128 * 128 * 4);
-    const nlohmann::json& point = shadows["per_light"][1];
-    EXPECT_EQ(point["map_size"], 64);
-    EXPECT_EQ(point["filter"], "poisson");
-    EXPECT_EQ(point["bias_constant_m"], shadows["bias_constant_m"]);
-    EXPECT_EQ(point["faces"], 2);
-    EXPECT_EQ(point["bytes"], 2 * 64 * 64 * 4);
-    // The sets' size per light and as a fraction of the scene's objects.
-    const double perLight =
-        0.5 * (spot["caster_objects"].get<double>() + point["caster_objects"].get<double>());
-    EXPECT_DOUBLE_EQ(shadows["caster_objects_per_light"].get<double>(), perLight);
-    EXPECT_DOUBLE_EQ(shadows["caster_objects_fraction"].get<double>(),
-                     perLight / shadows["objects"].get<double>());
+    for (const std::string depthFormat : {"float32", "unorm16"}) {
+        SCOPED_TRACE(depthFormat);
+        const std::filesystem::path folder =
+            std::filesystem::path(::testing::TempDir()) / ("render_light_shadow_" + depthFormat);
+        std::filesystem::remove_all(folder);
+        std::filesystem::create_directories(folder);
+        const nlohmann::json scene = {{"objects", {{{"procedural", "spheres"}}}},
+                                      {"lights",
+                                       {{{"type", "spot"},
+                                         {"position", {0, 6, 0}},
+                                         {"direction", {0, -1, 0}},
+                                         {"range", 20},
+                                         {"innerConeDegrees", 30},
+                                         {"outerConeDegrees", 40},
+                                         {"castsShadows", true},
+                                         {"shadow",
+                                          {{"mapSize", 128},
+                                           {"bias", {0.02, 3}},
+                                           {"filter", "pcf5"},
+                                           {"normalOffset", 0.5}}}},
+                                        {{"type", "point"},
+                                         {"position", {2, 3, 1}},
+                                         {"range", 15},
+                                         {"castsShadows", true}}}}};
+        std::ofstream(folder / "scene.json") << scene.dump(2);
+        experiments::RenderCommandOptions options;
+        options.render.scene = (folder / "scene.json").string();
+        options.render.stage = "brute";
+        options.render.width = 96;
+        options.render.height = 64;
+        options.render.shadows = "maps";
+        options.render.shadowMapSize = 64;
+        options.render.shadowFilter = "poisson";
+        options.render.shadowPoint = "dual-paraboloid";
+        options.render.shadowDepthFormat = depthFormat;
+        options.out = folder / "out";
+        testing::internal::CaptureStdout();
+        ASSERT_EQ(experiments::runRenderCommand(options), 0);
+        testing::internal::GetCapturedStdout();
+        std::ifstream statsFile(folder / "out" / "stats.json");
+        const nlohmann::json stats = nlohmann::json::parse(statsFile);
+        const nlohmann::json& shadows = stats["shadows"];
+        EXPECT_EQ(shadows["map_size"], 64);
+        EXPECT_EQ(shadows["filter"], "poisson");
+        EXPECT_EQ(shadows["point_projection"], "dual-paraboloid");
+        EXPECT_EQ(shadows["depth_format"], depthFormat);
+        const int texelBytes = depthFormat == "unorm16" ? 2 : 4;
+        ASSERT_EQ(shadows["per_light"].size(), 2u);
+        const nlohmann::json& spot = shadows["per_light"][0];
+        EXPECT_EQ(spot["map_size"], 128);
+        EXPECT_EQ(spot["filter"], "pcf5");
+        EXPECT_FLOAT_EQ(spot["bias_constant_m"].get<float>(), 0.02f);
+        EXPECT_FLOAT_EQ(spot["bias_slope_texels"].get<float>(), 3.0f);
+        EXPECT_FLOAT_EQ(spot["normal_offset_texels"].get<float>(), 0.5f);
+        EXPECT_EQ(spot["bytes"], 128 * 128 * texelBytes);
+        const nlohmann::json& point = shadows["per_light"][1];
+        EXPECT_EQ(point["map_size"], 64);
+        EXPECT_EQ(point["filter"], "poisson");
+        EXPECT_EQ(point["bias_constant_m"], shadows["bias_constant_m"]);
+        EXPECT_EQ(point["faces"], 2);
+        EXPECT_EQ(point["bytes"], 2 * 64 * 64 * texelBytes);
+        // The sets' size per light and as a fraction of the scene's objects.
+        const double perLight =
+            0.5 * (spot["caster_objects"].get<double>() + point["caster_objects"].get<double>());
+        EXPECT_DOUBLE_EQ(shadows["caster_objects_per_light"].get<double>(), perLight);
+        EXPECT_DOUBLE_EQ(shadows["caster_objects_fraction"].get<double>(),
+                         perLight / shadows["objects"].get<double>());
+    }
 }
 
 TEST(RenderCommand, WritesEveryOutputWithTheContractChannels) {
