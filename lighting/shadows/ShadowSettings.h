@@ -62,17 +62,17 @@ enum class ShadowDepthFormat { Float32, Unorm16 };
 // The names parseShadowDepthFormat accepts, for error messages.
 inline constexpr const char* kShadowDepthFormatNames = "float32|unorm16";
 
-// "float32", "unorm16" (the CLI and sweep names); nullopt for anything else.
-inline std::optional<ShadowDepthFormat> parseShadowDepthFormat(std::string_view name) {
-    if (name == "float32")
-        return ShadowDepthFormat::Float32;
-    if (name == "unorm16")
-        return ShadowDepthFormat::Unorm16;
-    return std::nullopt;
-}
-
 inline const char* formatShadowDepthFormat(ShadowDepthFormat format) {
     return format == ShadowDepthFormat::Unorm16 ? "unorm16" : "float32";
+}
+
+// "float32", "unorm16" (the CLI and sweep names: formatShadowDepthFormat's); nullopt for anything
+// else.
+inline std::optional<ShadowDepthFormat> parseShadowDepthFormat(std::string_view name) {
+    for (const ShadowDepthFormat format : {ShadowDepthFormat::Float32, ShadowDepthFormat::Unorm16})
+        if (name == formatShadowDepthFormat(format))
+            return format;
+    return std::nullopt;
 }
 
 // Bytes one texel costs in a face of this format (a face's array: ShadowMaps.h).

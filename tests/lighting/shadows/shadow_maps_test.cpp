@@ -135,34 +135,33 @@ struct Frame {
     }
 };
 
-// Every face's depth of `scene`'s maps, rendered in an arena of `threads`.
-std::vector<std::vector<float>> mapsDepth(const scenes::Scene& scene,
-                                          const ShadowSettings& settings, int threads) {
+// Every face's texels of `scene`'s maps (`texels`: ShadowFace::depth, or packedDepth for
+// Unorm16 maps), rendered in an arena of `threads`.
+template <typename Texel>
+std::vector<std::vector<Texel>> mapsTexels(const scenes::Scene& scene,
+                                           const ShadowSettings& settings, int threads,
+                                           std::vector<Texel> lighting::ShadowFace::*texels) {
     tbb::task_arena arena(threads);
     return arena.execute([&] {
         const Frame frame(scene, settings);
-        std::vector<std::vector<float>> depth;
+        std::vector<std::vector<Texel>> faces;
         for (size_t f = 0; f < frame.maps.faceCount(); ++f)
-            depth.push_back(frame.maps.face(f).depth);
-        return depth;
+            faces.push_back(frame.maps.face(f).*texels);
+        return faces;
     });
+}
+
+std::vector<std::vector<float>> mapsDepth(const scenes::Scene& scene,
+                                          const ShadowSettings& settings, int threads) {
+    return mapsTexels(scene, settings, threads, &lighting::ShadowFace::depth);
+}
+
+std::vector<std::vector<uint32_t>> mapsPackedDepth(const scenes::Scene& scene,
+                                                   const ShadowSettings& settings, int threads) {
+    return mapsTexels(scene, settings, threads, &lighting::ShadowFace::packedDepth);
 }
 
 const ShadowDepthFormat kDepthFormats[] = {ShadowDepthFormat::Float32, ShadowDepthFormat::Unorm16};
-
-// Every face's packed Unorm16 texels (ShadowFace::packedDepth), rendered in an arena of
-// `threads`.
-std::vector<std::vector<uint32_t>> mapsPackedDepth(const scenes::Scene& scene,
-                                                   const ShadowSettings& settings, int threads) {
-    tbb::task_arena arena(threads);
-    return arena.execute([&] {
-        const Frame frame(scene, settings);
-        std::vector<std::vector<uint32_t>> packed;
-        for (size_t f = 0; f < frame.maps.faceCount(); ++f)
-            packed.push_back(frame.maps.face(f).packedDepth);
-        return packed;
-    });
-}
 
 // ---- the brute-force oracle -----------------------------------------------------------------
 
@@ -661,10 +660,8 @@ TEST(ShadowMaps, CasterOutsideFrustumShadowsTheView) {
     }
 }
 
-// A scene with every kind of light, rendered with 1 and 2 threads, both schedules: the maps are
-// bitwise the same; visibility is finite and in [0, 1] for samples, zero normals and points at
-// the light.
-TEST(ShadowMaps, RenderIsBitwiseIndependentOfThreadsAndNeverNaN) {
+// Ground, two boxes, a spot, a point light and a sun: every kind of light over casters.
+TestScene everyLightKindScene() {
     TestScene t;
     t.ground(5.0f);
     t.box({-0.5f, 0.0f, -0.5f}, {0.5f, 1.0f, 0.5f});
@@ -673,6 +670,14 @@ TEST(ShadowMaps, RenderIsBitwiseIndependentOfThreadsAndNeverNaN) {
     t.light(spotLight({0, 4, 0}, {0.2f, -1, 0}, 8.0f, 40.0f));
     t.light(pointLight({-1.5f, 1.0f, 0.5f}, 5.0f));
     t.light(directionalLight({0.3f, -1.0f, 0.2f}));
+    return t;
+}
+
+// A scene with every kind of light, rendered with 1 and 2 threads, both schedules: the maps are
+// bitwise the same; visibility is finite and in [0, 1] for samples, zero normals and points at
+// the light.
+TEST(ShadowMaps, RenderIsBitwiseIndependentOfThreadsAndNeverNaN) {
+    const TestScene t = everyLightKindScene();
     for (const lighting::ShadowPointProjection projection :
          {lighting::ShadowPointProjection::Cube, lighting::ShadowPointProjection::DualParaboloid}) {
         SCOPED_TRACE(lighting::formatShadowPointProjection(projection));
@@ -719,14 +724,7 @@ TEST(ShadowMaps, RenderIsBitwiseIndependentOfThreadsAndNeverNaN) {
 // odd size (the last word holds one texel), half the bytes, bitwise the same for 1 and 2
 // threads and both schedules.
 TEST(ShadowMaps, Unorm16TexelsAreTheFloatDepthRoundedTowardsTheFarPlane) {
-    TestScene t;
-    t.ground(5.0f);
-    t.box({-0.5f, 0.0f, -0.5f}, {0.5f, 1.0f, 0.5f});
-    t.box({1.0f, 0.0f, 1.0f}, {1.5f, 2.0f, 1.5f});
-    t.camera({0, 3, 6}, {0, 0, 0});
-    t.light(spotLight({0, 4, 0}, {0.2f, -1, 0}, 8.0f, 40.0f));
-    t.light(pointLight({-1.5f, 1.0f, 0.5f}, 5.0f));
-    t.light(directionalLight({0.3f, -1.0f, 0.2f}));
+    const TestScene t = everyLightKindScene();
     constexpr int kSize = 255;
     for (const lighting::ShadowPointProjection projection :
          {lighting::ShadowPointProjection::Cube, lighting::ShadowPointProjection::DualParaboloid}) {
