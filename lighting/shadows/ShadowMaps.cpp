@@ -112,7 +112,8 @@ void packUnorm16(const ShadowFace& face, std::span<const float> depth,
                     std::memset(bytes + 2 * k0, 0, 2 * count);
                 continue;
             }
-            // Two loops without a branch inside, so that the compiler puts them on SIMD lanes.
+            // Two loops without a branch inside, which the compiler may put on SIMD lanes (not
+            // checked: the packing is bound by the memory it reads and writes, README.md).
             const float* z = depth.data() + k0;
             if (linear) {
                 for (size_t i = 0; i < count; ++i)
