@@ -36,12 +36,15 @@ namespace lighting {
 // clip positions of the face being drawn.
 struct ShadowMaps::RenderScratch {
     struct Thread {
-        std::vector<std::unique_ptr<raster::Rasterizer>> rasterizers; // one per map size
-        // Per rasterizer (the same index): the float buffer Unorm16 faces of its size are drawn
-        // into before packUnorm16, with its own record of the tiles that are not clear (the
-        // next face this thread draws at that size then clears only those).
-        std::vector<std::vector<float>> unormTargets;
-        std::vector<std::vector<uint8_t>> unormTargetTiles;
+        // One per map size met: its rasterizer, and the float buffer Unorm16 faces of that size
+        // are drawn into before packUnorm16, with its own record of the tiles that are not
+        // clear (the next face this thread draws at that size then clears only those).
+        struct SizedTarget {
+            std::unique_ptr<raster::Rasterizer> rasterizer;
+            std::vector<float> unormDepth;
+            std::vector<uint8_t> unormTilesNotClear;
+        };
+        std::vector<SizedTarget> sizes;
         std::vector<glm::vec4> clip;
         // Perspective and orthographic faces: the clip positions' frustum outcodes and the
         // indices of the triangles the face keeps.
@@ -768,17 +771,14 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         const auto faceStart = Clock::now();
         RenderScratch::Thread& scratch = scratches.local();
         const int size = face.mapSize;
-        size_t rasterizerIndex = 0;
-        while (rasterizerIndex < scratch.rasterizers.size() &&
-               scratch.rasterizers[rasterizerIndex]->width() != size)
-            ++rasterizerIndex;
-        if (rasterizerIndex == scratch.rasterizers.size()) {
+        auto sized = std::find_if(scratch.sizes.begin(), scratch.sizes.end(),
+                                  [&](const auto& s) { return s.rasterizer->width() == size; });
+        if (sized == scratch.sizes.end()) {
             // Lights with their own map size: one rasterizer per size met, each kept.
-            scratch.rasterizers.push_back(std::make_unique<raster::Rasterizer>(size, size));
-            scratch.unormTargets.emplace_back();
-            scratch.unormTargetTiles.emplace_back();
+            scratch.sizes.push_back({std::make_unique<raster::Rasterizer>(size, size), {}, {}});
+            sized = scratch.sizes.end() - 1;
         }
-        raster::Rasterizer* rasterizer = scratch.rasterizers[rasterizerIndex].get();
+        raster::Rasterizer* rasterizer = sized->rasterizer.get();
         const Casters& set = casters[jobs[f].shadow];
         const std::span<const glm::vec3> positions = set.positions(geometry);
         const std::span<const uint32_t> indices =
@@ -873,9 +873,9 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         const size_t texels = size_t(size) * size_t(size);
         const size_t tiles = size_t(rasterizer->tileCountX()) * size_t(rasterizer->tileCountY());
         const bool unorm16 = face.depthFormat == ShadowDepthFormat::Unorm16;
-        std::vector<float>& target = unorm16 ? scratch.unormTargets[rasterizerIndex] : face.depth;
+        std::vector<float>& target = unorm16 ? sized->unormDepth : face.depth;
         std::vector<uint8_t>& targetTiles =
-            unorm16 ? scratch.unormTargetTiles[rasterizerIndex] : face.tilesNotClear;
+            unorm16 ? sized->unormTilesNotClear : face.tilesNotClear;
         face.tilesNotClear = std::move(pooled[f].tilesNotClear);
         if (unorm16) {
             // The packed texels keep their own record of the tiles that are not zero.
