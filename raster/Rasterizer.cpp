@@ -71,48 +71,6 @@ int clipPolygon(const ClipVertex* in, int count, ClipVertex* out, int plane, flo
     return outCount;
 }
 
-// Depth (and, when asked, barycentric) planes from the unsnapped screen positions (see
-// SetupTriangle). With the edge function E_ab(p) = (bx-ax)(py-ay) - (by-ay)(px-ax):
-// l1 = E_20 / area, l2 = E_01 / area. A triangle that is degenerate before snapping but not
-// after falls back to the snapped positions, which are then the only consistent description.
-void setUpPlanes(SetupTriangle& s, SetupBarycentrics* barycentrics, double x[3], double y[3],
-                 const double depth[3]) {
-    double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-    const double snappedArea = (double(s.x[1] - s.x[0]) * (s.y[2] - s.y[0]) -
-                                double(s.y[1] - s.y[0]) * (s.x[2] - s.x[0])) /
-                               (double(kSubpixelScale) * kSubpixelScale);
-    if (!(area > 1e-6 * snappedArea)) {
-        for (int i = 0; i < 3; ++i) {
-            x[i] = double(s.x[i]) / kSubpixelScale;
-            y[i] = double(s.y[i]) / kSubpixelScale;
-        }
-        area = snappedArea;
-    }
-    double l1[3], l2[3];
-    const double inverseArea = 1.0 / area; // one division per triangle, not six
-    auto plane = [&](int a, int b, double out[3]) {
-        // E_ab at pixel (px, py), sampled at its centre (px + 0.5, py + 0.5), over the area.
-        const double dx = x[b] - x[a], dy = y[b] - y[a];
-        out[1] = -dy * inverseArea;
-        out[2] = dx * inverseArea;
-        out[0] = (dx * (0.5 - y[a]) - dy * (0.5 - x[a])) * inverseArea;
-    };
-    plane(2, 0, l1);
-    plane(0, 1, l2);
-    for (int k = 0; k < 3; ++k)
-        s.z[k] = (k == 0 ? depth[0] : 0.0) + l1[k] * (depth[1] - depth[0]) +
-                 l2[k] * (depth[2] - depth[0]);
-    if (!barycentrics)
-        return;
-    // Barycentrics relative to the bounding-box corner, rounded to float.
-    barycentrics->l1[0] = float(l1[0] + l1[1] * s.minX + l1[2] * s.minY);
-    barycentrics->l2[0] = float(l2[0] + l2[1] * s.minX + l2[2] * s.minY);
-    for (int k = 1; k < 3; ++k) {
-        barycentrics->l1[k] = float(l1[k]);
-        barycentrics->l2[k] = float(l2[k]);
-    }
-}
-
 } // namespace
 
 std::span<const SampleOffset> standardSamplePattern(int samples) {
@@ -239,6 +197,10 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
 
     const float guardX = kGuardBandPixels / (0.5f * float(mWidth));
     const float guardY = kGuardBandPixels / (0.5f * float(mHeight));
+    // The planes of the triangles set up last, computed a packet at a time. Value-initialised
+    // once per batch, so the vector lanes past a packet's count read zeros or an earlier
+    // packet's values, never indeterminate memory.
+    SetupPacket planes{};
 
     for (uint32_t t = first; t < last; ++t) {
         uint32_t index[3];
@@ -268,7 +230,7 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
                         needsClip = true;
 
         if (!needsClip) {
-            emitTriangle(clipOfVertex, projected, nullptr, t, state, batch);
+            emitTriangle(clipOfVertex, projected, nullptr, t, state, planes, batch);
             continue;
         }
         ++batch.stats.trianglesClipped;
@@ -291,9 +253,10 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
             const glm::vec3 pieceBarycentric[3] = {a.barycentric, b.barycentric, c.barycentric};
             const ProjectedVertex pieceProjected[3] = {project(a.clip), project(b.clip),
                                                        project(c.clip)};
-            emitTriangle(pieceClip, pieceProjected, pieceBarycentric, t, state, batch);
+            emitTriangle(pieceClip, pieceProjected, pieceBarycentric, t, state, planes, batch);
         }
     }
+    flushPending(planes, state, batch);
     // Counting sort of the (tile, triangle) pairs; stable, so each bin keeps submission order.
     const auto sortStart = std::chrono::steady_clock::now();
     batch.setupSeconds = std::chrono::duration<double>(sortStart - setupStart).count();
@@ -318,7 +281,7 @@ void Rasterizer::setUpBatch(const TriangleList& triangles, uint32_t first, uint3
 
 void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVertex projected[3],
                               const glm::vec3 barycentric[3], uint32_t triangle,
-                              const RasterState& state, Batch& batch) const {
+                              const RasterState& state, SetupPacket& planes, Batch& batch) const {
     SetupTriangle s;
     float invW[3];
     for (int i = 0; i < 3; ++i) {
@@ -379,38 +342,69 @@ void Rasterizer::emitTriangle(const glm::vec4* const clip[3], const ProjectedVer
     s.minY = int16_t(minY);
     s.maxX = int16_t(maxX);
     s.maxY = int16_t(maxY);
-    // Unsnapped positions in double, only for triangles that survived culling (most culled
-    // triangles are back faces, and these divisions showed in profiles): one per vertex.
-    double screenXs[3], screenYs[3], depth[3];
+    s.triangle = triangle;
+    // The planes come from the unsnapped positions in double, computed only for triangles that
+    // survived culling (most culled triangles are back faces), a packet at a time.
+    const int lane = planes.count++;
     for (int i = 0; i < 3; ++i) {
         const glm::vec4& c = *clip[order[i]];
-        const double inverseW = 1.0 / double(c.w);
-        screenXs[i] = (double(c.x) * inverseW + 1.0) * (0.5 * mWidth);
-        screenYs[i] = (1.0 - double(c.y) * inverseW) * (0.5 * mHeight);
-        depth[i] = double(c.z) * inverseW;
+        planes.clipX[i][lane] = double(c.x);
+        planes.clipY[i][lane] = double(c.y);
+        planes.clipZ[i][lane] = double(c.z);
+        planes.clipW[i][lane] = double(c.w);
+        planes.snappedX[i][lane] = double(s.x[i]);
+        planes.snappedY[i][lane] = double(s.y[i]);
     }
-    SetupBarycentrics* barycentrics = nullptr;
+    planes.minX[lane] = double(s.minX);
+    planes.minY[lane] = double(s.minY);
+    // The triangle joins the batch now, in submission order; its planes are filled in by the
+    // packet's flush.
+    const uint32_t index = uint32_t(batch.triangles.size());
+    batch.triangles.push_back(s);
+    ++batch.stats.trianglesSetUp;
     if (state.barycentrics) {
-        barycentrics = &batch.barycentrics.emplace_back();
+        SetupBarycentrics& barycentrics = batch.barycentrics.emplace_back();
         for (int i = 0; i < 3; ++i)
-            barycentrics->invW[i] = invW[i];
-        barycentrics->swapped = order[1] == 2;
-        barycentrics->clippedWeights = SetupBarycentrics::kNotClipped;
+            barycentrics.invW[i] = invW[i];
+        barycentrics.swapped = order[1] == 2;
+        barycentrics.clippedWeights = SetupBarycentrics::kNotClipped;
         if (barycentric) {
-            barycentrics->clippedWeights = uint32_t(batch.clippedWeights.size());
+            barycentrics.clippedWeights = uint32_t(batch.clippedWeights.size());
             batch.clippedWeights.push_back(
                 {barycentric[order[0]], barycentric[order[1]], barycentric[order[2]]});
         }
     }
-    setUpPlanes(s, barycentrics, screenXs, screenYs, depth);
-    s.triangle = triangle;
-    const uint32_t index = uint32_t(batch.triangles.size());
-    batch.triangles.push_back(s);
-    ++batch.stats.trianglesSetUp;
     for (int ty = s.minY / kTileSize; ty <= s.maxY / kTileSize; ++ty)
         for (int tx = s.minX / kTileSize; tx <= s.maxX / kTileSize; ++tx)
             batch.pairTile.push_back(uint32_t(ty * mTilesX + tx)),
                 batch.pairTriangle.push_back(index);
+    if (planes.count == kSetupPacketSize)
+        flushPending(planes, state, batch);
+}
+
+void Rasterizer::flushPending(SetupPacket& planes, const RasterState& state, Batch& batch) const {
+    if (planes.count == 0)
+        return;
+    const SetupViewport viewport{mWidth, mHeight, state.barycentrics};
+    if (state.scalarSetup)
+        setUpPlanesScalar(planes, viewport);
+    else
+        setUpPlanes(planes, viewport);
+    // The packet's lanes are the batch's last `count` triangles.
+    const size_t first = batch.triangles.size() - size_t(planes.count);
+    for (int lane = 0; lane < planes.count; ++lane) {
+        SetupTriangle& s = batch.triangles[first + size_t(lane)];
+        for (int k = 0; k < 3; ++k)
+            s.z[k] = planes.z[k][lane];
+        if (!state.barycentrics)
+            continue;
+        SetupBarycentrics& barycentrics = batch.barycentrics[first + size_t(lane)];
+        for (int k = 0; k < 3; ++k) {
+            barycentrics.l1[k] = planes.l1[k][lane];
+            barycentrics.l2[k] = planes.l2[k][lane];
+        }
+    }
+    planes.count = 0;
 }
 
 void Rasterizer::clearTile(int tileIndex, int samples, float value, float* depth) const {

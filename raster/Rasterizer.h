@@ -67,6 +67,7 @@
 #include <tbb/partitioner.h>
 
 #include "raster/DepthSpan.h"
+#include "raster/TriangleSetup.h"
 
 namespace raster {
 
@@ -140,6 +141,10 @@ struct RasterState {
     // depth-only span loop). The output is bitwise the same, fragments in the same order and
     // the same statistics; only slower.
     bool referenceTraversal = false;
+    // The oracle of the set-up: when set, the depth and barycentric planes are computed one
+    // triangle at a time (setUpPlanesScalar, TriangleSetup.h) instead of on SIMD lanes. The
+    // planes, and so everything drawn, are bitwise the same; only slower.
+    bool scalarSetup = false;
 };
 
 // Triangles as indexed clip-space vertices; triangle t uses indices[3t .. 3t+2].
@@ -306,10 +311,16 @@ private:
     ProjectedVertex project(const glm::vec4& clip) const;
     // `barycentric` (weights of the original vertices) is null for an unclipped triangle.
     // `clip` points at the three clip positions; they are read only for triangles that survive
-    // culling (most culled ones are back faces, decided from `projected` alone).
+    // culling (most culled ones are back faces, decided from `projected` alone). A surviving
+    // triangle is appended to the batch with its (tile, triangle) pairs, and its plane inputs to
+    // `planes`, which is flushed when full: the integer set-up (cull, orientation, pixel bounds)
+    // runs one triangle at a time, the planes a packet at a time (TriangleSetup.h).
     void emitTriangle(const glm::vec4* const clip[3], const ProjectedVertex projected[3],
                       const glm::vec3 barycentric[3], uint32_t triangle, const RasterState& state,
-                      Batch& batch) const;
+                      SetupPacket& planes, Batch& batch) const;
+    // Computes the planes of the packet's triangles, the batch's last planes.count ones, and
+    // writes them into their SetupTriangle and SetupBarycentrics.
+    void flushPending(SetupPacket& planes, const RasterState& state, Batch& batch) const;
 
     // The depth test is a template parameter so that the per-sample comparison is one
     // instruction, not a switch (draw() dispatches once per tile).
