@@ -113,10 +113,13 @@ void VisibilityPass::draw(raster::Rasterizer& rasterizer, std::span<float> depth
         });
         return;
     }
-    rasterizer.draw(triangles(), state, depth.data(), [&](const raster::Fragment& fragment) {
-        codes[size_t(fragment.y) * width + size_t(fragment.x)] =
-            code(fragment.triangle, fragment.frontFacing);
-    });
+    // Captured by value: the draw inlines this per pixel, and by reference the pointer and the
+    // width were reloaded through the closure for every pixel.
+    rasterizer.draw(triangles(), state, depth.data(),
+                    [codes, width](const raster::Fragment& fragment) {
+                        codes[size_t(fragment.y) * width + size_t(fragment.x)] =
+                            code(fragment.triangle, fragment.frontFacing);
+                    });
 }
 
 Surface VisibilityPass::surfaceAt(uint32_t code, int x, int y) const {
