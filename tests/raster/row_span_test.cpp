@@ -26,6 +26,7 @@
 #include <tbb/task_arena.h>
 
 #include "raster/Rasterizer.h"
+#include "tests/raster/DrawRecording.h"
 #include "tests/raster/TestMeshes.h"
 
 namespace {
@@ -39,19 +40,8 @@ using raster_test::Mesh;
 
 using raster_test::randomMesh;
 
-struct Recorded {
-    int x, y;
-    uint32_t triangle;
-    uint32_t depthBits;
-    bool frontFacing;
-    bool operator==(const Recorded&) const = default;
-};
-
-struct Drawn {
-    std::vector<float> depth;
-    std::vector<std::vector<Recorded>> fragmentsPerTile;
-    raster::RasterStats stats;
-};
+using raster_test::RecordedDraw;
+using raster_test::RecordedFragment;
 
 enum class Shading { Keep, Discard, DepthOnly };
 
@@ -60,18 +50,16 @@ bool discards(const raster::Fragment& f) {
     return (uint32_t(f.x) * 7u + uint32_t(f.y) * 13u + f.triangle * 5u) % 3u == 0u;
 }
 
-Drawn draw(const Mesh& mesh, raster::RasterState state, const std::vector<float>& startDepth,
-           Shading shading, int threads) {
-    Drawn drawn;
+RecordedDraw draw(const Mesh& mesh, raster::RasterState state, const std::vector<float>& startDepth,
+                  Shading shading, int threads) {
+    RecordedDraw drawn;
     drawn.depth = startDepth;
     tbb::task_arena(threads).execute([&] {
         raster::Rasterizer rasterizer(kWidth, kHeight);
         drawn.fragmentsPerTile.resize(size_t(rasterizer.tileCountX() * rasterizer.tileCountY()));
         auto record = [&](const raster::Fragment& f) {
-            uint32_t bits;
-            std::memcpy(&bits, &f.depth, sizeof bits);
             drawn.fragmentsPerTile[size_t(rasterizer.tileOf(f.x, f.y))].push_back(
-                Recorded{f.x, f.y, f.triangle, bits, f.frontFacing});
+                RecordedFragment::of(f));
         };
         const raster::TriangleList triangles{mesh.positions, mesh.indices};
         switch (shading) {
@@ -93,26 +81,6 @@ Drawn draw(const Mesh& mesh, raster::RasterState state, const std::vector<float>
         drawn.stats = rasterizer.lastStats();
     });
     return drawn;
-}
-
-void expectSame(const Drawn& got, const Drawn& reference, const std::string& name) {
-    ASSERT_EQ(got.fragmentsPerTile.size(), reference.fragmentsPerTile.size()) << name;
-    for (size_t tile = 0; tile < got.fragmentsPerTile.size(); ++tile) {
-        const auto& a = got.fragmentsPerTile[tile];
-        const auto& b = reference.fragmentsPerTile[tile];
-        ASSERT_EQ(a.size(), b.size()) << name << ", tile " << tile;
-        for (size_t i = 0; i < a.size(); ++i)
-            ASSERT_TRUE(a[i] == b[i])
-                << name << ", tile " << tile << ", fragment " << i << ": (" << a[i].x << ", "
-                << a[i].y << ") of triangle " << a[i].triangle << " against (" << b[i].x << ", "
-                << b[i].y << ") of triangle " << b[i].triangle;
-    }
-    ASSERT_EQ(
-        0, std::memcmp(got.depth.data(), reference.depth.data(), got.depth.size() * sizeof(float)))
-        << name << ": depth buffers differ";
-    EXPECT_EQ(got.stats.samplesCovered, reference.stats.samplesCovered) << name;
-    EXPECT_EQ(got.stats.samplesPassed, reference.stats.samplesPassed) << name;
-    EXPECT_EQ(got.stats.fragments, reference.stats.fragments) << name;
 }
 
 bool nearIsLarge(DepthTest test) {
@@ -156,16 +124,16 @@ TEST(RowSpanTraversal, BitwiseTheReferenceForEveryStateShadingAndThreadCount) {
                     state.cullMode = CullMode::None;
                     state.barycentrics = false;
                     state.referenceTraversal = true;
-                    const Drawn reference = draw(mesh, state, starts[start], shading, 1);
+                    const RecordedDraw reference = draw(mesh, state, starts[start], shading, 1);
                     state.referenceTraversal = false;
                     const std::string name = "test " + std::to_string(int(test)) + ", start " +
                                              std::to_string(start) + ", write " +
                                              std::to_string(write) + ", shading " +
                                              std::to_string(int(shading));
                     for (int threads : {1, 2}) {
-                        const Drawn got = draw(mesh, state, starts[start], shading, threads);
-                        expectSame(got, reference,
-                                   name + ", " + std::to_string(threads) + " threads");
+                        const RecordedDraw got = draw(mesh, state, starts[start], shading, threads);
+                        raster_test::expectSameDraw(
+                            got, reference, name + ", " + std::to_string(threads) + " threads");
                     }
                     EXPECT_GT(reference.stats.samplesCovered, 30000u) << name;
                     ++cases;

@@ -26,6 +26,7 @@
 
 #include "raster/Rasterizer.h"
 #include "raster/TriangleSetup.h"
+#include "tests/raster/DrawRecording.h"
 #include "tests/raster/TestMeshes.h"
 
 namespace {
@@ -151,38 +152,19 @@ TEST(TriangleSetup, VectorPlanesAreBitwiseTheScalarOnesOnEveryTarget) {
     hwy::SetSupportedTargetsForTest(0);
 }
 
-struct Recorded {
-    int x, y;
-    uint32_t triangle;
-    uint32_t depthBits;
-    uint32_t barycentricBits[3];
-    uint8_t coverage;
-    bool frontFacing;
-    bool operator==(const Recorded&) const = default;
-};
-
-struct Drawn {
-    std::vector<float> depth;
-    std::vector<std::vector<Recorded>> fragmentsPerTile;
-    raster::RasterStats stats;
-};
-
 constexpr int kWidth = 301, kHeight = 203; // several tiles, partial ones at the edges
 
-Drawn draw(const raster_test::Mesh& mesh, const raster::RasterState& state, int threads) {
-    Drawn drawn;
+raster_test::RecordedDraw draw(const raster_test::Mesh& mesh, const raster::RasterState& state,
+                               int threads) {
+    raster_test::RecordedDraw drawn;
     drawn.depth.assign(size_t(kWidth) * kHeight * size_t(state.samples), 1.0f);
     tbb::task_arena(threads).execute([&] {
         raster::Rasterizer rasterizer(kWidth, kHeight);
         drawn.fragmentsPerTile.resize(size_t(rasterizer.tileCountX() * rasterizer.tileCountY()));
         rasterizer.draw(raster::TriangleList{mesh.positions, mesh.indices}, state,
                         drawn.depth.data(), [&](const raster::Fragment& f) {
-                            Recorded r{f.x, f.y,        f.triangle,   uint32_t(bitsOf(f.depth)),
-                                       {},  f.coverage, f.frontFacing};
-                            for (int i = 0; i < 3; ++i)
-                                r.barycentricBits[i] = uint32_t(bitsOf(f.barycentric[i]));
                             drawn.fragmentsPerTile[size_t(rasterizer.tileOf(f.x, f.y))].push_back(
-                                r);
+                                raster_test::RecordedFragment::of(f));
                         });
         drawn.stats = rasterizer.lastStats();
     });
@@ -198,36 +180,15 @@ TEST(TriangleSetup, DrawsAreBitwiseTheScalarSetUpsForEveryCullModeSampleCountAnd
             state.cullMode = cull;
             state.samples = samples;
             state.scalarSetup = true;
-            const Drawn reference = draw(mesh, state, 1);
+            const raster_test::RecordedDraw reference = draw(mesh, state, 1);
             state.scalarSetup = false;
             const std::string name =
                 "cull " + std::to_string(int(cull)) + ", " + std::to_string(samples) + " samples";
             EXPECT_GT(reference.stats.trianglesClipped, 50u) << name;
             EXPECT_GT(reference.stats.trianglesSetUp, 300u) << name;
-            for (int threads : {1, 2}) {
-                const Drawn got = draw(mesh, state, threads);
-                const std::string where = name + ", " + std::to_string(threads) + " threads";
-                ASSERT_EQ(got.fragmentsPerTile.size(), reference.fragmentsPerTile.size());
-                for (size_t tile = 0; tile < got.fragmentsPerTile.size(); ++tile) {
-                    const auto& a = got.fragmentsPerTile[tile];
-                    const auto& b = reference.fragmentsPerTile[tile];
-                    ASSERT_EQ(a.size(), b.size()) << where << ", tile " << tile;
-                    for (size_t i = 0; i < a.size(); ++i)
-                        ASSERT_TRUE(a[i] == b[i])
-                            << where << ", tile " << tile << ", fragment " << i << " at (" << a[i].x
-                            << ", " << a[i].y << ") of triangle " << a[i].triangle;
-                }
-                ASSERT_EQ(0, std::memcmp(got.depth.data(), reference.depth.data(),
-                                         got.depth.size() * sizeof(float)))
-                    << where << ": depth buffers differ";
-                EXPECT_EQ(got.stats.trianglesIn, reference.stats.trianglesIn) << where;
-                EXPECT_EQ(got.stats.trianglesCulled, reference.stats.trianglesCulled) << where;
-                EXPECT_EQ(got.stats.trianglesClipped, reference.stats.trianglesClipped) << where;
-                EXPECT_EQ(got.stats.trianglesSetUp, reference.stats.trianglesSetUp) << where;
-                EXPECT_EQ(got.stats.samplesCovered, reference.stats.samplesCovered) << where;
-                EXPECT_EQ(got.stats.samplesPassed, reference.stats.samplesPassed) << where;
-                EXPECT_EQ(got.stats.fragments, reference.stats.fragments) << where;
-            }
+            for (int threads : {1, 2})
+                raster_test::expectSameDraw(draw(mesh, state, threads), reference,
+                                            name + ", " + std::to_string(threads) + " threads");
         }
 }
 
