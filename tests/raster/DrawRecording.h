@@ -2,7 +2,7 @@
 // triangle_setup_test.cpp): every fragment with its position, triangle, facing, coverage, depth
 // and barycentrics bitwise, kept per screen tile in the order the draw calls the fragment
 // function (the order determinism promises), and a comparison that also checks the depth buffer
-// bitwise and every statistic.
+// bitwise and every statistic (also on its own, for tests that record draws their own way).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -50,6 +50,18 @@ struct RecordedDraw {
     raster::RasterStats stats;
 };
 
+// Every statistic of two draws equal.
+inline void expectSameStats(const raster::RasterStats& got, const raster::RasterStats& reference,
+                            const std::string& name) {
+    EXPECT_EQ(got.trianglesIn, reference.trianglesIn) << name;
+    EXPECT_EQ(got.trianglesCulled, reference.trianglesCulled) << name;
+    EXPECT_EQ(got.trianglesClipped, reference.trianglesClipped) << name;
+    EXPECT_EQ(got.trianglesSetUp, reference.trianglesSetUp) << name;
+    EXPECT_EQ(got.samplesCovered, reference.samplesCovered) << name;
+    EXPECT_EQ(got.samplesPassed, reference.samplesPassed) << name;
+    EXPECT_EQ(got.fragments, reference.fragments) << name;
+}
+
 // The same fragments in the same order per tile, the depth buffers bitwise, every statistic.
 inline void expectSameDraw(const RecordedDraw& got, const RecordedDraw& reference,
                            const std::string& name) {
@@ -68,13 +80,7 @@ inline void expectSameDraw(const RecordedDraw& got, const RecordedDraw& referenc
     ASSERT_EQ(
         0, std::memcmp(got.depth.data(), reference.depth.data(), got.depth.size() * sizeof(float)))
         << name << ": depth buffers differ";
-    EXPECT_EQ(got.stats.trianglesIn, reference.stats.trianglesIn) << name;
-    EXPECT_EQ(got.stats.trianglesCulled, reference.stats.trianglesCulled) << name;
-    EXPECT_EQ(got.stats.trianglesClipped, reference.stats.trianglesClipped) << name;
-    EXPECT_EQ(got.stats.trianglesSetUp, reference.stats.trianglesSetUp) << name;
-    EXPECT_EQ(got.stats.samplesCovered, reference.stats.samplesCovered) << name;
-    EXPECT_EQ(got.stats.samplesPassed, reference.stats.samplesPassed) << name;
-    EXPECT_EQ(got.stats.fragments, reference.stats.fragments) << name;
+    expectSameStats(got.stats, reference.stats, name);
 }
 
 } // namespace raster_test

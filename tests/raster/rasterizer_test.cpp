@@ -43,6 +43,7 @@
 #include <tbb/task_arena.h>
 
 #include "raster/Rasterizer.h"
+#include "tests/raster/DrawRecording.h"
 
 namespace raster {
 namespace {
@@ -1814,12 +1815,7 @@ void expectIdentical(const SoupOutput& a, const SoupOutput& b, const std::string
     EXPECT_TRUE(same(a.depth, b.depth)) << label << ": fragment depths";
     EXPECT_TRUE(same(a.barycentric, b.barycentric)) << label << ": barycentrics";
     EXPECT_TRUE(same(a.depthBuffer, b.depthBuffer)) << label << ": depth buffer";
-    EXPECT_EQ(a.stats.trianglesIn, b.stats.trianglesIn) << label;
-    EXPECT_EQ(a.stats.trianglesCulled, b.stats.trianglesCulled) << label;
-    EXPECT_EQ(a.stats.trianglesClipped, b.stats.trianglesClipped) << label;
-    EXPECT_EQ(a.stats.trianglesSetUp, b.stats.trianglesSetUp) << label;
-    EXPECT_EQ(a.stats.samplesCovered, b.stats.samplesCovered) << label;
-    EXPECT_EQ(a.stats.samplesPassed, b.stats.samplesPassed) << label;
+    raster_test::expectSameStats(a.stats, b.stats, label);
 }
 
 TEST(RasterDeterminism, SameOutputForAnyThreadCount) {
