@@ -112,6 +112,10 @@ void setUpPlanes(SetupPacket& packet, const SetupViewport& viewport) {
     HWY_DYNAMIC_DISPATCH(setUpPlanesVector)(packet, viewport);
 }
 
+// With the edge function E_ab(p) = (bx-ax)(py-ay) - (by-ay)(px-ax) of the unsnapped screen
+// positions, the screen-space barycentrics are l1 = E_20 / area and l2 = E_01 / area, and depth is
+// interpolated linearly with them. A triangle that is degenerate before snapping but not after
+// takes the snapped positions, then the only consistent description of it.
 void setUpPlanesScalar(SetupPacket& p, const SetupViewport& viewport) {
     using setup_detail::kSubpixelScale;
     for (int lane = 0; lane < p.count; ++lane) {
