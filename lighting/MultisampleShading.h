@@ -8,7 +8,9 @@
 // made by the data), a light-volume stage tests its volumes against the layer's depth, and the
 // shading kernel runs full packets over the complex pixels' fragments. Scenes with blended
 // surfaces get one more run over an empty G-buffer: the blended surfaces over the background, for
-// the background samples of partially covered pixels.
+// the background samples of partially covered pixels. In each run the blended pass composites per
+// sample over the run's own samples and leaves their mean (passes/BlendedPass.h), so the resolve
+// below gives the per-sample composite averaged over the pixel.
 // Resolve ("resolve" pass): radiance = sum over layers of weight x the layer's radiance
 // (FragmentLayers::weight: the fraction of the pixel's samples the fragment covers), plus the
 // background run weighted by the background samples. lightsEvaluated adds every run's evaluations

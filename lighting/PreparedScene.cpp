@@ -49,6 +49,7 @@ PreparedScene::PreparedScene(scenes::Scene sceneIn, int width, int height, bool 
     inputs.lights = &lights;
     inputs.samples = multisample ? multisampling.samples : 1;
     inputs.fragmentLayers = multisample ? &multisample->layers : nullptr;
+    inputs.sampleDepths = multisample ? &multisample->sampleDepth : nullptr;
     inputs.alphaToCoverage = multisample && multisampling.alphaToCoverage;
 }
 

@@ -119,6 +119,10 @@ struct StageInputs {
     const gbuffer::FragmentLayers* fragmentLayers = nullptr;
     int fragmentLayer = 0;
     static constexpr int kBackgroundRun = -1;
+    // With fragmentLayers: the G-buffer pass's per-sample depth buffer (samples floats per pixel,
+    // pixel-major, the rasterizer's depth of each sample's visible triangle), against which the
+    // blended pass depth-tests each sample of a blended triangle (BlendedPass.h).
+    const std::vector<float>* sampleDepths = nullptr;
     // Alpha-to-coverage (`--alpha-to-coverage on`, gbuffer/visibility/AlphaCoverage.h): at
     // samples > 1 alpha-masked fragments keep round(alpha * samples) of their samples instead of
     // being alpha-tested. The G-buffer pass drew the frame this way (Multisampling); a stage that

@@ -1,8 +1,10 @@
 #include "lighting/passes/BlendedPass.h"
 
 #include <algorithm>
+#include <bit>
 #include <numeric>
 #include <stdexcept>
+#include <string>
 
 #include <tbb/parallel_for.h>
 
@@ -16,6 +18,11 @@ namespace lighting {
 
 bool BlendedPass::prepare(const StageInputs& inputs, SampleRadiance* samples) {
     mTarget = samples;
+    mLayered = !samples && inputs.fragmentLayers && inputs.samples > 1;
+    mSamples = samples ? samples->samples() : mLayered ? inputs.samples : 1;
+    if (mLayered && !inputs.sampleDepths)
+        throw std::invalid_argument(
+            "BlendedPass: a layered multisampled frame needs inputs.sampleDepths");
     const scenes::Scene& scene = *inputs.scene;
     mActive = std::any_of(scene.materials.begin(), scene.materials.end(),
                           [](const auto& m) { return m.alphaMode == scenes::AlphaMode::Blend; });
@@ -69,6 +76,112 @@ gbuffer::Surface BlendedPass::surfaceOf(const raster::Fragment& fragment, uint32
     return s;
 }
 
+std::span<const float> BlendedPass::testedDepth(std::span<const float> opaqueDepth) const {
+    const std::span<const float> tested =
+        mLayered ? std::span<const float>(*mInputs->sampleDepths) : opaqueDepth;
+    const size_t expected =
+        size_t(mInputs->view->width) * size_t(mInputs->view->height) * size_t(mSamples);
+    if (tested.size() != expected)
+        throw std::invalid_argument("BlendedPass: the opaque depth holds " +
+                                    std::to_string(tested.size()) + " floats, the frame " +
+                                    std::to_string(expected) + " (" + std::to_string(mSamples) +
+                                    " per pixel)");
+    return tested;
+}
+
+uint8_t BlendedPass::runSamples(size_t pixel) const {
+    const gbuffer::FragmentLayers& layers = *mInputs->fragmentLayers;
+    const uint8_t all = uint8_t((1u << mSamples) - 1u);
+    const int layer = mInputs->fragmentLayer;
+    if (layer == StageInputs::kBackgroundRun) {
+        // The background samples of a covered pixel (an uncovered one is layer 0's).
+        if (layers.coverage(0)[pixel] == 0)
+            return 0;
+        uint8_t surfaces = 0;
+        for (int k = 0; k < layers.layerCount(); ++k)
+            surfaces |= layers.coverage(k)[pixel];
+        return uint8_t(all & ~surfaces);
+    }
+    const uint8_t mask = layers.coverage(layer)[pixel];
+    return layer == 0 && mask == 0 ? all : mask;
+}
+
+std::span<const float> BlendedPass::listBounds(std::span<const float> opaqueDepth) {
+    if (mSamples == 1)
+        return opaqueDepth;
+    const std::span<const float> tested = testedDepth(opaqueDepth);
+    const size_t width = size_t(mInputs->view->width);
+    const size_t pixelCount = width * size_t(mInputs->view->height);
+    const size_t samples = size_t(mSamples);
+    const bool reversed = mInputs->view->reversedZ();
+    auto farther = [reversed](float a, float b) {
+        return reversed ? std::min(a, b) : std::max(a, b);
+    };
+    mBounds.resize(pixelCount);
+    tbb::parallel_for(size_t(0), pixelCount, [&](size_t pixel) {
+        const float* sample = tested.data() + pixel * samples;
+        float bound = sample[0];
+        for (size_t s = 1; s < samples; ++s)
+            bound = farther(bound, sample[s]);
+        mBounds[pixel] = bound;
+    });
+    draw(opaqueDepth, [&](const raster::Fragment& fragment) {
+        float& bound = mBounds[size_t(fragment.y) * width + size_t(fragment.x)];
+        bound = farther(bound, fragment.depth);
+    });
+    return mBounds;
+}
+
+void BlendedPass::beginComposite(StageResult& result) {
+    mComposite = mTarget;
+    if (mLayered) {
+        mLayerSamples.resetUnfilled(result.width, result.height, mSamples);
+        mComposite = &mLayerSamples;
+    }
+}
+
+void BlendedPass::compositeOver(const raster::Fragment& fragment, const glm::vec3& lit, float alpha,
+                                StageResult& result) {
+    const size_t pixel = size_t(fragment.y) * size_t(result.width) + size_t(fragment.x);
+    if (!mComposite) {
+        for (int c = 0; c < 3; ++c)
+            result.radiance[c][pixel] = alpha * lit[c] + (1.0f - alpha) * result.radiance[c][pixel];
+        return;
+    }
+    if (mComposite->fillsOnDemand())
+        mComposite->fillOnce(pixel, result);
+    for (int c = 0; c < 3; ++c) {
+        float* sample = mComposite->pixel(c, pixel);
+        for (int s = 0; s < mSamples; ++s)
+            if (fragment.coverage >> s & 1u)
+                sample[s] = alpha * lit[c] + (1.0f - alpha) * sample[s];
+    }
+}
+
+void BlendedPass::endComposite(StageResult& result) {
+    if (!mLayered)
+        return;
+    // Each pixel a fragment reached: the mean of the run's own samples.
+    const size_t width = size_t(result.width);
+    tbb::parallel_for(0, result.height, [&](int y) {
+        for (size_t pixel = size_t(y) * width; pixel < size_t(y + 1) * width; ++pixel) {
+            if (!mLayerSamples.filled(pixel))
+                continue;
+            const uint8_t own = runSamples(pixel);
+            const float count = float(std::popcount(own));
+            for (int c = 0; c < 3; ++c) {
+                const float* sample = mLayerSamples.pixel(c, pixel);
+                float sum = 0.0f;
+                for (int s = 0; s < mSamples; ++s)
+                    if (own >> s & 1u)
+                        sum += sample[s];
+                result.radiance[c][pixel] = sum / count;
+            }
+        }
+    });
+    mComposite = nullptr;
+}
+
 std::span<const uint32_t> BlendedPass::contributingLights(const gbuffer::Surface& point) const {
     thread_local std::vector<uint32_t> list;
     list.clear();
@@ -83,7 +196,8 @@ std::span<const uint32_t> BlendedPass::contributingLights(const gbuffer::Surface
 void BlendedPass::shadeWithContributingLights(std::span<const float> opaqueDepth,
                                               StageResult& result) {
     PassTimer blendPass(result, pass::kBlend);
-    mShading.begin(*mInputs, FragmentApply::Over, result, mTarget);
+    beginComposite(result);
+    mShading.begin(*mInputs, FragmentApply::Over, result, mComposite);
     draw(opaqueDepth, [&](const raster::Fragment& fragment) {
         const uint32_t triangle = mSceneTriangle[fragment.triangle];
         float alpha = 0.0f;
@@ -92,6 +206,7 @@ void BlendedPass::shadeWithContributingLights(std::span<const float> opaqueDepth
     });
     mShading.flush();
     mShading.end();
+    endComposite(result);
     blendPass.stop();
 }
 
@@ -100,7 +215,7 @@ void BlendedPass::shadeWithTileLists(std::span<const float> opaqueDepth, int til
     PassTimer blendPass(result, pass::kBlend);
     const TileGrid grid = TileGrid::make(result.width, result.height, tileSizePixels);
     const std::vector<std::vector<uint32_t>> lists =
-        blendedTileLightLists(*mInputs, opaqueDepth, grid, viewFrustumCulling);
+        blendedTileLightLists(*mInputs, listBounds(opaqueDepth), grid, viewFrustumCulling);
     shade(
         opaqueDepth,
         [&](int x, int y, const gbuffer::Surface&, uint32_t) {

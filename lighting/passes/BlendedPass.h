@@ -41,19 +41,33 @@
 // output of a surface is its lit colour plus its emission (Appendix B adds the emissive term to
 // the BRDF's result), so the emission is weighted by alpha like the lit colour; a pane of
 // alpha 0 neither reflects nor emits. KHR_materials_emissive_strength only scales the factor.
-// Multisampling (the forward stages' hardware-style MSAA: prepare() with a SampleRadiance): the
-// opaque depth plane then holds samples per pixel (the SHADING depth of each sample's opaque
-// fragment, ForwardGeometry::shadedDepth), blended triangles are rasterized at one sample per
-// pixel, and a fragment composites over each sample whose opaque depth its centre depth is
-// closer than (the draw's depth test, per sample), in the sample colour buffer. That is exactly
-// what the G-buffer stages do per fragment layer (this pass at one sample over the layer's
-// centre depths, MultisampleShading.h), so every exact stage keeps one image; coverage of a
-// blended triangle's own edges at the samples (what a GPU does) would differ from it there.
+// Multisampling: blended triangles are rasterized at the frame's sample count, each sample
+// covered and depth-tested (closer, no writes) against the rasterizer's depth of that sample's
+// opaque surface, as a GPU blends into a multisampled target. A fragment is shaded once, at the
+// pixel centre like every attribute (raster/Rasterizer.h; a centre depth extrapolated to or past
+// the far plane is moved one float step nearer, as gbuffer::FragmentLayers does for opaque
+// fragments), and composited over each sample of its coverage. So a pane's own edges and the
+// opaque edges behind it are both anti-aliased, not only the latter.
+//  - Forward stages (prepare() with their SampleRadiance; they pass their per-sample depth
+//    plane): the composite goes into their sample colour buffer, which they resolve.
+//  - G-buffer stages (inputs.fragmentLayers, MultisampleShading.h: one run per fragment layer and
+//    one over the background samples): a run owns the samples of its layer's fragment at each
+//    pixel (layer 0 of an uncovered pixel: all of them; the background run: the background
+//    samples of partially covered pixels), tests them against inputs.sampleDepths, and keeps
+//    only coverage within them. A pixel's samples start at the run's opaque radiance the first
+//    time a fragment reaches it (SampleRadiance, filled on demand), take the composite, and the
+//    run's radiance there becomes the mean of its own samples. The layers' resolve weights that
+//    mean by the run's share of samples, so the frame is the per-sample composite averaged over
+//    every sample: what the forward stages give, up to float rounding of the means.
+//  - Tile lists (shadeWithTileLists): they are bounded, per pixel, by the farthest of the tested
+//    sample depths and of the depths at which the pixel's fragments are shaded (a fragment may
+//    pass at a sample while its centre lies behind it), so they stay conservative.
 // Thread safety: one frame at a time per object; parallel inside (the rasterizer's
 // tiles), each pixel composited by the thread owning its tile, in submission order, so the
 // result does not depend on the thread count.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -76,9 +90,15 @@ public:
     // Per frame: false (and nothing else done, O(materials)) when no material of inputs.scene is
     // BLEND; else transforms the scene (its own gbuffer::VisibilityPass, so the clip positions
     // are bitwise the opaque pass's) and sorts the blended triangles. Requires inputs.scene,
-    // .geometry, .view, .lights. With `samples`, the frame is multisampled and shade()
-    // composites per sample into it (see the file comment); it must outlive the frame's shade.
+    // .geometry, .view, .lights. With `samples` (a forward stage's colour buffer), the frame is
+    // multisampled at samples->samples() and shade() composites per sample into it; it must
+    // outlive the frame's shade. Without, a frame with inputs.fragmentLayers and inputs.samples > 1
+    // is a layered multisampled run (see the file comment), which needs inputs.sampleDepths.
     bool prepare(const StageInputs& inputs, SampleRadiance* samples = nullptr);
+    // Another run of the frame prepare() was called for (a fragment layer of the same
+    // multisampled frame, MultisampleShading.h): keeps the transform and the order, and takes
+    // this run's inputs (its layer, hence its samples), which must outlive the run's shade.
+    void switchRun(const StageInputs& inputs) { mInputs = &inputs; }
     bool active() const { return mActive; }
     // Number of blended triangles this frame.
     size_t triangleCount() const { return mSceneTriangle.size(); }
@@ -86,8 +106,9 @@ public:
     std::span<const uint32_t> everyLight() const { return mEveryLight; }
 
     // Composites the blended fragments in front of opaqueDepth (the frame's opaque depth plane,
-    // the view's convention) over result.radiance, in the pass's order, with the lists of
-    // lightsAt (see the file comment). Appends pass::kBlend to result.timingsMs.
+    // the view's convention: one sample per pixel, or a forward stage's samples; a layered
+    // multisampled run tests inputs.sampleDepths instead) over result.radiance, in the pass's
+    // order, with the lists of lightsAt (see the file comment). Appends pass::kBlend.
     template <class LightsAt>
     void shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt, StageResult& result) {
         PassTimer blendPass(result, pass::kBlend);
@@ -128,7 +149,8 @@ public:
     // opaqueDepth, in the pass's order per pixel (the composite order of shade()), with its scene
     // triangle and its surface (position from its depth) and alpha; concurrently for pixels of
     // different raster tiles, so fn writes only data of the fragment's pixel. For stages that
-    // light blended surfaces their own way (inferred's stipple layers).
+    // light blended surfaces their own way (inferred's stipple layers), which composite with
+    // compositeOver() between beginComposite() and endComposite().
     template <class Fn> void forEachFragment(std::span<const float> opaqueDepth, Fn&& fn) {
         draw(opaqueDepth, [&](const raster::Fragment& fragment) {
             const uint32_t triangle = mSceneTriangle[fragment.triangle];
@@ -141,23 +163,44 @@ public:
     // Adds the blended fragments' contributing lights (every light tested) to `oracle`.
     void addOracle(std::span<const float> opaqueDepth, std::vector<uint32_t>& oracle);
 
+    // A composite of the caller's own (forEachFragment): beginComposite() before the first
+    // compositeOver(), endComposite() after the last. compositeOver() composites `lit` (light
+    // plus emission) with `alpha` over the fragment's pixel, or multisampled over each sample of
+    // its coverage; from the thread that was given the fragment.
+    void beginComposite(StageResult& result);
+    void compositeOver(const raster::Fragment& fragment, const glm::vec3& lit, float alpha,
+                       StageResult& result);
+    void endComposite(StageResult& result);
+
 private:
     // The blended surface of a fragment: the visibility pass's surface at the pixel, its
     // position from the fragment's depth (the lossless decoder, as ForwardGeometry), its alpha.
     gbuffer::Surface surfaceOf(const raster::Fragment& fragment, uint32_t triangle,
                                float& alpha) const;
-    // Draws the sorted blended triangles over a copy of opaqueDepth. Multisampled (opaqueDepth
-    // with several samples per pixel), over each pixel's farthest sample, and each fragment's
-    // coverage is set to the samples it is closer than; fragments closer than none are dropped.
+    // Draws the sorted blended triangles over the tested depth (testedDepth(opaqueDepth)),
+    // without writing it, at mSamples samples per pixel; multisampled, a fragment's coverage is
+    // the samples it covers and is closer than, within the run's samples (layered runs), and its
+    // centre depth is kept nearer than the far plane (see the file comment).
     template <class FragmentFn>
     void draw(std::span<const float> opaqueDepth, FragmentFn&& fragmentFn);
+    // The depth plane the draw tests: inputs.sampleDepths in a layered multisampled run, else
+    // opaqueDepth; throws std::invalid_argument unless it holds mSamples floats per pixel.
+    std::span<const float> testedDepth(std::span<const float> opaqueDepth) const;
+    // Layered multisampled runs: the samples of `pixel` this run composites over (file comment).
+    uint8_t runSamples(size_t pixel) const;
+    // Per pixel, a depth no shaded fragment lies behind (file comment, "Tile lists").
+    std::span<const float> listBounds(std::span<const float> opaqueDepth);
 
     bool mActive = false;
     const StageInputs* mInputs = nullptr;
     gbuffer::VisibilityPass mVisibility;
     std::optional<gbuffer::DepthDecoder> mDepthDecoder;
     std::unique_ptr<raster::Rasterizer> mRasterizer;
-    std::vector<float> mDepth;            // the opaque depth, tested, never written
+    int mSamples = 1;                     // the draw's samples per pixel
+    bool mLayered = false;                // a layered multisampled run (file comment)
+    SampleRadiance mLayerSamples;         // layered runs: the run's samples, filled on demand
+    SampleRadiance* mComposite = nullptr; // the composite's sample buffer (null: pixels)
+    std::vector<float> mBounds;           // listBounds()
     std::vector<uint32_t> mSortedIndices; // vertex indices of the sorted triangles
     std::vector<uint32_t> mSceneTriangle; // drawn triangle -> scene triangle
     std::vector<uint32_t> mEveryLight;
@@ -169,45 +212,37 @@ template <class FragmentFn>
 void BlendedPass::draw(std::span<const float> opaqueDepth, FragmentFn&& fragmentFn) {
     raster::RasterState state = mVisibility.drawState();
     state.depthWrite = false;
+    state.samples = mSamples;
     const raster::TriangleList triangles{mVisibility.clipPositions(), mSortedIndices};
-    const size_t width = size_t(mVisibility.view().width);
-    const size_t pixelCount = width * size_t(mVisibility.view().height);
-    const size_t samples = opaqueDepth.size() / pixelCount;
-    if (samples <= 1) {
-        mDepth.assign(opaqueDepth.begin(), opaqueDepth.end());
-        mRasterizer->draw(triangles, state, mDepth.data(), fragmentFn);
+    // With depthWrite off the rasterizer only reads the plane.
+    float* depth = const_cast<float*>(testedDepth(opaqueDepth).data());
+    if (mSamples == 1) {
+        mRasterizer->draw(triangles, state, depth, fragmentFn);
         return;
     }
-    // The farthest sample of each pixel: a fragment closer than some sample is closer than it.
-    mDepth.resize(pixelCount);
+    const size_t width = size_t(mVisibility.view().width);
     const bool reversed = mVisibility.view().reversedZ();
-    for (size_t pixel = 0; pixel < pixelCount; ++pixel) {
-        const float* sample = opaqueDepth.data() + pixel * samples;
-        float farthest = sample[0];
-        for (size_t s = 1; s < samples; ++s)
-            farthest = reversed ? std::min(farthest, sample[s]) : std::max(farthest, sample[s]);
-        mDepth[pixel] = farthest;
-    }
-    auto perSample = [&](const raster::Fragment& fragment) {
-        const float* sample =
-            opaqueDepth.data() + (size_t(fragment.y) * width + size_t(fragment.x)) * samples;
-        unsigned coverage = 0;
-        for (size_t s = 0; s < samples; ++s)
-            if (reversed ? fragment.depth > sample[s] : fragment.depth < sample[s])
-                coverage |= 1u << s;
-        if (coverage == 0)
-            return;
-        raster::Fragment covered = fragment;
-        covered.coverage = uint8_t(coverage);
-        fragmentFn(covered);
+    const float clear = mVisibility.view().clearDepth();
+    const float nearestToClear = std::nextafter(clear, reversed ? 1.0f : 0.0f);
+    auto covered = [&](const raster::Fragment& fragment) {
+        raster::Fragment kept = fragment;
+        if (mLayered) {
+            kept.coverage &= runSamples(size_t(fragment.y) * width + size_t(fragment.x));
+            if (kept.coverage == 0)
+                return;
+        }
+        if (!(reversed ? kept.depth > clear : kept.depth < clear))
+            kept.depth = nearestToClear;
+        fragmentFn(kept);
     };
-    mRasterizer->draw(triangles, state, mDepth.data(), perSample);
+    mRasterizer->draw(triangles, state, depth, covered);
 }
 
 template <class LightsAt>
 void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
                         StageResult& result, PassTimer& blendPass) {
-    mShading.begin(*mInputs, FragmentApply::Over, result, mTarget);
+    beginComposite(result);
+    mShading.begin(*mInputs, FragmentApply::Over, result, mComposite);
     draw(opaqueDepth, [&](const raster::Fragment& fragment) {
         const uint32_t triangle = mSceneTriangle[fragment.triangle];
         float alpha = 0.0f;
@@ -218,6 +253,7 @@ void BlendedPass::shade(std::span<const float> opaqueDepth, LightsAt&& lightsAt,
     });
     mShading.flush();
     mShading.end();
+    endComposite(result);
     blendPass.stop();
 }
 

@@ -17,7 +17,7 @@ void ForwardGeometry::shadeBlended(const StageInputs& inputs, BlendedPass& blend
                                    const LightIndexLists& objectLights, StageResult& result) {
     if (blended.prepare(inputs, sampleTarget()))
         blended.shade(
-            shadedDepth(),
+            depth(),
             [&](int, int, const gbuffer::Surface&, uint32_t triangle) {
                 return objectLights[objectOfTriangle(triangle)];
             },

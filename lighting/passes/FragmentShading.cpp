@@ -186,6 +186,8 @@ void applyToSamples(FragmentApply apply, bool countOracle, SampleRadiance& targe
                     StageResult& result, const QueuedFragment& q,
                     const kernel::PacketAccumulator& accumulator, int lane, size_t pixel) {
     const int samples = target.samples();
+    if (target.fillsOnDemand())
+        target.fillOnce(pixel, result);
     float lit[3];
     for (int c = 0; c < 3; ++c)
         lit[c] = accumulator.radiance[c][lane] +

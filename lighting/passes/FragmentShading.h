@@ -33,11 +33,13 @@
 // The light trace follows: Replace assigns the lane's list, Add appends its lights, Over appends
 // a blended fragment (StageResult::traceBlendedFragment).
 //
-// Multisampling (the forward stages' hardware-style MSAA, begin() with a SampleRadiance): the
-// fragment is still shaded once, and its result is applied as above to each sample of its
-// coverage mask (raster::Fragment::coverage, queued with it) in the per-sample colour buffer
-// instead of the pixel; lightsEvaluated still adds once per fragment, the opaque trace goes to
-// the buffer's per-sample lists (SampleRadiance.h), blended fragments are traced per pixel.
+// Multisampling (begin() with a SampleRadiance: the forward stages' hardware-style MSAA, and the
+// blended pass of every multisampled frame): the fragment is still shaded once, and its result is
+// applied as above to each sample of its coverage mask (raster::Fragment::coverage, queued with
+// it) in the per-sample colour buffer instead of the pixel (a buffer filled on demand first takes
+// the pixel's radiance from the StageResult, SampleRadiance::fillOnce); lightsEvaluated still
+// adds once per fragment, the opaque trace goes to the buffer's per-sample lists
+// (SampleRadiance.h), blended fragments are traced per pixel.
 //
 // Exactness: a lane's sum is the kernel's sum over its own list in list order from 0, the same
 // sequence of float operations `brute` runs on the same ISA at the same surface (bitwise the

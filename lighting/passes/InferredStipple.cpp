@@ -131,6 +131,7 @@ InferredStipple::Counts InferredStipple::composite(BlendedPass& blended,
         a = last < 0 ? -1 : std::clamp(a, offset, last);
         b = last < 0 ? -1 : std::clamp(b, offset, last);
     };
+    blended.beginComposite(result);
     blended.forEachFragment(opaqueDepth, [&](const raster::Fragment& fragment, uint32_t triangle,
                                              const gbuffer::Surface& surface, float alpha) {
         const size_t pixel = size_t(fragment.y) * size_t(l.width) + size_t(fragment.x);
@@ -176,9 +177,9 @@ InferredStipple::Counts InferredStipple::composite(BlendedPass& blended,
         const glm::vec3 lit =
             combineSplitLighting(surface, light.diffuse, light.specular, light.specularEdge) +
             surface.emissive;
-        for (int c = 0; c < 3; ++c)
-            result.radiance[c][pixel] = alpha * lit[c] + (1.0f - alpha) * result.radiance[c][pixel];
+        blended.compositeOver(fragment, lit, alpha, result);
     });
+    blended.endComposite(result);
     Counts counts;
     for (size_t p = 0; p < pixelCount; ++p) {
         counts.fragments += fragments[p];

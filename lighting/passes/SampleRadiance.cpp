@@ -18,6 +18,17 @@ void SampleRadiance::reset(int width, int height, int samples, bool tracing) {
     mTrace.clear();
     if (tracing)
         mTrace.resize(mPixelCount * size_t(samples));
+    mFilled.clear();
+}
+
+void SampleRadiance::resetUnfilled(int width, int height, int samples) {
+    mSamples = samples;
+    mWidth = width;
+    mPixelCount = size_t(width) * size_t(height);
+    for (std::vector<float>& plane : mPlanes)
+        plane.resize(mPixelCount * size_t(samples));
+    mTrace.clear();
+    mFilled.assign(mPixelCount, 0);
 }
 
 void SampleRadiance::resolve(StageResult& result) const {

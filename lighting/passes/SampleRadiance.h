@@ -1,5 +1,5 @@
 // SampleRadiance: the per-sample colour buffer of the forward stages' hardware-style MSAA
-// (inputs.samples > 1): linear HDR R, G, B per sample, pixel-major like the rasterizer's depth
+// (inputs.samples > 1) and of the blended pass in a layered multisampled run (BlendedPass.h): linear HDR R, G, B per sample, pixel-major like the rasterizer's depth
 // (plane[(y * width + x) * samples + s]), and its resolve into a StageResult.
 //
 // How it is written (FragmentShading.h): a fragment is shaded ONCE (its surface at the pixel
@@ -13,11 +13,18 @@
 // pixel the ascending union of its samples' lists: the lights of the fragments that ended up
 // visible in some sample. lightsEvaluated stays per pixel and per fragment (FragmentShading).
 //
+// Filled on demand (resetUnfilled(), the blended pass of a layered multisampled frame,
+// BlendedPass.h): the planes are sized but not cleared, and a pixel's samples all take the
+// radiance the StageResult holds at that pixel when the first fragment is applied there
+// (fillOnce()); only those pixels are ever read (filled()), so a frame pays for the pixels its
+// blended fragments touch, not for the screen.
+//
 // Memory: 12 bytes per sample (1280x720 at 4 samples: 44 MB), cleared per frame by reset().
 // Thread safety: each sample is written by the task owning its pixel's raster tile; reset() and
 // resolve() from the stage's thread (resolve is parallel over rows, deterministic).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -30,6 +37,19 @@ public:
     // Sizes and zeroes the planes for width x height pixels of `samples` samples; with `tracing`
     // one empty light list per sample, else none.
     void reset(int width, int height, int samples, bool tracing);
+    // Sizes the planes without clearing them and marks every pixel unfilled (see the file
+    // comment); no light trace.
+    void resetUnfilled(int width, int height, int samples);
+    bool fillsOnDemand() const { return !mFilled.empty(); }
+    // Filled on demand: on the pixel's first call, sets its samples to `result`'s radiance there.
+    void fillOnce(size_t pixelIndex, const StageResult& result) {
+        if (mFilled[pixelIndex])
+            return;
+        mFilled[pixelIndex] = 1;
+        for (int c = 0; c < 3; ++c)
+            std::fill_n(pixel(c, pixelIndex), mSamples, result.radiance[c][pixelIndex]);
+    }
+    bool filled(size_t pixelIndex) const { return mFilled[pixelIndex] != 0; }
     int samples() const { return mSamples; }
     // The first of the pixel's samples in channel `channel`.
     float* pixel(int channel, size_t pixelIndex) {
@@ -49,6 +69,7 @@ private:
     int mWidth = 0;
     std::vector<float> mPlanes[3];
     std::vector<std::vector<uint32_t>> mTrace;
+    std::vector<uint8_t> mFilled; // filled on demand only: per pixel
 };
 
 } // namespace lighting

@@ -151,6 +151,8 @@ public:
                 throw std::logic_error("inferred shades a multisampled frame's layer 0 first");
             PassTimer blendPass(result, pass::kBlend); // the composite only, after "material"
             blendPass.pause();
+            if (mFrameBlended)
+                mBlended.switchRun(inputs); // this layer's samples
             materialPassOverLBuffer(inputs, lowWidth, lowHeight, mFrameBlended, blendPass, result,
                                     [] {});
             return;

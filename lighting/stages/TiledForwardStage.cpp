@@ -114,7 +114,7 @@ public:
         shading.stop();
         result.parameters["shaded_fragments"] = std::to_string(mShading.fragmentCount());
         if (mBlended.prepare(inputs, mForward.sampleTarget()))
-            mBlended.shadeWithTileLists(mForward.shadedDepth(), mOptions.tileSizePixels,
+            mBlended.shadeWithTileLists(mForward.depth(), mOptions.tileSizePixels,
                                         mOptions.viewFrustumCulling, result);
         mForward.endFrame(result);
 
