@@ -70,6 +70,36 @@ for name in aa-1x aa-4x aa-edge-blur; do
     python3 -c "import json,sys; e=json.load(open(sys.argv[1]))['error']; print(sys.argv[2], 'FLIP', e['flip'], 'relative RMSE', e['relative_rmse'])" \
         "$work/$name/stats.json" "$name"
 done
+# The edges: mean HDR-FLIP over a set of edge pixels, the same set for every mode. The sets are
+# the complex pixels of a 4x frame (its render.exr layer msaa.complex, clamped to 0/1):
+#   complex      `primitive` detection: every pixel whose samples show more than one triangle (the
+#                silhouettes, and every shared edge of a tessellated mesh, where nothing aliases)
+#   geometric    `discontinuity` detection: depth and normal breaks only (the fence's outline, the
+#                box, the wall's foot), opaque surfaces only
+#   fence+panes  geometric, plus the same detection on the scene with its panes drawn opaque
+#                (--scene-option opaque_panes=1): the blended panes' silhouettes too
+# The fence's cut-out stripes are alpha-tested per pixel, so no 4x set holds their edges (MSAA
+# does not anti-alias them; alpha-to-coverage would).
+aa aa-4x-discontinuity --msaa 4 --complex-detect discontinuity
+aa aa-4x-opaque-panes --msaa 4 --complex-detect discontinuity --scene-option opaque_panes=1
+oiiotool "$work/aa-4x/render.exr" --ch msaa.complex --clamp:min=0:max=1 -o "$work/complex.exr"
+oiiotool "$work/aa-4x-discontinuity/render.exr" --ch msaa.complex --clamp:min=0:max=1 \
+    -o "$work/geometric.exr"
+oiiotool "$work/geometric.exr" "$work/aa-4x-opaque-panes/render.exr" --ch msaa.complex --add \
+    --clamp:min=0:max=1 -o "$work/fence+panes.exr"
+edgeFlip() { # MASK_EXR RUN_DIR: mean flip of RUN over the mask's pixels
+    covered=$(oiiotool "$1" --printstats | awk '/Stats Avg/ {print $3}')
+    masked=$(oiiotool "$2/render.exr" --ch flip "$1" --mul --printstats |
+        awk '/Stats Avg/ {print $3}')
+    python3 -c "import sys; print('%.5f' % (float(sys.argv[1]) / float(sys.argv[2])))" \
+        "$masked" "$covered"
+}
+for edges in complex geometric fence+panes; do
+    pixels=$(oiiotool "$work/$edges.exr" --printstats | awk '/Stats Avg/ {print int($3 * 640 * 360 + 0.5)}')
+    for name in aa-1x aa-4x aa-edge-blur; do
+        echo "$name HDR-FLIP over the $edges edges ($pixels pixels): $(edgeFlip "$work/$edges.exr" "$work/$name")"
+    done
+done
 
 # Alpha-to-coverage (issue 28): foliage with tiled at 4x MSAA, alpha-tested and with
 # alpha-to-coverage, and the 16-spp reference; HDR-FLIP maps below, a 160x100 crop of the leaves

@@ -193,7 +193,11 @@ std::vector<SceneOption> wallOptions(int lightCount) {
         0);
 }
 std::vector<SceneOption> glassOptions(int) {
-    return withAmbientAndSun({}, 0);
+    return withAmbientAndSun(
+        {{"opaque_panes", 0, 0, 1,
+          "1: the three panes drawn opaque, so a multisampled frame's edge layer (msaa.complex) "
+          "holds their silhouettes: a mask for measuring the panes' edges, not a glass scene"}},
+        0);
 }
 std::vector<SceneOption> spheresOptions(int) {
     return withAmbientAndSun(
@@ -790,7 +794,8 @@ Scene buildGlass(const SceneRequest& request) {
     auto addPane = [&](const std::string& name, const glm::vec3& tint, float alpha) {
         const uint32_t material = addMaterial(scene, name, tint, 0.3f, 128.0f);
         scene.materials[material].baseColorFactor.a = alpha;
-        scene.materials[material].alphaMode = AlphaMode::Blend;
+        scene.materials[material].alphaMode =
+            options.at("opaque_panes") == 1 ? AlphaMode::Opaque : AlphaMode::Blend;
         return material;
     };
     const uint32_t red = addPane("glass-red", {0.9f, 0.25f, 0.2f}, 1.0f);

@@ -958,5 +958,24 @@ TEST(Spheres, SegmentsOptionSetsTheTessellation) {
     EXPECT_EQ(meshNamed(scene, "sphere-gold").triangleCount(), 2u * 16u * 7u);
 }
 
+// opaque_panes=1 (the edge mask of docs/make_images.sh) turns exactly the three BLEND panes
+// opaque and changes nothing else; 2 is refused.
+TEST(Glass, OpaquePanesOptionTurnsOnlyTheBlendedPanesOpaque) {
+    const Scene blended = buildProceduralScene("glass", requestWith({}));
+    const Scene opaque = buildProceduralScene("glass", requestWith({{"opaque_panes", "1"}}));
+    ASSERT_EQ(blended.materials.size(), opaque.materials.size());
+    int turned = 0;
+    for (size_t m = 0; m < blended.materials.size(); ++m) {
+        const bool pane = blended.materials[m].alphaMode == AlphaMode::Blend;
+        turned += pane ? 1 : 0;
+        EXPECT_EQ(opaque.materials[m].alphaMode,
+                  pane ? AlphaMode::Opaque : blended.materials[m].alphaMode)
+            << blended.materials[m].name;
+    }
+    EXPECT_EQ(turned, 3);
+    EXPECT_EQ(blended.meshes.size(), opaque.meshes.size());
+    EXPECT_NE(errorOf("glass", requestWith({{"opaque_panes", "2"}})), "");
+}
+
 } // namespace
 } // namespace scenes
