@@ -24,6 +24,7 @@
 #include "lighting/MultisampleShading.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
+#include "tests/lighting/StageTestName.h"
 
 namespace {
 
@@ -149,12 +150,6 @@ TEST_P(BlendedMsaa, PaneEdgesAreCoveredAndDepthTestedPerSample) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryStage, BlendedMsaa, ::testing::ValuesIn(multisampledStages()),
-                         [](const auto& info) {
-                             std::string name = info.param;
-                             for (char& c : name)
-                                 if (c == '-')
-                                     c = '_';
-                             return name;
-                         });
+                         stagecheck::stageTestName);
 
 } // namespace

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gbuffer/TwoQuads.h"
+#include "tests/lighting/StageTestName.h"
 
 #include <cmath>
 
@@ -143,13 +144,7 @@ TEST_P(EmissionPerStage, AddedOncePerPixelAfterTheLights) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryStage, EmissionPerStage, ::testing::ValuesIn(everyStage()),
-                         [](const auto& info) {
-                             std::string name = info.param;
-                             for (char& c : name)
-                                 if (c == '-')
-                                     c = '_';
-                             return name;
-                         });
+                         stagecheck::stageTestName);
 
 // A blended pane that emits, over an emitting opaque wall: the pane's emission joins its lit
 // colour before "over" (glTF's BLEND composites the surface's whole output; BlendedPass.h,
