@@ -5,12 +5,13 @@
 // Checked in closed form without lights: every surface shows its emission only, so each sample
 // is one of three colours, the wall W, the pane composited over the wall P = a E + (1 - a) W, or
 // an opaque occluder C in front of part of the pane, and every resolved pixel must be
-// (n_C C + n_P P + n_W W) / 4 for whole sample counts summing to 4. The pane is turned about the
-// view axis, so its silhouette crosses pixels at every offset: pixels with 1 to 3 pane samples
-// and no occluder sample are the pane's own anti-aliased edge (compositing at the pixel centre,
-// as before this was built, leaves none); pixels with both occluder and pane samples are the
-// per-sample depth test against the occluder's edge. Every stage that takes multisampled frames,
-// layered (G-buffer stages) and native (forward stages), and 1 and 2 threads alike.
+// (n_C C + n_P P + n_W W) / N for whole sample counts summing to N. The pane is turned about the
+// view axis, so its silhouette crosses pixels at every offset: pixels with some but not all pane
+// samples and no occluder sample are the pane's own anti-aliased edge (compositing at the pixel
+// centre, as before this was built, leaves none); pixels with both occluder and pane samples are
+// the per-sample depth test against the occluder's edge. Every stage that takes multisampled
+// frames, layered (G-buffer stages) and native (forward stages), and 1 and 2 threads alike, at 4
+// samples; brute, tiled and forward at 2 and 8 too.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -30,7 +31,6 @@ namespace {
 
 constexpr int kWidth = 96;
 constexpr int kHeight = 64;
-constexpr int kSamples = 4;
 constexpr float kPaneAlpha = 0.375f; // exact in binary
 const glm::vec3 kWall(0.2f, 0.1f, 0.05f);
 const glm::vec3 kPaneEmission(0.2f, 1.0f, 2.0f);
@@ -76,14 +76,15 @@ struct Counts {
     int occluder = 0, pane = 0, wall = 0;
 };
 
-// The sample counts whose mix is `rgb`, or false when no mix of 4 samples is within tolerance.
-bool mixOf(const glm::vec3& rgb, Counts& counts) {
+// The sample counts whose mix is `rgb`, or false when no mix of `samples` samples is within
+// tolerance. The mix is unique: red gives the occluder's count, then green the pane's.
+bool mixOf(const glm::vec3& rgb, int samples, Counts& counts) {
     const glm::vec3 overWall = kPaneAlpha * kPaneEmission + (1.0f - kPaneAlpha) * kWall;
-    for (int c = 0; c <= kSamples; ++c)
-        for (int p = 0; c + p <= kSamples; ++p) {
-            const int w = kSamples - c - p;
+    for (int c = 0; c <= samples; ++c)
+        for (int p = 0; c + p <= samples; ++p) {
+            const int w = samples - c - p;
             const glm::vec3 mix =
-                (float(c) * kOccluder + float(p) * overWall + float(w) * kWall) / float(kSamples);
+                (float(c) * kOccluder + float(p) * overWall + float(w) * kWall) / float(samples);
             bool close = true;
             for (int ch = 0; ch < 3; ++ch)
                 close = close && std::abs(rgb[ch] - mix[ch]) <= 2e-5f * std::max(mix[ch], 0.05f);
@@ -103,16 +104,15 @@ std::vector<std::string> multisampledStages() {
     return names;
 }
 
-class BlendedMsaa : public ::testing::TestWithParam<std::string> {};
-
-TEST_P(BlendedMsaa, PaneEdgesAreCoveredAndDepthTestedPerSample) {
-    const std::string stageName = GetParam();
+// The frame of `stageName` at `samples` samples, checked as the file comment says; returns the
+// pixels of the pane's own edge and of the occluder's edge over the pane.
+void checkPaneEdges(const std::string& stageName, int samples, int& paneEdge, int& occludedPane) {
     const scenes::Scene scene = paneScene();
     const std::unique_ptr<lighting::ShadingStage> stage = lighting::makeStage(stageName);
     const gbuffer::GBufferLayout layout =
         gbuffer::makeLayout(scene, stage->requirements().channels, stageName, {});
     lighting::Multisampling multisampling;
-    multisampling.samples = kSamples;
+    multisampling.samples = samples;
     lighting::StageResult resolved[2];
     for (int threads = 1; threads <= 2; ++threads) {
         tbb::task_arena arena(threads);
@@ -122,7 +122,8 @@ TEST_P(BlendedMsaa, PaneEdgesAreCoveredAndDepthTestedPerSample) {
             shading.shade(*stage, frame, resolved[threads - 1]);
         });
     }
-    int paneEdge = 0, occludedPane = 0, failures = 0;
+    paneEdge = 0, occludedPane = 0;
+    int failures = 0;
     for (int y = 0; y < kHeight; ++y)
         for (int x = 0; x < kWidth; ++x) {
             const size_t pixel = size_t(y) * kWidth + size_t(x);
@@ -133,20 +134,38 @@ TEST_P(BlendedMsaa, PaneEdgesAreCoveredAndDepthTestedPerSample) {
                 EXPECT_EQ(image.radiance[ch][pixel], resolved[1].radiance[ch][pixel])
                     << stageName << ": 1 and 2 threads differ at " << x << "," << y;
             Counts counts;
-            if (!mixOf(rgb, counts)) {
+            if (!mixOf(rgb, samples, counts)) {
                 if (failures++ < 5)
                     ADD_FAILURE() << stageName << " pixel (" << x << ", " << y << "): " << rgb.r
-                                  << " " << rgb.g << " " << rgb.b
-                                  << " is no mix of 4 wall, pane and occluder samples";
+                                  << " " << rgb.g << " " << rgb.b << " is no mix of " << samples
+                                  << " wall, pane and occluder samples";
                 continue;
             }
-            paneEdge += counts.occluder == 0 && counts.pane > 0 && counts.pane < kSamples;
+            paneEdge += counts.occluder == 0 && counts.pane > 0 && counts.pane < samples;
             occludedPane += counts.occluder > 0 && counts.pane > 0;
         }
-    EXPECT_EQ(failures, 0) << stageName;
+    EXPECT_EQ(failures, 0) << stageName << ", " << samples << " samples";
+}
+
+class BlendedMsaa : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(BlendedMsaa, PaneEdgesAreCoveredAndDepthTestedPerSample) {
+    int paneEdge = 0, occludedPane = 0;
+    checkPaneEdges(GetParam(), 4, paneEdge, occludedPane);
     // Measured: 65 pixels of the pane's own edge, 20 of the occluder's edge over the pane.
-    EXPECT_GT(paneEdge, 40) << stageName << ": the pane's own edges are not anti-aliased";
-    EXPECT_GT(occludedPane, 10) << stageName;
+    EXPECT_GT(paneEdge, 40) << GetParam() << ": the pane's own edges are not anti-aliased";
+    EXPECT_GT(occludedPane, 10) << GetParam();
+}
+
+// 2 and 8 samples (8: every bit of the coverage byte), layered and native.
+TEST(BlendedMsaaSamples, TwoAndEightSamplesMixWholeSamples) {
+    for (const char* stageName : {"brute", "tiled", "forward"})
+        for (int samples : {2, 8}) {
+            int paneEdge = 0, occludedPane = 0;
+            checkPaneEdges(stageName, samples, paneEdge, occludedPane);
+            EXPECT_GT(paneEdge, 30) << stageName << ", " << samples << " samples";
+            EXPECT_GT(occludedPane, 5) << stageName << ", " << samples << " samples";
+        }
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryStage, BlendedMsaa, ::testing::ValuesIn(multisampledStages()),
