@@ -1,6 +1,7 @@
 // SampleRadiance: the per-sample colour buffer of the forward stages' hardware-style MSAA
-// (inputs.samples > 1) and of the blended pass in a layered multisampled run (BlendedPass.h): linear HDR R, G, B per sample, pixel-major like the rasterizer's depth
-// (plane[(y * width + x) * samples + s]), and its resolve into a StageResult.
+// (inputs.samples > 1) and of the blended pass in a layered multisampled run (BlendedPass.h):
+// linear HDR R, G, B per sample, pixel-major like the rasterizer's depth (plane[(y * width + x) *
+// samples + s]), and its resolve into a StageResult.
 //
 // How it is written (FragmentShading.h): a fragment is shaded ONCE (its surface at the pixel
 // centre, raster/Rasterizer.h) and its result is applied to each sample of its coverage mask
