@@ -14,8 +14,10 @@
 // samples; brute, tiled and forward at 2 and 8 too.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -25,6 +27,7 @@
 #include "lighting/MultisampleShading.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/passes/BlendedPass.h"
 #include "tests/lighting/StageTestName.h"
 
 namespace {
@@ -170,5 +173,88 @@ TEST(BlendedMsaaSamples, TwoAndEightSamplesMixWholeSamples) {
 
 INSTANTIATE_TEST_SUITE_P(EveryStage, BlendedMsaa, ::testing::ValuesIn(multisampledStages()),
                          stagecheck::stageTestName);
+
+// The tiled stages' blended lists (BlendedPass.h, "Tile lists"): a blended fragment that passes
+// at a sample is shaded at its centre depth, which at a steep pane's edge is extrapolated past the
+// opaque surface behind. Panes recede towards a wall and end 5 mm in front of it (about 0.04 m of
+// depth per pixel there), and thousands of small lights sit just behind the wall: lights that
+// reach only the extrapolated centres. Bounded by the sample depths alone, the lists drop them
+// and the image differs from brute's; with the fragments' centre depths it is bitwise brute's.
+scenes::Scene steepPanesBeforeLights() {
+    scenes::Scene scene;
+    scene.name = "steep-panes";
+    scenes::Material wall, pane;
+    wall.baseColorFactor = glm::vec4(0.6f, 0.5f, 0.4f, 1.0f);
+    pane.baseColorFactor = glm::vec4(0.3f, 0.7f, 0.5f, 0.5f);
+    pane.alphaMode = scenes::AlphaMode::Blend;
+    scene.materials = {wall, pane};
+    scene.meshes.push_back(quad(0.0f, 0.0f, 12.0f, 8.0f, -4.0f, 0.0f, 0));
+    scenes::Mesh panes;
+    for (int i = 0; i < 6; ++i) {
+        const float x0 = -1.5f + 0.5f * float(i), x1 = x0 + 0.4f;
+        const uint32_t base = uint32_t(panes.positions.size());
+        // The near edge slants, so that it crosses pixels at every sub-pixel offset.
+        panes.positions.insert(
+            panes.positions.end(),
+            {{x0, -0.4f, -3.995f}, {x1, -0.46f, -3.995f}, {x1, 0.6f, -2.5f}, {x0, 0.6f, -2.5f}});
+        panes.normals.insert(panes.normals.end(), 4, glm::normalize(glm::vec3(0, -1.495f, 1.0f)));
+        panes.uvs.insert(panes.uvs.end(), {{0, 1}, {1, 1}, {1, 0}, {0, 0}});
+        for (uint32_t index : {0u, 1u, 2u, 0u, 2u, 3u})
+            panes.indices.push_back(base + index);
+    }
+    panes.material = 1;
+    scene.meshes.push_back(panes);
+    scene.instances = {{0, glm::mat4(1.0f)}, {1, glm::mat4(1.0f)}};
+    scene.cameras.push_back(scenes::Camera{});
+    std::mt19937 random(11);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (int i = 0; i < 3000; ++i) {
+        scenes::Light light;
+        light.type = scenes::LightType::Point;
+        light.positionWorld = {-1.6f + 3.2f * unit(random), -0.5f + 0.2f * unit(random),
+                               -4.06f + 0.06f * unit(random)};
+        light.color = glm::vec3(1.0f);
+        light.intensity = 1.0f;
+        light.rangeMetres = 0.01f + 0.04f * unit(random);
+        scene.lights.push_back(light);
+    }
+    scenes::validate(scene);
+    return scene;
+}
+
+TEST(BlendedMsaaTileLists, StayConservativeWhereEdgeFragmentsAreShadedBehindTheOpaqueSamples) {
+    const scenes::Scene scene = steepPanesBeforeLights();
+    lighting::Multisampling multisampling;
+    multisampling.samples = 4;
+    lighting::PreparedScene frame(
+        scene, kWidth, kHeight, false,
+        gbuffer::GBufferLayout::lossless(gbuffer::DepthConvention::Reversed), multisampling);
+    // The case exists: layer 0 shades blended fragments behind every sample of their pixel
+    // (measured: 12, the farthest 3 cm behind the wall).
+    lighting::BlendedPass blended;
+    ASSERT_TRUE(blended.prepare(frame.inputs));
+    int behind = 0;
+    const std::vector<float>& sampleDepths = *frame.inputs.sampleDepths;
+    blended.forEachFragment(frame.inputs.gbuffer->depth(), [&](const raster::Fragment& fragment,
+                                                               uint32_t, const gbuffer::Surface&,
+                                                               float) {
+        const float* sample = sampleDepths.data() + (size_t(fragment.y) * kWidth + fragment.x) * 4;
+        behind += fragment.depth < *std::min_element(sample, sample + 4); // reversed Z
+    });
+    EXPECT_GT(behind, 5);
+    lighting::StageResult brute;
+    lighting::MultisampleShading bruteShading;
+    bruteShading.shade(*lighting::makeStage("brute"), frame, brute);
+    for (const char* stageName : {"tiled", "tiled-backface", "clustered-explicit"}) {
+        lighting::StageResult result;
+        lighting::MultisampleShading shading;
+        shading.shade(*lighting::makeStage(stageName), frame, result);
+        int differing = 0;
+        for (int ch = 0; ch < 3; ++ch)
+            for (size_t pixel = 0; pixel < result.radiance[ch].size(); ++pixel)
+                differing += result.radiance[ch][pixel] != brute.radiance[ch][pixel];
+        EXPECT_EQ(differing, 0) << stageName;
+    }
+}
 
 } // namespace
