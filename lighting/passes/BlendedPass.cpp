@@ -148,14 +148,7 @@ void BlendedPass::compositeOver(const raster::Fragment& fragment, const glm::vec
             result.radiance[c][pixel] = alpha * lit[c] + (1.0f - alpha) * result.radiance[c][pixel];
         return;
     }
-    if (mComposite->fillsOnDemand())
-        mComposite->fillOnce(pixel, result);
-    for (int c = 0; c < 3; ++c) {
-        float* sample = mComposite->pixel(c, pixel);
-        for (int s = 0; s < mSamples; ++s)
-            if (fragment.coverage >> s & 1u)
-                sample[s] = alpha * lit[c] + (1.0f - alpha) * sample[s];
-    }
+    mComposite->over(pixel, fragment.coverage, lit, alpha, result);
 }
 
 void BlendedPass::endComposite(StageResult& result) {

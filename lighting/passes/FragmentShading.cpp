@@ -186,35 +186,22 @@ void applyToSamples(FragmentApply apply, bool countOracle, SampleRadiance& targe
                     StageResult& result, const QueuedFragment& q,
                     const kernel::PacketAccumulator& accumulator, int lane, size_t pixel) {
     const int samples = target.samples();
-    if (target.fillsOnDemand())
-        target.fillOnce(pixel, result);
-    float lit[3];
+    glm::vec3 lit;
     for (int c = 0; c < 3; ++c)
         lit[c] = accumulator.radiance[c][lane] +
                  (apply == FragmentApply::Add ? 0.0f : q.surface.emissive[c]);
-    for (int c = 0; c < 3; ++c) {
-        float* sample = target.pixel(c, pixel);
-        for (int s = 0; s < samples; ++s) {
-            if (!(q.coverage >> s & 1u))
-                continue;
-            switch (apply) {
-            case FragmentApply::Replace:
-                sample[s] = lit[c];
-                break;
-            case FragmentApply::Add:
-                sample[s] += lit[c];
-                break;
-            case FragmentApply::Over:
-                sample[s] = q.alpha * lit[c] + (1.0f - q.alpha) * sample[s];
-                break;
-            }
-        }
-    }
     if (apply == FragmentApply::Over) {
+        target.over(pixel, q.coverage, lit, q.alpha, result);
         if (countOracle)
             result.lightsOracle[pixel] += accumulator.lightsContributing[lane];
         result.traceBlendedFragment(pixel, q.triangle, q.frontFacing, q.lights);
         return;
+    }
+    for (int c = 0; c < 3; ++c) {
+        float* sample = target.pixel(c, pixel);
+        for (int s = 0; s < samples; ++s)
+            if (q.coverage >> s & 1u)
+                sample[s] = apply == FragmentApply::Add ? sample[s] + lit[c] : lit[c];
     }
     if (!target.tracing())
         return;

@@ -37,7 +37,7 @@
 // blended pass of every multisampled frame): the fragment is still shaded once, and its result is
 // applied as above to each sample of its coverage mask (raster::Fragment::coverage, queued with
 // it) in the per-sample colour buffer instead of the pixel (a buffer filled on demand first takes
-// the pixel's radiance from the StageResult, SampleRadiance::fillOnce); lightsEvaluated still
+// the pixel's radiance from the StageResult, SampleRadiance::over); lightsEvaluated still
 // adds once per fragment, the opaque trace goes to the buffer's per-sample lists
 // (SampleRadiance.h), blended fragments are traced per pixel.
 //

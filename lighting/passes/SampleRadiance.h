@@ -29,6 +29,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "lighting/ShadingStage.h"
 
 namespace lighting {
@@ -51,6 +53,19 @@ public:
             std::fill_n(pixel(c, pixelIndex), mSamples, result.radiance[c][pixelIndex]);
     }
     bool filled(size_t pixelIndex) const { return mFilled[pixelIndex] != 0; }
+    // "Over" at the samples of `coverage`: sample = alpha * lit + (1 - alpha) * sample, after
+    // fillOnce() when filled on demand (the blended composite, BlendedPass.h).
+    void over(size_t pixelIndex, unsigned coverage, const glm::vec3& lit, float alpha,
+              const StageResult& result) {
+        if (fillsOnDemand())
+            fillOnce(pixelIndex, result);
+        for (int c = 0; c < 3; ++c) {
+            float* sample = pixel(c, pixelIndex);
+            for (int s = 0; s < mSamples; ++s)
+                if (coverage >> s & 1u)
+                    sample[s] = alpha * lit[c] + (1.0f - alpha) * sample[s];
+        }
+    }
     int samples() const { return mSamples; }
     // The first of the pixel's samples in channel `channel`.
     float* pixel(int channel, size_t pixelIndex) {
