@@ -67,15 +67,38 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     const float nearer = view.reversedZ() ? 1.0f : 0.0f;
     const bool mergeSmooth = options.detection == ComplexDetection::Discontinuity;
 
+    const uint8_t allSamples = uint8_t((1u << samples) - 1u);
     tbb::parallel_for(0, mHeight, [&](int y) {
         Counts& counts = rowCounts[size_t(y)];
+        // The merge test's surfaces, one reader for main fragments and one for the others: along
+        // an edge both keep showing the same two triangles, so each reuses its corners (bitwise
+        // surfaceAt()).
+        VisibilityPass::RowSurfaces mainSurfaces(visibility, y), otherSurfaces(visibility, y);
         for (int x = 0; x < mWidth; ++x) {
             const size_t pixel = size_t(y) * mWidth + size_t(x);
             uint32_t* code = &fragmentCode[pixel * stride];
             uint8_t* mask = &fragmentMask[pixel * stride];
             float* depth = &fragmentDepth[pixel * stride];
             int count = 0, background = 0;
-            for (size_t s = 0; s < stride; ++s) {
+            // Most pixels: every sample shows one triangle (or none), what the loop below finds
+            // for them, without its search.
+            const uint32_t* pixelCodes = &sampleCodes[pixel * stride];
+            bool uniform = true;
+            for (size_t s = 1; s < stride; ++s)
+                uniform &= pixelCodes[s] == pixelCodes[0];
+            if (uniform) {
+                if (pixelCodes[0] == VisibilityPass::kNoTriangle) {
+                    background = samples;
+                } else {
+                    code[0] = pixelCodes[0];
+                    mask[0] = allSamples;
+                    depth[0] = sampleDepths[pixel * stride];
+                    if (depth[0] == clear)
+                        depth[0] = std::nextafter(clear, nearer);
+                    count = 1;
+                }
+            }
+            for (size_t s = 0; s < (uniform ? 0 : stride); ++s) {
                 const uint32_t c = sampleCodes[pixel * stride + s];
                 if (c == VisibilityPass::kNoTriangle) {
                     ++background;
@@ -103,11 +126,11 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
             std::rotate(mask, mask + main, mask + main + 1);
             std::rotate(depth, depth + main, depth + main + 1);
             if (mergeSmooth && count > 1) {
-                const Surface first = visibility.surfaceAt(code[0], x, y);
+                const Surface& first = mainSurfaces.at(code[0], x);
                 const float firstDepth = viewDepthAt(view, x, y, depth[0]);
                 int kept = 1;
                 for (int k = 1; k < count; ++k) {
-                    const Surface other = visibility.surfaceAt(code[k], x, y);
+                    const Surface& other = otherSurfaces.at(code[k], x);
                     const float otherDepth = viewDepthAt(view, x, y, depth[k]);
                     const bool smooth =
                         std::abs(otherDepth - firstDepth) <= options.depthTolerance * firstDepth &&

@@ -2,12 +2,19 @@
 // its fragments and the background; the main fragment has the most samples; primitive detection
 // marks every pixel whose samples show two triangles; discontinuity detection leaves the shared
 // edges of a smooth mesh simple but keeps silhouettes complex; silhouettes against the far plane
-// stay covered; sub-pixel triangles make complex pixels; the byte counts add up.
+// stay covered; sub-pixel triangles make complex pixels; the byte counts add up; and every layer
+// is bitwise what the definition gives pixel by pixel (an oracle written here from the header's
+// description, without the build's shortcuts).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
+#include <cstring>
 #include <memory>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "gbuffer/GBuffer.h"
 #include "gbuffer/GBufferPass.h"
@@ -178,6 +185,130 @@ TEST(FragmentLayers, RefusesASingleSampleVisibilityPass) {
     visibility.draw(rasterizer, depth);
     FragmentLayers layers;
     EXPECT_THROW(layers.build(visibility, {}), std::invalid_argument);
+}
+
+// The layers by their definition (FragmentLayers.h), pixel by pixel: the distinct codes of the
+// pixel's samples in order of their first sample, each with its coverage and the centre depth its
+// first sample recorded (one float step nearer when it is the clear value); the one with the most
+// samples first (ties to the earliest), the others after it in their order; with discontinuity
+// detection, each other fragment merged into the main one when its view depth, normal and
+// material are close (surfaceAt, one call per fragment).
+struct OracleFragment {
+    uint32_t code;
+    uint8_t mask;
+    float depth;
+};
+std::vector<OracleFragment> oracleFragments(const VisibilityPass& visibility, int x, int y,
+                                            const FragmentLayerOptions& options) {
+    const CameraView& view = visibility.view();
+    const size_t samples = size_t(visibility.sampleCount());
+    const size_t first = (size_t(y) * size_t(view.width) + size_t(x)) * samples;
+    std::vector<OracleFragment> fragments;
+    for (size_t s = 0; s < samples; ++s) {
+        const uint32_t code = visibility.codes()[first + s];
+        if (code == VisibilityPass::kNoTriangle)
+            continue;
+        auto it = std::find_if(fragments.begin(), fragments.end(),
+                               [&](const OracleFragment& f) { return f.code == code; });
+        if (it == fragments.end()) {
+            float depth = visibility.centreDepths()[first + s];
+            if (depth == view.clearDepth())
+                depth = std::nextafter(view.clearDepth(), view.reversedZ() ? 1.0f : 0.0f);
+            fragments.push_back({code, 0, depth});
+            it = fragments.end() - 1;
+        }
+        it->mask = uint8_t(it->mask | 1u << s);
+    }
+    if (fragments.empty())
+        return fragments;
+    size_t main = 0;
+    for (size_t k = 1; k < fragments.size(); ++k)
+        if (std::popcount(fragments[k].mask) > std::popcount(fragments[main].mask))
+            main = k;
+    std::rotate(fragments.begin(), fragments.begin() + long(main),
+                fragments.begin() + long(main) + 1);
+    if (options.detection == ComplexDetection::Primitive)
+        return fragments;
+    auto viewDepth = [&](float depth) {
+        const glm::vec2 ndc = view.ndcOfPixel(x, y);
+        const glm::vec4 p = view.viewFromClip * glm::vec4(ndc.x, ndc.y, depth, 1.0f);
+        return -p.z / p.w;
+    };
+    const Surface mainSurface = visibility.surfaceAt(fragments[0].code, x, y);
+    const float mainDepth = viewDepth(fragments[0].depth);
+    std::vector<OracleFragment> kept{fragments[0]};
+    for (size_t k = 1; k < fragments.size(); ++k) {
+        const Surface other = visibility.surfaceAt(fragments[k].code, x, y);
+        if (std::abs(viewDepth(fragments[k].depth) - mainDepth) <=
+                options.depthTolerance * mainDepth &&
+            glm::dot(other.normalView, mainSurface.normalView) >= options.normalCosine &&
+            other.material == mainSurface.material)
+            kept[0].mask = uint8_t(kept[0].mask | fragments[k].mask);
+        else
+            kept.push_back(fragments[k]);
+    }
+    return kept;
+}
+
+TEST(FragmentLayers, EveryLayerIsBitwiseTheDefinitionPixelByPixel) {
+    for (const char* sceneName : {"atrium", "spheres", "glass"})
+        for (int samples : {2, 4, 8})
+            for (ComplexDetection detection :
+                 {ComplexDetection::Primitive, ComplexDetection::Discontinuity}) {
+                const std::string name = std::string(sceneName) + ", " + std::to_string(samples) +
+                                         " samples, " + complexDetectionName(detection);
+                scenes::SceneRequest request;
+                request.lightCount = 1;
+                const scenes::Scene scene = scenes::buildProceduralScene(sceneName, request);
+                const SceneGeometry geometry = SceneGeometry::build(scene);
+                const int width = 200, height = 120;
+                const CameraView view =
+                    CameraView::fromCamera(scene.cameras.front(), width, height);
+                VisibilityPass visibility;
+                visibility.transform(scene, geometry, view);
+                raster::Rasterizer rasterizer(width, height);
+                std::vector<float> depth(size_t(width) * height * size_t(samples));
+                visibility.draw(rasterizer, depth, samples);
+                FragmentLayerOptions options;
+                options.detection = detection;
+                FragmentLayers layers;
+                layers.build(visibility, options);
+                uint64_t complexPixels = 0, fragments = 0;
+                for (int y = 0; y < height; ++y)
+                    for (int x = 0; x < width; ++x) {
+                        const size_t pixel = size_t(y) * width + size_t(x);
+                        const std::vector<OracleFragment> expected =
+                            oracleFragments(visibility, x, y, options);
+                        fragments += expected.size();
+                        int covered = 0;
+                        for (const OracleFragment& f : expected)
+                            covered += std::popcount(f.mask);
+                        const bool complex =
+                            !expected.empty() && (expected.size() > 1 || covered < samples);
+                        complexPixels += complex;
+                        ASSERT_EQ(layers.complex(pixel), complex) << name << ", pixel " << pixel;
+                        ASSERT_EQ(layers.backgroundWeight(pixel),
+                                  float(samples - covered) / float(samples))
+                            << name << ", pixel " << pixel;
+                        for (int k = 0; k < layers.layerCount(); ++k) {
+                            const bool present = size_t(k) < expected.size();
+                            ASSERT_EQ(layers.codes(k)[pixel], present ? expected[size_t(k)].code
+                                                                      : VisibilityPass::kNoTriangle)
+                                << name << ", layer " << k << ", pixel " << pixel;
+                            ASSERT_EQ(layers.coverage(k)[pixel],
+                                      present ? expected[size_t(k)].mask : 0)
+                                << name << ", layer " << k << ", pixel " << pixel;
+                            const float want =
+                                present ? expected[size_t(k)].depth : view.clearDepth();
+                            const float got = layers.depths(k)[pixel];
+                            ASSERT_EQ(std::memcmp(&got, &want, sizeof got), 0)
+                                << name << ", layer " << k << ", pixel " << pixel;
+                        }
+                    }
+                EXPECT_EQ(layers.counts().complexPixels, complexPixels) << name;
+                EXPECT_EQ(layers.counts().fragments, fragments) << name;
+                EXPECT_GT(complexPixels, 100u) << name;
+            }
 }
 
 } // namespace
