@@ -63,6 +63,23 @@ PacketPath::PacketPath(const StageInputs& inputs, bool decodePixels)
 }
 
 void PacketPath::decode(int x0, int y0, kernel::ShadingPacket& packet) const {
+    // A packet without a covered pixel (most of an upper MSAA layer's, whose fragments lie at
+    // complex pixels only) has nothing to decode: its lane mask is empty either way, and every
+    // caller skips such a packet before reading a lane.
+    const int columns = std::min(kPacketWidth, gbuffer.width() - x0);
+    const int rows = std::min(kPacketHeight, gbuffer.height() - y0);
+    bool anyCovered = false;
+    for (int row = 0; row < rows && !anyCovered; ++row) {
+        const size_t first = size_t(y0 + row) * size_t(gbuffer.width()) + size_t(x0);
+        for (int column = 0; column < columns; ++column)
+            anyCovered |= gbuffer.covered(first + size_t(column));
+    }
+    if (!anyCovered) {
+        packet.laneMask = 0;
+        packet.x0 = x0;
+        packet.y0 = y0;
+        return;
+    }
     if (decoder) {
         decoder->decode(isa, x0, y0, packet);
         return;
