@@ -440,4 +440,55 @@ TEST(MultisampleStages, EveryStageSaysWhetherItTakesMultisampledFrames) {
     }
 }
 
+// `tiled` builds its lists once per multisampled frame, on layer 0's run, over every layer's
+// depths, and the upper layers reuse them only when they are covered (TiledStage.cpp): on atrium
+// at 4x, with a lossless and a 16-bit depth format (whose quantisation the shared bounds must
+// reproduce), every upper layer takes them and each layer stays exact (every contributing light
+// evaluated, bitwise brute's image); with other lights than layer 0's, or with the depth mask, a
+// layer builds its own.
+TEST(MultisampledTiledLists, UpperLayersReuseLayerZerosListsOnlyWhenTheyCoverThem) {
+    for (const char* depth : {"f32-reversed", "unorm16"}) {
+        gbuffer::GBufferLayout layout =
+            gbuffer::GBufferLayout::lossless(gbuffer::DepthConvention::Reversed);
+        layout.depth = gbuffer::DepthFormatSpec::parse(depth);
+        lighting::Multisampling multisampling;
+        multisampling.samples = 4;
+        lighting::PreparedScene frame(loadCase(kScenes[0]), kWidth, kHeight, false, layout,
+                                      multisampling);
+        ASSERT_GE(frame.layerCount(), 3) << depth;
+        const auto tiled = lighting::makeStage("tiled");
+        const auto brute = lighting::makeStage("brute");
+        for (int k = 0; k < frame.layerCount(); ++k) {
+            const lighting::StageInputs inputs = frame.layerInputs(k);
+            lighting::ContributingLights contributing;
+            contributing.build(*inputs.gbuffer, inputs.lights->lights);
+            const lighting::StageResult result = stagecheck::shadeTraced(*tiled, inputs);
+            EXPECT_EQ(result.parameters.at("tile_lists"), k == 0 ? "own" : "shared")
+                << depth << ", layer " << k;
+            lighting::StageResult bruteResult;
+            brute->shade(inputs, bruteResult);
+            EXPECT_TRUE(stagecheck::everyContributingLightEvaluated(result, contributing, true))
+                << depth << ", layer " << k;
+            EXPECT_TRUE(stagecheck::bitwiseEqualImages(result, bruteResult))
+                << depth << ", layer " << k;
+        }
+        // Other lights after layer 0's run: layer 1 must not take lists built for the old ones.
+        lighting::StageResult layer0, layer1;
+        tiled->shade(frame.layerInputs(0), layer0);
+        std::vector<scenes::Light> moved = frame.scene.lights;
+        for (scenes::Light& light : moved)
+            light.positionWorld += glm::vec3(0.5f, 0.0f, 0.0f);
+        frame.setLights(moved);
+        tiled->shade(frame.layerInputs(1), layer1);
+        EXPECT_EQ(layer1.parameters.at("tile_lists"), "own") << depth;
+        // The depth mask is not shared.
+        const auto masked = lighting::makeStage("tiled:mask=1");
+        for (int k = 0; k < frame.layerCount(); ++k) {
+            lighting::StageResult result;
+            masked->shade(frame.layerInputs(k), result);
+            EXPECT_EQ(result.parameters.at("tile_lists"), "own") << depth << ", layer " << k;
+        }
+    }
+}
+
 } // namespace
