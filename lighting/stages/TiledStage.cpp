@@ -123,9 +123,7 @@ public:
         const size_t lightCount = spheres.size();
         // Only depth ranges can be shared between layers (a depth mask's bins or a normal cone
         // would have to be rebuilt over the union to stay conservative).
-        const bool layered = inputs.fragmentLayers && !mOptions.depthMask && !mOptions.backface &&
-                             inputs.fragmentLayers->width() == gb.width() &&
-                             inputs.fragmentLayers->height() == gb.height();
+        const bool layered = inputs.fragmentLayers && !mOptions.depthMask && !mOptions.backface;
         std::vector<TileSurfaceBounds> bounds =
             layered && inputs.fragmentLayer == 0
                 ? boundsOverEveryLayer(gb, *inputs.fragmentLayers, grid)
