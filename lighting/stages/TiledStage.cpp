@@ -24,13 +24,6 @@
 // Passes: "cull" (light spheres, view-frustum culling, tile bounds and cones, light lists) and
 // "shading". Parameters record the options and counts: lights_after_vfc, vfc_culled,
 // tile_light_pairs and (tiled-backface) backface_rejected.
-// Multisampled frames (`tiled` without mask, lighting/MultisampleShading.h): the lists are built
-// once per frame, on layer 0's run, from tile depth bounds over every layer's fragments (layer 0's
-// G-buffer and the upper layers' centre depths as their G-buffers store them), as Lauritzen culls
-// once per tile for all samples. An upper layer's run reuses them only after checking that they
-// cover it: the same lights, the same view, and each of its tiles' depth range inside the range
-// the lists were built for; otherwise it builds its own. Parameter tile_lists: "own" or
-// "shared" (taken from layer 0's run).
 // Threads: tiles in parallel; each tile's list and pixels are written by one task only.
 // Cost note (CPU): a light that faces away from a whole packet is rejected by the kernel's n.l
 // early-out at almost no cost, so the samples tiled-backface removes are the cheap ones; the
@@ -41,7 +34,6 @@
 #include "lighting/StageRegistry.h"
 
 #include <algorithm>
-#include <optional>
 #include <span>
 
 #include <tbb/parallel_for.h>
@@ -56,45 +48,6 @@
 namespace lighting {
 
 namespace {
-
-bool sameSphere(const LightSphere& a, const LightSphere& b) {
-    return a.centreView == b.centreView && a.radius == b.radius && a.unbounded == b.unbounded &&
-           a.positionView == b.positionView && a.spot == b.spot && a.axisView == b.axisView &&
-           a.spotOuterCos == b.spotOuterCos && a.rangeMetres == b.rangeMetres;
-}
-
-// Tile depth bounds over every fragment layer of a multisampled frame: layer 0's G-buffer `gb`
-// and the layers above, whose depths are their fragments' centre depths as a G-buffer of gb's
-// layout stores them (quantised by its depth format, as GBuffer::quantiseDepth does).
-std::vector<TileSurfaceBounds> boundsOverEveryLayer(const gbuffer::GBuffer& gb,
-                                                    const gbuffer::FragmentLayers& layers,
-                                                    const TileGrid& grid) {
-    std::vector<TileSurfaceBounds> bounds = computeTileSurfaceBounds(gb, grid, {});
-    const gbuffer::DepthDecoder& decoder = gb.depthDecoder();
-    const float clear = gb.view().clearDepth();
-    tbb::parallel_for(0, grid.tileCount(), [&](int tile) {
-        const int tx = tile % grid.tileCountX, ty = tile / grid.tileCountX;
-        TileSurfaceBounds& b = bounds[size_t(tile)];
-        for (int k = 1; k < layers.layerCount(); ++k) {
-            const std::span<const float> depths = layers.depths(k);
-            for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
-                for (int x = grid.x0(tx); x < grid.x1(tx); ++x) {
-                    const float d = depths[size_t(y) * size_t(grid.widthPixels) + size_t(x)];
-                    if (d == clear)
-                        continue;
-                    const float stored = decoder.lossless() ? d : decoder.storedDepthNdc(d);
-                    const float metres = decoder.viewDepthMetres(x, y, stored);
-                    if (!b.covered) {
-                        b.covered = true;
-                        b.minDepthMetres = b.maxDepthMetres = metres;
-                    }
-                    b.minDepthMetres = std::min(b.minDepthMetres, metres);
-                    b.maxDepthMetres = std::max(b.maxDepthMetres, metres);
-                }
-        }
-    });
-    return bounds;
-}
 
 struct TiledOptions {
     int tileSizePixels = 16;
@@ -119,32 +72,14 @@ public:
         PassTimer cull(result, pass::kCull);
 
         const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
-        std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
-        const size_t lightCount = spheres.size();
-        // Only depth ranges can be shared between layers (a depth mask's bins or a normal cone
-        // would have to be rebuilt over the union to stay conservative).
-        const bool layered = inputs.fragmentLayers && !mOptions.depthMask && !mOptions.backface;
-        std::vector<TileSurfaceBounds> bounds =
-            layered && inputs.fragmentLayer == 0
-                ? boundsOverEveryLayer(gb, *inputs.fragmentLayers, grid)
-                : computeTileSurfaceBounds(gb, grid, {mOptions.depthMask, mOptions.backface});
-        const bool shared =
-            layered && inputs.fragmentLayer != 0 && sharedListsCover(gb, bounds, spheres);
-        TileLightListStats lists;
-        if (shared) {
-            lists = mSharedStats;
-        } else {
-            lists = buildTileLightLists(view, grid, bounds, spheres,
-                                        {mOptions.viewFrustumCulling, mOptions.depthMask,
-                                         mOptions.backface, mOptions.assign, mOptions.hierarchical},
-                                        mTileLights, &mBvh);
-            mShared.reset();
-            if (layered && inputs.fragmentLayer == 0) {
-                mShared = SharedLists{std::move(bounds), std::move(spheres), view.clipFromView,
-                                      gb.width(), gb.height()};
-                mSharedStats = lists;
-            }
-        }
+        const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
+        const std::vector<TileSurfaceBounds> bounds =
+            computeTileSurfaceBounds(gb, grid, {mOptions.depthMask, mOptions.backface});
+        const TileLightListStats lists =
+            buildTileLightLists(view, grid, bounds, spheres,
+                                {mOptions.viewFrustumCulling, mOptions.depthMask, mOptions.backface,
+                                 mOptions.assign, mOptions.hierarchical},
+                                mTileLights, &mBvh);
         cull.stop();
 
         PassTimer shading(result, pass::kShading);
@@ -161,46 +96,14 @@ public:
         result.parameters["assign"] = mOptions.assign == TileAssign::Bvh ? "bvh" : "loop";
         result.parameters["hier"] = mOptions.hierarchical ? "1" : "0";
         result.parameters["lights_after_vfc"] = std::to_string(lists.lightsAfterVfc);
-        result.parameters["vfc_culled"] = std::to_string(lightCount - lists.lightsAfterVfc);
+        result.parameters["vfc_culled"] = std::to_string(spheres.size() - lists.lightsAfterVfc);
         result.parameters["tile_light_pairs"] = std::to_string(mTileLights.pairCount());
-        if (inputs.fragmentLayers)
-            result.parameters["tile_lists"] = shared ? "shared" : "own";
         if (mOptions.backface)
             result.parameters["backface_rejected"] = std::to_string(lists.backfaceRejected);
     }
 
 private:
-    // What layer 0's lists of a multisampled frame were built for (see the file comment).
-    struct SharedLists {
-        std::vector<TileSurfaceBounds> bounds;
-        std::vector<LightSphere> spheres;
-        glm::mat4 clipFromView;
-        int width, height;
-    };
-    // Whether the lists built on layer 0's run cover a layer with tile bounds `bounds`: the same
-    // view and lights, and each covered tile's depth range inside the one they were built for.
-    bool sharedListsCover(const gbuffer::GBuffer& gb, const std::vector<TileSurfaceBounds>& bounds,
-                          const std::vector<LightSphere>& spheres) const {
-        if (!mShared || mShared->width != gb.width() || mShared->height != gb.height() ||
-            mShared->clipFromView != gb.view().clipFromView ||
-            mShared->bounds.size() != bounds.size() || mShared->spheres.size() != spheres.size())
-            return false;
-        for (size_t i = 0; i < spheres.size(); ++i)
-            if (!sameSphere(spheres[i], mShared->spheres[i]))
-                return false;
-        for (size_t tile = 0; tile < bounds.size(); ++tile) {
-            const TileSurfaceBounds& own = bounds[tile];
-            const TileSurfaceBounds& built = mShared->bounds[tile];
-            if (own.covered && !(built.covered && built.minDepthMetres <= own.minDepthMetres &&
-                                 own.maxDepthMetres <= built.maxDepthMetres))
-                return false;
-        }
-        return true;
-    }
-
     TiledOptions mOptions;
-    std::optional<SharedLists> mShared;
-    TileLightListStats mSharedStats;
     LightIndexLists mTileLights; // per tile, ascending; storage reused across frames
     LightBvh mBvh;               // assign=bvh; storage reused across frames
     BlendedPass mBlended;        // blended surfaces after the opaque pass (BlendedPass.h)
