@@ -215,6 +215,7 @@ nlohmann::json shadowsJson(const RenderRun& run) {
     for (const lighting::ShadowLightStats& light : stats.lights)
         lights.push_back({{"light", light.lightIndex},
                           {"faces", light.faceCount},
+                          {"faces_outside_view", light.facesOutsideView},
                           {"bytes", light.bytes},
                           {"triangles_drawn", light.trianglesDrawn},
                           {"caster_objects", light.casterObjects},
@@ -244,6 +245,7 @@ nlohmann::json shadowsJson(const RenderRun& run) {
         {"casting_lights", stats.castingLightCount},
         {"lights_with_maps", maps.shadowCount()},
         {"faces", stats.faceCount},
+        {"faces_outside_view", stats.facesOutsideView},
         {"caster_sets", settings.casterSets},
         {"objects", stats.objectCount},
         {"caster_objects_per_light",

@@ -166,6 +166,91 @@ glm::dmat4 perspectiveReversed(double tanHalfFov, double nearMetres, double farM
     return m;
 }
 
+// Relative widening of both solids in perspectiveFaceOutsideView: covers the float positions a
+// forward stage interpolates, a supersampled reference's sub-pixel jitter of the camera (under
+// 1/width of the frustum's width) and a point on a cube face's edge, which the major axis may
+// give to either face.
+constexpr double kFaceCullSlack = 0.01;
+
+// Whether a perspective face can never be looked up: its pyramid (apex at the light, axis down
+// the light frame's -Z, half-width tanHalfFov, out to light-space depth farMetres, beyond which
+// every lookup is lit) and the camera's frustum (every receiver a stage looks up lies on a ray
+// of the image's samples, at a view depth between the near and far planes: G-buffer positions
+// are reconstructed from a depth in [near, far], forward fragments are clipped to it) are
+// disjoint. Proved by a separating plane among the two solids' faces, each solid widened by
+// kFaceCullSlack; a pair that only an edge-edge plane separates is kept (conservative). With an
+// infinite far plane only the pyramid's corners are tested against the camera's planes.
+bool perspectiveFaceOutsideView(const glm::dmat4& lightFromWorld, double tanHalfFov,
+                                double farMetres, const gbuffer::CameraView& view) {
+    const double grow = 1.0 + kFaceCullSlack;
+    const double t = tanHalfFov * grow, far = farMetres * grow;
+    // Symmetric pinhole (CameraView.h): the side slopes from the projection's diagonal.
+    const double tanX = grow / double(view.clipFromView[0][0]);
+    const double tanY = grow / double(view.clipFromView[1][1]);
+    const double cameraNear = double(view.nearMetres) / grow;
+    const double cameraFar = double(view.farMetres) * grow;
+    const bool finiteFar = !view.infiniteFar && std::isfinite(cameraFar);
+    const glm::dmat4 viewFromLight = view.viewFromWorldExact * glm::inverse(lightFromWorld);
+
+    // True when every point lies outside one of the planes `outside` tests (k = 0..5).
+    auto separated = [](const auto& points, auto outside) {
+        for (int plane = 0; plane < 6; ++plane)
+            if (std::all_of(points.begin(), points.end(),
+                            [&](const glm::dvec3& p) { return outside(plane, p); }))
+                return true;
+        return false;
+    };
+    std::array<glm::dvec3, 5> pyramid;
+    pyramid[0] = glm::dvec3(viewFromLight * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+    for (int k = 0; k < 4; ++k)
+        pyramid[size_t(k) + 1] = glm::dvec3(
+            viewFromLight * glm::dvec4((k & 1 ? t : -t) * far, (k & 2 ? t : -t) * far, -far, 1.0));
+    const bool pyramidOutside = separated(pyramid, [&](int plane, const glm::dvec3& p) {
+        const double depth = -p.z;
+        switch (plane) {
+        case 0:
+            return depth < cameraNear;
+        case 1:
+            return finiteFar && depth > cameraFar;
+        case 2:
+            return p.x > tanX * depth;
+        case 3:
+            return p.x < -tanX * depth;
+        case 4:
+            return p.y > tanY * depth;
+        default:
+            return p.y < -tanY * depth;
+        }
+    });
+    if (pyramidOutside || !finiteFar)
+        return pyramidOutside;
+    const glm::dmat4 lightFromView = glm::inverse(viewFromLight);
+    std::array<glm::dvec3, 8> frustum;
+    for (int k = 0; k < 8; ++k) {
+        const double depth = k & 4 ? cameraFar : cameraNear;
+        frustum[size_t(k)] =
+            glm::dvec3(lightFromView * glm::dvec4((k & 1 ? tanX : -tanX) * depth,
+                                                  (k & 2 ? tanY : -tanY) * depth, -depth, 1.0));
+    }
+    return separated(frustum, [&](int plane, const glm::dvec3& p) {
+        const double depth = -p.z;
+        switch (plane) {
+        case 0:
+            return p.x > t * depth;
+        case 1:
+            return p.x < -t * depth;
+        case 2:
+            return p.y > t * depth;
+        case 3:
+            return p.y < -t * depth;
+        case 4:
+            return depth > far;
+        default:
+            return false;
+        }
+    });
+}
+
 // Reversed-Z orthographic box: x in [x0, x1], y in [y0, y1], depth d = -z in [near, far] maps
 // to z_ndc = (far - d) / (far - near).
 glm::dmat4 orthographicReversed(double x0, double x1, double y0, double y1, double nearMetres,
@@ -469,6 +554,14 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         face.farMetres = farMetres;
         face.tanHalfFov = tanHalfFov;
         face.extentMetres = extentMetres;
+        // A cube or spot face no receiver in view can select is never looked up: left empty,
+        // it is neither drawn nor stored (typically the faces of a light that look away from
+        // the camera).
+        if (!orthographic && settings.cullFacesOutsideView &&
+            perspectiveFaceOutsideView(lightFromWorld, tanHalfFov, farMetres, view)) {
+            face.empty = true;
+            face.outsideView = true;
+        }
         maps.mFaces.push_back(std::move(face));
         jobs.push_back({shadow, glm::mat4(clipFromWorld)});
     };
@@ -1000,12 +1093,14 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         lightStats.casterObjects = useSets ? setStats[s].casterObjects : maps.mStats.objectCount;
         lightStats.lightInFrustum = setStats[s].lightInFrustum;
         for (size_t f = shadow.firstFace; f < shadow.firstFace + shadow.faceCount; ++f) {
+            lightStats.facesOutsideView += maps.mFaces[f].outsideView ? 1 : 0;
             lightStats.bytes += maps.mFaces[f].depth.size() * sizeof(float) +
                                 maps.mFaces[f].packedDepth.size() * sizeof(uint32_t);
             lightStats.renderMs += faceMs[f];
             lightStats.trianglesDrawn += faceTriangles[f];
         }
         maps.mStats.totalBytes += lightStats.bytes;
+        maps.mStats.facesOutsideView += lightStats.facesOutsideView;
         maps.mStats.lights.push_back(lightStats);
     }
     maps.mStats.faceCount = maps.mFaces.size();

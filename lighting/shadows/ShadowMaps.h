@@ -105,8 +105,12 @@ struct ShadowFace {
     // face's centre; at its rim a texel spans half that).
     double tanHalfFov = 0.0;
     double extentMetres = 0.0;
-    bool empty = false; // nothing to receive (a cascade outside the scene): lookups lit
-    int mapSize = 0;    // its light's (ShadowLightStats::settings.mapSize)
+    // Nothing to receive: lookups lit. A cascade outside the scene, or a perspective face that
+    // no receiver in the camera's frustum can select (outsideView, ShadowSettings::
+    // cullFacesOutsideView): never looked up.
+    bool empty = false;
+    bool outsideView = false;
+    int mapSize = 0; // its light's (ShadowLightStats::settings.mapSize)
     ShadowDepthFormat depthFormat = ShadowDepthFormat::Float32;
     // Float32 faces: mapSize^2, row 0 at the top; empty when `empty` and for Unorm16 faces.
     std::vector<float> depth;
@@ -127,6 +131,7 @@ struct ShadowLightStats {
     size_t lightIndex = 0;
     scenes::LightType type = scenes::LightType::Point;
     size_t faceCount = 0;
+    size_t facesOutsideView = 0; // of faceCount, left empty by cullFacesOutsideView
     size_t bytes = 0;
     // The settings its maps were rendered and are looked up with: the global ones with the
     // light's own (scenes::LightShadow) over them (settingsForLight).
@@ -145,6 +150,7 @@ struct ShadowLightStats {
 
 struct ShadowStats {
     size_t faceCount = 0;
+    size_t facesOutsideView = 0; // of faceCount, left empty by cullFacesOutsideView
     size_t totalBytes = 0;
     double renderMs = 0.0;                // wall time of render(), all lights
     size_t castingLightCount = 0;         // lights that would cast without the budget
@@ -212,6 +218,11 @@ public:
     // Faces of a shadow: [firstFace, firstFace + faceCount).
     size_t firstFace(uint32_t shadow) const { return mShadows[shadow].firstFace; }
     size_t faceCountOf(uint32_t shadow) const { return mShadows[shadow].faceCount; }
+    // The face a lookup of `shadow` at positionView (camera view space) reads: the cube face of
+    // its major axis, the cascade of its depth, a spot's or paraboloid's own; SIZE_MAX for none.
+    size_t faceOf(uint32_t shadow, const glm::vec3& positionView) const {
+        return faceFor(mShadows[shadow], glm::dvec3(positionView));
+    }
     const ShadowStats& stats() const { return mStats; }
     // The global settings render() was given (each light's own: stats().lights[s].settings).
     const ShadowSettings& settings() const { return mSettings; }

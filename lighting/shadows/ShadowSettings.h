@@ -124,6 +124,10 @@ struct ShadowSettings {
     // trivial reject (raster::frustumOutcode) before the draw; the maps are bitwise the same.
     // Off (tests, A/B): every face hands its light's whole caster list to the draw.
     bool cullCastersPerFace = true;
+    // A cube or spot face whose pyramid misses the camera's frustum (no receiver in view can
+    // select it) is left empty: not drawn, not stored; the image is bitwise the same. Off (tests,
+    // A/B): every face is drawn.
+    bool cullFacesOutsideView = true;
 };
 
 // The names parseShadowPointProjection accepts, for error messages.
