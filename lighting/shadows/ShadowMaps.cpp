@@ -62,6 +62,11 @@ struct ShadowMaps::RenderScratch {
         std::vector<glm::vec3> testedLightSpace, testedWeights; // one triangle's pieces
     };
     tbb::enumerable_thread_specific<Thread> threads;
+    // Per light, the corner lists of its casters (Casters::ownPositions, by shadow index) and
+    // 0, 1, 2, ... to index them: a frame's lists are megabytes, which a fresh allocation pays
+    // in page faults every frame.
+    std::vector<std::vector<glm::vec3>> casterPositions;
+    std::vector<uint32_t> sequentialIndices;
 };
 
 namespace {
@@ -743,6 +748,10 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     const double sweepMetres = 1.01 * double(glm::length(sceneBounds.size())) + 1.0;
     std::vector<std::vector<uint8_t>> mayCast(maps.mShadows.size()); // per instance; empty: all
     std::vector<ShadowLightStats> setStats(maps.mShadows.size());
+    // Per light with the sets on: its volume and margin, which also cull its point or spot
+    // casters chunk by chunk below.
+    std::vector<CasterVolume> volumes(maps.mShadows.size());
+    std::vector<double> margins(maps.mShadows.size(), 0.0);
     for (const scenes::Aabb& box : objectBounds)
         maps.mStats.objectCount += box.empty() ? 0 : 1;
     if (useSets)
@@ -760,8 +769,9 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
             }
             const double margin =
                 (kMaxTapDistanceTexels + 1.0 + double(shadow.settings.normalOffset)) * texelWorld;
-            const CasterVolume volume =
-                casterVolume(frustumCorners, scene.lights[shadow.lightIndex], sweepMetres);
+            volumes[s] = casterVolume(frustumCorners, scene.lights[shadow.lightIndex], sweepMetres);
+            margins[s] = margin;
+            const CasterVolume& volume = volumes[s];
             std::vector<uint8_t>& set = mayCast[s];
             set.resize(objectBounds.size());
             for (size_t i = 0; i < objectBounds.size(); ++i) {
@@ -781,7 +791,17 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     const shadows::CasterAlphaTest alphaTest(scene, geometry);
     const bool everyMaterial = std::all_of(castingMaterial.begin(), castingMaterial.end(),
                                            [](uint8_t casts) { return casts != 0; });
+    // Per-thread rasterizers and clip buffers, and the casters' lists, taken over from the
+    // recycled maps (their bins and buffers then cost no allocation and no page fault).
+    maps.mScratch = recycled && recycled->mScratch ? std::move(recycled->mScratch)
+                                                   : std::make_shared<RenderScratch>();
     std::vector<Casters> casters(maps.mShadows.size());
+    std::vector<std::vector<glm::vec3>>& casterPositions = maps.mScratch->casterPositions;
+    casterPositions.resize(std::max(casterPositions.size(), casters.size()));
+    for (size_t s = 0; s < casters.size(); ++s) {
+        casters[s].ownPositions = std::move(casterPositions[s]);
+        casters[s].ownPositions.clear();
+    }
     tbb::parallel_for(size_t(0), maps.mShadows.size(), [&](size_t s) {
         const scenes::Light& light = scene.lights[maps.mShadows[s].lightIndex];
         Casters& set = casters[s];
@@ -812,8 +832,17 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         }
         const glm::dvec3 centre(light.positionWorld);
         const double radius = light.rangeMetres;
+        // The casting set's volume applied to chunk boxes as to object boxes: a box farther
+        // than the margin from the hull of the view and the light holds nothing that can shadow
+        // a texel a visible receiver reads (ShadowCasterSets.h), so a large object partly in
+        // view (a room's walls) draws only its chunks near the view. Per triangle the test
+        // costs more than the triangles it drops (lighting/shadows/README.md).
+        const bool hull = useSets && !volumes[s].unbounded;
+        auto outsideHull = [&](const scenes::Aabb& box) {
+            return hull && !volumes[s].mayContain(box, margins[s]);
+        };
         for (uint32_t c = 0; c < chunkCount; ++c) {
-            if (!boxTouchesSphere(centre, radius, chunkBounds[c]))
+            if (!boxTouchesSphere(centre, radius, chunkBounds[c]) || outsideHull(chunkBounds[c]))
                 continue;
             const uint32_t end = std::min(triangleCount, (c + 1) * kTrianglesPerChunk);
             for (uint32_t t = c * kTrianglesPerChunk; t < end; ++t) {
@@ -832,8 +861,11 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     for (const Casters& set : casters)
         if (!set.whole)
             maxCorners = std::max(maxCorners, set.ownPositions.size());
-    std::vector<uint32_t> sequentialIndices(maxCorners);
-    std::iota(sequentialIndices.begin(), sequentialIndices.end(), 0u);
+    std::vector<uint32_t>& sequentialIndices = maps.mScratch->sequentialIndices;
+    if (sequentialIndices.size() < maxCorners) {
+        sequentialIndices.resize(maxCorners);
+        std::iota(sequentialIndices.begin(), sequentialIndices.end(), 0u);
+    }
 
     // The depth-only renders. Per face: clip positions, then a draw with a no-op fragment
     // function (reversed Z: Greater, cleared to 0).
@@ -842,10 +874,6 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
     state.depthTest = raster::DepthTest::Greater;
     state.barycentrics = false;
     state.clearDepth = 0.0f;
-    // Per-thread rasterizers and clip buffers, taken over from the recycled maps (their bins and
-    // buffers then cost no allocation and no page fault).
-    maps.mScratch = recycled && recycled->mScratch ? std::move(recycled->mScratch)
-                                                   : std::make_shared<RenderScratch>();
     tbb::enumerable_thread_specific<RenderScratch::Thread>& scratches = maps.mScratch->threads;
     std::vector<double> faceMs(maps.mFaces.size(), 0.0);
     std::vector<uint64_t> faceTriangles(maps.mFaces.size(), 0);
@@ -1082,6 +1110,9 @@ ShadowMaps ShadowMaps::render(const scenes::Scene& scene, const gbuffer::SceneGe
         for (size_t f = 0; f < maps.mFaces.size(); ++f)
             renderFace(f);
     }
+
+    for (size_t s = 0; s < casters.size(); ++s)
+        casterPositions[s] = std::move(casters[s].ownPositions);
 
     for (size_t s = 0; s < maps.mShadows.size(); ++s) {
         const Shadow& shadow = maps.mShadows[s];
