@@ -605,6 +605,11 @@ TEST(RenderCommand, StatsRecordEachLightsShadowSettings) {
         EXPECT_EQ(point["bias_constant_m"], shadows["bias_constant_m"]);
         EXPECT_EQ(point["faces"], 2);
         EXPECT_EQ(point["bytes"], 2 * 64 * 64 * texelBytes);
+        // Both lights' faces are drawn (a paraboloid face is never left out; the spot is in
+        // view), and the total is the lights' sum.
+        EXPECT_EQ(spot["faces_outside_view"], 0);
+        EXPECT_EQ(point["faces_outside_view"], 0);
+        EXPECT_EQ(shadows["faces_outside_view"], 0);
         // The sets' size per light and as a fraction of the scene's objects.
         const double perLight =
             0.5 * (spot["caster_objects"].get<double>() + point["caster_objects"].get<double>());
