@@ -177,6 +177,35 @@ glm::dmat4 perspectiveReversed(double tanHalfFov, double nearMetres, double farM
 // give to either face.
 constexpr double kFaceCullSlack = 0.01;
 
+// A pyramid or frustum with its apex at the origin of its own frame, looking down -Z: the points
+// with |x| <= slopeX d, |y| <= slopeY d and near <= d <= far, d = -z (far may be infinite).
+struct ViewVolume {
+    double slopeX, slopeY, near, far;
+
+    // Whether every one of `points` (in the volume's frame) lies outside one of its six planes.
+    bool allOutsideOnePlane(std::span<const glm::dvec3> points) const {
+        auto all = [&](auto outside) { return std::all_of(points.begin(), points.end(), outside); };
+        return all([&](const glm::dvec3& p) { return -p.z < near; }) ||
+               all([&](const glm::dvec3& p) { return -p.z > far; }) ||
+               all([&](const glm::dvec3& p) { return p.x > slopeX * -p.z; }) ||
+               all([&](const glm::dvec3& p) { return p.x < -slopeX * -p.z; }) ||
+               all([&](const glm::dvec3& p) { return p.y > slopeY * -p.z; }) ||
+               all([&](const glm::dvec3& p) { return p.y < -slopeY * -p.z; });
+    }
+    // Its 8 corners (near then far; a pyramid's near ones are its apex) through `otherFromVolume`.
+    // Needs a finite far.
+    std::array<glm::dvec3, 8> corners(const glm::dmat4& otherFromVolume) const {
+        std::array<glm::dvec3, 8> points;
+        for (int k = 0; k < 8; ++k) {
+            const double d = k & 4 ? far : near;
+            points[size_t(k)] =
+                glm::dvec3(otherFromVolume * glm::dvec4((k & 1 ? slopeX : -slopeX) * d,
+                                                        (k & 2 ? slopeY : -slopeY) * d, -d, 1.0));
+        }
+        return points;
+    }
+};
+
 // Whether a perspective face can never be looked up: its pyramid (apex at the light, axis down
 // the light frame's -Z, half-width tanHalfFov, out to light-space depth farMetres, beyond which
 // every lookup is lit) and the camera's frustum (every receiver a stage looks up lies on a ray
@@ -188,72 +217,17 @@ constexpr double kFaceCullSlack = 0.01;
 bool perspectiveFaceOutsideView(const glm::dmat4& lightFromWorld, double tanHalfFov,
                                 double farMetres, const gbuffer::CameraView& view) {
     const double grow = 1.0 + kFaceCullSlack;
-    const double t = tanHalfFov * grow, far = farMetres * grow;
+    const ViewVolume pyramid{tanHalfFov * grow, tanHalfFov * grow, 0.0, farMetres * grow};
     // Symmetric pinhole (CameraView.h): the side slopes from the projection's diagonal.
-    const double tanX = grow / double(view.clipFromView[0][0]);
-    const double tanY = grow / double(view.clipFromView[1][1]);
-    const double cameraNear = double(view.nearMetres) / grow;
-    const double cameraFar = double(view.farMetres) * grow;
-    const bool finiteFar = !view.infiniteFar && std::isfinite(cameraFar);
+    const bool finiteFar = !view.infiniteFar && std::isfinite(double(view.farMetres) * grow);
+    const ViewVolume camera{grow / double(view.clipFromView[0][0]),
+                            grow / double(view.clipFromView[1][1]), double(view.nearMetres) / grow,
+                            finiteFar ? double(view.farMetres) * grow
+                                      : std::numeric_limits<double>::infinity()};
     const glm::dmat4 viewFromLight = view.viewFromWorldExact * glm::inverse(lightFromWorld);
-
-    // True when every point lies outside one of the planes `outside` tests (k = 0..5).
-    auto separated = [](const auto& points, auto outside) {
-        for (int plane = 0; plane < 6; ++plane)
-            if (std::all_of(points.begin(), points.end(),
-                            [&](const glm::dvec3& p) { return outside(plane, p); }))
-                return true;
-        return false;
-    };
-    std::array<glm::dvec3, 5> pyramid;
-    pyramid[0] = glm::dvec3(viewFromLight * glm::dvec4(0.0, 0.0, 0.0, 1.0));
-    for (int k = 0; k < 4; ++k)
-        pyramid[size_t(k) + 1] = glm::dvec3(
-            viewFromLight * glm::dvec4((k & 1 ? t : -t) * far, (k & 2 ? t : -t) * far, -far, 1.0));
-    const bool pyramidOutside = separated(pyramid, [&](int plane, const glm::dvec3& p) {
-        const double depth = -p.z;
-        switch (plane) {
-        case 0:
-            return depth < cameraNear;
-        case 1:
-            return finiteFar && depth > cameraFar;
-        case 2:
-            return p.x > tanX * depth;
-        case 3:
-            return p.x < -tanX * depth;
-        case 4:
-            return p.y > tanY * depth;
-        default:
-            return p.y < -tanY * depth;
-        }
-    });
-    if (pyramidOutside || !finiteFar)
-        return pyramidOutside;
-    const glm::dmat4 lightFromView = glm::inverse(viewFromLight);
-    std::array<glm::dvec3, 8> frustum;
-    for (int k = 0; k < 8; ++k) {
-        const double depth = k & 4 ? cameraFar : cameraNear;
-        frustum[size_t(k)] =
-            glm::dvec3(lightFromView * glm::dvec4((k & 1 ? tanX : -tanX) * depth,
-                                                  (k & 2 ? tanY : -tanY) * depth, -depth, 1.0));
-    }
-    return separated(frustum, [&](int plane, const glm::dvec3& p) {
-        const double depth = -p.z;
-        switch (plane) {
-        case 0:
-            return p.x > t * depth;
-        case 1:
-            return p.x < -t * depth;
-        case 2:
-            return p.y > t * depth;
-        case 3:
-            return p.y < -t * depth;
-        case 4:
-            return depth > far;
-        default:
-            return false;
-        }
-    });
+    if (camera.allOutsideOnePlane(pyramid.corners(viewFromLight)))
+        return true;
+    return finiteFar && pyramid.allOutsideOnePlane(camera.corners(glm::inverse(viewFromLight)));
 }
 
 // Reversed-Z orthographic box: x in [x0, x1], y in [y0, y1], depth d = -z in [near, far] maps
