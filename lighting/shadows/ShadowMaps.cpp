@@ -172,9 +172,10 @@ glm::dmat4 perspectiveReversed(double tanHalfFov, double nearMetres, double farM
 }
 
 // Relative widening of both solids in perspectiveFaceOutsideView: covers the float positions a
-// forward stage interpolates, a supersampled reference's sub-pixel jitter of the camera (under
-// 1/width of the frustum's width) and a point on a cube face's edge, which the major axis may
-// give to either face.
+// forward stage interpolates and a G-buffer reconstructs, and a point on a cube face's edge,
+// which the major axis may give to either face. (Multisampled receivers lie inside the image's
+// rectangle like pixel centres; the maps are rendered for the unjittered view only: the
+// supersampled reference, whose sub-frames jitter the camera, shadows with rays.)
 constexpr double kFaceCullSlack = 0.01;
 
 // A pyramid or frustum with its apex at the origin of its own frame, looking down -Z: the points
