@@ -15,8 +15,8 @@ namespace raster::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 // Depth in double lanes (the plane is double), tested and stored as float lanes of the same
-// count. The tail (fewer pixels than a vector) runs the scalar loop, so no load or store ever
-// leaves [lo, hi].
+// count. No load or store ever leaves [lo, hi]: the tail (fewer pixels than a vector) is one
+// masked vector where masked memory operations cannot fault (AVX-512), the scalar loop elsewhere.
 template <DepthTest kTest> HWY_INLINE uint64_t spanLoop(const DepthSpanArgs& span) {
     const hn::ScalableTag<double> dd;
     const hn::Rebind<float, decltype(dd)> df;
@@ -51,25 +51,58 @@ template <DepthTest kTest> HWY_INLINE uint64_t spanLoop(const DepthSpanArgs& spa
         if (span.write)
             hn::StoreU(hn::IfThenElse(pass, depth, stored), df, row + x);
     }
+#if HWY_MEM_OPS_MIGHT_FAULT
     DepthSpanArgs tail = span;
     tail.lo = x;
     return passed + detail::depthSpanScalarLoop<kTest>(tail);
+#else
+    // The tail (and a whole short span) as one masked vector: lanes past hi are neither loaded
+    // nor stored (masked memory operations do not fault on this target), and the lanes inside
+    // compute exactly what the full vectors do.
+    if (x > span.hi)
+        return passed;
+    const auto inside = hn::FirstN(df, size_t(span.hi - x + 1));
+    auto z = hn::Add(zRow, hn::Mul(zStep, px));
+    z = hn::IfThenElse(hn::Lt(z, zero), zero, hn::IfThenElse(hn::Lt(one, z), one, z));
+    const auto depth = hn::DemoteTo(df, z);
+    const auto stored = hn::MaskedLoad(inside, df, row + x);
+    hn::Mask<decltype(df)> pass;
+    if constexpr (kTest == DepthTest::Always)
+        pass = inside;
+    else if constexpr (kTest == DepthTest::Less)
+        pass = hn::And(inside, hn::Lt(depth, stored));
+    else if constexpr (kTest == DepthTest::LessEqual)
+        pass = hn::And(inside, hn::Le(depth, stored));
+    else if constexpr (kTest == DepthTest::Greater)
+        pass = hn::And(inside, hn::Gt(depth, stored));
+    else
+        pass = hn::And(inside, hn::Ge(depth, stored));
+    passed += hn::CountTrue(df, pass);
+    if (span.write)
+        hn::BlendedStore(depth, pass, df, row + x);
+    return passed;
+#endif
 }
 
-uint64_t depthSpanVector(DepthTest test, const DepthSpanArgs& span) {
+// The loop for one test as a plain function, so that a draw can take its address once.
+template <DepthTest kTest> uint64_t spanLoopFunction(const DepthSpanArgs& span) {
+    return spanLoop<kTest>(span);
+}
+
+DepthSpanLoop depthSpanLoopFor(DepthTest test) {
     switch (test) {
     case DepthTest::Always:
-        return spanLoop<DepthTest::Always>(span);
+        return &spanLoopFunction<DepthTest::Always>;
     case DepthTest::Less:
-        return spanLoop<DepthTest::Less>(span);
+        return &spanLoopFunction<DepthTest::Less>;
     case DepthTest::LessEqual:
-        return spanLoop<DepthTest::LessEqual>(span);
+        return &spanLoopFunction<DepthTest::LessEqual>;
     case DepthTest::Greater:
-        return spanLoop<DepthTest::Greater>(span);
+        return &spanLoopFunction<DepthTest::Greater>;
     case DepthTest::GreaterEqual:
-        return spanLoop<DepthTest::GreaterEqual>(span);
+        return &spanLoopFunction<DepthTest::GreaterEqual>;
     }
-    return 0;
+    return nullptr;
 }
 
 } // namespace raster::HWY_NAMESPACE
@@ -78,10 +111,14 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace raster {
 
-HWY_EXPORT(depthSpanVector);
+HWY_EXPORT(depthSpanLoopFor);
+
+DepthSpanLoop depthSpanLoop(DepthTest test) {
+    return HWY_DYNAMIC_DISPATCH(depthSpanLoopFor)(test);
+}
 
 uint64_t depthSpan(DepthTest test, const DepthSpanArgs& span) {
-    return HWY_DYNAMIC_DISPATCH(depthSpanVector)(test, span);
+    return depthSpanLoop(test)(span);
 }
 
 uint64_t depthSpanScalar(DepthTest test, const DepthSpanArgs& span) {

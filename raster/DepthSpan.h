@@ -63,6 +63,10 @@ template <DepthTest test> inline uint64_t depthSpanScalarLoop(const DepthSpanArg
 // Tests (and writes) the span; returns how many of its pixels passed. The widest instruction set
 // this CPU runs (Highway's dispatch). Thread-safe; touches only row[lo..hi].
 uint64_t depthSpan(DepthTest test, const DepthSpanArgs& span);
+// The same loop for one test, chosen once: a draw calls it per span through this pointer and
+// does not pay the dispatch for every span (most shadow-map spans are a few pixels long).
+using DepthSpanLoop = uint64_t (*)(const DepthSpanArgs&);
+DepthSpanLoop depthSpanLoop(DepthTest test);
 // The same, one pixel at a time: the oracle.
 uint64_t depthSpanScalar(DepthTest test, const DepthSpanArgs& span);
 

@@ -518,8 +518,11 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     using Result = std::invoke_result_t<FragmentFn&, const Fragment&>;
     constexpr bool kCanDiscard = std::is_same_v<Result, bool> || std::is_same_v<Result, SampleMask>;
     constexpr bool kDepthOnly = std::is_same_v<std::remove_cvref_t<FragmentFn>, DepthOnly>;
-    // Depth-only spans of fewer pixels than this run the scalar loop inline (DepthSpan.h).
-    constexpr int kShortSpan = 8;
+    // Every depth-only span, however short, runs the vector loop (DepthSpan.h): chosen once here,
+    // its masked tail costs less than the scalar loop inline even for a pixel or two.
+    DepthSpanLoop spanLoop = nullptr;
+    if constexpr (kDepthOnly)
+        spanLoop = depthSpanLoop(kDepthTest);
 
     // Counted in registers, stored once: a memory increment per sample costs measurably.
     uint64_t samplesCovered = 0, samplesPassed = 0;
@@ -638,10 +641,7 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                     span.zRow = zRow;
                     span.zStep = t.z[1];
                     span.write = state.depthWrite;
-                    // Short spans stay inline: the dispatched call costs more than they do.
-                    samplesPassed += hi - lo < kShortSpan
-                                         ? detail::depthSpanScalarLoop<kDepthTest>(span)
-                                         : depthSpan(kDepthTest, span);
+                    samplesPassed += spanLoop(span);
                 } else {
                     float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;
                     for (int px = lo; px <= hi; ++px)
