@@ -17,9 +17,11 @@ namespace hn = hwy::HWY_NAMESPACE;
 // Depth in double lanes (the plane is double), tested and stored as float lanes of the same
 // count. No load or store ever leaves [lo, hi]: the tail (fewer pixels than a vector) is one
 // masked vector where masked memory operations cannot fault (AVX-512), the scalar loop elsewhere.
-template <DepthTest kTest> HWY_INLINE uint64_t spanLoop(const DepthSpanArgs& span) {
+template <DepthTest kTest, bool kValues> HWY_INLINE uint64_t spanLoop(const DepthSpanArgs& span) {
     const hn::ScalableTag<double> dd;
     const hn::Rebind<float, decltype(dd)> df;
+    const hn::Rebind<uint32_t, decltype(dd)> du;
+    const auto value = hn::Set(du, span.value);
     const int lanes = int(hn::Lanes(dd));
     const auto zero = hn::Zero(dd);
     const auto one = hn::Set(dd, 1.0);
@@ -50,10 +52,14 @@ template <DepthTest kTest> HWY_INLINE uint64_t spanLoop(const DepthSpanArgs& spa
         passed += hn::CountTrue(df, pass);
         if (span.write)
             hn::StoreU(hn::IfThenElse(pass, depth, stored), df, row + x);
+        if constexpr (kValues)
+            hn::BlendedStore(value, hn::RebindMask(du, pass), du, span.values + x);
     }
 #if HWY_MEM_OPS_MIGHT_FAULT
     DepthSpanArgs tail = span;
     tail.lo = x;
+    if constexpr (!kValues)
+        tail.values = nullptr;
     return passed + detail::depthSpanScalarLoop<kTest>(tail);
 #else
     // The tail (and a whole short span) as one masked vector: lanes past hi are neither loaded
@@ -80,29 +86,35 @@ template <DepthTest kTest> HWY_INLINE uint64_t spanLoop(const DepthSpanArgs& spa
     passed += hn::CountTrue(df, pass);
     if (span.write)
         hn::BlendedStore(depth, pass, df, row + x);
+    if constexpr (kValues)
+        hn::BlendedStore(value, hn::RebindMask(du, pass), du, span.values + x);
     return passed;
 #endif
 }
 
 // The loop for one test as a plain function, so that a draw can take its address once.
-template <DepthTest kTest> uint64_t spanLoopFunction(const DepthSpanArgs& span) {
-    return spanLoop<kTest>(span);
+template <DepthTest kTest, bool kValues> uint64_t spanLoopFunction(const DepthSpanArgs& span) {
+    return spanLoop<kTest, kValues>(span);
 }
 
-DepthSpanLoop depthSpanLoopFor(DepthTest test) {
+template <bool kValues> DepthSpanLoop spanLoopFor(DepthTest test) {
     switch (test) {
     case DepthTest::Always:
-        return &spanLoopFunction<DepthTest::Always>;
+        return &spanLoopFunction<DepthTest::Always, kValues>;
     case DepthTest::Less:
-        return &spanLoopFunction<DepthTest::Less>;
+        return &spanLoopFunction<DepthTest::Less, kValues>;
     case DepthTest::LessEqual:
-        return &spanLoopFunction<DepthTest::LessEqual>;
+        return &spanLoopFunction<DepthTest::LessEqual, kValues>;
     case DepthTest::Greater:
-        return &spanLoopFunction<DepthTest::Greater>;
+        return &spanLoopFunction<DepthTest::Greater, kValues>;
     case DepthTest::GreaterEqual:
-        return &spanLoopFunction<DepthTest::GreaterEqual>;
+        return &spanLoopFunction<DepthTest::GreaterEqual, kValues>;
     }
     return nullptr;
+}
+
+DepthSpanLoop depthSpanLoopFor(DepthTest test, bool values) {
+    return values ? spanLoopFor<true>(test) : spanLoopFor<false>(test);
 }
 
 } // namespace raster::HWY_NAMESPACE
@@ -113,12 +125,12 @@ namespace raster {
 
 HWY_EXPORT(depthSpanLoopFor);
 
-DepthSpanLoop depthSpanLoop(DepthTest test) {
-    return HWY_DYNAMIC_DISPATCH(depthSpanLoopFor)(test);
+DepthSpanLoop depthSpanLoop(DepthTest test, bool values) {
+    return HWY_DYNAMIC_DISPATCH(depthSpanLoopFor)(test, values);
 }
 
 uint64_t depthSpan(DepthTest test, const DepthSpanArgs& span) {
-    return depthSpanLoop(test)(span);
+    return depthSpanLoop(test, span.values != nullptr)(span);
 }
 
 uint64_t depthSpanScalar(DepthTest test, const DepthSpanArgs& span) {

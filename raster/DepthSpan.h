@@ -28,6 +28,10 @@ struct DepthSpanArgs {
     double zRow = 0.0;
     double zStep = 0.0;
     bool write = true;
+    // When set (the visibility draw, Rasterizer.h's TriangleIds): `values[px] = value` at every
+    // pixel that passes, whether or not depth is written; `values` is indexed as `row`.
+    uint32_t* values = nullptr;
+    uint32_t value = 0;
 };
 
 namespace detail {
@@ -55,6 +59,8 @@ template <DepthTest test> inline uint64_t depthSpanScalarLoop(const DepthSpanArg
         const bool pass = depthPasses<test>(z, span.row[px]);
         passed += pass;
         span.row[px] = pass && span.write ? z : span.row[px];
+        if (span.values && pass)
+            span.values[px] = span.value;
     }
     return passed;
 }
@@ -65,8 +71,10 @@ template <DepthTest test> inline uint64_t depthSpanScalarLoop(const DepthSpanArg
 uint64_t depthSpan(DepthTest test, const DepthSpanArgs& span);
 // The same loop for one test, chosen once: a draw calls it per span through this pointer and
 // does not pay the dispatch for every span (most shadow-map spans are a few pixels long).
+// `values`: whether the spans it will be given carry DepthSpanArgs::values (a loop chosen without
+// them ignores them).
 using DepthSpanLoop = uint64_t (*)(const DepthSpanArgs&);
-DepthSpanLoop depthSpanLoop(DepthTest test);
+DepthSpanLoop depthSpanLoop(DepthTest test, bool values = false);
 // The same, one pixel at a time: the oracle.
 uint64_t depthSpanScalar(DepthTest test, const DepthSpanArgs& span);
 

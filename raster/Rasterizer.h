@@ -177,6 +177,23 @@ struct DepthOnly {
     void operator()(const Fragment&) const {}
 };
 
+// The fragment function of a visibility draw (one sample per pixel): each passing pixel records
+// its triangle, `ids[y * width + x] = triangle | (frontFacing ? 0 : backFaceBit)`. draw() given
+// it takes the depth-only path's spans and writes the ids in the same vector loop (DepthSpan.h)
+// when a depth buffer is given; otherwise, and multisampled, it is called per fragment.
+struct TriangleIds {
+    uint32_t* ids = nullptr;
+    size_t width = 0;
+    uint32_t backFaceBit = 0;
+    constexpr uint32_t idOf(uint32_t triangle, bool frontFacing) const {
+        return triangle | (frontFacing ? 0u : backFaceBit);
+    }
+    void operator()(const Fragment& fragment) const {
+        ids[size_t(fragment.y) * width + size_t(fragment.x)] =
+            idOf(fragment.triangle, fragment.frontFacing);
+    }
+};
+
 // What a fragment function returns to keep a subset of its samples (see the file comment): the
 // kept samples are `bits & Fragment::coverage`. Without multisampling, bit 0 keeps the fragment.
 struct SampleMask {
@@ -520,9 +537,10 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
     constexpr bool kDepthOnly = std::is_same_v<std::remove_cvref_t<FragmentFn>, DepthOnly>;
     // Every depth-only span, however short, runs the vector loop (DepthSpan.h): chosen once here,
     // its masked tail costs less than the scalar loop inline even for a pixel or two.
+    constexpr bool kTriangleIds = std::is_same_v<std::remove_cvref_t<FragmentFn>, TriangleIds>;
     DepthSpanLoop spanLoop = nullptr;
-    if constexpr (kDepthOnly)
-        spanLoop = depthSpanLoop(kDepthTest);
+    if constexpr (kDepthOnly || kTriangleIds)
+        spanLoop = depthSpanLoop(kDepthTest, kTriangleIds);
 
     // Counted in registers, stored once: a memory increment per sample costs measurably.
     uint64_t samplesCovered = 0, samplesPassed = 0;
@@ -641,6 +659,20 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                     span.zRow = zRow;
                     span.zStep = t.z[1];
                     span.write = state.depthWrite;
+                    samplesPassed += spanLoop(span);
+                } else if (kTriangleIds && depth && !state.barycentrics) {
+                    samplesCovered += uint64_t(hi - lo + 1);
+                    DepthSpanArgs span;
+                    span.row = depth + size_t(py) * mWidth;
+                    span.lo = lo;
+                    span.hi = hi;
+                    span.zRow = zRow;
+                    span.zStep = t.z[1];
+                    span.write = state.depthWrite;
+                    if constexpr (kTriangleIds) {
+                        span.values = fragmentFn.ids + size_t(py) * fragmentFn.width;
+                        span.value = fragmentFn.idOf(t.triangle, t.frontFacing);
+                    }
                     samplesPassed += spanLoop(span);
                 } else {
                     float* depthRow = depth ? depth + size_t(py) * mWidth : nullptr;

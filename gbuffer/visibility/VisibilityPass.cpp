@@ -113,13 +113,11 @@ void VisibilityPass::draw(raster::Rasterizer& rasterizer, std::span<float> depth
         });
         return;
     }
-    // Captured by value: the draw inlines this per pixel, and by reference the pointer and the
-    // width were reloaded through the closure for every pixel.
+    // The rasterizer writes the codes over each row's span in its vector depth loop
+    // (raster::TriangleIds: the same value as code()).
+    static_assert(raster::TriangleIds{nullptr, 0, kBackFaceBit}.idOf(7, false) == code(7, false));
     rasterizer.draw(triangles(), state, depth.data(),
-                    [codes, width](const raster::Fragment& fragment) {
-                        codes[size_t(fragment.y) * width + size_t(fragment.x)] =
-                            code(fragment.triangle, fragment.frontFacing);
-                    });
+                    raster::TriangleIds{codes, width, kBackFaceBit});
 }
 
 Surface VisibilityPass::surfaceAt(uint32_t code, int x, int y) const {

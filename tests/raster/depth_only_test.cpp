@@ -2,8 +2,9 @@
 // random clip-space triangles (large and tiny, slivers, triangles crossing the near and far
 // planes and the guard band, shared edges of fans), with every depth test, depth writes on and
 // off, every cull mode, the depth buffer must be bitwise the same and the coverage counters
-// equal, for 1 and 2 threads. The span loop's SIMD form (DepthSpan.h) against its scalar oracle,
-// and the in-draw clear (RasterState::clearDepth) against a clear before the draw, with and
+// equal, for 1 and 2 threads; the same for raster::TriangleIds (the visibility draw's spans, which
+// also write each pixel's triangle id). The span loop's SIMD form (DepthSpan.h) against its scalar
+// oracle, and the in-draw clear (RasterState::clearDepth) against a clear before the draw, with and
 // without the record of clear tiles (RasterState::tilesNotClear).
 #include <gtest/gtest.h>
 
@@ -12,6 +13,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -112,6 +114,72 @@ TEST(DepthOnlyPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
     EXPECT_EQ(cases, 30);
 }
 
+// raster::TriangleIds (the visibility draw) takes the same spans and writes each passing pixel's
+// id in the vector loop: the ids and the depth buffer bitwise what a per-fragment function
+// writing the same ids gives, every depth test, depth writes on and off, every cull mode (back
+// faces carry the bit), 1 and 2 threads; and without a depth buffer (per fragment).
+TEST(TriangleIdsPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
+    const Mesh mesh = randomMesh(6, 3000);
+    const int width = 301, height = 203; // draw()'s size
+    constexpr uint32_t kNone = 0xdeadbeefu, kBackFaceBit = 1u << 31;
+    int cases = 0, backFacesSeen = 0;
+    for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
+                           DepthTest::Greater, DepthTest::GreaterEqual})
+        for (bool write : {true, false})
+            for (CullMode cull : {CullMode::None, CullMode::Back, CullMode::Front}) {
+                raster::RasterState state;
+                state.depthTest = test;
+                state.depthWrite = write;
+                state.cullMode = cull;
+                state.barycentrics = false;
+                const bool nearer = test == DepthTest::Greater || test == DepthTest::GreaterEqual;
+                const float clear = nearer ? 0.0f : 1.0f;
+                std::vector<uint32_t> genericIds(size_t(width) * height, kNone);
+                const raster::TriangleIds genericWriter{genericIds.data(), size_t(width),
+                                                        kBackFaceBit};
+                const Drawn generic =
+                    draw(mesh, state, clear, 1,
+                         [&](const raster::Fragment& fragment) { genericWriter(fragment); });
+                const std::string name = "test " + std::to_string(int(test)) + " write " +
+                                         std::to_string(write) + " cull " +
+                                         std::to_string(int(cull));
+                for (int threads : {1, 2}) {
+                    std::vector<uint32_t> ids(genericIds.size(), kNone);
+                    const Drawn fast =
+                        draw(mesh, state, clear, threads,
+                             raster::TriangleIds{ids.data(), size_t(width), kBackFaceBit});
+                    ASSERT_EQ(0, std::memcmp(fast.depth.data(), generic.depth.data(),
+                                             fast.depth.size() * sizeof(float)))
+                        << name << ", " << threads << " threads";
+                    ASSERT_EQ(ids, genericIds) << name << ", " << threads << " threads";
+                    EXPECT_EQ(fast.stats.samplesCovered, generic.stats.samplesCovered) << name;
+                    EXPECT_EQ(fast.stats.samplesPassed, generic.stats.samplesPassed) << name;
+                    EXPECT_EQ(fast.stats.fragments, generic.stats.fragments) << name;
+                }
+                backFacesSeen +=
+                    int(std::count_if(genericIds.begin(), genericIds.end(), [](uint32_t id) {
+                            return id != kNone && (id & kBackFaceBit);
+                        }) > 0);
+                EXPECT_GT(generic.stats.samplesPassed, 10000u) << name;
+                ++cases;
+            }
+    EXPECT_EQ(cases, 30);
+    EXPECT_GE(backFacesSeen, 20); // every state but the back-face cull sees back faces
+
+    // Without a depth buffer the ids are written per fragment: every covered pixel's last one.
+    raster::RasterState state;
+    state.depthTest = DepthTest::Always;
+    state.barycentrics = false;
+    std::vector<uint32_t> genericIds(size_t(width) * height, kNone), ids = genericIds;
+    const raster::TriangleIds genericWriter{genericIds.data(), size_t(width), kBackFaceBit};
+    raster::Rasterizer a(width, height), b(width, height);
+    a.draw(raster::TriangleList{mesh.positions, mesh.indices}, state, nullptr,
+           [&](const raster::Fragment& fragment) { genericWriter(fragment); });
+    b.draw(raster::TriangleList{mesh.positions, mesh.indices}, state, nullptr,
+           raster::TriangleIds{ids.data(), size_t(width), kBackFaceBit});
+    EXPECT_EQ(ids, genericIds);
+}
+
 TEST(DepthOnlyPath, DrawsWithoutADepthBufferCountLikeTheGenericPath) {
     const Mesh mesh = randomMesh(9, 500);
     raster::RasterState state;
@@ -132,7 +200,7 @@ TEST(DepthSpan, VectorLoopIsBitwiseTheScalarLoop) {
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    int spans = 0, passedSomewhere = 0, failedSomewhere = 0;
+    int spans = 0, passedSomewhere = 0, failedSomewhere = 0, valuesWritten = 0;
     for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
                            DepthTest::Greater, DepthTest::GreaterEqual})
         for (bool write : {true, false})
@@ -153,10 +221,19 @@ TEST(DepthSpan, VectorLoopIsBitwiseTheScalarLoop) {
                                              : float(unit(rng));
                 }
                 std::vector<float> scalarRow = stored, vectorRow = stored;
+                // Every other span also writes a value where it passes (TriangleIds).
+                std::vector<uint32_t> scalarValues(stored.size()), vectorValues;
+                std::iota(scalarValues.begin(), scalarValues.end(), 1000u);
+                vectorValues = scalarValues;
+                span.value = uint32_t(rng());
                 span.row = scalarRow.data();
+                span.values = trial % 2 ? scalarValues.data() : nullptr;
                 const uint64_t scalarPassed = raster::depthSpanScalar(test, span);
                 span.row = vectorRow.data();
+                span.values = trial % 2 ? vectorValues.data() : nullptr;
                 const uint64_t vectorPassed = raster::depthSpan(test, span);
+                ASSERT_EQ(vectorValues, scalarValues) << "test " << int(test) << " trial " << trial;
+                valuesWritten += trial % 2 && scalarPassed > 0;
                 ASSERT_EQ(vectorPassed, scalarPassed) << "test " << int(test) << " trial " << trial;
                 ASSERT_EQ(0, std::memcmp(vectorRow.data(), scalarRow.data(),
                                          scalarRow.size() * sizeof(float)))
@@ -168,6 +245,7 @@ TEST(DepthSpan, VectorLoopIsBitwiseTheScalarLoop) {
     EXPECT_EQ(spans, 4000);
     EXPECT_GT(passedSomewhere, 1000);
     EXPECT_GT(failedSomewhere, 1000);
+    EXPECT_GT(valuesWritten, 500);
 }
 
 // RasterState::clearDepth: each tile clears its own pixels (all samples) inside the draw; the
