@@ -407,15 +407,18 @@ void Rasterizer::flushPending(SetupPacket& planes, const RasterState& state, Bat
     planes.count = 0;
 }
 
-void Rasterizer::clearTile(int tileIndex, int samples, float value, float* depth) const {
+void Rasterizer::clearTile(int tileIndex, const RasterState& state, float* depth) const {
     const int minX = (tileIndex % mTilesX) * kTileSize;
     const int minY = (tileIndex / mTilesX) * kTileSize;
     const int maxX = std::min(minX + kTileSize, mWidth);
     const int maxY = std::min(minY + kTileSize, mHeight);
+    const size_t samples = size_t(state.samples);
     for (int y = minY; y < maxY; ++y) {
-        float* row = depth + (size_t(y) * size_t(mWidth) + size_t(minX)) * size_t(samples);
-        std::fill(row, row + size_t(maxX - minX) * size_t(samples), value);
+        float* row = depth + (size_t(y) * size_t(mWidth) + size_t(minX)) * samples;
+        std::fill(row, row + size_t(maxX - minX) * samples, *state.clearDepth);
     }
+    if (state.alsoClearTile)
+        state.alsoClearTile(minX, minY, maxX, maxY);
 }
 
 } // namespace raster

@@ -54,6 +54,7 @@
 #include <bit>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -136,6 +137,11 @@ struct RasterState {
     // The span's elements are written even though the state is const: it is the buffer's record,
     // not a setting.
     std::span<uint8_t> tilesNotClear;
+    // With clearDepth, optional: the caller's own per-pixel buffers cleared with each tile's depth,
+    // in the same task, so that they too are in cache when the tile is drawn (the visibility
+    // draw's codes). Called as alsoClearTile(x0, y0, x1, y1), the tile's pixels [x0, x1) x
+    // [y0, y1) with every sample; tiles run in parallel, each called once, before its triangles.
+    std::function<void(int, int, int, int)> alsoClearTile;
     // The oracle of the tests: when set, the one-sample traversal edge-tests every pixel of the
     // triangle's bounding box in turn (no per-row span by division, no hierarchical depth, no
     // depth-only span loop). The output is bitwise the same, fragments in the same order and
@@ -310,8 +316,9 @@ private:
     };
 
     static void checkSampleCount(int samples);
-    // Sets the depth of every sample of tile `tileIndex`'s pixels to `value`.
-    void clearTile(int tileIndex, int samples, float value, float* depth) const;
+    // Sets the depth of every sample of tile `tileIndex`'s pixels to state.clearDepth, then calls
+    // state.alsoClearTile on them.
+    void clearTile(int tileIndex, const RasterState& state, float* depth) const;
     // Clip, cull, snap and bin all triangles into mBatches (parallel, deterministic).
     void setUpAndBin(const TriangleList& triangles, const RasterState& state);
     void setUpBatch(const TriangleList& triangles, uint32_t first, uint32_t last,
@@ -442,12 +449,12 @@ void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, f
                 binned |= batch.binOffsets[size_t(tile) + 1] > batch.binOffsets[size_t(tile)];
             uint8_t& notClear = state.tilesNotClear[size_t(tile)];
             if (binned || notClear)
-                clearTile(tile, state.samples, *state.clearDepth, depth);
+                clearTile(tile, state, depth);
             notClear = binned ? 1 : 0;
             if (!binned)
                 return; // nothing to draw; its statistics stay zero
         } else if (depth && state.clearDepth) {
-            clearTile(tile, state.samples, *state.clearDepth, depth);
+            clearTile(tile, state, depth);
         }
         RasterStats& stats = mTileStats[size_t(tile)].stats;
         const bool multisample = state.samples > 1;

@@ -5,7 +5,8 @@
 // equal, for 1 and 2 threads; the same for raster::TriangleIds (the visibility draw's spans, which
 // also write each pixel's triangle id). The span loop's SIMD form (DepthSpan.h) against its scalar
 // oracle, and the in-draw clear (RasterState::clearDepth) against a clear before the draw, with and
-// without the record of clear tiles (RasterState::tilesNotClear).
+// without the record of clear tiles (RasterState::tilesNotClear), and the caller's planes cleared
+// with it (RasterState::alsoClearTile).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -283,6 +284,67 @@ TEST(DepthOnlyPath, ClearInsideTheDrawEqualsAClearBefore) {
 // and 2 threads; a tile recorded clear that no triangle reaches is not written at all (its
 // sentinel survives: the clear really is skipped), and the record is rewritten to the tiles
 // triangles were binned to.
+// RasterState::alsoClearTile: called once per tile, with the tile's pixels, before the tile's
+// triangles: ids cleared inside the draw end as with a clear before it (the visibility draw's
+// codes), for 1 and 4 samples and 1 and 2 threads, and every pixel's samples are handed over
+// exactly once.
+TEST(DepthOnlyPath, AlsoClearTileClearsEachPixelOnceBeforeItsTriangles) {
+    const Mesh mesh = randomMesh(29, 0); // the fan alone: the corners stay uncovered
+    constexpr uint32_t kNone = 0xffffffffu;
+    for (int samples : {1, 4})
+        for (int threads : {1, 2}) {
+            raster::RasterState state;
+            state.depthTest = DepthTest::Greater;
+            state.cullMode = CullMode::None;
+            state.barycentrics = false;
+            state.samples = samples;
+            const int width = 301, height = 203;
+            const size_t pixels = size_t(width) * height, size = pixels * size_t(samples);
+            std::vector<float> depthBefore(size, 0.0f), depthInside(size, 0.5f);
+            std::vector<uint32_t> idsBefore(size, kNone), idsInside(size, 12345u);
+            std::vector<int> handedOver(pixels, 0);
+            // Per sample for the multisampled draw (no span path there), as the visibility
+            // draw records its codes.
+            auto writer = [samples](std::vector<uint32_t>& ids, int width) {
+                return [&ids, samples, width](const raster::Fragment& f) {
+                    for (int s = 0; s < samples; ++s)
+                        if (samples == 1 || (f.coverage >> s & 1u))
+                            ids[(size_t(f.y) * size_t(width) + size_t(f.x)) * size_t(samples) +
+                                size_t(s)] = f.triangle;
+                };
+            };
+            tbb::task_arena(threads).execute([&] {
+                raster::Rasterizer rasterizer(width, height);
+                const raster::TriangleList triangles{mesh.positions, mesh.indices};
+                rasterizer.draw(triangles, state, depthBefore.data(), writer(idsBefore, width));
+                state.clearDepth = 0.0f;
+                state.alsoClearTile = [&](int x0, int y0, int x1, int y1) {
+                    for (int y = y0; y < y1; ++y)
+                        for (int x = x0; x < x1; ++x) {
+                            const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+                            ++handedOver[pixel];
+                            std::fill_n(idsInside.begin() + std::ptrdiff_t(pixel * samples),
+                                        samples, kNone);
+                        }
+                };
+                rasterizer.draw(triangles, state, depthInside.data(), writer(idsInside, width));
+            });
+            const std::string name =
+                std::to_string(samples) + " samples, " + std::to_string(threads) + " threads";
+            EXPECT_EQ(0, std::memcmp(depthInside.data(), depthBefore.data(), size * sizeof(float)))
+                << name;
+            EXPECT_EQ(idsInside, idsBefore) << name;
+            EXPECT_TRUE(std::all_of(handedOver.begin(), handedOver.end(), [](int calls) {
+                return calls == 1;
+            })) << name;
+            EXPECT_GT(std::count(idsBefore.begin(), idsBefore.end(), kNone), 1000) << name;
+            EXPECT_GT(std::count_if(idsBefore.begin(), idsBefore.end(),
+                                    [](uint32_t id) { return id != kNone; }),
+                      10000)
+                << name;
+        }
+}
+
 TEST(DepthOnlyPath, ClearOnlyTilesNotClearEqualsAFullClear) {
     const int width = 301, height = 203; // 3 x 2 tiles of 128, partial ones at the edges
     // Small triangles around NDC centres: each lies within one tile.
