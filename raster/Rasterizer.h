@@ -653,21 +653,10 @@ void Rasterizer::rasterizeTile(int tileIndex, const RasterState& state, float* d
                     continue;
                 const int lo = minX + int(k.kLo), hi = minX + int(k.kHi);
                 const double zRow = t.z[0] + t.z[2] * py;
-                if constexpr (kDepthOnly) {
+                if (kDepthOnly && !depth) {
                     samplesCovered += uint64_t(hi - lo + 1);
-                    if (!depth) {
-                        samplesPassed += uint64_t(hi - lo + 1);
-                        continue;
-                    }
-                    DepthSpanArgs span;
-                    span.row = depth + size_t(py) * mWidth;
-                    span.lo = lo;
-                    span.hi = hi;
-                    span.zRow = zRow;
-                    span.zStep = t.z[1];
-                    span.write = state.depthWrite;
-                    samplesPassed += spanLoop(span);
-                } else if (kTriangleIds && depth && !state.barycentrics) {
+                    samplesPassed += uint64_t(hi - lo + 1);
+                } else if (kDepthOnly || (kTriangleIds && depth && !state.barycentrics)) {
                     samplesCovered += uint64_t(hi - lo + 1);
                     DepthSpanArgs span;
                     span.row = depth + size_t(py) * mWidth;
