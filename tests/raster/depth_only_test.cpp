@@ -83,8 +83,10 @@ Drawn draw(const Mesh& mesh, const raster::RasterState& state, float clear, int 
     return drawn;
 }
 
-TEST(DepthOnlyPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
-    const Mesh mesh = randomMesh(5, 3000);
+// Calls fn(state, clear, name) for every depth test, depth writes on and off and every cull mode
+// (30 states, no barycentrics), with the clear value the test starts from and a name for the
+// failure messages; returns how many states it ran.
+template <class Fn> int forEveryDrawState(Fn&& fn) {
     int cases = 0;
     for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
                            DepthTest::Greater, DepthTest::GreaterEqual})
@@ -97,22 +99,30 @@ TEST(DepthOnlyPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
                 state.barycentrics = false;
                 const bool nearer = test == DepthTest::Greater || test == DepthTest::GreaterEqual;
                 const float clear = nearer ? 0.0f : 1.0f;
-                const Drawn generic = draw(mesh, state, clear, 1, [](const raster::Fragment&) {});
-                const std::string name = "test " + std::to_string(int(test)) + " write " +
-                                         std::to_string(write) + " cull " +
-                                         std::to_string(int(cull));
-                for (int threads : {1, 2}) {
-                    const Drawn fast = draw(mesh, state, clear, threads, raster::DepthOnly{});
-                    ASSERT_EQ(0, std::memcmp(fast.depth.data(), generic.depth.data(),
-                                             fast.depth.size() * sizeof(float)))
-                        << name << ", " << threads << " threads";
-                    EXPECT_EQ(fast.stats.samplesCovered, generic.stats.samplesCovered) << name;
-                    EXPECT_EQ(fast.stats.samplesPassed, generic.stats.samplesPassed) << name;
-                    EXPECT_EQ(fast.stats.fragments, generic.stats.fragments) << name;
-                }
-                EXPECT_GT(generic.stats.samplesCovered, 100000u) << name;
+                fn(state, clear,
+                   "test " + std::to_string(int(test)) + " write " + std::to_string(write) +
+                       " cull " + std::to_string(int(cull)));
                 ++cases;
             }
+    return cases;
+}
+
+TEST(DepthOnlyPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
+    const Mesh mesh = randomMesh(5, 3000);
+    const int cases = forEveryDrawState(
+        [&](const raster::RasterState& state, float clear, const std::string& name) {
+            const Drawn generic = draw(mesh, state, clear, 1, [](const raster::Fragment&) {});
+            for (int threads : {1, 2}) {
+                const Drawn fast = draw(mesh, state, clear, threads, raster::DepthOnly{});
+                ASSERT_EQ(0, std::memcmp(fast.depth.data(), generic.depth.data(),
+                                         fast.depth.size() * sizeof(float)))
+                    << name << ", " << threads << " threads";
+                EXPECT_EQ(fast.stats.samplesCovered, generic.stats.samplesCovered) << name;
+                EXPECT_EQ(fast.stats.samplesPassed, generic.stats.samplesPassed) << name;
+                EXPECT_EQ(fast.stats.fragments, generic.stats.fragments) << name;
+            }
+            EXPECT_GT(generic.stats.samplesCovered, 100000u) << name;
+        });
     EXPECT_EQ(cases, 30);
 }
 
@@ -124,47 +134,31 @@ TEST(TriangleIdsPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
     const Mesh mesh = randomMesh(6, 3000);
     const int width = 301, height = 203; // draw()'s size
     constexpr uint32_t kNone = 0xdeadbeefu, kBackFaceBit = 1u << 31;
-    int cases = 0, backFacesSeen = 0;
-    for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
-                           DepthTest::Greater, DepthTest::GreaterEqual})
-        for (bool write : {true, false})
-            for (CullMode cull : {CullMode::None, CullMode::Back, CullMode::Front}) {
-                raster::RasterState state;
-                state.depthTest = test;
-                state.depthWrite = write;
-                state.cullMode = cull;
-                state.barycentrics = false;
-                const bool nearer = test == DepthTest::Greater || test == DepthTest::GreaterEqual;
-                const float clear = nearer ? 0.0f : 1.0f;
-                std::vector<uint32_t> genericIds(size_t(width) * height, kNone);
-                const raster::TriangleIds genericWriter{genericIds.data(), size_t(width),
-                                                        kBackFaceBit};
-                const Drawn generic =
-                    draw(mesh, state, clear, 1,
-                         [&](const raster::Fragment& fragment) { genericWriter(fragment); });
-                const std::string name = "test " + std::to_string(int(test)) + " write " +
-                                         std::to_string(write) + " cull " +
-                                         std::to_string(int(cull));
-                for (int threads : {1, 2}) {
-                    std::vector<uint32_t> ids(genericIds.size(), kNone);
-                    const Drawn fast =
-                        draw(mesh, state, clear, threads,
-                             raster::TriangleIds{ids.data(), size_t(width), kBackFaceBit});
-                    ASSERT_EQ(0, std::memcmp(fast.depth.data(), generic.depth.data(),
-                                             fast.depth.size() * sizeof(float)))
-                        << name << ", " << threads << " threads";
-                    ASSERT_EQ(ids, genericIds) << name << ", " << threads << " threads";
-                    EXPECT_EQ(fast.stats.samplesCovered, generic.stats.samplesCovered) << name;
-                    EXPECT_EQ(fast.stats.samplesPassed, generic.stats.samplesPassed) << name;
-                    EXPECT_EQ(fast.stats.fragments, generic.stats.fragments) << name;
-                }
-                backFacesSeen +=
-                    int(std::count_if(genericIds.begin(), genericIds.end(), [](uint32_t id) {
-                            return id != kNone && (id & kBackFaceBit);
-                        }) > 0);
-                EXPECT_GT(generic.stats.samplesPassed, 10000u) << name;
-                ++cases;
-            }
+    int backFacesSeen = 0;
+    const int cases = forEveryDrawState([&](const raster::RasterState& state, float clear,
+                                            const std::string& name) {
+        std::vector<uint32_t> genericIds(size_t(width) * height, kNone);
+        const raster::TriangleIds genericWriter{genericIds.data(), size_t(width), kBackFaceBit};
+        const Drawn generic = draw(mesh, state, clear, 1, [&](const raster::Fragment& fragment) {
+            genericWriter(fragment);
+        });
+        for (int threads : {1, 2}) {
+            std::vector<uint32_t> ids(genericIds.size(), kNone);
+            const Drawn fast = draw(mesh, state, clear, threads,
+                                    raster::TriangleIds{ids.data(), size_t(width), kBackFaceBit});
+            ASSERT_EQ(0, std::memcmp(fast.depth.data(), generic.depth.data(),
+                                     fast.depth.size() * sizeof(float)))
+                << name << ", " << threads << " threads";
+            ASSERT_EQ(ids, genericIds) << name << ", " << threads << " threads";
+            EXPECT_EQ(fast.stats.samplesCovered, generic.stats.samplesCovered) << name;
+            EXPECT_EQ(fast.stats.samplesPassed, generic.stats.samplesPassed) << name;
+            EXPECT_EQ(fast.stats.fragments, generic.stats.fragments) << name;
+        }
+        backFacesSeen += int(std::count_if(genericIds.begin(), genericIds.end(), [&](uint32_t id) {
+                                 return id != kNone && (id & kBackFaceBit);
+                             }) > 0);
+        EXPECT_GT(generic.stats.samplesPassed, 10000u) << name;
+    });
     EXPECT_EQ(cases, 30);
     EXPECT_GE(backFacesSeen, 20); // every state but the back-face cull sees back faces
 
