@@ -260,15 +260,21 @@ TEST(DepthSpan, VectorLoopIsBitwiseTheScalarLoop) {
 // RasterState::clearDepth: each tile clears its own pixels (all samples) inside the draw; the
 // buffer, filled with garbage before, ends bitwise as with a clear before the draw, for 1 and 4
 // samples and 1 and 2 threads, including pixels no triangle covers.
+// The in-draw clear tests' state: reversed depth (Greater), no cull, no barycentrics.
+raster::RasterState clearTestState(int samples) {
+    raster::RasterState state;
+    state.depthTest = DepthTest::Greater;
+    state.cullMode = CullMode::None;
+    state.barycentrics = false;
+    state.samples = samples;
+    return state;
+}
+
 TEST(DepthOnlyPath, ClearInsideTheDrawEqualsAClearBefore) {
     const Mesh mesh = randomMesh(23, 0); // the fan alone: the corners stay uncovered
     for (int samples : {1, 4})
         for (int threads : {1, 2}) {
-            raster::RasterState state;
-            state.depthTest = DepthTest::Greater;
-            state.cullMode = CullMode::None;
-            state.barycentrics = false;
-            state.samples = samples;
+            raster::RasterState state = clearTestState(samples);
             const int width = 301, height = 203;
             const size_t size = size_t(width) * height * size_t(samples);
             std::vector<float> before(size, 0.0f), inside(size, 0.75f);
@@ -301,11 +307,7 @@ TEST(DepthOnlyPath, AlsoClearTileClearsEachPixelOnceBeforeItsTriangles) {
     constexpr uint32_t kNone = 0xffffffffu;
     for (int samples : {1, 4})
         for (int threads : {1, 2}) {
-            raster::RasterState state;
-            state.depthTest = DepthTest::Greater;
-            state.cullMode = CullMode::None;
-            state.barycentrics = false;
-            state.samples = samples;
+            raster::RasterState state = clearTestState(samples);
             const int width = 301, height = 203;
             const size_t pixels = size_t(width) * height, size = pixels * size_t(samples);
             std::vector<float> depthBefore(size, 0.0f), depthInside(size, 0.5f);
