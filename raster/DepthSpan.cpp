@@ -3,6 +3,8 @@
 // HWY_DYNAMIC_DISPATCH calls the best one this CPU runs. See DepthSpan.h for the contract.
 #include "raster/DepthSpan.h"
 
+#include <cstring>
+
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/DepthSpan.cpp"
 #include <hwy/foreach_target.h> // must come before highway.h
@@ -14,6 +16,28 @@ namespace raster::HWY_NAMESPACE {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
+// std::clamp(z, 0, 1): z < 0 ? 0 : (1 < z ? 1 : z), NaN kept.
+template <class DD, class V> HWY_INLINE V clampToUnit(DD dd, V z) {
+    const auto zero = hn::Zero(dd);
+    const auto one = hn::Set(dd, 1.0);
+    return hn::IfThenElse(hn::Lt(z, zero), zero, hn::IfThenElse(hn::Lt(one, z), one, z));
+}
+
+// detail::depthPasses on lanes.
+template <DepthTest kTest, class DF, class V>
+HWY_INLINE hn::Mask<DF> depthPassesLanes(DF df, V depth, V stored) {
+    if constexpr (kTest == DepthTest::Always)
+        return hn::FirstN(df, hn::Lanes(df));
+    else if constexpr (kTest == DepthTest::Less)
+        return hn::Lt(depth, stored);
+    else if constexpr (kTest == DepthTest::LessEqual)
+        return hn::Le(depth, stored);
+    else if constexpr (kTest == DepthTest::Greater)
+        return hn::Gt(depth, stored);
+    else
+        return hn::Ge(depth, stored);
+}
+
 // Depth in double lanes (the plane is double), tested and stored as float lanes of the same
 // count. No load or store ever leaves [lo, hi]: the tail (fewer pixels than a vector) is one
 // masked vector where masked memory operations cannot fault (AVX-512), the scalar loop elsewhere.
@@ -23,8 +47,6 @@ template <DepthTest kTest, bool kValues> HWY_INLINE uint64_t spanLoop(const Dept
     const hn::Rebind<uint32_t, decltype(dd)> du;
     const auto value = hn::Set(du, span.value);
     const int lanes = int(hn::Lanes(dd));
-    const auto zero = hn::Zero(dd);
-    const auto one = hn::Set(dd, 1.0);
     const auto zRow = hn::Set(dd, span.zRow);
     const auto zStep = hn::Set(dd, span.zStep);
     const auto advance = hn::Set(dd, double(lanes));
@@ -33,22 +55,9 @@ template <DepthTest kTest, bool kValues> HWY_INLINE uint64_t spanLoop(const Dept
     uint64_t passed = 0;
     int x = span.lo;
     for (; x + lanes - 1 <= span.hi; x += lanes, px = hn::Add(px, advance)) {
-        auto z = hn::Add(zRow, hn::Mul(zStep, px));
-        // std::clamp(z, 0, 1): z < 0 ? 0 : (1 < z ? 1 : z), NaN kept.
-        z = hn::IfThenElse(hn::Lt(z, zero), zero, hn::IfThenElse(hn::Lt(one, z), one, z));
-        const auto depth = hn::DemoteTo(df, z);
+        const auto depth = hn::DemoteTo(df, clampToUnit(dd, hn::Add(zRow, hn::Mul(zStep, px))));
         const auto stored = hn::LoadU(df, row + x);
-        hn::Mask<decltype(df)> pass;
-        if constexpr (kTest == DepthTest::Always)
-            pass = hn::FirstN(df, size_t(lanes));
-        else if constexpr (kTest == DepthTest::Less)
-            pass = hn::Lt(depth, stored);
-        else if constexpr (kTest == DepthTest::LessEqual)
-            pass = hn::Le(depth, stored);
-        else if constexpr (kTest == DepthTest::Greater)
-            pass = hn::Gt(depth, stored);
-        else
-            pass = hn::Ge(depth, stored);
+        const auto pass = depthPassesLanes<kTest>(df, depth, stored);
         passed += hn::CountTrue(df, pass);
         if (span.write)
             hn::StoreU(hn::IfThenElse(pass, depth, stored), df, row + x);
@@ -68,21 +77,9 @@ template <DepthTest kTest, bool kValues> HWY_INLINE uint64_t spanLoop(const Dept
     if (x > span.hi)
         return passed;
     const auto inside = hn::FirstN(df, size_t(span.hi - x + 1));
-    auto z = hn::Add(zRow, hn::Mul(zStep, px));
-    z = hn::IfThenElse(hn::Lt(z, zero), zero, hn::IfThenElse(hn::Lt(one, z), one, z));
-    const auto depth = hn::DemoteTo(df, z);
+    const auto depth = hn::DemoteTo(df, clampToUnit(dd, hn::Add(zRow, hn::Mul(zStep, px))));
     const auto stored = hn::MaskedLoad(inside, df, row + x);
-    hn::Mask<decltype(df)> pass;
-    if constexpr (kTest == DepthTest::Always)
-        pass = inside;
-    else if constexpr (kTest == DepthTest::Less)
-        pass = hn::And(inside, hn::Lt(depth, stored));
-    else if constexpr (kTest == DepthTest::LessEqual)
-        pass = hn::And(inside, hn::Le(depth, stored));
-    else if constexpr (kTest == DepthTest::Greater)
-        pass = hn::And(inside, hn::Gt(depth, stored));
-    else
-        pass = hn::And(inside, hn::Ge(depth, stored));
+    const auto pass = hn::And(inside, depthPassesLanes<kTest>(df, depth, stored));
     passed += hn::CountTrue(df, pass);
     if (span.write)
         hn::BlendedStore(depth, pass, df, row + x);
@@ -117,6 +114,176 @@ DepthSpanLoop depthSpanLoopFor(DepthTest test, bool values) {
     return values ? spanLoopFor<true>(test) : spanLoopFor<false>(test);
 }
 
+// One vector of a multisampled span: `lanes` consecutive samples from flat index i (whole pixels,
+// or a whole pixel's part when a pixel has more samples than a vector has lanes), the centre's
+// plane value zCentre and the samples' offsets per lane, the covered lanes `covered` (none
+// outside the span). Returns the passing lanes and adds to the counts.
+template <DepthTest kTest, class DD, class VD>
+HWY_INLINE hn::Mask<hn::Rebind<float, DD>>
+multisampleVector(DD dd, const MultisampleSpanArgs& span, size_t i, VD zCentre, VD offsets,
+                  hn::Mask<hn::Rebind<float, DD>> covered, bool full) {
+    const hn::Rebind<float, DD> df;
+    const hn::Rebind<uint32_t, DD> du;
+    const auto depth = hn::DemoteTo(df, clampToUnit(dd, hn::Add(zCentre, offsets)));
+    const auto stored =
+        full ? hn::LoadU(df, span.depth + i) : hn::MaskedLoad(covered, df, span.depth + i);
+    const auto pass = hn::And(covered, depthPassesLanes<kTest>(df, depth, stored));
+    if (span.write) {
+        if (full)
+            hn::StoreU(hn::IfThenElse(pass, depth, stored), df, span.depth + i);
+        else
+            hn::BlendedStore(depth, pass, df, span.depth + i);
+    }
+    if (span.values)
+        hn::BlendedStore(hn::Set(du, span.value), hn::RebindMask(du, pass), du, span.values + i);
+    if (span.centreDepths)
+        hn::BlendedStore(hn::DemoteTo(df, clampToUnit(dd, zCentre)), pass, df,
+                         span.centreDepths + i);
+    return pass;
+}
+
+// The covered lanes: every edge value (the sample's, fill bias included) >= 0. The int64 lanes'
+// mask becomes the float lanes' through its bits (no mask conversion across lane sizes here).
+template <class DF, class VI> HWY_INLINE hn::Mask<DF> coveredLanes(DF df, const VI* edge) {
+    const hn::RebindToSigned<hn::Rebind<double, DF>> di;
+    const auto outside = hn::Lt(hn::Or(hn::Or(edge[0], edge[1]), edge[2]), hn::Zero(di));
+    uint8_t bits[8] = {}; // at most 64 lanes
+    hn::StoreMaskBits(di, hn::Not(outside), bits);
+    return hn::LoadMaskBits(df, bits);
+}
+
+// Of `pixels` pixels of `samples` lanes each, those with a passing lane.
+template <class DF>
+HWY_INLINE uint64_t pixelsWithAPass(DF df, hn::Mask<DF> pass, size_t pixels, size_t samples) {
+    uint8_t bytes[8] = {}; // at most 64 lanes
+    hn::StoreMaskBits(df, pass, bytes);
+    uint64_t bits = 0;
+    std::memcpy(&bits, bytes, sizeof(bytes));
+    const uint64_t pixelMask = (1ull << samples) - 1ull; // samples <= 8
+    uint64_t count = 0;
+    for (size_t p = 0; p < pixels; ++p)
+        count += (bits >> (p * samples) & pixelMask) != 0;
+    return count;
+}
+
+// The samples of [lo, hi] are contiguous (depth[px * samples + s]), so the loop walks them as one
+// flat array: with at least as many lanes as samples a vector holds whole pixels (lane l is
+// pixel l / samples, sample l % samples), otherwise a pixel takes samples / lanes vectors. Edge
+// values are int64 lanes of the same count, advanced by adds.
+template <DepthTest kTest>
+MultisampleSpanCounts multisampleSpanLoopFunction(const MultisampleSpanArgs& span) {
+    const hn::ScalableTag<double> dd;
+    const hn::Rebind<float, decltype(dd)> df;
+    const hn::RebindToSigned<decltype(dd)> di;
+    const size_t lanes = hn::Lanes(dd);
+    const size_t samples = size_t(span.samples);
+    MultisampleSpanCounts counts;
+    // sampleOffsets and edgeOffsets hold kMaxSamples values: one vector's load (the lane
+    // patterns' source).
+    if (lanes > size_t(kMaxSamples) || span.lo > span.hi)
+        return lanes > size_t(kMaxSamples) ? detail::multisampleSpanScalarLoop<kTest>(span)
+                                           : counts;
+    const auto zRow = hn::Set(dd, span.zRow);
+    const auto zStep = hn::Set(dd, span.zStep);
+    if (lanes < samples) {
+        for (int px = span.lo; px <= span.hi; ++px) {
+            const int64_t k = px - span.lo;
+            const auto zCentre = hn::Add(zRow, hn::Mul(zStep, hn::Set(dd, double(px))));
+            bool any = false;
+            for (size_t c = 0; c < samples; c += lanes) {
+                hn::Vec<decltype(di)> edge[3];
+                for (int e = 0; e < 3; ++e)
+                    edge[e] = hn::Add(hn::Set(di, span.edgeAtLo[e] + span.edgeStep[e] * k),
+                                      hn::LoadU(di, span.edgeOffsets[e] + c));
+                const auto covered = coveredLanes(df, edge);
+                counts.samplesCovered += hn::CountTrue(df, covered);
+                const auto offsets = hn::LoadU(dd, span.sampleOffsets + c);
+                const auto pass = multisampleVector<kTest>(dd, span, size_t(px) * samples + c,
+                                                           zCentre, offsets, covered, true);
+                counts.samplesPassed += hn::CountTrue(df, pass);
+                any |= !hn::AllFalse(df, pass);
+            }
+            counts.fragments += any;
+        }
+        return counts;
+    }
+    // Lane l's sample l % samples and pixel l / samples, made in registers: spans are short, and
+    // patterns written to memory and loaded back as a vector stalled on store forwarding.
+    const size_t pixelsPerVector = lanes / samples;
+    const auto sampleOfLane = hn::And(hn::Iota(di, 0), hn::Set(di, int64_t(samples) - 1));
+    const auto pixelOfLane = hn::ShiftRightSame(hn::Iota(di, 0), std::countr_zero(samples));
+    const auto sampleIndices = hn::IndicesFromVec(dd, sampleOfLane);
+    const auto offsets = hn::TableLookupLanes(hn::LoadU(dd, span.sampleOffsets), sampleIndices);
+    hn::Vec<decltype(di)> edge[3], edgeAdvance[3];
+    for (int e = 0; e < 3; ++e) {
+        // edgeAtLo + edgeStep * pixel + offset of the lane's sample, by adds (no int64 multiply
+        // on every target).
+        const auto step = hn::Set(di, span.edgeStep[e]);
+        auto value = hn::Add(hn::Set(di, span.edgeAtLo[e]),
+                             hn::TableLookupLanes(hn::LoadU(di, span.edgeOffsets[e]),
+                                                  hn::IndicesFromVec(di, sampleOfLane)));
+        for (int64_t p = 1; p < int64_t(pixelsPerVector); ++p)
+            value =
+                hn::Add(value, hn::IfThenElseZero(hn::Gt(pixelOfLane, hn::Set(di, p - 1)), step));
+        edge[e] = value;
+        edgeAdvance[e] = hn::Set(di, span.edgeStep[e] * int64_t(pixelsPerVector));
+    }
+    const auto advance = hn::Set(dd, double(pixelsPerVector));
+    auto px = hn::Add(hn::Set(dd, double(span.lo)), hn::ConvertTo(dd, pixelOfLane));
+    int x = span.lo;
+    for (; x + int(pixelsPerVector) - 1 <= span.hi; x += int(pixelsPerVector)) {
+        const auto covered = coveredLanes(df, edge);
+        counts.samplesCovered += hn::CountTrue(df, covered);
+        const auto zCentre = hn::Add(zRow, hn::Mul(zStep, px));
+        const auto pass = multisampleVector<kTest>(dd, span, size_t(x) * samples, zCentre, offsets,
+                                                   covered, true);
+        counts.samplesPassed += hn::CountTrue(df, pass);
+        counts.fragments += pixelsWithAPass(df, pass, pixelsPerVector, samples);
+        px = hn::Add(px, advance);
+        for (int e = 0; e < 3; ++e)
+            edge[e] = hn::Add(edge[e], edgeAdvance[e]);
+    }
+    if (x > span.hi)
+        return counts;
+#if HWY_MEM_OPS_MIGHT_FAULT
+    MultisampleSpanArgs tail = span;
+    tail.lo = x;
+    for (int e = 0; e < 3; ++e)
+        tail.edgeAtLo[e] = span.edgeAtLo[e] + span.edgeStep[e] * int64_t(x - span.lo);
+    const MultisampleSpanCounts rest = detail::multisampleSpanScalarLoop<kTest>(tail);
+    counts.samplesCovered += rest.samplesCovered;
+    counts.samplesPassed += rest.samplesPassed;
+    counts.fragments += rest.fragments;
+#else
+    // The last pixels (fewer than a vector holds) as one masked vector, as spanLoop's tail.
+    const size_t pixels = size_t(span.hi - x + 1);
+    const auto covered = hn::And(hn::FirstN(df, pixels * samples), coveredLanes(df, edge));
+    counts.samplesCovered += hn::CountTrue(df, covered);
+    const auto zCentre = hn::Add(zRow, hn::Mul(zStep, px));
+    const auto pass =
+        multisampleVector<kTest>(dd, span, size_t(x) * samples, zCentre, offsets, covered, false);
+    counts.samplesPassed += hn::CountTrue(df, pass);
+    counts.fragments += pixelsWithAPass(df, pass, pixels, samples);
+#endif
+    return counts;
+}
+
+MultisampleSpanLoop multisampleSpanLoopFor(DepthTest test) {
+    switch (test) {
+    case DepthTest::Always:
+        return &multisampleSpanLoopFunction<DepthTest::Always>;
+    case DepthTest::Less:
+        return &multisampleSpanLoopFunction<DepthTest::Less>;
+    case DepthTest::LessEqual:
+        return &multisampleSpanLoopFunction<DepthTest::LessEqual>;
+    case DepthTest::Greater:
+        return &multisampleSpanLoopFunction<DepthTest::Greater>;
+    case DepthTest::GreaterEqual:
+        return &multisampleSpanLoopFunction<DepthTest::GreaterEqual>;
+    }
+    return nullptr;
+}
+
 } // namespace raster::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -124,6 +291,27 @@ HWY_AFTER_NAMESPACE();
 namespace raster {
 
 HWY_EXPORT(depthSpanLoopFor);
+HWY_EXPORT(multisampleSpanLoopFor);
+
+MultisampleSpanLoop multisampleSpanLoop(DepthTest test) {
+    return HWY_DYNAMIC_DISPATCH(multisampleSpanLoopFor)(test);
+}
+
+MultisampleSpanCounts multisampleSpanScalar(DepthTest test, const MultisampleSpanArgs& span) {
+    switch (test) {
+    case DepthTest::Always:
+        return detail::multisampleSpanScalarLoop<DepthTest::Always>(span);
+    case DepthTest::Less:
+        return detail::multisampleSpanScalarLoop<DepthTest::Less>(span);
+    case DepthTest::LessEqual:
+        return detail::multisampleSpanScalarLoop<DepthTest::LessEqual>(span);
+    case DepthTest::Greater:
+        return detail::multisampleSpanScalarLoop<DepthTest::Greater>(span);
+    case DepthTest::GreaterEqual:
+        return detail::multisampleSpanScalarLoop<DepthTest::GreaterEqual>(span);
+    }
+    return {};
+}
 
 DepthSpanLoop depthSpanLoop(DepthTest test, bool values) {
     return HWY_DYNAMIC_DISPATCH(depthSpanLoopFor)(test, values);

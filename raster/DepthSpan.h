@@ -13,6 +13,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 
 namespace raster {
@@ -65,6 +66,88 @@ template <DepthTest test> inline uint64_t depthSpanScalarLoop(const DepthSpanArg
     return passed;
 }
 } // namespace detail
+
+// The multisampled form (Rasterizer.h, rasterizeTileMultisample): a row's pixels [lo, hi] of one
+// triangle, each sample covered when the triangle's three edge functions accept it, each covered
+// sample's depth z = float(clamp((zRow + zStep * double(px)) + sampleOffsets[s], 0, 1)) tested
+// against depth[px * samples + s] and written where it passes; `values` (optional, TriangleIds)
+// gets `value` at every passing sample, and `centreDepths` (optional, indexed like depth) the
+// pixel centre's float(clamp(zRow + zStep * double(px), 0, 1)) there: the visibility draw's
+// record. Sample s of pixel px is covered when, for every edge e,
+// edgeAtLo[e] + edgeStep[e] * (px - lo) + edgeOffsets[e][s] >= 0 (integers, as the rasterizer's
+// per-sample test: the edge at the pixel centre plus its exact change to the sample, fill bias
+// included).
+inline constexpr int kMaxSamples = 8; // Rasterizer.h's limit (Fragment::coverage is a byte)
+struct MultisampleSpanArgs {
+    float* depth = nullptr; // the row's samples: pixel px's sample s at depth[px * samples + s]
+    int lo = 0;
+    int hi = -1;
+    int samples = 4;   // 2, 4 or 8
+    double zRow = 0.0; // the centre's plane along the row, as DepthSpanArgs
+    double zStep = 0.0;
+    // The plane's change from the centre to sample s; kMaxSamples entries readable (the vector
+    // loop loads them whole), as each row of edgeOffsets.
+    const double* sampleOffsets = nullptr;
+    int64_t edgeAtLo[3] = {0, 0, 0};
+    int64_t edgeStep[3] = {0, 0, 0};
+    const int64_t (*edgeOffsets)[kMaxSamples] = nullptr; // [3][kMaxSamples]
+    bool write = true;
+    uint32_t* values = nullptr;
+    uint32_t value = 0;
+    float* centreDepths = nullptr;
+};
+
+// What a multisampled span covered and passed: samples, and pixels with a passing sample
+// (fragments).
+struct MultisampleSpanCounts {
+    uint64_t samplesCovered = 0;
+    uint64_t samplesPassed = 0;
+    uint64_t fragments = 0;
+};
+
+namespace detail {
+// The scalar loop: the rasterizer's per-sample path, the oracle.
+template <DepthTest test>
+inline MultisampleSpanCounts multisampleSpanScalarLoop(const MultisampleSpanArgs& span) {
+    MultisampleSpanCounts counts;
+    const size_t samples = size_t(span.samples);
+    for (int px = span.lo; px <= span.hi; ++px) {
+        const int64_t k = px - span.lo;
+        const int64_t w0 = span.edgeAtLo[0] + span.edgeStep[0] * k;
+        const int64_t w1 = span.edgeAtLo[1] + span.edgeStep[1] * k;
+        const int64_t w2 = span.edgeAtLo[2] + span.edgeStep[2] * k;
+        const double zCentre = span.zRow + span.zStep * double(px);
+        const float centre = float(std::clamp(zCentre, 0.0, 1.0));
+        unsigned passed = 0;
+        for (size_t s = 0; s < samples; ++s) {
+            if (((w0 + span.edgeOffsets[0][s]) | (w1 + span.edgeOffsets[1][s]) |
+                 (w2 + span.edgeOffsets[2][s])) < 0)
+                continue;
+            ++counts.samplesCovered;
+            const size_t i = size_t(px) * samples + s;
+            const float z = float(std::clamp(zCentre + span.sampleOffsets[s], 0.0, 1.0));
+            if (!depthPasses<test>(z, span.depth[i]))
+                continue;
+            passed |= 1u << s;
+            if (span.write)
+                span.depth[i] = z;
+            if (span.values)
+                span.values[i] = span.value;
+            if (span.centreDepths)
+                span.centreDepths[i] = centre;
+        }
+        counts.samplesPassed += unsigned(std::popcount(passed));
+        counts.fragments += passed != 0;
+    }
+    return counts;
+}
+} // namespace detail
+
+using MultisampleSpanLoop = MultisampleSpanCounts (*)(const MultisampleSpanArgs&);
+// The widest instruction set this CPU runs, chosen once per test (as depthSpanLoop).
+MultisampleSpanLoop multisampleSpanLoop(DepthTest test);
+// The same, one sample at a time: the oracle.
+MultisampleSpanCounts multisampleSpanScalar(DepthTest test, const MultisampleSpanArgs& span);
 
 // Tests (and writes) the span; returns how many of its pixels passed. The widest instruction set
 // this CPU runs (Highway's dispatch). Thread-safe; touches only row[lo..hi].

@@ -85,8 +85,8 @@ inline constexpr int kTileSize = 128;
 // Input triangles per set-up batch: fixed so that binning order never depends on the threads.
 inline constexpr uint32_t kTrianglesPerBatch = 2048;
 
-// Multisampling: at most 8 samples per pixel (Fragment::coverage is a byte).
-inline constexpr int kMaxSamples = 8;
+// Multisampling: at most kMaxSamples (DepthSpan.h: 8) samples per pixel (Fragment::coverage is a
+// byte).
 // A sample position relative to the pixel centre in 1/16 pixel, screen axes (x right, y down).
 struct SampleOffset {
     int8_t x, y;
@@ -183,20 +183,36 @@ struct DepthOnly {
     void operator()(const Fragment&) const {}
 };
 
-// The fragment function of a visibility draw (one sample per pixel): each passing pixel records
-// its triangle, `ids[y * width + x] = triangle | (frontFacing ? 0 : backFaceBit)`. draw() given
-// it takes the depth-only path's spans and writes the ids in the same vector loop (DepthSpan.h)
-// when a depth buffer is given; otherwise, and multisampled, it is called per fragment.
+// The fragment function of a visibility draw: each passing pixel records its triangle,
+// `ids[y * width + x] = triangle | (frontFacing ? 0 : backFaceBit)`. draw() given it takes the
+// depth-only path's spans and writes the ids in the same vector loop (DepthSpan.h) when a depth
+// buffer is given; otherwise it is called per fragment. Multisampled (`samples` > 1, equal to
+// RasterState::samples), ids hold `samples` entries per pixel and each passing sample gets its
+// fragment's id and, when `centreDepths` is set (indexed as ids), the fragment's centre depth;
+// with a depth buffer each row of a triangle takes DepthSpan.h's multisampled loop.
 struct TriangleIds {
     uint32_t* ids = nullptr;
     size_t width = 0;
     uint32_t backFaceBit = 0;
+    int samples = 1;
+    float* centreDepths = nullptr; // multisampled only
     constexpr uint32_t idOf(uint32_t triangle, bool frontFacing) const {
         return triangle | (frontFacing ? 0u : backFaceBit);
     }
-    void operator()(const Fragment& fragment) const {
-        ids[size_t(fragment.y) * width + size_t(fragment.x)] =
-            idOf(fragment.triangle, fragment.frontFacing);
+    [[gnu::always_inline]] void operator()(const Fragment& fragment) const {
+        const size_t pixel = size_t(fragment.y) * width + size_t(fragment.x);
+        const uint32_t id = idOf(fragment.triangle, fragment.frontFacing);
+        if (samples == 1) {
+            ids[pixel] = id;
+            return;
+        }
+        const size_t first = pixel * size_t(samples);
+        for (int s = 0; s < samples; ++s)
+            if (fragment.coverage >> s & 1u) {
+                ids[first + size_t(s)] = id;
+                if (centreDepths)
+                    centreDepths[first + size_t(s)] = fragment.depth;
+            }
     }
 };
 
@@ -406,7 +422,8 @@ inline int64_t fillBias(int32_t ax, int32_t ay, int32_t bx, int32_t by) {
 struct RowSpan {
     int64_t kLo, kHi;
 };
-inline RowSpan coveredSpan(const int64_t value[3], const int64_t step[3], int64_t kMax) {
+[[gnu::always_inline]] inline RowSpan coveredSpan(const int64_t value[3], const int64_t step[3],
+                                                  int64_t kMax) {
     RowSpan span{0, kMax};
     for (int e = 0; e < 3; ++e) {
         const int64_t v = value[e], s = step[e];
@@ -433,6 +450,11 @@ template <class FragmentFn>
 void Rasterizer::draw(const TriangleList& triangles, const RasterState& state, float* depth,
                       FragmentFn&& fragmentFn) {
     checkSampleCount(state.samples);
+    if constexpr (std::is_same_v<std::remove_cvref_t<FragmentFn>, TriangleIds>)
+        if (fragmentFn.samples != state.samples)
+            throw std::invalid_argument("TriangleIds holds " + std::to_string(fragmentFn.samples) +
+                                        " samples per pixel, the draw " +
+                                        std::to_string(state.samples));
     setUpAndBin(triangles, state);
     const auto traversalStart = std::chrono::steady_clock::now();
     const int tileCount = mTilesX * mTilesY;
@@ -700,6 +722,17 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
                   "a fragment function returns void, bool or SampleMask");
     const int sampleCount = state.samples;
     const std::span<const SampleOffset> pattern = standardSamplePattern(sampleCount);
+    // The depth-only and visibility draws run each row's pixels with a covered sample through
+    // DepthSpan.h's multisampled loop: coverage, depth test and writes per sample on lanes. On
+    // dense scenes most covered pixels are on a triangle's edge (atrium: ~5 pixels a triangle),
+    // so the per-sample tests, not the fully covered runs, are what this loop is for.
+    constexpr bool kDepthOnly = std::is_same_v<std::remove_cvref_t<FragmentFn>, DepthOnly>;
+    constexpr bool kTriangleIds = std::is_same_v<std::remove_cvref_t<FragmentFn>, TriangleIds>;
+    MultisampleSpanLoop spanLoop = nullptr;
+    if constexpr (kDepthOnly || kTriangleIds)
+        if (depth && (kDepthOnly || !state.barycentrics))
+            spanLoop = multisampleSpanLoop(kDepthTest);
+    const size_t rowSamples = size_t(mWidth) * size_t(sampleCount);
 
     uint64_t samplesCovered = 0, samplesPassed = 0, fragments = 0;
     for (const Batch& batch : mBatches) {
@@ -722,7 +755,7 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
             const int32_t ax[3] = {x[1], x[2], x[0]}, ay[3] = {y[1], y[2], y[0]};
             const int32_t bx[3] = {x[2], x[0], x[1]}, by[3] = {y[2], y[0], y[1]};
             int64_t stepX[3], stepY[3], bias[3], row[3], maxOffset[3], minOffset[3];
-            int64_t offset[3][kMaxSamples];
+            int64_t offset[3][kMaxSamples] = {};
             const int64_t px0 = int64_t(minX) * kSubpixelScale + kHalf;
             const int64_t py0 = int64_t(minY) * kSubpixelScale + kHalf;
             for (int e = 0; e < 3; ++e) {
@@ -740,75 +773,124 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
                 }
             }
             // Depth at a sample: the centre's plane value plus the plane's change over the offset.
-            double depthOffset[kMaxSamples];
+            double depthOffset[kMaxSamples] = {};
             for (int s = 0; s < sampleCount; ++s)
                 depthOffset[s] = t.z[1] * (pattern[s].x / 16.0) + t.z[2] * (pattern[s].y / 16.0);
 
-            for (int py = minY; py <= maxY; ++py) {
-                int64_t w0 = row[0], w1 = row[1], w2 = row[2];
-                const double zRow = t.z[0] + t.z[2] * py;
-                double pxDouble = minX;
-                for (int px = minX; px <= maxX;
-                     ++px, pxDouble += 1.0, w0 += stepX[0], w1 += stepX[1], w2 += stepX[2]) {
-                    // No sample can be inside when an edge rejects even its most favourable one.
-                    if (((w0 + maxOffset[0]) | (w1 + maxOffset[1]) | (w2 + maxOffset[2])) < 0)
-                        continue;
-                    // Every sample is inside when each edge accepts even its least favourable one
-                    // (most pixels of a triangle): no per-sample test.
+            // The samples `covered` of pixel (px, py): depth test, fragment function, depth write.
+            auto shadeSamples = [&](int px, int py, unsigned covered, double zRow) {
+                samplesCovered += unsigned(std::popcount(covered));
+                const double zCentre = zRow + t.z[1] * double(px);
+                float* depthPixel =
+                    depth ? depth + (size_t(py) * mWidth + size_t(px)) * size_t(sampleCount)
+                          : nullptr;
+                // Every sample's depth and test, covered or not (a pixel's samples are all in
+                // the buffer), without a branch: which samples pass an edge pixel's test is as
+                // good as random, and a mispredicted branch per sample was this loop's cost.
+                float sampleDepth[kMaxSamples];
+                unsigned passed = 0;
+                for (int s = 0; s < sampleCount; ++s) {
+                    sampleDepth[s] = float(std::clamp(zCentre + depthOffset[s], 0.0, 1.0));
+                    passed |= unsigned(!depthPixel || detail::depthPasses<kDepthTest>(
+                                                          sampleDepth[s], depthPixel[s]))
+                              << s;
+                }
+                passed &= covered;
+                if (passed == 0)
+                    return;
+                Fragment fragment;
+                fragment.x = px;
+                fragment.y = py;
+                fragment.depth = float(std::clamp(zCentre, 0.0, 1.0));
+                if (state.barycentrics)
+                    fragment.barycentric = barycentricAt(batch, index, t, px, py);
+                fragment.triangle = t.triangle;
+                fragment.frontFacing = t.frontFacing;
+                fragment.coverage = uint8_t(passed);
+                bool kept = true;
+                if constexpr (kCanMask) {
+                    // Alpha-to-coverage: only these samples are written and counted.
+                    passed &= fragmentFn(fragment).bits;
+                    kept = passed != 0;
+                } else if constexpr (kCanDiscard) {
+                    kept = fragmentFn(fragment);
+                } else {
+                    fragmentFn(fragment);
+                }
+                if (!kept)
+                    return;
+                ++fragments;
+                samplesPassed += unsigned(std::popcount(passed));
+                if (depthPixel && state.depthWrite)
+                    for (int s = 0; s < sampleCount; ++s)
+                        if (passed >> s & 1u)
+                            depthPixel[s] = sampleDepth[s];
+            };
+            // Pixels first + k, k in [kFrom, kTo], of a row whose edge values at k = 0 are `w`,
+            // with each sample tested against the edges.
+            const unsigned allSamples = (1u << sampleCount) - 1u;
+            auto testedPixels = [&](const int64_t w[3], int64_t kFrom, int64_t kTo, int py,
+                                    double zRow) {
+                int64_t w0 = w[0] + stepX[0] * kFrom, w1 = w[1] + stepX[1] * kFrom,
+                        w2 = w[2] + stepX[2] * kFrom;
+                for (int64_t k = kFrom; k <= kTo;
+                     ++k, w0 += stepX[0], w1 += stepX[1], w2 += stepX[2]) {
                     unsigned covered = 0;
-                    if (((w0 + minOffset[0]) | (w1 + minOffset[1]) | (w2 + minOffset[2])) >= 0)
-                        covered = (1u << sampleCount) - 1u;
-                    else
-                        for (int s = 0; s < sampleCount; ++s)
-                            if (((w0 + offset[0][s]) | (w1 + offset[1][s]) | (w2 + offset[2][s])) >=
-                                0)
-                                covered |= 1u << s;
-                    if (covered == 0)
-                        continue;
-                    samplesCovered += unsigned(std::popcount(covered));
-                    const double zCentre = zRow + t.z[1] * pxDouble;
-                    float* depthPixel =
-                        depth ? depth + (size_t(py) * mWidth + size_t(px)) * size_t(sampleCount)
-                              : nullptr;
-                    float sampleDepth[kMaxSamples];
-                    unsigned passed = 0;
-                    for (int s = 0; s < sampleCount; ++s) {
-                        if (!(covered >> s & 1u))
-                            continue;
-                        sampleDepth[s] = float(std::clamp(zCentre + depthOffset[s], 0.0, 1.0));
-                        if (!depthPixel ||
-                            detail::depthPasses<kDepthTest>(sampleDepth[s], depthPixel[s]))
-                            passed |= 1u << s;
-                    }
-                    if (passed == 0)
-                        continue;
-                    Fragment fragment;
-                    fragment.x = px;
-                    fragment.y = py;
-                    fragment.depth = float(std::clamp(zCentre, 0.0, 1.0));
-                    if (state.barycentrics)
-                        fragment.barycentric = barycentricAt(batch, index, t, px, py);
-                    fragment.triangle = t.triangle;
-                    fragment.frontFacing = t.frontFacing;
-                    fragment.coverage = uint8_t(passed);
-                    bool kept = true;
-                    if constexpr (kCanMask) {
-                        // Alpha-to-coverage: only these samples are written and counted.
-                        passed &= fragmentFn(fragment).bits;
-                        kept = passed != 0;
-                    } else if constexpr (kCanDiscard) {
-                        kept = fragmentFn(fragment);
+                    for (int s = 0; s < sampleCount; ++s)
+                        if (((w0 + offset[0][s]) | (w1 + offset[1][s]) | (w2 + offset[2][s])) >= 0)
+                            covered |= 1u << s;
+                    if (covered != 0)
+                        shadeSamples(minX + int(k), py, covered, zRow);
+                }
+            };
+
+            for (int py = minY; py <= maxY; ++py) {
+                // The row's pixels with a sample inside (each edge's most favourable sample
+                // accepted) and, within them, those with every sample inside (each edge's least
+                // favourable one accepted): the same sets a per-pixel test of both finds.
+                const int64_t anyInside[3] = {row[0] + maxOffset[0], row[1] + maxOffset[1],
+                                              row[2] + maxOffset[2]};
+                const int64_t allInside[3] = {row[0] + minOffset[0], row[1] + minOffset[1],
+                                              row[2] + minOffset[2]};
+                const detail::RowSpan outer = detail::coveredSpan(anyInside, stepX, maxX - minX);
+                if (outer.kLo <= outer.kHi) {
+                    const double zRow = t.z[0] + t.z[2] * py;
+                    if (spanLoop) {
+                        // The whole row on lanes, each sample's coverage with its depth test.
+                        MultisampleSpanArgs span;
+                        span.depth = depth + size_t(py) * rowSamples;
+                        span.lo = minX + int(outer.kLo);
+                        span.hi = minX + int(outer.kHi);
+                        span.samples = sampleCount;
+                        span.zRow = zRow;
+                        span.zStep = t.z[1];
+                        span.sampleOffsets = depthOffset;
+                        for (int e = 0; e < 3; ++e) {
+                            span.edgeAtLo[e] = row[e] + stepX[e] * outer.kLo;
+                            span.edgeStep[e] = stepX[e];
+                        }
+                        span.edgeOffsets = offset;
+                        span.write = state.depthWrite;
+                        if constexpr (kTriangleIds) {
+                            span.values = fragmentFn.ids + size_t(py) * rowSamples;
+                            span.value = fragmentFn.idOf(t.triangle, t.frontFacing);
+                            if (fragmentFn.centreDepths)
+                                span.centreDepths =
+                                    fragmentFn.centreDepths + size_t(py) * rowSamples;
+                        }
+                        const MultisampleSpanCounts counts = spanLoop(span);
+                        samplesCovered += counts.samplesCovered;
+                        samplesPassed += counts.samplesPassed;
+                        fragments += counts.fragments;
                     } else {
-                        fragmentFn(fragment);
+                        detail::RowSpan inner = detail::coveredSpan(allInside, stepX, maxX - minX);
+                        if (inner.kLo > inner.kHi)
+                            inner = {outer.kHi + 1, outer.kHi};
+                        testedPixels(row, outer.kLo, inner.kLo - 1, py, zRow);
+                        for (int64_t k = inner.kLo; k <= inner.kHi; ++k)
+                            shadeSamples(minX + int(k), py, allSamples, zRow);
+                        testedPixels(row, inner.kHi + 1, outer.kHi, py, zRow);
                     }
-                    if (!kept)
-                        continue;
-                    ++fragments;
-                    samplesPassed += unsigned(std::popcount(passed));
-                    if (depthPixel && state.depthWrite)
-                        for (int s = 0; s < sampleCount; ++s)
-                            if (passed >> s & 1u)
-                                depthPixel[s] = sampleDepth[s];
                 }
                 row[0] += stepY[0];
                 row[1] += stepY[1];

@@ -94,17 +94,9 @@ void VisibilityPass::draw(raster::Rasterizer& rasterizer, std::span<float> depth
     if (samples > 1) {
         // Read only where a code was written: resized, not cleared.
         mCentreDepths.resize(sampleCount);
-        float* centreDepths = mCentreDepths.data();
-        const size_t stride = size_t(samples);
-        auto record = [&](const raster::Fragment& fragment) {
-            const size_t first = (size_t(fragment.y) * width + size_t(fragment.x)) * stride;
-            const uint32_t value = code(fragment.triangle, fragment.frontFacing);
-            for (size_t s = 0; s < stride; ++s)
-                if (fragment.coverage >> s & 1u) {
-                    codes[first + s] = value;
-                    centreDepths[first + s] = fragment.depth;
-                }
-        };
+        // Each passing sample records its fragment's code and centre depth; pixels whose samples
+        // are all covered take the rasterizer's multisampled span loop.
+        const raster::TriangleIds record{codes, width, kBackFaceBit, samples, mCentreDepths.data()};
         if (mAlpha.active())
             rasterizer.draw(triangles(), state, depth.data(), [&](const raster::Fragment& f) {
                 raster::Fragment kept = f;

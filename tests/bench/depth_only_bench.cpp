@@ -81,4 +81,46 @@ BENCHMARK(depthOnlyDraw)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(15);
 
+// The visibility draw (gbuffer::VisibilityPass::draw, the G-buffer pass's traversal) at 1, 2, 4
+// and 8 samples on the atrium default, 2 threads: what multisampling costs the traversal (issue
+// 28's G-buffer ratio). Reports the minimum and median draw, the traversal phase alone, samples
+// covered and fragments, and the share of covered samples in pixels the triangle covers whole
+// (the multisampled span loop's; the rest are tested one sample at a time).
+//   build/bin/testbed_bench --benchmark_filter=visibilityDraw --benchmark_counters_tabular=true
+void visibilityDraw(benchmark::State& state) {
+    const int samples = int(state.range(0));
+    tbb::task_arena arena(2);
+    const bench::BenchScene frame("atrium", 0);
+    gbuffer::VisibilityPass visibility;
+    arena.execute([&] { visibility.transform(frame.scene, frame.geometry, frame.view); });
+    raster::Rasterizer rasterizer(bench::kWidth, bench::kHeight);
+    std::vector<float> depth(size_t(bench::kWidth) * bench::kHeight * size_t(samples));
+    std::vector<double> drawMs, traversalMs;
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        arena.execute([&] { visibility.draw(rasterizer, depth, samples); });
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        drawMs.push_back(ms);
+        traversalMs.push_back(rasterizer.lastPhaseTimes().traversalMs);
+        state.SetIterationTime(ms / 1e3);
+    }
+    const raster::RasterStats& stats = rasterizer.lastStats();
+    state.counters["draw_ms_min"] = *std::min_element(drawMs.begin(), drawMs.end());
+    state.counters["draw_ms_med"] = median(drawMs);
+    state.counters["traversal_ms_min"] = *std::min_element(traversalMs.begin(), traversalMs.end());
+    state.counters["samples_covered_M"] = 1e-6 * double(stats.samplesCovered);
+    state.counters["fragments_M"] = 1e-6 * double(stats.fragments);
+}
+
+BENCHMARK(visibilityDraw)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(4)
+    ->Arg(8)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(15);
+
 } // namespace

@@ -3,10 +3,11 @@
 // planes and the guard band, shared edges of fans), with every depth test, depth writes on and
 // off, every cull mode, the depth buffer must be bitwise the same and the coverage counters
 // equal, for 1 and 2 threads; the same for raster::TriangleIds (the visibility draw's spans, which
-// also write each pixel's triangle id). The span loop's SIMD form (DepthSpan.h) against its scalar
-// oracle, and the in-draw clear (RasterState::clearDepth) against a clear before the draw, with and
-// without the record of clear tiles (RasterState::tilesNotClear), and the caller's planes cleared
-// with it (RasterState::alsoClearTile).
+// also write each pixel's triangle id), one-sample and multisampled. The span loops' SIMD forms
+// (DepthSpan.h) against their scalar oracles, and the in-draw clear (RasterState::clearDepth)
+// against a clear before the draw, with and without the record of clear tiles
+// (RasterState::tilesNotClear), and the caller's planes cleared with it
+// (RasterState::alsoClearTile).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -73,7 +74,7 @@ Drawn draw(const Mesh& mesh, const raster::RasterState& state, float clear, int 
            FragmentFn fn) {
     const int width = 301, height = 203; // several tiles, partial ones at the edges
     Drawn drawn;
-    drawn.depth.assign(size_t(width) * height, clear);
+    drawn.depth.assign(size_t(width) * height * size_t(state.samples), clear);
     tbb::task_arena(threads).execute([&] {
         raster::Rasterizer rasterizer(width, height);
         rasterizer.draw(raster::TriangleList{mesh.positions, mesh.indices}, state,
@@ -176,6 +177,71 @@ TEST(TriangleIdsPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
     EXPECT_EQ(ids, genericIds);
 }
 
+// Multisampled (2, 4 and 8 samples): pixels whose every sample is covered take DepthSpan.h's
+// multisampled loop; the per-sample depths, the ids and centre depths of the visibility draw
+// (TriangleIds with centreDepths) and the counters are bitwise what a per-fragment function
+// writing the same gives, every depth test, depth writes on and off, every cull mode, 1 and 2
+// threads; and DepthOnly the same against an empty fragment function.
+TEST(TriangleIdsPath, MultisampledBitwiseTheGenericPathForEveryStateAndThreadCount) {
+    const Mesh mesh = randomMesh(8, 400);
+    const size_t pixels = 301 * 203; // draw()'s size
+    constexpr uint32_t kNone = 0xdeadbeefu, kBackFaceBit = 1u << 31;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    int cases = 0;
+    for (int samples : {2, 4, 8})
+        cases += forEveryDrawState([&](raster::RasterState state, float clear,
+                                       const std::string& stateName) {
+            state.samples = samples;
+            const std::string name = stateName + ", " + std::to_string(samples) + " samples";
+            const size_t count = pixels * size_t(samples);
+            std::vector<uint32_t> genericIds(count, kNone);
+            std::vector<float> genericCentres(count, nan);
+            const raster::TriangleIds genericWriter{genericIds.data(), 301, kBackFaceBit, samples,
+                                                    genericCentres.data()};
+            const Drawn generic =
+                draw(mesh, state, clear, 1, [&](const raster::Fragment& f) { genericWriter(f); });
+            const Drawn genericDepthOnly =
+                draw(mesh, state, clear, 1, [](const raster::Fragment&) {});
+            for (int threads : {1, 2}) {
+                std::vector<uint32_t> ids(count, kNone);
+                std::vector<float> centres(count, nan);
+                const Drawn fast = draw(
+                    mesh, state, clear, threads,
+                    raster::TriangleIds{ids.data(), 301, kBackFaceBit, samples, centres.data()});
+                ASSERT_EQ(
+                    0, std::memcmp(fast.depth.data(), generic.depth.data(), count * sizeof(float)))
+                    << name << ", " << threads << " threads";
+                ASSERT_EQ(ids, genericIds) << name << ", " << threads << " threads";
+                ASSERT_EQ(0,
+                          std::memcmp(centres.data(), genericCentres.data(), count * sizeof(float)))
+                    << name << ", " << threads << " threads";
+                EXPECT_EQ(fast.stats.samplesCovered, generic.stats.samplesCovered) << name;
+                EXPECT_EQ(fast.stats.samplesPassed, generic.stats.samplesPassed) << name;
+                EXPECT_EQ(fast.stats.fragments, generic.stats.fragments) << name;
+
+                const Drawn depthOnly = draw(mesh, state, clear, threads, raster::DepthOnly{});
+                ASSERT_EQ(0, std::memcmp(depthOnly.depth.data(), genericDepthOnly.depth.data(),
+                                         count * sizeof(float)))
+                    << name << ", " << threads << " threads, depth only";
+                EXPECT_EQ(depthOnly.stats.samplesPassed, genericDepthOnly.stats.samplesPassed)
+                    << name;
+                EXPECT_EQ(depthOnly.stats.fragments, genericDepthOnly.stats.fragments) << name;
+            }
+            EXPECT_GT(generic.stats.samplesPassed, 10000u) << name;
+        });
+    EXPECT_EQ(cases, 90);
+
+    // A TriangleIds of another sample count than the draw's is refused.
+    raster::RasterState state;
+    state.samples = 4;
+    std::vector<float> depth(pixels * 4, 1.0f);
+    std::vector<uint32_t> ids(pixels * 4);
+    raster::Rasterizer rasterizer(301, 203);
+    EXPECT_THROW(rasterizer.draw(raster::TriangleList{mesh.positions, mesh.indices}, state,
+                                 depth.data(), raster::TriangleIds{ids.data(), 301, 0, 2}),
+                 std::invalid_argument);
+}
+
 TEST(DepthOnlyPath, DrawsWithoutADepthBufferCountLikeTheGenericPath) {
     const Mesh mesh = randomMesh(9, 500);
     raster::RasterState state;
@@ -244,17 +310,119 @@ void checkVectorSpansAgainstScalar() {
     EXPECT_GT(valuesWritten, 500);
 }
 
-TEST(DepthSpan, VectorLoopIsBitwiseTheScalarLoop) {
-    // Every target this build has and this CPU runs: the masked tail exists only where masked
-    // memory operations cannot fault (AVX-512), the others keep the scalar tail.
+// The multisampled loop the same way: 2, 4 and 8 samples (more and fewer samples than a vector
+// has lanes), runs of 0 to 24 pixels (every tail), edges that cover every sample, none or some
+// (and change along the run), sample offsets that push samples across 0 and 1, NaN planes, stored
+// depths random, equal and NaN; ids and centre depths on and off.
+void checkMultisampledSpansAgainstScalar() {
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::uniform_int_distribution<int64_t> edgeValue(-3000, 3000), edgeStep(-900, 900),
+        edgeOffset(-400, 400);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    int spans = 0, passedSomewhere = 0, failedSomewhere = 0, partlyPassed = 0, partlyCovered = 0;
+    for (int samples : {2, 4, 8})
+        for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
+                               DepthTest::Greater, DepthTest::GreaterEqual})
+            for (bool write : {true, false})
+                for (int trial = 0; trial < 120; ++trial) {
+                    raster::MultisampleSpanArgs span;
+                    span.samples = samples;
+                    span.lo = int(rng() % 20);
+                    span.hi = span.lo + int(rng() % 25) - 1;
+                    span.zStep = (unit(rng) - 0.5) * (trial % 3 == 0 ? 0.1 : 1e-4);
+                    span.zRow = unit(rng) * 1.4 - 0.2 - span.zStep * span.lo;
+                    if (trial % 40 == 7)
+                        span.zStep = std::numeric_limits<double>::quiet_NaN();
+                    double offsets[raster::kMaxSamples];
+                    for (double& o : offsets)
+                        o = (unit(rng) - 0.5) * (trial % 4 == 1 ? 0.2 : 1e-4);
+                    span.sampleOffsets = offsets;
+                    int64_t edgeOffsets[3][raster::kMaxSamples];
+                    const bool whole = trial % 5 == 0; // every sample covered
+                    for (int e = 0; e < 3; ++e) {
+                        span.edgeAtLo[e] = whole ? 100000 : edgeValue(rng);
+                        span.edgeStep[e] = whole ? 0 : edgeStep(rng);
+                        for (int64_t& o : edgeOffsets[e])
+                            o = edgeOffset(rng) - int64_t(rng() % 2); // with a fill bias
+                    }
+                    span.edgeOffsets = edgeOffsets;
+                    span.write = write;
+                    const size_t count = 48 * size_t(samples);
+                    std::vector<float> stored(count);
+                    for (size_t i = 0; i < count; ++i) {
+                        const double z = span.zRow + span.zStep * double(i / size_t(samples)) +
+                                         offsets[i % size_t(samples)];
+                        stored[i] = i % 11 == 3  ? nan
+                                    : i % 5 == 1 ? float(std::clamp(z, 0.0, 1.0)) // equal
+                                                 : float(unit(rng));
+                    }
+                    std::vector<float> scalarDepth = stored, vectorDepth = stored;
+                    std::vector<uint32_t> scalarValues(count), vectorValues;
+                    std::iota(scalarValues.begin(), scalarValues.end(), 1000u);
+                    vectorValues = scalarValues;
+                    std::vector<float> scalarCentres(count, -1.0f), vectorCentres = scalarCentres;
+                    span.value = uint32_t(rng());
+                    const bool values = trial % 2 == 1, centres = trial % 3 != 2;
+                    span.depth = scalarDepth.data();
+                    span.values = values ? scalarValues.data() : nullptr;
+                    span.centreDepths = centres ? scalarCentres.data() : nullptr;
+                    const raster::MultisampleSpanCounts scalar =
+                        raster::multisampleSpanScalar(test, span);
+                    span.depth = vectorDepth.data();
+                    span.values = values ? vectorValues.data() : nullptr;
+                    span.centreDepths = centres ? vectorCentres.data() : nullptr;
+                    const raster::MultisampleSpanCounts vector =
+                        raster::multisampleSpanLoop(test)(span);
+                    const std::string name = std::to_string(samples) + " samples, test " +
+                                             std::to_string(int(test)) + " trial " +
+                                             std::to_string(trial);
+                    ASSERT_EQ(vector.samplesCovered, scalar.samplesCovered) << name;
+                    ASSERT_EQ(vector.samplesPassed, scalar.samplesPassed) << name;
+                    ASSERT_EQ(vector.fragments, scalar.fragments) << name;
+                    ASSERT_EQ(0, std::memcmp(vectorDepth.data(), scalarDepth.data(),
+                                             count * sizeof(float)))
+                        << name;
+                    ASSERT_EQ(vectorValues, scalarValues) << name;
+                    ASSERT_EQ(0, std::memcmp(vectorCentres.data(), scalarCentres.data(),
+                                             count * sizeof(float)))
+                        << name;
+                    const uint64_t spanSamples =
+                        uint64_t(std::max(0, span.hi - span.lo + 1)) * uint64_t(samples);
+                    passedSomewhere += scalar.samplesPassed > 0;
+                    failedSomewhere += scalar.samplesPassed < scalar.samplesCovered;
+                    partlyCovered +=
+                        scalar.samplesCovered > 0 && scalar.samplesCovered < spanSamples;
+                    // Pixels with some samples passing and others not.
+                    partlyPassed += scalar.fragments * uint64_t(samples) > scalar.samplesPassed;
+                    ++spans;
+                }
+    EXPECT_EQ(spans, 3600);
+    EXPECT_GT(passedSomewhere, 1000);
+    EXPECT_GT(failedSomewhere, 1000);
+    EXPECT_GT(partlyCovered, 600);
+    EXPECT_GT(partlyPassed, 300);
+}
+
+// Runs `check` on every target this build has and this CPU runs: the masked tail exists only
+// where masked memory operations cannot fault (AVX-512), the others keep the scalar tail.
+template <class Check> void onEveryTarget(Check check) {
     const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
     ASSERT_FALSE(targets.empty());
     for (int64_t target : targets) {
         hwy::SetSupportedTargetsForTest(target); // lifted after the loop
         SCOPED_TRACE(hwy::TargetName(target));
-        checkVectorSpansAgainstScalar();
+        check();
     }
     hwy::SetSupportedTargetsForTest(0);
+}
+
+TEST(DepthSpan, VectorLoopIsBitwiseTheScalarLoop) {
+    onEveryTarget(checkVectorSpansAgainstScalar);
+}
+
+TEST(DepthSpan, MultisampledVectorLoopIsBitwiseTheScalarLoop) {
+    onEveryTarget(checkMultisampledSpansAgainstScalar);
 }
 
 // RasterState::clearDepth: each tile clears its own pixels (all samples) inside the draw; the
