@@ -83,9 +83,8 @@ BENCHMARK(depthOnlyDraw)
 
 // The visibility draw (gbuffer::VisibilityPass::draw, the G-buffer pass's traversal) at 1, 2, 4
 // and 8 samples on the atrium default, 2 threads: what multisampling costs the traversal (issue
-// 28's G-buffer ratio). Reports the minimum and median draw, the traversal phase alone, samples
-// covered and fragments, and the share of covered samples in pixels the triangle covers whole
-// (the multisampled span loop's; the rest are tested one sample at a time).
+// 28's G-buffer ratio). Reports the minimum and median draw (clears included: they run inside
+// the draw), the traversal phase alone, samples covered and fragments.
 //   build/bin/testbed_bench --benchmark_filter=visibilityDraw --benchmark_counters_tabular=true
 void visibilityDraw(benchmark::State& state) {
     const int samples = int(state.range(0));
