@@ -733,6 +733,7 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
         if (depth && (kDepthOnly || !state.barycentrics))
             spanLoop = multisampleSpanLoop(kDepthTest);
     const size_t rowSamples = size_t(mWidth) * size_t(sampleCount);
+    constexpr int kShortRow = 16; // pixels
 
     uint64_t samplesCovered = 0, samplesPassed = 0, fragments = 0;
     for (const Batch& batch : mBatches) {
@@ -852,7 +853,17 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
                                               row[2] + maxOffset[2]};
                 const int64_t allInside[3] = {row[0] + minOffset[0], row[1] + minOffset[1],
                                               row[2] + minOffset[2]};
-                const detail::RowSpan outer = detail::coveredSpan(anyInside, stepX, maxX - minX);
+                // A short row (most rows of small triangles) goes to the span loop whole, which
+                // tests every sample anyway, unless an edge rejects both its ends: two int64
+                // divisions per edge cost more than the few lanes they would save.
+                detail::RowSpan outer{0, maxX - minX};
+                if (spanLoop && maxX - minX < kShortRow) {
+                    for (int e = 0; e < 3; ++e)
+                        if (anyInside[e] < 0 && anyInside[e] + stepX[e] * outer.kHi < 0)
+                            outer = {0, -1};
+                } else {
+                    outer = detail::coveredSpan(anyInside, stepX, maxX - minX);
+                }
                 if (outer.kLo <= outer.kHi) {
                     const double zRow = t.z[0] + t.z[2] * py;
                     if (spanLoop) {
