@@ -26,6 +26,7 @@
 
 #include "raster/DepthSpan.h"
 #include "raster/Rasterizer.h"
+#include "tests/raster/SanitizerBuild.h"
 #include "tests/raster/TestMeshes.h"
 
 namespace {
@@ -84,15 +85,21 @@ Drawn draw(const Mesh& mesh, const raster::RasterState& state, float clear, int 
     return drawn;
 }
 
+// The 30 states of forEveryDrawState, and the stride of its sample under the sanitizers (7:
+// every depth test, write mode and cull mode stays in the sample; SanitizerBuild.h).
+constexpr int kDrawStates = 30, kDrawStateStride = 7;
+
 // Calls fn(state, clear, name) for every depth test, depth writes on and off and every cull mode
-// (30 states, no barycentrics), with the clear value the test starts from and a name for the
-// failure messages; returns how many states it ran.
+// (kDrawStates states, no barycentrics; a sample of them in the sanitizer build), with the clear
+// value the test starts from and a name for the failure messages; returns how many states it ran.
 template <class Fn> int forEveryDrawState(Fn&& fn) {
-    int cases = 0;
+    int cases = 0, index = 0;
     for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
                            DepthTest::Greater, DepthTest::GreaterEqual})
         for (bool write : {true, false})
             for (CullMode cull : {CullMode::None, CullMode::Back, CullMode::Front}) {
+                if (!raster_test::sweepRunsCase(index++, kDrawStateStride))
+                    continue;
                 raster::RasterState state;
                 state.depthTest = test;
                 state.depthWrite = write;
@@ -124,7 +131,7 @@ TEST(DepthOnlyPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
             }
             EXPECT_GT(generic.stats.samplesCovered, 100000u) << name;
         });
-    EXPECT_EQ(cases, 30);
+    EXPECT_EQ(cases, raster_test::sweptCaseCount(kDrawStates, kDrawStateStride));
 }
 
 // raster::TriangleIds (the visibility draw) takes the same spans and writes each passing pixel's
@@ -135,7 +142,7 @@ TEST(TriangleIdsPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
     const Mesh mesh = randomMesh(6, 3000);
     const int width = 301, height = 203; // draw()'s size
     constexpr uint32_t kNone = 0xdeadbeefu, kBackFaceBit = 1u << 31;
-    int backFacesSeen = 0;
+    int backFacesSeen = 0, statesShowingBackFaces = 0;
     const int cases = forEveryDrawState([&](const raster::RasterState& state, float clear,
                                             const std::string& name) {
         std::vector<uint32_t> genericIds(size_t(width) * height, kNone);
@@ -155,13 +162,16 @@ TEST(TriangleIdsPath, BitwiseTheGenericPathForEveryStateAndThreadCount) {
             EXPECT_EQ(fast.stats.samplesPassed, generic.stats.samplesPassed) << name;
             EXPECT_EQ(fast.stats.fragments, generic.stats.fragments) << name;
         }
-        backFacesSeen += int(std::count_if(genericIds.begin(), genericIds.end(), [&](uint32_t id) {
-                                 return id != kNone && (id & kBackFaceBit);
-                             }) > 0);
+        const bool backFaceSeen =
+            std::any_of(genericIds.begin(), genericIds.end(),
+                        [&](uint32_t id) { return id != kNone && (id & kBackFaceBit); });
+        backFacesSeen += int(backFaceSeen);
+        statesShowingBackFaces += int(state.cullMode != CullMode::Back);
         EXPECT_GT(generic.stats.samplesPassed, 10000u) << name;
     });
-    EXPECT_EQ(cases, 30);
-    EXPECT_GE(backFacesSeen, 20); // every state but the back-face cull sees back faces
+    EXPECT_EQ(cases, raster_test::sweptCaseCount(kDrawStates, kDrawStateStride));
+    EXPECT_EQ(backFacesSeen, statesShowingBackFaces); // every state but the back-face cull
+    EXPECT_GT(statesShowingBackFaces, 0);
 
     // Without a depth buffer the ids are written per fragment: every covered pixel's last one.
     raster::RasterState state;
@@ -229,7 +239,7 @@ TEST(TriangleIdsPath, MultisampledBitwiseTheGenericPathForEveryStateAndThreadCou
             }
             EXPECT_GT(generic.stats.samplesPassed, 10000u) << name;
         });
-    EXPECT_EQ(cases, 90);
+    EXPECT_EQ(cases, 3 * raster_test::sweptCaseCount(kDrawStates, kDrawStateStride));
 
     // A TriangleIds of another sample count than the draw's is refused.
     raster::RasterState state;
