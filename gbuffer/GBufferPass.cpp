@@ -12,6 +12,16 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
         .count();
 }
+// Whether a G-buffer made for view `a` decodes like one made for `b` (an upper layer kept from the
+// last frame is reused only then: a jittered or moved camera makes a new one).
+bool sameView(const CameraView& a, const CameraView& b) {
+    return a.width == b.width && a.height == b.height && a.nearMetres == b.nearMetres &&
+           a.farMetres == b.farMetres && a.depthConvention == b.depthConvention &&
+           a.infiniteFar == b.infiniteFar && a.pixelOffset == b.pixelOffset &&
+           a.viewFromWorld == b.viewFromWorld && a.clipFromView == b.clipFromView &&
+           a.viewFromClip == b.viewFromClip;
+}
+
 } // namespace
 
 GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geometry)
@@ -66,27 +76,46 @@ void GBufferPass::storeCodes(std::span<const uint32_t> codes, GBuffer& target) c
     target.fetchSurfacesFrom(mVisibility);
 }
 
-void GBufferPass::resolveSparse(std::span<const uint32_t> codes, GBuffer& target,
-                                std::vector<uint8_t>& written) const {
+void GBufferPass::resolveUpperLayer(const FragmentLayers& layers, int k, GBuffer& target,
+                                    const std::vector<std::vector<uint32_t>>* lastColumns) const {
+    const std::span<const uint32_t> codes = layers.codes(k);
+    const std::span<const float> depths = layers.depths(k);
+    const std::span<float> depth = target.depthPlane();
     if (target.layout().visibilityBuffer) {
+        // The codes and depths are the G-buffer: copied whole.
+        std::copy(depths.begin(), depths.end(), depth.begin());
+        target.quantiseDepth();
         storeCodes(codes, target);
         return;
     }
     const int width = target.width();
+    const float clear = target.view().clearDepth();
+    const DepthDecoder& decoder = target.depthDecoder();
+    const bool lossless = decoder.lossless();
     const GBuffer::Writer sharedWriter = target.writer();
     tbb::parallel_for(0, target.height(), [&](int y) {
         const GBuffer::Writer writer = sharedWriter;
-        VisibilityPass::RowSurfaces row(mVisibility, y);
-        for (int x = 0; x < width; ++x) {
-            const size_t pixel = size_t(y) * width + x;
-            const uint32_t code = codes[pixel];
-            if (code != VisibilityPass::kNoTriangle) {
-                writer.write(pixel, row.at(code, x));
-                written[pixel] = 1;
-            } else if (written[pixel]) {
+        const size_t rowStart = size_t(y) * size_t(width);
+        if (!lastColumns) {
+            for (size_t pixel = rowStart; pixel < rowStart + size_t(width); ++pixel) {
                 writer.writeBackground(pixel);
-                written[pixel] = 0;
+                depth[pixel] = clear;
             }
+        } else {
+            for (const uint32_t x : (*lastColumns)[size_t(y)]) {
+                writer.writeBackground(rowStart + x);
+                depth[rowStart + x] = clear;
+            }
+        }
+        VisibilityPass::RowSurfaces row(mVisibility, y);
+        for (const uint32_t x : layers.upperColumns(y)) {
+            const size_t pixel = rowStart + x;
+            const uint32_t code = codes[pixel];
+            if (code == VisibilityPass::kNoTriangle)
+                continue;
+            // As GBuffer::quantiseDepth (a fragment's depth is never the clear value).
+            depth[pixel] = lossless ? depths[pixel] : decoder.storedDepthNdc(depths[pixel]);
+            writer.write(pixel, row.at(code, int(x)));
         }
     });
 }
@@ -127,20 +156,21 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     resolve(codes, target, exact);
     if (multisample) {
         const FragmentLayers& layers = multisample->layers;
+        std::vector<std::vector<uint32_t>>& lastColumns = multisample->upperWrittenColumns;
+        if (lastColumns.size() != size_t(view.height))
+            multisample->upperLayers.clear(); // another size: every layer is new
         multisample->upperLayers.resize(size_t(layers.layerCount() - 1));
-        multisample->upperWritten.resize(size_t(layers.layerCount() - 1));
         for (int k = 1; k < layers.layerCount(); ++k) {
             std::unique_ptr<GBuffer>& layer = multisample->upperLayers[size_t(k - 1)];
-            std::vector<uint8_t>& written = multisample->upperWritten[size_t(k - 1)];
-            if (!layer || layer->width() != view.width || layer->height() != view.height) {
-                // A new layer: every pixel gets the background value once.
+            const bool fresh = !layer || !sameView(layer->view(), view);
+            if (fresh)
                 layer = std::make_unique<GBuffer>(target.layout(), view);
-                written.assign(target.pixelCount(), 1);
-            }
-            std::span<const float> depths = layers.depths(k);
-            std::copy(depths.begin(), depths.end(), layer->depthPlane().begin());
-            layer->quantiseDepth();
-            resolveSparse(layers.codes(k), *layer, written);
+            resolveUpperLayer(layers, k, *layer, fresh ? nullptr : &lastColumns);
+        }
+        lastColumns.resize(size_t(view.height));
+        for (int y = 0; y < view.height; ++y) {
+            const std::span<const uint32_t> columns = layers.upperColumns(y);
+            lastColumns[size_t(y)].assign(columns.begin(), columns.end());
         }
     }
     timings.resolveMs = millisecondsSince(start);

@@ -44,10 +44,11 @@ struct MultisampleTarget {
     FragmentLayerOptions options;
     FragmentLayers layers;
     std::vector<std::unique_ptr<GBuffer>> upperLayers; // layers 1 .. layerCount - 1
-    // Per upper layer and pixel: whether the last frame wrote a surface there (the upper layers'
-    // resolve writes only their fragments and clears only what the last frame left: their cost
-    // follows the complex pixels, not the screen).
-    std::vector<std::vector<uint8_t>> upperWritten;
+    // Per row, the columns where the last frame's upper layers may hold a surface
+    // (FragmentLayers::upperColumns then): the upper layers' resolve writes only this frame's
+    // fragments and resets only what the last frame left, so its cost follows the complex
+    // pixels, not the screen.
+    std::vector<std::vector<uint32_t>> upperWrittenColumns;
     std::vector<float> sampleDepth; // the per-sample depth buffer
     // The G-buffer of layer k: `target` for 0.
     const GBuffer& layer(const GBuffer& target, int k) const {
@@ -77,10 +78,12 @@ private:
     // Visibility-buffer layouts: `codes` copied into the target, which then fetches its surfaces
     // from this pass's visibility pass.
     void storeCodes(std::span<const uint32_t> codes, GBuffer& target) const;
-    // The same for an upper fragment layer (mostly background): surfaces where `codes` has one,
-    // the background value where `written` says the last frame left a surface; `written` updated.
-    void resolveSparse(std::span<const uint32_t> codes, GBuffer& target,
-                       std::vector<uint8_t>& written) const;
+    // The same for upper fragment layer k (mostly background) into `target`, depth included:
+    // surfaces and depths at the layer's fragments, the background value and clear depth at
+    // `lastColumns` (what the last frame may have written); null `lastColumns`: a new layer,
+    // background everywhere first.
+    void resolveUpperLayer(const FragmentLayers& layers, int k, GBuffer& target,
+                           const std::vector<std::vector<uint32_t>>* lastColumns) const;
 
     const scenes::Scene& mScene;
     const SceneGeometry& mGeometry;

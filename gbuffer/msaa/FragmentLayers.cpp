@@ -32,6 +32,15 @@ float viewDepthAt(const CameraView& view, int x, int y, float depth) {
     return -p.z / p.w;
 }
 
+// Moves values[first] to the front, the ones before it one place up (std::rotate's effect; its
+// inlined form on these 8-entry arrays draws a false -Wstringop-overflow from GCC 12).
+template <class T> void moveToFront(T* values, int first) {
+    const T value = values[first];
+    for (int k = first; k > 0; --k)
+        values[k] = values[k - 1];
+    values[0] = value;
+}
+
 } // namespace
 
 void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayerOptions& options) {
@@ -39,36 +48,63 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     const int samples = visibility.sampleCount();
     if (samples < 2 || visibility.centreDepths().empty())
         throw std::invalid_argument("FragmentLayers: the visibility pass was not multisampled");
+    const float clear = view.clearDepth();
+    // The planes are kept between builds of one size, sample count and clear value (the upper
+    // layers are then "none" except where the last build wrote, which is reset below).
+    if (view.width != mWidth || view.height != mHeight || samples != mSamples ||
+        !(clear == mClearDepth)) {
+        mLayers.clear();
+        mLayerCount = 0;
+        mUpperColumns.assign(size_t(view.height), {});
+    }
     mOptions = options;
     mSamples = samples;
     mWidth = view.width;
     mHeight = view.height;
+    mClearDepth = clear;
     const size_t pixels = pixelCount();
     const size_t stride = size_t(samples);
     const std::span<const uint32_t> sampleCodes = visibility.codes();
     const std::span<const float> sampleDepths = visibility.centreDepths();
 
-    // Per pixel, its fragments in order of their first sample (the main one first after the
-    // sort below): code, coverage and centre depth, at most `samples` of them.
-    // Scratch kept between frames and only resized: every entry read is written first (a fresh
-    // allocation and clear per frame cost more than the build itself, in page faults and memset).
-    std::vector<uint32_t>& fragmentCode = mScratchCode;
-    std::vector<uint8_t>& fragmentMask = mScratchMask;
-    std::vector<float>& fragmentDepth = mScratchDepth;
-    std::vector<uint8_t>& fragmentCount = mScratchCount;
-    fragmentCode.resize(pixels * stride);
-    fragmentMask.resize(pixels * stride);
-    fragmentDepth.resize(pixels * stride);
-    fragmentCount.resize(pixels);
+    if (mLayers.empty()) {
+        // Layer 0: every entry is written by every build.
+        mLayers.resize(1);
+        mLayers[0].codes.resize(pixels);
+        mLayers[0].depths.resize(pixels);
+        mLayers[0].coverage.resize(pixels);
+    }
+    // Per pixel with an extra fragment, its fragments in order (the main one first), at most
+    // `samples` of them: what the upper layers get once their count is known. Scratch kept
+    // between frames and only resized: every entry read is written first.
+    mScratchCode.resize(pixels * stride);
+    mScratchMask.resize(pixels * stride);
+    mScratchDepth.resize(pixels * stride);
+    mScratchCount.resize(pixels);
     mBackground.resize(pixels);
     mComplex.resize(pixels);
+    mRowLayers.resize(size_t(mHeight));
     std::vector<Counts> rowCounts(static_cast<size_t>(mHeight));
-    const float clear = view.clearDepth();
     const float nearer = view.reversedZ() ? 1.0f : 0.0f;
     const bool mergeSmooth = options.detection == ComplexDetection::Discontinuity;
+    const int lastLayerCount = mLayerCount;
+    Layer& main = mLayers[0];
 
     const uint8_t allSamples = uint8_t((1u << samples) - 1u);
     tbb::parallel_for(0, mHeight, [&](int y) {
+        // What the last build left in this row's upper layers goes back to "none".
+        std::vector<uint32_t>& upperColumns = mUpperColumns[size_t(y)];
+        for (const uint32_t x : upperColumns) {
+            const size_t pixel = size_t(y) * mWidth + x;
+            for (int k = 1; k < lastLayerCount; ++k) {
+                Layer& layer = mLayers[size_t(k)];
+                layer.codes[pixel] = VisibilityPass::kNoTriangle;
+                layer.depths[pixel] = clear;
+                layer.coverage[pixel] = 0;
+            }
+        }
+        upperColumns.clear();
+        int rowLayers = 1;
         Counts& counts = rowCounts[size_t(y)];
         // The merge test's surfaces, one reader for main fragments and one for the others: along
         // an edge both keep showing the same two triangles, so each reuses its corners (bitwise
@@ -76,9 +112,9 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
         VisibilityPass::RowSurfaces mainSurfaces(visibility, y), otherSurfaces(visibility, y);
         for (int x = 0; x < mWidth; ++x) {
             const size_t pixel = size_t(y) * mWidth + size_t(x);
-            uint32_t* code = &fragmentCode[pixel * stride];
-            uint8_t* mask = &fragmentMask[pixel * stride];
-            float* depth = &fragmentDepth[pixel * stride];
+            uint32_t code[raster::kMaxSamples];
+            uint8_t mask[raster::kMaxSamples];
+            float depth[raster::kMaxSamples];
             int count = 0, background = 0;
             // Most pixels: every sample shows one triangle (or none), what the loop below finds
             // for them, without its search.
@@ -99,7 +135,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 }
             }
             for (size_t s = 0; s < (uniform ? 0 : stride); ++s) {
-                const uint32_t c = sampleCodes[pixel * stride + s];
+                const uint32_t c = pixelCodes[s];
                 if (c == VisibilityPass::kNoTriangle) {
                     ++background;
                     continue;
@@ -118,15 +154,15 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 mask[k] = uint8_t(mask[k] | 1u << s);
             }
             // The main fragment: most samples, ties to the earliest (stable order).
-            int main = 0;
+            int first = 0;
             for (int k = 1; k < count; ++k)
-                if (std::popcount(mask[k]) > std::popcount(mask[main]))
-                    main = k;
-            std::rotate(code, code + main, code + main + 1);
-            std::rotate(mask, mask + main, mask + main + 1);
-            std::rotate(depth, depth + main, depth + main + 1);
+                if (std::popcount(mask[k]) > std::popcount(mask[first]))
+                    first = k;
+            moveToFront(code, first);
+            moveToFront(mask, first);
+            moveToFront(depth, first);
             if (mergeSmooth && count > 1) {
-                const Surface& first = mainSurfaces.at(code[0], x);
+                const Surface& firstSurface = mainSurfaces.at(code[0], x);
                 const float firstDepth = viewDepthAt(view, x, y, depth[0]);
                 int kept = 1;
                 for (int k = 1; k < count; ++k) {
@@ -134,8 +170,9 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                     const float otherDepth = viewDepthAt(view, x, y, depth[k]);
                     const bool smooth =
                         std::abs(otherDepth - firstDepth) <= options.depthTolerance * firstDepth &&
-                        glm::dot(other.normalView, first.normalView) >= options.normalCosine &&
-                        other.material == first.material;
+                        glm::dot(other.normalView, firstSurface.normalView) >=
+                            options.normalCosine &&
+                        other.material == firstSurface.material;
                     if (smooth) {
                         mask[0] = uint8_t(mask[0] | mask[k]);
                         ++counts.mergedFragments;
@@ -148,7 +185,17 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 }
                 count = kept;
             }
-            fragmentCount[pixel] = uint8_t(count);
+            main.codes[pixel] = count > 0 ? code[0] : VisibilityPass::kNoTriangle;
+            main.depths[pixel] = count > 0 ? depth[0] : clear;
+            main.coverage[pixel] = count > 0 ? mask[0] : 0;
+            if (count > 1) {
+                upperColumns.push_back(uint32_t(x));
+                rowLayers = std::max(rowLayers, count);
+                mScratchCount[pixel] = uint8_t(count);
+                std::copy(code, code + count, &mScratchCode[pixel * stride]);
+                std::copy(mask, mask + count, &mScratchMask[pixel * stride]);
+                std::copy(depth, depth + count, &mScratchDepth[pixel * stride]);
+            }
             mBackground[pixel] = uint8_t(background);
             mComplex[pixel] = 0;
             if (count > 0) {
@@ -161,6 +208,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 }
             }
         }
+        mRowLayers[size_t(y)] = rowLayers;
     });
     mCounts = Counts{};
     for (const Counts& row : rowCounts) {
@@ -171,24 +219,24 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
         mCounts.partialPixels += row.partialPixels;
     }
 
-    const int layers =
-        std::max(1, int(*std::max_element(fragmentCount.begin(), fragmentCount.end())));
-    mLayers.resize(size_t(layers));
-    for (Layer& layer : mLayers) {
-        layer.codes.resize(pixels);
-        layer.depths.resize(pixels);
-        layer.coverage.resize(pixels);
+    mLayerCount = *std::max_element(mRowLayers.begin(), mRowLayers.end());
+    while (int(mLayers.size()) < mLayerCount) {
+        // A layer first needed now: "none" everywhere, then written where it has fragments.
+        Layer& layer = mLayers.emplace_back();
+        layer.codes.assign(pixels, VisibilityPass::kNoTriangle);
+        layer.depths.assign(pixels, clear);
+        layer.coverage.assign(pixels, 0);
     }
-    // Every entry of every layer written once: the fragment, or "none".
+    // The extra fragments into the upper layers, at the pixels that have them only.
     tbb::parallel_for(0, mHeight, [&](int y) {
-        for (int k = 0; k < layers; ++k) {
-            Layer& layer = mLayers[size_t(k)];
-            for (size_t pixel = size_t(y) * mWidth; pixel < size_t(y + 1) * mWidth; ++pixel) {
-                const bool present = k < fragmentCount[pixel];
+        for (const uint32_t x : mUpperColumns[size_t(y)]) {
+            const size_t pixel = size_t(y) * mWidth + x;
+            for (int k = 1; k < mScratchCount[pixel]; ++k) {
+                Layer& layer = mLayers[size_t(k)];
                 const size_t entry = pixel * stride + size_t(k);
-                layer.codes[pixel] = present ? fragmentCode[entry] : VisibilityPass::kNoTriangle;
-                layer.depths[pixel] = present ? fragmentDepth[entry] : clear;
-                layer.coverage[pixel] = present ? fragmentMask[entry] : 0;
+                layer.codes[pixel] = mScratchCode[entry];
+                layer.depths[pixel] = mScratchDepth[entry];
+                layer.coverage[pixel] = mScratchMask[entry];
             }
         }
     });

@@ -32,6 +32,11 @@
 // byte per pixel (fragment count and flags) and the layer's bytes plus a coverage byte per extra
 // fragment; allocatedBytes is what the full planes take.
 //
+// Cost: layer 0 is written at every pixel; the layers above only at the pixels that have an extra
+// fragment (upperColumns) and at those the last build left, which are reset to "none": the planes
+// are kept between builds of one size, so an upper layer's cost follows the complex pixels, not
+// the screen.
+//
 // Deterministic: built per pixel from the visibility buffer; parallel over rows (TBB).
 #pragma once
 
@@ -67,7 +72,7 @@ public:
     int width() const { return mWidth; }
     int height() const { return mHeight; }
     size_t pixelCount() const { return size_t(mWidth) * size_t(mHeight); }
-    int layerCount() const { return int(mLayers.size()); }
+    int layerCount() const { return mLayerCount; }
     const FragmentLayerOptions& options() const { return mOptions; }
 
     // Layer `layer`'s visibility code per pixel (kNoTriangle where the layer has no fragment).
@@ -90,6 +95,12 @@ public:
     float backgroundWeight(size_t pixel) const {
         return float(mBackground[pixel]) / float(mSamples);
     }
+    // The columns x of row y whose pixels have a fragment in some layer above 0, ascending: for
+    // k >= 1, codes(k) is kNoTriangle (and depths(k) the clear depth, coverage(k) 0) everywhere
+    // else. What the upper layers' consumers walk instead of the screen (their cost follows the
+    // complex pixels); valid until the next build.
+    std::span<const uint32_t> upperColumns(int y) const { return mUpperColumns[size_t(y)]; }
+
     // Complex: covered by some sample, and not all samples show one surface (after merging).
     bool complex(size_t pixel) const { return mComplex[pixel] != 0; }
     std::span<const uint8_t> complexMask() const { return mComplex; }
@@ -123,15 +134,19 @@ private:
     int mSamples = 1;
     int mWidth = 0;
     int mHeight = 0;
-    std::vector<Layer> mLayers;
-    std::vector<uint8_t> mBackground; // background samples per pixel
+    std::vector<Layer> mLayers; // allocated; the first mLayerCount are this build's
+    int mLayerCount = 0;
+    float mClearDepth = 0.0f;                         // the view's, at the last build
+    std::vector<std::vector<uint32_t>> mUpperColumns; // per row (upperColumns)
+    std::vector<uint8_t> mBackground;                 // background samples per pixel
     std::vector<uint8_t> mComplex;
     Counts mCounts;
-    // Per pixel and fragment, during build() (kept: see build()).
+    // Per pixel with an extra fragment, its fragments, during build() (kept: see build()).
     std::vector<uint32_t> mScratchCode;
     std::vector<uint8_t> mScratchMask;
     std::vector<float> mScratchDepth;
     std::vector<uint8_t> mScratchCount;
+    std::vector<int> mRowLayers; // per row, the most fragments of a pixel
 };
 
 } // namespace gbuffer

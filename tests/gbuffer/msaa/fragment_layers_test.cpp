@@ -13,6 +13,7 @@
 #include <cstring>
 #include <memory>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -250,9 +251,13 @@ std::vector<OracleFragment> oracleFragments(const VisibilityPass& visibility, in
     return kept;
 }
 
+// One FragmentLayers object per sample count builds the three scenes in turn, so every build
+// but the first reuses planes whose upper layers the last build wrote elsewhere (FragmentLayers
+// resets only those entries): each must still be the definition everywhere.
 TEST(FragmentLayers, EveryLayerIsBitwiseTheDefinitionPixelByPixel) {
-    for (const char* sceneName : {"atrium", "spheres", "glass"})
-        for (int samples : {2, 4, 8})
+    for (int samples : {2, 4, 8}) {
+        FragmentLayers layers;
+        for (const char* sceneName : {"glass", "atrium", "spheres"})
             for (ComplexDetection detection :
                  {ComplexDetection::Primitive, ComplexDetection::Discontinuity}) {
                 const std::string name = std::string(sceneName) + ", " + std::to_string(samples) +
@@ -271,9 +276,17 @@ TEST(FragmentLayers, EveryLayerIsBitwiseTheDefinitionPixelByPixel) {
                 visibility.draw(rasterizer, depth, samples);
                 FragmentLayerOptions options;
                 options.detection = detection;
-                FragmentLayers layers;
                 layers.build(visibility, options);
                 uint64_t complexPixels = 0, fragments = 0;
+                for (int y = 0; y < height; ++y) {
+                    std::vector<uint32_t> upperColumns;
+                    for (int x = 0; x < width; ++x)
+                        if (oracleFragments(visibility, x, y, options).size() > 1)
+                            upperColumns.push_back(uint32_t(x));
+                    const std::span<const uint32_t> got = layers.upperColumns(y);
+                    ASSERT_EQ(std::vector<uint32_t>(got.begin(), got.end()), upperColumns)
+                        << name << ", row " << y;
+                }
                 for (int y = 0; y < height; ++y)
                     for (int x = 0; x < width; ++x) {
                         const size_t pixel = size_t(y) * width + size_t(x);
@@ -309,6 +322,95 @@ TEST(FragmentLayers, EveryLayerIsBitwiseTheDefinitionPixelByPixel) {
                 EXPECT_EQ(layers.counts().fragments, fragments) << name;
                 EXPECT_GT(complexPixels, 100u) << name;
             }
+    }
+}
+
+// Bitwise equality of two surfaces, field by field.
+void expectSameSurface(const Surface& a, const Surface& b, const std::string& where) {
+    auto same = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+    EXPECT_TRUE(same(a.positionView, b.positionView) && same(a.normalView, b.normalView) &&
+                same(a.albedo, b.albedo) && same(a.specularIntensity, b.specularIntensity) &&
+                same(a.specularPower, b.specularPower) && same(a.roughness, b.roughness) &&
+                same(a.metallic, b.metallic) && same(a.occlusion, b.occlusion) &&
+                same(a.emissive, b.emissive) && a.model == b.model && a.material == b.material)
+        << where;
+}
+
+// The multisampled G-buffer pass keeps its fragment layers and upper-layer G-buffers between
+// frames and rewrites an upper layer only where this frame or the last has an extra fragment
+// (GBufferPass::resolveUpperLayer). A sequence of frames through one pass and MultisampleTarget,
+// whose complex pixels change under one view (the detection switched) and then with the view (a
+// jittered camera: new G-buffers), equals a fresh pass rendering each frame alone: the layers,
+// and every upper layer's depth plane and decoded surfaces, bitwise; for a lossless depth format
+// and a quantised one (f16-linear: the depths stored through the format).
+TEST(FragmentLayers, KeptLayersEqualAFreshRenderFrameAfterFrame) {
+    scenes::SceneRequest request;
+    request.lightCount = 4;
+    const scenes::Scene scene = scenes::buildProceduralScene("atrium", request);
+    const SceneGeometry geometry = SceneGeometry::build(scene);
+    const int width = 160, height = 90;
+    struct Step {
+        glm::dvec2 pixelOffset;
+        ComplexDetection detection;
+    };
+    const Step steps[] = {{{0.0, 0.0}, ComplexDetection::Primitive},
+                          {{0.0, 0.0}, ComplexDetection::Discontinuity},
+                          {{0.0, 0.0}, ComplexDetection::Primitive},
+                          {{0.3, -0.2}, ComplexDetection::Primitive},
+                          {{0.3, -0.2}, ComplexDetection::Discontinuity}};
+    for (DepthFormatKind depthKind : {DepthFormatKind::F32Reversed, DepthFormatKind::F16Linear}) {
+        GBufferLayout layout = GBufferLayout::lossless(DepthConvention::Reversed);
+        layout.depth.kind = depthKind;
+        layout.materials = materialTable(scene);
+        GBufferPass keptPass(scene, geometry);
+        MultisampleTarget kept;
+        kept.samples = 4;
+        std::unique_ptr<GBuffer> keptTarget;
+        raster::Rasterizer rasterizer(width, height);
+        int layersSeen = 0;
+        for (size_t step = 0; step < std::size(steps); ++step) {
+            const std::string name =
+                "depth " + std::to_string(int(depthKind)) + ", frame " + std::to_string(step);
+            const CameraView view =
+                CameraView::fromCamera(scene.cameras.front(), width, height,
+                                       DepthConvention::Reversed, false, steps[step].pixelOffset);
+            if (!keptTarget || keptTarget->view().pixelOffset != view.pixelOffset)
+                keptTarget = std::make_unique<GBuffer>(layout, view);
+            kept.options.detection = steps[step].detection;
+            keptPass.render(rasterizer, *keptTarget, nullptr, &kept);
+
+            GBufferPass freshPass(scene, geometry);
+            MultisampleTarget fresh;
+            fresh.samples = 4;
+            fresh.options.detection = steps[step].detection;
+            GBuffer freshTarget(layout, view);
+            freshPass.render(rasterizer, freshTarget, nullptr, &fresh);
+
+            const FragmentLayers& a = kept.layers;
+            const FragmentLayers& b = fresh.layers;
+            ASSERT_EQ(a.layerCount(), b.layerCount()) << name;
+            layersSeen = std::max(layersSeen, a.layerCount());
+            for (int k = 0; k < a.layerCount(); ++k) {
+                ASSERT_TRUE(std::equal(a.codes(k).begin(), a.codes(k).end(), b.codes(k).begin()))
+                    << name << ", layer " << k;
+                ASSERT_TRUE(
+                    std::equal(a.coverage(k).begin(), a.coverage(k).end(), b.coverage(k).begin()))
+                    << name << ", layer " << k;
+                const GBuffer& got = kept.layer(*keptTarget, k);
+                const GBuffer& want = fresh.layer(freshTarget, k);
+                ASSERT_EQ(0, std::memcmp(got.depth().data(), want.depth().data(),
+                                         got.depth().size() * sizeof(float)))
+                    << name << ", layer " << k;
+                for (int y = 0; y < height; ++y)
+                    for (int x = 0; x < width; ++x)
+                        if (want.covered(size_t(y) * width + size_t(x)))
+                            expectSameSurface(got.decode(x, y), want.decode(x, y),
+                                              name + ", layer " + std::to_string(k) + ", pixel " +
+                                                  std::to_string(x) + " " + std::to_string(y));
+            }
+        }
+        EXPECT_GE(layersSeen, 3); // upper layers to keep and reset
+    }
 }
 
 } // namespace
