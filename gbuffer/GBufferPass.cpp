@@ -29,8 +29,8 @@ GBufferPass::GBufferPass(const scenes::Scene& scene, const SceneGeometry& geomet
     VisibilityPass::checkTriangleCount(scene, geometry);
 }
 
-void GBufferPass::resolve(std::span<const uint32_t> codeSpan, GBuffer& target,
-                          ExactSurface* exact) const {
+void GBufferPass::resolve(std::span<const uint32_t> codeSpan, GBuffer& target, ExactSurface* exact,
+                          const UpperLayers* upper) const {
     if (target.layout().visibilityBuffer) {
         storeCodes(codeSpan, target);
         if (!exact)
@@ -64,7 +64,39 @@ void GBufferPass::resolve(std::span<const uint32_t> codeSpan, GBuffer& target,
                 exact->emissive[pixel] = surface.emissive;
             }
         }
+        if (upper)
+            resolveUpperRow(*upper, y);
     });
+}
+
+void GBufferPass::resolveUpperRow(const UpperLayers& upper, int y) const {
+    const FragmentLayers& layers = upper.layers;
+    const size_t rowStart = size_t(y) * size_t(layers.width());
+    const float clear = upper.targets[0]->view().clearDepth(); // targets is not empty
+    for (size_t i = 0; i < upper.targets.size(); ++i) {
+        const std::span<float> depth = upper.targets[i]->depthPlane();
+        for (const uint32_t x : upper.lastColumns[size_t(y)]) {
+            upper.writers[i].writeBackground(rowStart + x);
+            depth[rowStart + x] = clear;
+        }
+    }
+    const DepthDecoder& decoder = upper.targets[0]->depthDecoder(); // every layer's layout
+    const bool lossless = decoder.lossless();
+    VisibilityPass::RowSurfaces surfaces(mVisibility, y);
+    for (const uint32_t x : layers.upperColumns(y)) {
+        const size_t pixel = rowStart + x;
+        // A pixel's fragments fill layers 1, 2, ... in order: the first without one ends them.
+        for (int k = 1; k < layers.layerCount(); ++k) {
+            const uint32_t code = layers.codes(k)[pixel];
+            if (code == VisibilityPass::kNoTriangle)
+                break;
+            // As GBuffer::quantiseDepth (a fragment's depth is never the clear value).
+            const float z = layers.depths(k)[pixel];
+            upper.targets[size_t(k - 1)]->depthPlane()[pixel] =
+                lossless ? z : decoder.storedDepthNdc(z);
+            upper.writers[size_t(k - 1)].write(pixel, surfaces.at(code, int(x)));
+        }
+    }
 }
 
 void GBufferPass::storeCodes(std::span<const uint32_t> codes, GBuffer& target) const {
@@ -76,48 +108,55 @@ void GBufferPass::storeCodes(std::span<const uint32_t> codes, GBuffer& target) c
     target.fetchSurfacesFrom(mVisibility);
 }
 
-void GBufferPass::resolveUpperLayer(const FragmentLayers& layers, int k, GBuffer& target,
-                                    const std::vector<std::vector<uint32_t>>* lastColumns) const {
-    const std::span<const uint32_t> codes = layers.codes(k);
-    const std::span<const float> depths = layers.depths(k);
-    const std::span<float> depth = target.depthPlane();
-    if (target.layout().visibilityBuffer) {
-        // The codes and depths are the G-buffer: copied whole.
-        std::copy(depths.begin(), depths.end(), depth.begin());
-        target.quantiseDepth();
-        storeCodes(codes, target);
-        return;
+void GBufferPass::resolveLayers(std::span<const uint32_t> codes, GBuffer& target,
+                                ExactSurface* exact, MultisampleTarget& multisample) const {
+    const FragmentLayers& layers = multisample.layers;
+    const CameraView& view = target.view();
+    std::vector<std::vector<uint32_t>>& lastColumns = multisample.upperWrittenColumns;
+    if (lastColumns.size() != size_t(view.height)) {
+        multisample.upperLayers.clear(); // another size: every layer is new
+        lastColumns.assign(size_t(view.height), {});
     }
-    const int width = target.width();
-    const float clear = target.view().clearDepth();
-    const DepthDecoder& decoder = target.depthDecoder();
-    const bool lossless = decoder.lossless();
-    const GBuffer::Writer sharedWriter = target.writer();
-    tbb::parallel_for(0, target.height(), [&](int y) {
-        const GBuffer::Writer writer = sharedWriter;
-        const size_t rowStart = size_t(y) * size_t(width);
-        if (!lastColumns) {
-            for (size_t pixel = rowStart; pixel < rowStart + size_t(width); ++pixel) {
-                writer.writeBackground(pixel);
-                depth[pixel] = clear;
-            }
-        } else {
-            for (const uint32_t x : (*lastColumns)[size_t(y)]) {
-                writer.writeBackground(rowStart + x);
-                depth[rowStart + x] = clear;
-            }
+    multisample.upperLayers.resize(size_t(layers.layerCount() - 1));
+    std::vector<GBuffer*> targets;
+    std::vector<GBuffer::Writer> writers;
+    for (std::unique_ptr<GBuffer>& layer : multisample.upperLayers) {
+        if (!layer || !sameView(layer->view(), view)) {
+            // A new layer: background everywhere (a moved or jittered view makes a new one).
+            layer = std::make_unique<GBuffer>(target.layout(), view);
+            const std::span<float> depth = layer->depthPlane();
+            const GBuffer::Writer writer = layer->writer();
+            const float clear = view.clearDepth();
+            tbb::parallel_for(
+                tbb::blocked_range<size_t>(0, layer->pixelCount(), 16384), [&](const auto& range) {
+                    for (size_t pixel = range.begin(); pixel != range.end(); ++pixel) {
+                        writer.writeBackground(pixel);
+                        depth[pixel] = clear;
+                    }
+                });
         }
-        VisibilityPass::RowSurfaces row(mVisibility, y);
-        for (const uint32_t x : layers.upperColumns(y)) {
-            const size_t pixel = rowStart + x;
-            const uint32_t code = codes[pixel];
-            if (code == VisibilityPass::kNoTriangle)
-                continue;
-            // As GBuffer::quantiseDepth (a fragment's depth is never the clear value).
-            depth[pixel] = lossless ? depths[pixel] : decoder.storedDepthNdc(depths[pixel]);
-            writer.write(pixel, row.at(code, int(x)));
+        targets.push_back(layer.get());
+        writers.push_back(layer->writer());
+    }
+    if (target.layout().visibilityBuffer || targets.empty()) {
+        // The codes and depths are a visibility-buffer layout's G-buffer: copied whole.
+        resolve(codes, target, exact);
+        for (int k = 1; k < layers.layerCount(); ++k) {
+            GBuffer& layer = *targets[size_t(k - 1)];
+            const std::span<const float> depths = layers.depths(k);
+            std::copy(depths.begin(), depths.end(), layer.depthPlane().begin());
+            layer.quantiseDepth();
+            if (layer.layout().visibilityBuffer)
+                storeCodes(layers.codes(k), layer);
         }
-    });
+    } else {
+        const UpperLayers upper{layers, targets, writers, lastColumns};
+        resolve(codes, target, exact, &upper);
+    }
+    for (int y = 0; y < view.height; ++y) {
+        const std::span<const uint32_t> columns = layers.upperColumns(y);
+        lastColumns[size_t(y)].assign(columns.begin(), columns.end());
+    }
 }
 
 GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& target,
@@ -153,26 +192,10 @@ GBufferPassTimings GBufferPass::render(raster::Rasterizer& rasterizer, GBuffer& 
     target.quantiseDepth();
     if (exact)
         exact->resize(view.width, view.height);
-    resolve(codes, target, exact);
-    if (multisample) {
-        const FragmentLayers& layers = multisample->layers;
-        std::vector<std::vector<uint32_t>>& lastColumns = multisample->upperWrittenColumns;
-        if (lastColumns.size() != size_t(view.height))
-            multisample->upperLayers.clear(); // another size: every layer is new
-        multisample->upperLayers.resize(size_t(layers.layerCount() - 1));
-        for (int k = 1; k < layers.layerCount(); ++k) {
-            std::unique_ptr<GBuffer>& layer = multisample->upperLayers[size_t(k - 1)];
-            const bool fresh = !layer || !sameView(layer->view(), view);
-            if (fresh)
-                layer = std::make_unique<GBuffer>(target.layout(), view);
-            resolveUpperLayer(layers, k, *layer, fresh ? nullptr : &lastColumns);
-        }
-        lastColumns.resize(size_t(view.height));
-        for (int y = 0; y < view.height; ++y) {
-            const std::span<const uint32_t> columns = layers.upperColumns(y);
-            lastColumns[size_t(y)].assign(columns.begin(), columns.end());
-        }
-    }
+    if (multisample)
+        resolveLayers(codes, target, exact, *multisample);
+    else
+        resolve(codes, target, exact);
     timings.resolveMs = millisecondsSince(start);
 
     if (exact) {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "gbuffer/GBuffer.h"
@@ -72,18 +73,31 @@ public:
                               MultisampleTarget* multisample = nullptr);
 
 private:
+    // The upper fragment layers a multisampled resolve fills beside layer 0 (resolve()).
+    struct UpperLayers {
+        const FragmentLayers& layers;
+        std::span<GBuffer* const> targets;        // layer k's G-buffer at k - 1
+        std::span<const GBuffer::Writer> writers; // the same order
+        // Per row, the columns where the last frame's upper layers may hold a surface: reset to
+        // the background value and clear depth before this frame's are written.
+        const std::vector<std::vector<uint32_t>>& lastColumns;
+    };
     // Encodes the surfaces of `codes` (one per pixel) into `target`, whose depth plane holds
-    // their depths already.
-    void resolve(std::span<const uint32_t> codes, GBuffer& target, ExactSurface* exact) const;
+    // their depths already; with `upper`, each row's upper-layer fragments right after the row
+    // (an upper fragment's triangle is mostly the main fragment of a neighbouring pixel, so its
+    // vertices are still in cache: resolved in passes of their own, they missed it at every
+    // pixel and cost four times a main fragment).
+    void resolve(std::span<const uint32_t> codes, GBuffer& target, ExactSurface* exact,
+                 const UpperLayers* upper = nullptr) const;
+    void resolveUpperRow(const UpperLayers& upper, int y) const;
     // Visibility-buffer layouts: `codes` copied into the target, which then fetches its surfaces
     // from this pass's visibility pass.
     void storeCodes(std::span<const uint32_t> codes, GBuffer& target) const;
-    // The same for upper fragment layer k (mostly background) into `target`, depth included:
-    // surfaces and depths at the layer's fragments, the background value and clear depth at
-    // `lastColumns` (what the last frame may have written); null `lastColumns`: a new layer,
-    // background everywhere first.
-    void resolveUpperLayer(const FragmentLayers& layers, int k, GBuffer& target,
-                           const std::vector<std::vector<uint32_t>>* lastColumns) const;
+    // Sets up multisample->upperLayers for this frame's layers (a new layer: background
+    // everywhere) and resolves them: beside layer 0 in resolve(), or for a visibility-buffer
+    // layout by copying each layer's codes and depths whole.
+    void resolveLayers(std::span<const uint32_t> codes, GBuffer& target, ExactSurface* exact,
+                       MultisampleTarget& multisample) const;
 
     const scenes::Scene& mScene;
     const SceneGeometry& mGeometry;
