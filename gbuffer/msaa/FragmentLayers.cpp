@@ -105,36 +105,38 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
         }
         upperColumns.clear();
         int rowLayers = 1;
-        Counts& counts = rowCounts[size_t(y)];
+        Counts counts; // local: the byte planes' stores could alias a reference's fields
         // The merge test's surfaces, one reader for main fragments and one for the others: along
         // an edge both keep showing the same two triangles, so each reuses its corners (bitwise
         // surfaceAt()).
         VisibilityPass::RowSurfaces mainSurfaces(visibility, y), otherSurfaces(visibility, y);
         for (int x = 0; x < mWidth; ++x) {
             const size_t pixel = size_t(y) * mWidth + size_t(x);
-            uint32_t code[raster::kMaxSamples];
-            uint8_t mask[raster::kMaxSamples];
-            float depth[raster::kMaxSamples];
-            int count = 0, background = 0;
-            // Most pixels: every sample shows one triangle (or none), what the loop below finds
-            // for them, without its search.
+            // Most pixels: every sample shows one triangle (or none), what the search below
+            // finds for them, written straight into layer 0 (no fragment arrays).
             const uint32_t* pixelCodes = &sampleCodes[pixel * stride];
             bool uniform = true;
             for (size_t s = 1; s < stride; ++s)
                 uniform &= pixelCodes[s] == pixelCodes[0];
             if (uniform) {
-                if (pixelCodes[0] == VisibilityPass::kNoTriangle) {
-                    background = samples;
-                } else {
-                    code[0] = pixelCodes[0];
-                    mask[0] = allSamples;
-                    depth[0] = sampleDepths[pixel * stride];
-                    if (depth[0] == clear)
-                        depth[0] = std::nextafter(clear, nearer);
-                    count = 1;
-                }
+                const bool covered = pixelCodes[0] != VisibilityPass::kNoTriangle;
+                const float centre = sampleDepths[pixel * stride];
+                main.codes[pixel] = pixelCodes[0];
+                main.depths[pixel] = !covered          ? clear
+                                     : centre == clear ? std::nextafter(clear, nearer)
+                                                       : centre;
+                main.coverage[pixel] = covered ? allSamples : 0;
+                mBackground[pixel] = covered ? 0 : uint8_t(samples);
+                mComplex[pixel] = 0;
+                counts.coveredPixels += covered;
+                counts.fragments += covered;
+                continue;
             }
-            for (size_t s = 0; s < (uniform ? 0 : stride); ++s) {
+            uint32_t code[raster::kMaxSamples];
+            uint8_t mask[raster::kMaxSamples];
+            float depth[raster::kMaxSamples];
+            int count = 0, background = 0;
+            for (size_t s = 0; s < stride; ++s) {
                 const uint32_t c = pixelCodes[s];
                 if (c == VisibilityPass::kNoTriangle) {
                     ++background;
@@ -209,6 +211,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
             }
         }
         mRowLayers[size_t(y)] = rowLayers;
+        rowCounts[size_t(y)] = counts;
     });
     mCounts = Counts{};
     for (const Counts& row : rowCounts) {

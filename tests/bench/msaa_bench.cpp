@@ -2,7 +2,8 @@
 // 2 threads, the stage's derived G-buffer layout. One benchmark per (stage, samples, detection)
 // renders the 1-sample frame and the multisampled one ALTERNATELY in the same minutes and reports
 // their ratios (frame, G-buffer pass, G-buffer bytes as the fragment layers store them), the
-// complex fraction and the surfaces shaded per covered pixel, with minimum and median times.
+// complex fraction and the surfaces shaded per covered pixel, with minimum and median times, and
+// the G-buffer pass's phases (rasterization, fragment layers, resolve; minimum, 1x beside).
 // Targets at 4x: frame <= 2.0x (tiled, clustered), G-buffer pass <= 2.5x, bytes <= 2.5x.
 //   build/bin/testbed_bench --benchmark_filter=msaaCost --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
@@ -27,9 +28,13 @@ const char* const kStages[] = {"brute", "deferred",       "light-indexed", "clus
 
 struct Sampled {
     std::vector<double> frameMs, gbufferMs;
-    void add(double frame, double gbuffer) {
+    std::vector<double> rasterMs, layersMs, resolveMs; // the G-buffer pass's phases
+    void add(double frame, const gbuffer::GBufferPassTimings& t) {
         frameMs.push_back(frame);
-        gbufferMs.push_back(gbuffer);
+        gbufferMs.push_back(t.transformMs + t.rasterMs + t.layersMs + t.resolveMs);
+        rasterMs.push_back(t.rasterMs);
+        layersMs.push_back(t.layersMs);
+        resolveMs.push_back(t.resolveMs);
     }
     static double median(std::vector<double> v) {
         std::sort(v.begin(), v.end());
@@ -76,8 +81,7 @@ void msaaCost(benchmark::State& state) {
             const double ms =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                     .count();
-            const gbuffer::GBufferPassTimings& t = frames[i]->gbufferTimings;
-            measured[i].add(ms, t.transformMs + t.rasterMs + t.layersMs + t.resolveMs);
+            measured[i].add(ms, frames[i]->gbufferTimings);
             if (i == 1)
                 iteration = ms;
         }
@@ -95,6 +99,13 @@ void msaaCost(benchmark::State& state) {
         Sampled::min(measured[1].frameMs) / Sampled::min(measured[0].frameMs);
     state.counters["gbuffer_ratio_min"] =
         Sampled::min(measured[1].gbufferMs) / Sampled::min(measured[0].gbufferMs);
+    // The G-buffer pass's phases (minimum over the iterations): rasterization, the fragment
+    // layers' build, the resolve of every layer; 1x beside.
+    state.counters["raster_1x_ms_min"] = Sampled::min(measured[0].rasterMs);
+    state.counters["resolve_1x_ms_min"] = Sampled::min(measured[0].resolveMs);
+    state.counters["raster_ms_min"] = Sampled::min(measured[1].rasterMs);
+    state.counters["layers_ms_min"] = Sampled::min(measured[1].layersMs);
+    state.counters["resolve_ms_min"] = Sampled::min(measured[1].resolveMs);
     state.counters["bytes_ratio"] = layers.storedBytes(bytesPerPixel) / oneSampleBytes;
     state.counters["alloc_ratio"] = layers.allocatedBytes(bytesPerPixel) / oneSampleBytes;
     state.counters["complex_frac"] = layers.complexFraction();
