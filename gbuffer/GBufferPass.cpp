@@ -138,7 +138,9 @@ void GBufferPass::resolveLayers(std::span<const uint32_t> codes, GBuffer& target
         targets.push_back(layer.get());
         writers.push_back(layer->writer());
     }
-    if (target.layout().visibilityBuffer || targets.empty()) {
+    if (targets.empty()) {
+        resolve(codes, target, exact);
+    } else if (target.layout().visibilityBuffer) {
         // The codes and depths are a visibility-buffer layout's G-buffer: copied whole.
         resolve(codes, target, exact);
         for (int k = 1; k < layers.layerCount(); ++k) {
@@ -146,8 +148,7 @@ void GBufferPass::resolveLayers(std::span<const uint32_t> codes, GBuffer& target
             const std::span<const float> depths = layers.depths(k);
             std::copy(depths.begin(), depths.end(), layer.depthPlane().begin());
             layer.quantiseDepth();
-            if (layer.layout().visibilityBuffer)
-                storeCodes(layers.codes(k), layer);
+            storeCodes(layers.codes(k), layer);
         }
     } else {
         const UpperLayers upper{layers, targets, writers, lastColumns};
