@@ -12,7 +12,10 @@ namespace {
 // planes, cleared at every shade() call (once per fragment layer with MSAA), which one thread's
 // memset made a visible share of the frame.
 template <class T> void zeroFill(std::vector<T>& plane, size_t n) {
-    plane.resize(n);
+    if (plane.size() != n) {
+        plane.assign(n, T{}); // another size (the first frame): allocated zeroed, once
+        return;
+    }
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const auto& range) {
         std::fill(plane.begin() + range.begin(), plane.begin() + range.end(), T{});
     });
