@@ -166,82 +166,78 @@ HWY_INLINE uint64_t pixelsWithAPass(DF df, hn::Mask<DF> pass, size_t pixels, siz
     return count;
 }
 
-// The samples of [lo, hi] are contiguous (depth[px * samples + s]), so the loop walks them as one
-// flat array: with at least as many lanes as samples a vector holds whole pixels (lane l is
-// pixel l / samples, sample l % samples), otherwise a pixel takes samples / lanes vectors. Edge
-// values are int64 lanes of the same count, advanced by adds.
-template <DepthTest kTest>
-MultisampleSpanCounts multisampleSpanLoopFunction(const MultisampleSpanArgs& span) {
-    const hn::ScalableTag<double> dd;
-    const hn::Rebind<float, decltype(dd)> df;
-    const hn::RebindToSigned<decltype(dd)> di;
-    const size_t lanes = hn::Lanes(dd);
+// What the vectors of a multisampled span share when a vector holds whole pixels (lanes >=
+// samples; lane l is pixel l / samples, sample l % samples): the lanes' depth offsets, their
+// pixel (as double), and per edge the lanes' offsets from the span's first pixel centre (the
+// sample's offset plus the edge's step times the lane's pixel) and the step of a whole vector.
+// Fixed over a triangle: made once per MultisampleTriangleArgs, or per span by the span form.
+// Made in registers: patterns written to memory and loaded back as a vector stalled on store
+// forwarding.
+template <class DD> struct LanePatterns {
+    hn::Vec<DD> offsets;
+    hn::Vec<DD> pixelOfLane;
+    hn::Vec<hn::RebindToSigned<DD>> edgeOfLane[3];
+    hn::Vec<hn::RebindToSigned<DD>> edgeAdvance[3];
+    size_t pixelsPerVector;
+
+    // From the samples' offsets (kMaxSamples readable), the edges' offsets and steps.
+    HWY_INLINE static LanePatterns make(DD dd, size_t samples, const double* sampleOffsets,
+                                        const int64_t (*edgeOffsets)[kMaxSamples],
+                                        const int64_t edgeStep[3]) {
+        const hn::RebindToSigned<DD> di;
+        LanePatterns p;
+        p.pixelsPerVector = hn::Lanes(dd) / samples;
+        const auto sampleOfLane = hn::And(hn::Iota(di, 0), hn::Set(di, int64_t(samples) - 1));
+        const auto pixelOfLane = hn::ShiftRightSame(hn::Iota(di, 0), std::countr_zero(samples));
+        p.offsets = hn::TableLookupLanes(hn::LoadU(dd, sampleOffsets),
+                                         hn::IndicesFromVec(dd, sampleOfLane));
+        p.pixelOfLane = hn::ConvertTo(dd, pixelOfLane);
+        for (int e = 0; e < 3; ++e) {
+            // The offset of the lane's sample plus step * pixel, by adds (no int64 multiply on
+            // every target).
+            const auto step = hn::Set(di, edgeStep[e]);
+            auto value = hn::TableLookupLanes(hn::LoadU(di, edgeOffsets[e]),
+                                              hn::IndicesFromVec(di, sampleOfLane));
+            for (int64_t q = 1; q < int64_t(p.pixelsPerVector); ++q)
+                value = hn::Add(value,
+                                hn::IfThenElseZero(hn::Gt(pixelOfLane, hn::Set(di, q - 1)), step));
+            p.edgeOfLane[e] = value;
+            p.edgeAdvance[e] = hn::Set(di, edgeStep[e] * int64_t(p.pixelsPerVector));
+        }
+        return p;
+    }
+};
+
+// A span of whole-pixel vectors with its triangle's patterns: a flat walk over the span's samples
+// (contiguous: depth[px * samples + s]). Edge values are int64 lanes of the vector's count,
+// advanced by adds.
+template <DepthTest kTest, class DD>
+HWY_INLINE MultisampleSpanCounts wholePixelSpan(DD dd, const MultisampleSpanArgs& span,
+                                                const LanePatterns<DD>& patterns) {
+    const hn::Rebind<float, DD> df;
+    const hn::RebindToSigned<DD> di;
     const size_t samples = size_t(span.samples);
+    const size_t pixelsPerVector = patterns.pixelsPerVector;
     MultisampleSpanCounts counts;
-    // sampleOffsets and edgeOffsets hold kMaxSamples values: one vector's load (the lane
-    // patterns' source).
-    if (lanes > size_t(kMaxSamples) || span.lo > span.hi)
-        return lanes > size_t(kMaxSamples) ? detail::multisampleSpanScalarLoop<kTest>(span)
-                                           : counts;
     const auto zRow = hn::Set(dd, span.zRow);
     const auto zStep = hn::Set(dd, span.zStep);
-    if (lanes < samples) {
-        for (int px = span.lo; px <= span.hi; ++px) {
-            const int64_t k = px - span.lo;
-            const auto zCentre = hn::Add(zRow, hn::Mul(zStep, hn::Set(dd, double(px))));
-            bool any = false;
-            for (size_t c = 0; c < samples; c += lanes) {
-                hn::Vec<decltype(di)> edge[3];
-                for (int e = 0; e < 3; ++e)
-                    edge[e] = hn::Add(hn::Set(di, span.edgeAtLo[e] + span.edgeStep[e] * k),
-                                      hn::LoadU(di, span.edgeOffsets[e] + c));
-                const auto covered = coveredLanes(df, edge);
-                counts.samplesCovered += hn::CountTrue(df, covered);
-                const auto offsets = hn::LoadU(dd, span.sampleOffsets + c);
-                const auto pass = multisampleVector<kTest>(dd, span, size_t(px) * samples + c,
-                                                           zCentre, offsets, covered, true);
-                counts.samplesPassed += hn::CountTrue(df, pass);
-                any |= !hn::AllFalse(df, pass);
-            }
-            counts.fragments += any;
-        }
-        return counts;
-    }
-    // Lane l's sample l % samples and pixel l / samples, made in registers: spans are short, and
-    // patterns written to memory and loaded back as a vector stalled on store forwarding.
-    const size_t pixelsPerVector = lanes / samples;
-    const auto sampleOfLane = hn::And(hn::Iota(di, 0), hn::Set(di, int64_t(samples) - 1));
-    const auto pixelOfLane = hn::ShiftRightSame(hn::Iota(di, 0), std::countr_zero(samples));
-    const auto sampleIndices = hn::IndicesFromVec(dd, sampleOfLane);
-    const auto offsets = hn::TableLookupLanes(hn::LoadU(dd, span.sampleOffsets), sampleIndices);
-    hn::Vec<decltype(di)> edge[3], edgeAdvance[3];
-    for (int e = 0; e < 3; ++e) {
-        // edgeAtLo + edgeStep * pixel + offset of the lane's sample, by adds (no int64 multiply
-        // on every target).
-        const auto step = hn::Set(di, span.edgeStep[e]);
-        auto value = hn::Add(hn::Set(di, span.edgeAtLo[e]),
-                             hn::TableLookupLanes(hn::LoadU(di, span.edgeOffsets[e]),
-                                                  hn::IndicesFromVec(di, sampleOfLane)));
-        for (int64_t p = 1; p < int64_t(pixelsPerVector); ++p)
-            value =
-                hn::Add(value, hn::IfThenElseZero(hn::Gt(pixelOfLane, hn::Set(di, p - 1)), step));
-        edge[e] = value;
-        edgeAdvance[e] = hn::Set(di, span.edgeStep[e] * int64_t(pixelsPerVector));
-    }
+    hn::Vec<decltype(di)> edge[3];
+    for (int e = 0; e < 3; ++e)
+        edge[e] = hn::Add(hn::Set(di, span.edgeAtLo[e]), patterns.edgeOfLane[e]);
     const auto advance = hn::Set(dd, double(pixelsPerVector));
-    auto px = hn::Add(hn::Set(dd, double(span.lo)), hn::ConvertTo(dd, pixelOfLane));
+    auto px = hn::Add(hn::Set(dd, double(span.lo)), patterns.pixelOfLane);
     int x = span.lo;
     for (; x + int(pixelsPerVector) - 1 <= span.hi; x += int(pixelsPerVector)) {
         const auto covered = coveredLanes(df, edge);
         counts.samplesCovered += hn::CountTrue(df, covered);
         const auto zCentre = hn::Add(zRow, hn::Mul(zStep, px));
-        const auto pass = multisampleVector<kTest>(dd, span, size_t(x) * samples, zCentre, offsets,
-                                                   covered, true);
+        const auto pass = multisampleVector<kTest>(dd, span, size_t(x) * samples, zCentre,
+                                                   patterns.offsets, covered, true);
         counts.samplesPassed += hn::CountTrue(df, pass);
         counts.fragments += pixelsWithAPass(df, pass, pixelsPerVector, samples);
         px = hn::Add(px, advance);
         for (int e = 0; e < 3; ++e)
-            edge[e] = hn::Add(edge[e], edgeAdvance[e]);
+            edge[e] = hn::Add(edge[e], patterns.edgeAdvance[e]);
     }
     if (x > span.hi)
         return counts;
@@ -250,22 +246,113 @@ MultisampleSpanCounts multisampleSpanLoopFunction(const MultisampleSpanArgs& spa
     tail.lo = x;
     for (int e = 0; e < 3; ++e)
         tail.edgeAtLo[e] = span.edgeAtLo[e] + span.edgeStep[e] * int64_t(x - span.lo);
-    const MultisampleSpanCounts rest = detail::multisampleSpanScalarLoop<kTest>(tail);
-    counts.samplesCovered += rest.samplesCovered;
-    counts.samplesPassed += rest.samplesPassed;
-    counts.fragments += rest.fragments;
+    detail::addCounts(counts, detail::multisampleSpanScalarLoop<kTest>(tail));
 #else
     // The last pixels (fewer than a vector holds) as one masked vector, as spanLoop's tail.
     const size_t pixels = size_t(span.hi - x + 1);
     const auto covered = hn::And(hn::FirstN(df, pixels * samples), coveredLanes(df, edge));
     counts.samplesCovered += hn::CountTrue(df, covered);
     const auto zCentre = hn::Add(zRow, hn::Mul(zStep, px));
-    const auto pass =
-        multisampleVector<kTest>(dd, span, size_t(x) * samples, zCentre, offsets, covered, false);
+    const auto pass = multisampleVector<kTest>(dd, span, size_t(x) * samples, zCentre,
+                                               patterns.offsets, covered, false);
     counts.samplesPassed += hn::CountTrue(df, pass);
     counts.fragments += pixelsWithAPass(df, pass, pixels, samples);
 #endif
     return counts;
+}
+
+// A pixel takes samples / lanes vectors (more samples than a vector has lanes).
+template <DepthTest kTest, class DD>
+HWY_INLINE MultisampleSpanCounts splitPixelSpan(DD dd, const MultisampleSpanArgs& span) {
+    const hn::Rebind<float, DD> df;
+    const hn::RebindToSigned<DD> di;
+    const size_t lanes = hn::Lanes(dd);
+    const size_t samples = size_t(span.samples);
+    MultisampleSpanCounts counts;
+    const auto zRow = hn::Set(dd, span.zRow);
+    const auto zStep = hn::Set(dd, span.zStep);
+    for (int px = span.lo; px <= span.hi; ++px) {
+        const int64_t k = px - span.lo;
+        const auto zCentre = hn::Add(zRow, hn::Mul(zStep, hn::Set(dd, double(px))));
+        bool any = false;
+        for (size_t c = 0; c < samples; c += lanes) {
+            hn::Vec<decltype(di)> edge[3];
+            for (int e = 0; e < 3; ++e)
+                edge[e] = hn::Add(hn::Set(di, span.edgeAtLo[e] + span.edgeStep[e] * k),
+                                  hn::LoadU(di, span.edgeOffsets[e] + c));
+            const auto covered = coveredLanes(df, edge);
+            counts.samplesCovered += hn::CountTrue(df, covered);
+            const auto offsets = hn::LoadU(dd, span.sampleOffsets + c);
+            const auto pass = multisampleVector<kTest>(dd, span, size_t(px) * samples + c, zCentre,
+                                                       offsets, covered, true);
+            counts.samplesPassed += hn::CountTrue(df, pass);
+            any |= !hn::AllFalse(df, pass);
+        }
+        counts.fragments += any;
+    }
+    return counts;
+}
+
+// The span form: with at least as many lanes as samples a vector holds whole pixels, otherwise a
+// pixel takes samples / lanes vectors.
+template <DepthTest kTest>
+MultisampleSpanCounts multisampleSpanLoopFunction(const MultisampleSpanArgs& span) {
+    const hn::ScalableTag<double> dd;
+    const size_t lanes = hn::Lanes(dd);
+    const size_t samples = size_t(span.samples);
+    // sampleOffsets and edgeOffsets hold kMaxSamples values: one vector's load (the lane
+    // patterns' source).
+    if (lanes > size_t(kMaxSamples))
+        return detail::multisampleSpanScalarLoop<kTest>(span);
+    if (span.lo > span.hi)
+        return {};
+    if (lanes < samples)
+        return splitPixelSpan<kTest>(dd, span);
+    return wholePixelSpan<kTest>(
+        dd, span,
+        LanePatterns<hn::ScalableTag<double>>::make(dd, samples, span.sampleOffsets,
+                                                    span.edgeOffsets, span.edgeStep));
+}
+
+// The triangle form: the patterns once, then every row's span.
+template <DepthTest kTest>
+MultisampleSpanCounts multisampleTriangleFunction(const MultisampleTriangleArgs& t) {
+    const hn::ScalableTag<double> dd;
+    const size_t lanes = hn::Lanes(dd);
+    const size_t samples = size_t(t.samples);
+    MultisampleSpanCounts counts;
+    if (lanes > size_t(kMaxSamples)) {
+        detail::forEachMultisampleRow(t, [&](const MultisampleSpanArgs& span) {
+            detail::addCounts(counts, detail::multisampleSpanScalarLoop<kTest>(span));
+        });
+    } else if (lanes < samples) {
+        detail::forEachMultisampleRow(t, [&](const MultisampleSpanArgs& span) {
+            detail::addCounts(counts, splitPixelSpan<kTest>(dd, span));
+        });
+    } else {
+        const auto patterns = LanePatterns<hn::ScalableTag<double>>::make(
+            dd, samples, t.sampleOffsets, t.edgeOffsets, t.edgeStepX);
+        detail::forEachMultisampleRow(t, [&](const MultisampleSpanArgs& span) {
+            detail::addCounts(counts, wholePixelSpan<kTest>(dd, span, patterns));
+        });
+    }
+    return counts;
+}
+
+MultisampleTriangleLoop multisampleTriangleLoopFor(DepthTest test) {
+    switch (test) {
+    case DepthTest::Always:
+        return &multisampleTriangleFunction<DepthTest::Always>;
+    case DepthTest::Less:
+        return &multisampleTriangleFunction<DepthTest::Less>;
+    case DepthTest::LessEqual:
+        return &multisampleTriangleFunction<DepthTest::LessEqual>;
+    case DepthTest::Greater:
+        return &multisampleTriangleFunction<DepthTest::Greater>;
+    case DepthTest::GreaterEqual:
+        return &multisampleTriangleFunction<DepthTest::GreaterEqual>;
+    }
+    return nullptr;
 }
 
 MultisampleSpanLoop multisampleSpanLoopFor(DepthTest test) {
@@ -292,9 +379,22 @@ namespace raster {
 
 HWY_EXPORT(depthSpanLoopFor);
 HWY_EXPORT(multisampleSpanLoopFor);
+HWY_EXPORT(multisampleTriangleLoopFor);
 
 MultisampleSpanLoop multisampleSpanLoop(DepthTest test) {
     return HWY_DYNAMIC_DISPATCH(multisampleSpanLoopFor)(test);
+}
+
+MultisampleTriangleLoop multisampleTriangleLoop(DepthTest test) {
+    return HWY_DYNAMIC_DISPATCH(multisampleTriangleLoopFor)(test);
+}
+
+MultisampleSpanCounts multisampleTriangleScalar(DepthTest test, const MultisampleTriangleArgs& t) {
+    MultisampleSpanCounts counts;
+    detail::forEachMultisampleRow(t, [&](const MultisampleSpanArgs& span) {
+        detail::addCounts(counts, multisampleSpanScalar(test, span));
+    });
+    return counts;
 }
 
 MultisampleSpanCounts multisampleSpanScalar(DepthTest test, const MultisampleSpanArgs& span) {

@@ -413,37 +413,6 @@ inline int64_t fillBias(int32_t ax, int32_t ay, int32_t bx, int32_t by) {
     return topLeft ? 0 : -1;
 }
 
-// One row's covered pixels: pixel first + k, 0 <= k <= kMax, is covered when
-// value[e] + k * step[e] >= 0 for the three edges (value: the edge function at the row's first
-// pixel plus the fill bias, step: its change per pixel). The half-planes are convex, so the
-// covered k form one interval [kLo, kHi], found with at most one integer division per edge and
-// none for an edge that does not bound the interval inside [0, kMax] (most edges of a small
-// triangle's rows). Exact: the same integer tests as pixel by pixel. Empty when kLo > kHi.
-struct RowSpan {
-    int64_t kLo, kHi;
-};
-[[gnu::always_inline]] inline RowSpan coveredSpan(const int64_t value[3], const int64_t step[3],
-                                                  int64_t kMax) {
-    RowSpan span{0, kMax};
-    for (int e = 0; e < 3; ++e) {
-        const int64_t v = value[e], s = step[e];
-        if (s >= 0) {
-            if (v < 0) {
-                // Covered from ceil(-v / s) on; never when s == 0.
-                if (s == 0 || v + s * span.kHi < 0)
-                    return RowSpan{0, -1};
-                if (v + s * span.kLo < 0)
-                    span.kLo = (-v + s - 1) / s;
-            }
-        } else if (v < 0) {
-            return RowSpan{0, -1};
-        } else if (v + s * span.kHi < 0) {
-            // Covered up to floor(v / -s).
-            span.kHi = v / -s;
-        }
-    }
-    return span;
-}
 } // namespace detail
 
 template <class FragmentFn>
@@ -728,12 +697,29 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
     // so the per-sample tests, not the fully covered runs, are what this loop is for.
     constexpr bool kDepthOnly = std::is_same_v<std::remove_cvref_t<FragmentFn>, DepthOnly>;
     constexpr bool kTriangleIds = std::is_same_v<std::remove_cvref_t<FragmentFn>, TriangleIds>;
-    MultisampleSpanLoop spanLoop = nullptr;
+    MultisampleTriangleLoop triangleLoop = nullptr;
     if constexpr (kDepthOnly || kTriangleIds)
         if (depth && (kDepthOnly || !state.barycentrics))
-            spanLoop = multisampleSpanLoop(kDepthTest);
+            triangleLoop = multisampleTriangleLoop(kDepthTest);
     const size_t rowSamples = size_t(mWidth) * size_t(sampleCount);
-    constexpr int kShortRow = 16; // pixels
+    // Per triangle, the edges' and the plane's change from a pixel centre to each sample. Zeroed
+    // once per tile, not per triangle (a zeroing per triangle was 6% of this function): the
+    // triangle loop loads kMaxSamples entries of each, and only the first sampleCount are set.
+    int64_t offset[3][kMaxSamples] = {};
+    double depthOffset[kMaxSamples] = {};
+    // The triangle loop's arguments: the fixed ones set here, the triangle's below (made per
+    // triangle, its zeroing was 18% of this function).
+    MultisampleTriangleArgs rows;
+    rows.depth = depth;
+    rows.rowStride = rowSamples;
+    rows.samples = sampleCount;
+    rows.sampleOffsets = depthOffset;
+    rows.edgeOffsets = offset;
+    rows.write = state.depthWrite;
+    if constexpr (kTriangleIds) {
+        rows.values = fragmentFn.ids;
+        rows.centreDepths = fragmentFn.centreDepths;
+    }
 
     uint64_t samplesCovered = 0, samplesPassed = 0, fragments = 0;
     for (const Batch& batch : mBatches) {
@@ -756,7 +742,6 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
             const int32_t ax[3] = {x[1], x[2], x[0]}, ay[3] = {y[1], y[2], y[0]};
             const int32_t bx[3] = {x[2], x[0], x[1]}, by[3] = {y[2], y[0], y[1]};
             int64_t stepX[3], stepY[3], bias[3], row[3], maxOffset[3], minOffset[3];
-            int64_t offset[3][kMaxSamples] = {};
             const int64_t px0 = int64_t(minX) * kSubpixelScale + kHalf;
             const int64_t py0 = int64_t(minY) * kSubpixelScale + kHalf;
             for (int e = 0; e < 3; ++e) {
@@ -774,7 +759,6 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
                 }
             }
             // Depth at a sample: the centre's plane value plus the plane's change over the offset.
-            double depthOffset[kMaxSamples] = {};
             for (int s = 0; s < sampleCount; ++s)
                 depthOffset[s] = t.z[1] * (pattern[s].x / 16.0) + t.z[2] * (pattern[s].y / 16.0);
 
@@ -851,54 +835,30 @@ void Rasterizer::rasterizeTileMultisample(int tileIndex, const RasterState& stat
                 }
             };
 
-            for (int py = minY; py <= maxY; ++py) {
-                const double zRow = t.z[0] + t.z[2] * py;
-                if (!spanLoop) {
-                    boundingBoxRow(row, py, zRow);
-                } else {
-                    // The row's pixels with a sample inside: each edge's most favourable sample
-                    // accepted. A short row (most rows of small triangles) goes to the span loop
-                    // whole, which tests every sample anyway, unless an edge rejects both its
-                    // ends: two int64 divisions per edge cost more than the lanes they save.
-                    const int64_t anyInside[3] = {row[0] + maxOffset[0], row[1] + maxOffset[1],
-                                                  row[2] + maxOffset[2]};
-                    detail::RowSpan outer{0, maxX - minX};
-                    if (maxX - minX < kShortRow) {
-                        for (int e = 0; e < 3; ++e)
-                            if (anyInside[e] < 0 && anyInside[e] + stepX[e] * outer.kHi < 0)
-                                outer = {0, -1};
-                    } else {
-                        outer = detail::coveredSpan(anyInside, stepX, maxX - minX);
-                    }
-                    if (outer.kLo <= outer.kHi) {
-                        // The row on lanes, each sample's coverage with its depth test.
-                        MultisampleSpanArgs span;
-                        span.depth = depth + size_t(py) * rowSamples;
-                        span.lo = minX + int(outer.kLo);
-                        span.hi = minX + int(outer.kHi);
-                        span.samples = sampleCount;
-                        span.zRow = zRow;
-                        span.zStep = t.z[1];
-                        span.sampleOffsets = depthOffset;
-                        for (int e = 0; e < 3; ++e) {
-                            span.edgeAtLo[e] = row[e] + stepX[e] * outer.kLo;
-                            span.edgeStep[e] = stepX[e];
-                        }
-                        span.edgeOffsets = offset;
-                        span.write = state.depthWrite;
-                        if constexpr (kTriangleIds) {
-                            span.values = fragmentFn.ids + size_t(py) * rowSamples;
-                            span.value = fragmentFn.idOf(t.triangle, t.frontFacing);
-                            if (fragmentFn.centreDepths)
-                                span.centreDepths =
-                                    fragmentFn.centreDepths + size_t(py) * rowSamples;
-                        }
-                        const MultisampleSpanCounts counts = spanLoop(span);
-                        samplesCovered += counts.samplesCovered;
-                        samplesPassed += counts.samplesPassed;
-                        fragments += counts.fragments;
-                    }
+            if (triangleLoop) {
+                // The triangle's rows on lanes, each sample's coverage with its depth test.
+                rows.minX = minX;
+                rows.maxX = maxX;
+                rows.minY = minY;
+                rows.maxY = maxY;
+                rows.zOrigin = t.z[0];
+                rows.zStepX = t.z[1];
+                rows.zStepY = t.z[2];
+                for (int e = 0; e < 3; ++e) {
+                    rows.edgeAtMin[e] = row[e];
+                    rows.edgeStepX[e] = stepX[e];
+                    rows.edgeStepY[e] = stepY[e];
                 }
+                if constexpr (kTriangleIds)
+                    rows.value = fragmentFn.idOf(t.triangle, t.frontFacing);
+                const MultisampleSpanCounts counts = triangleLoop(rows);
+                samplesCovered += counts.samplesCovered;
+                samplesPassed += counts.samplesPassed;
+                fragments += counts.fragments;
+                continue;
+            }
+            for (int py = minY; py <= maxY; ++py) {
+                boundingBoxRow(row, py, t.z[0] + t.z[2] * py);
                 row[0] += stepY[0];
                 row[1] += stepY[1];
                 row[2] += stepY[2];

@@ -4,9 +4,9 @@
 // off, every cull mode, the depth buffer must be bitwise the same and the coverage counters
 // equal, for 1 and 2 threads; the same for raster::TriangleIds (the visibility draw's spans, which
 // also write each pixel's triangle id), one-sample and multisampled. The span loops' SIMD forms
-// (DepthSpan.h) against their scalar oracles, and the in-draw clear (RasterState::clearDepth)
-// against a clear before the draw, with and without the record of clear tiles
-// (RasterState::tilesNotClear), and the caller's planes cleared with it
+// (DepthSpan.h, the multisampled one per row and per triangle) against their scalar oracles, and
+// the in-draw clear (RasterState::clearDepth) against a clear before the draw, with and without
+// the record of clear tiles (RasterState::tilesNotClear), and the caller's planes cleared with it
 // (RasterState::alsoClearTile).
 #include <gtest/gtest.h>
 
@@ -414,6 +414,131 @@ void checkMultisampledSpansAgainstScalar() {
     EXPECT_GT(partlyPassed, 300);
 }
 
+// The triangle form (raster::MultisampleTriangleArgs, one call per triangle): random bounding
+// boxes of 1 to 40 pixels by 1 to 6 rows (rows shorter than forEachMultisampleRow's 16 pixels go
+// whole, longer ones are cut by coveredSpan), edges that change along rows and down columns, 2, 4
+// and 8 samples, every depth test. Two oracles: the vector loop against
+// multisampleTriangleScalar (bitwise: depth, ids, centre depths, counters), and that against
+// every row's whole bounding box through the scalar span loop, which tests every sample, so the
+// rows' cutting drops no sample an edge accepts.
+void checkMultisampledTrianglesAgainstScalar() {
+    std::mt19937 rng(29);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::uniform_int_distribution<int64_t> edgeValue(-3000, 9000), edgeStep(-900, 900),
+        edgeOffset(-400, 400);
+    constexpr int kWidth = 64, kRows = 8;
+    int triangles = 0, covering = 0, cutRows = 0;
+    for (int samples : {2, 4, 8})
+        for (DepthTest test : {DepthTest::Always, DepthTest::Less, DepthTest::LessEqual,
+                               DepthTest::Greater, DepthTest::GreaterEqual})
+            for (int trial = 0; trial < 60; ++trial) {
+                raster::MultisampleTriangleArgs t;
+                t.samples = samples;
+                t.rowStride = size_t(kWidth) * size_t(samples);
+                t.minX = int(rng() % 20);
+                t.maxX = t.minX + int(rng() % 40);
+                t.minY = int(rng() % 2);
+                t.maxY = t.minY + int(rng() % 6);
+                t.zStepX = (unit(rng) - 0.5) * 0.01;
+                t.zStepY = (unit(rng) - 0.5) * 0.01;
+                t.zOrigin = unit(rng) * 1.2 - 0.1;
+                double offsets[raster::kMaxSamples];
+                for (double& o : offsets)
+                    o = (unit(rng) - 0.5) * 1e-3;
+                t.sampleOffsets = offsets;
+                int64_t edgeOffsets[3][raster::kMaxSamples];
+                for (int e = 0; e < 3; ++e) {
+                    t.edgeAtMin[e] = edgeValue(rng);
+                    t.edgeStepX[e] = edgeStep(rng);
+                    t.edgeStepY[e] = edgeStep(rng);
+                    for (int64_t& o : edgeOffsets[e])
+                        o = edgeOffset(rng) - int64_t(rng() % 2);
+                }
+                t.edgeOffsets = edgeOffsets;
+                t.write = trial % 3 != 0;
+                t.value = uint32_t(rng());
+                const size_t count = size_t(kRows) * t.rowStride;
+                std::vector<float> stored(count);
+                for (float& z : stored)
+                    z = float(unit(rng));
+                struct Target {
+                    std::vector<float> depth, centres;
+                    std::vector<uint32_t> values;
+                };
+                auto fresh = [&] {
+                    Target target{stored, std::vector<float>(count, -1.0f), {}};
+                    target.values.resize(count);
+                    std::iota(target.values.begin(), target.values.end(), 7u);
+                    return target;
+                };
+                auto aim = [&](raster::MultisampleTriangleArgs& args, Target& target) {
+                    args.depth = target.depth.data();
+                    args.values = target.values.data();
+                    args.centreDepths = trial % 2 ? target.centres.data() : nullptr;
+                };
+                Target vector = fresh(), scalar = fresh(), whole = fresh();
+                aim(t, vector);
+                const raster::MultisampleSpanCounts vectorCounts =
+                    raster::multisampleTriangleLoop(test)(t);
+                aim(t, scalar);
+                const raster::MultisampleSpanCounts scalarCounts =
+                    raster::multisampleTriangleScalar(test, t);
+                // Every row's whole bounding box, one span per row.
+                raster::MultisampleSpanCounts wholeCounts;
+                int64_t row[3] = {t.edgeAtMin[0], t.edgeAtMin[1], t.edgeAtMin[2]};
+                for (int py = t.minY; py <= t.maxY; ++py) {
+                    raster::MultisampleSpanArgs span;
+                    const size_t rowStart = size_t(py) * t.rowStride;
+                    span.depth = whole.depth.data() + rowStart;
+                    span.values = whole.values.data() + rowStart;
+                    span.centreDepths = trial % 2 ? whole.centres.data() + rowStart : nullptr;
+                    span.value = t.value;
+                    span.lo = t.minX;
+                    span.hi = t.maxX;
+                    span.samples = samples;
+                    span.zRow = t.zOrigin + t.zStepY * py;
+                    span.zStep = t.zStepX;
+                    span.sampleOffsets = offsets;
+                    for (int e = 0; e < 3; ++e) {
+                        span.edgeAtLo[e] = row[e];
+                        span.edgeStep[e] = t.edgeStepX[e];
+                        row[e] += t.edgeStepY[e];
+                    }
+                    span.edgeOffsets = edgeOffsets;
+                    span.write = t.write;
+                    const raster::MultisampleSpanCounts counts =
+                        raster::multisampleSpanScalar(test, span);
+                    wholeCounts.samplesCovered += counts.samplesCovered;
+                    wholeCounts.samplesPassed += counts.samplesPassed;
+                    wholeCounts.fragments += counts.fragments;
+                }
+                const std::string name = std::to_string(samples) + " samples, test " +
+                                         std::to_string(int(test)) + " trial " +
+                                         std::to_string(trial);
+                const raster::MultisampleSpanCounts* otherCounts[] = {&vectorCounts, &wholeCounts};
+                for (const raster::MultisampleSpanCounts* other : otherCounts) {
+                    ASSERT_EQ(other->samplesCovered, scalarCounts.samplesCovered) << name;
+                    ASSERT_EQ(other->samplesPassed, scalarCounts.samplesPassed) << name;
+                    ASSERT_EQ(other->fragments, scalarCounts.fragments) << name;
+                }
+                for (const Target* other : {&vector, &whole}) {
+                    ASSERT_EQ(0, std::memcmp(other->depth.data(), scalar.depth.data(),
+                                             count * sizeof(float)))
+                        << name;
+                    ASSERT_EQ(other->values, scalar.values) << name;
+                    ASSERT_EQ(0, std::memcmp(other->centres.data(), scalar.centres.data(),
+                                             count * sizeof(float)))
+                        << name;
+                }
+                ++triangles;
+                covering += scalarCounts.samplesCovered > 0;
+                cutRows += t.maxX - t.minX >= 16 && scalarCounts.samplesCovered > 0;
+            }
+    EXPECT_EQ(triangles, 900);
+    EXPECT_GT(covering, 500);
+    EXPECT_GT(cutRows, 300);
+}
+
 // Runs `check` on every target this build has and this CPU runs: the masked tail exists only
 // where masked memory operations cannot fault (AVX-512), the others keep the scalar tail.
 template <class Check> void onEveryTarget(Check check) {
@@ -433,6 +558,10 @@ TEST(DepthSpan, VectorLoopIsBitwiseTheScalarLoop) {
 
 TEST(DepthSpan, MultisampledVectorLoopIsBitwiseTheScalarLoop) {
     onEveryTarget(checkMultisampledSpansAgainstScalar);
+}
+
+TEST(DepthSpan, MultisampledTriangleLoopIsBitwiseTheScalarLoopAndDropsNoSample) {
+    onEveryTarget(checkMultisampledTrianglesAgainstScalar);
 }
 
 // RasterState::clearDepth: each tile clears its own pixels (all samples) inside the draw; the
