@@ -4,6 +4,8 @@
 #include <bit>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
 
 #include <tbb/parallel_for.h>
 
@@ -48,6 +50,9 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     const int samples = visibility.sampleCount();
     if (samples < 2 || visibility.centreDepths().empty())
         throw std::invalid_argument("FragmentLayers: the visibility pass was not multisampled");
+    if (samples != 2 && samples != 4 && samples != 8)
+        throw std::invalid_argument("FragmentLayers: " + std::to_string(samples) +
+                                    " samples per pixel (2, 4 or 8 are built)");
     const float clear = view.clearDepth();
     // The planes are kept between builds of one size, sample count and clear value (the upper
     // layers are then "none" except where the last build wrote, which is reset below).
@@ -91,7 +96,10 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     Layer& main = mLayers[0];
 
     const uint8_t allSamples = uint8_t((1u << samples) - 1u);
-    tbb::parallel_for(0, mHeight, [&](int y) {
+    // One row; `kSamples` is the sample count as a constant, so that the per-pixel loops over a
+    // pixel's samples (the uniformity test first) are unrolled.
+    auto buildRow = [&](int y, auto kSamples) {
+        constexpr size_t kStride = decltype(kSamples)::value;
         // What the last build left in this row's upper layers goes back to "none".
         std::vector<uint32_t>& upperColumns = mUpperColumns[size_t(y)];
         for (const uint32_t x : upperColumns) {
@@ -114,13 +122,13 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
             const size_t pixel = size_t(y) * mWidth + size_t(x);
             // Most pixels: every sample shows one triangle (or none), what the search below
             // finds for them, written straight into layer 0 (no fragment arrays).
-            const uint32_t* pixelCodes = &sampleCodes[pixel * stride];
+            const uint32_t* pixelCodes = &sampleCodes[pixel * kStride];
             bool uniform = true;
-            for (size_t s = 1; s < stride; ++s)
+            for (size_t s = 1; s < kStride; ++s)
                 uniform &= pixelCodes[s] == pixelCodes[0];
             if (uniform) {
                 const bool covered = pixelCodes[0] != VisibilityPass::kNoTriangle;
-                const float centre = sampleDepths[pixel * stride];
+                const float centre = sampleDepths[pixel * kStride];
                 main.codes[pixel] = pixelCodes[0];
                 main.depths[pixel] = !covered          ? clear
                                      : centre == clear ? std::nextafter(clear, nearer)
@@ -136,7 +144,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
             uint8_t mask[raster::kMaxSamples];
             float depth[raster::kMaxSamples];
             int count = 0, background = 0;
-            for (size_t s = 0; s < stride; ++s) {
+            for (size_t s = 0; s < kStride; ++s) {
                 const uint32_t c = pixelCodes[s];
                 if (c == VisibilityPass::kNoTriangle) {
                     ++background;
@@ -148,7 +156,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 if (k == count) {
                     code[k] = c;
                     mask[k] = 0;
-                    depth[k] = sampleDepths[pixel * stride + s];
+                    depth[k] = sampleDepths[pixel * kStride + s];
                     if (depth[k] == clear)
                         depth[k] = std::nextafter(clear, nearer);
                     ++count;
@@ -194,9 +202,9 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 upperColumns.push_back(uint32_t(x));
                 rowLayers = std::max(rowLayers, count);
                 mScratchCount[pixel] = uint8_t(count);
-                std::copy(code, code + count, &mScratchCode[pixel * stride]);
-                std::copy(mask, mask + count, &mScratchMask[pixel * stride]);
-                std::copy(depth, depth + count, &mScratchDepth[pixel * stride]);
+                std::copy(code, code + count, &mScratchCode[pixel * kStride]);
+                std::copy(mask, mask + count, &mScratchMask[pixel * kStride]);
+                std::copy(depth, depth + count, &mScratchDepth[pixel * kStride]);
             }
             mBackground[pixel] = uint8_t(background);
             mComplex[pixel] = 0;
@@ -212,6 +220,16 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
         }
         mRowLayers[size_t(y)] = rowLayers;
         rowCounts[size_t(y)] = counts;
+    };
+    tbb::parallel_for(0, mHeight, [&](int y) {
+        switch (samples) {
+        case 2:
+            return buildRow(y, std::integral_constant<size_t, 2>{});
+        case 4:
+            return buildRow(y, std::integral_constant<size_t, 4>{});
+        default: // 8, checked above
+            return buildRow(y, std::integral_constant<size_t, 8>{});
+        }
     });
     mCounts = Counts{};
     for (const Counts& row : rowCounts) {
