@@ -1,8 +1,11 @@
 #include "gbuffer/msaa/FragmentLayers.h"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -68,24 +71,35 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     mHeight = view.height;
     mClearDepth = clear;
     const size_t pixels = pixelCount();
-    const size_t stride = size_t(samples);
     const std::span<const uint32_t> sampleCodes = visibility.codes();
     const std::span<const float> sampleDepths = visibility.centreDepths();
 
-    if (mLayers.empty()) {
-        // Layer 0: every entry is written by every build.
-        mLayers.resize(1);
-        mLayers[0].codes.resize(pixels);
-        mLayers[0].depths.resize(pixels);
-        mLayers[0].coverage.resize(pixels);
-    }
-    // Per pixel with an extra fragment, its fragments in order (the main one first), at most
-    // `samples` of them: what the upper layers get once their count is known. Scratch kept
-    // between frames and only resized: every entry read is written first.
-    mScratchCode.resize(pixels * stride);
-    mScratchMask.resize(pixels * stride);
-    mScratchDepth.resize(pixels * stride);
-    mScratchCount.resize(pixels);
+    // Layer 0 is written at every entry by every build; the layers above are made when a row
+    // first needs them (below) and kept: "none" everywhere, then written where they have
+    // fragments and reset where the last build wrote.
+    mLayers.resize(size_t(samples));
+    const auto makeLayer = [&](Layer& layer) {
+        layer.codes.assign(pixels, VisibilityPass::kNoTriangle);
+        layer.depths.assign(pixels, clear);
+        layer.coverage.assign(pixels, 0);
+    };
+    if (mLayers[0].codes.empty())
+        makeLayer(mLayers[0]);
+    // Whether upper layer k exists: read by every row, set once under `makeLock` by the first
+    // row that needs it (the planes are then complete before any row writes into them).
+    std::array<std::atomic<bool>, raster::kMaxSamples> made{};
+    for (size_t k = 0; k < mLayers.size(); ++k)
+        made[k].store(!mLayers[k].codes.empty(), std::memory_order_relaxed);
+    std::mutex makeLock;
+    const auto ensureLayer = [&](int k) {
+        if (made[size_t(k)].load(std::memory_order_acquire))
+            return;
+        const std::lock_guard<std::mutex> lock(makeLock);
+        if (!made[size_t(k)].load(std::memory_order_relaxed)) {
+            makeLayer(mLayers[size_t(k)]);
+            made[size_t(k)].store(true, std::memory_order_release);
+        }
+    };
     mBackground.resize(pixels);
     mComplex.resize(pixels);
     mRowLayers.resize(size_t(mHeight));
@@ -93,22 +107,30 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     const float nearer = view.reversedZ() ? 1.0f : 0.0f;
     const bool mergeSmooth = options.detection == ComplexDetection::Discontinuity;
     const int lastLayerCount = mLayerCount;
-    Layer& main = mLayers[0];
 
     const uint8_t allSamples = uint8_t((1u << samples) - 1u);
     // One row; `kSamples` is the sample count as a constant, so that the per-pixel loops over a
     // pixel's samples (the uniformity test first) are unrolled.
     auto buildRow = [&](int y, auto kSamples) {
         constexpr size_t kStride = decltype(kSamples)::value;
+        // The planes as local pointers: the byte planes' stores could otherwise alias the
+        // vectors' own fields and force a reload of every pointer per pixel.
+        const size_t rowStart = size_t(y) * size_t(mWidth);
+        const uint32_t* rowCodes = sampleCodes.data() + rowStart * kStride;
+        const float* rowDepths = sampleDepths.data() + rowStart * kStride;
+        uint32_t* mainCodes = mLayers[0].codes.data() + rowStart;
+        float* mainDepths = mLayers[0].depths.data() + rowStart;
+        uint8_t* mainCoverage = mLayers[0].coverage.data() + rowStart;
+        uint8_t* background = mBackground.data() + rowStart;
+        uint8_t* complex = mComplex.data() + rowStart;
         // What the last build left in this row's upper layers goes back to "none".
         std::vector<uint32_t>& upperColumns = mUpperColumns[size_t(y)];
-        for (const uint32_t x : upperColumns) {
-            const size_t pixel = size_t(y) * mWidth + x;
-            for (int k = 1; k < lastLayerCount; ++k) {
-                Layer& layer = mLayers[size_t(k)];
-                layer.codes[pixel] = VisibilityPass::kNoTriangle;
-                layer.depths[pixel] = clear;
-                layer.coverage[pixel] = 0;
+        for (int k = 1; k < lastLayerCount; ++k) {
+            Layer& layer = mLayers[size_t(k)];
+            for (const uint32_t x : upperColumns) {
+                layer.codes[rowStart + x] = VisibilityPass::kNoTriangle;
+                layer.depths[rowStart + x] = clear;
+                layer.coverage[rowStart + x] = 0;
             }
         }
         upperColumns.clear();
@@ -119,23 +141,22 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
         // surfaceAt()).
         VisibilityPass::RowSurfaces mainSurfaces(visibility, y), otherSurfaces(visibility, y);
         for (int x = 0; x < mWidth; ++x) {
-            const size_t pixel = size_t(y) * mWidth + size_t(x);
             // Most pixels: every sample shows one triangle (or none), what the search below
             // finds for them, written straight into layer 0 (no fragment arrays).
-            const uint32_t* pixelCodes = &sampleCodes[pixel * kStride];
+            const uint32_t* pixelCodes = rowCodes + size_t(x) * kStride;
             bool uniform = true;
             for (size_t s = 1; s < kStride; ++s)
                 uniform &= pixelCodes[s] == pixelCodes[0];
             if (uniform) {
                 const bool covered = pixelCodes[0] != VisibilityPass::kNoTriangle;
-                const float centre = sampleDepths[pixel * kStride];
-                main.codes[pixel] = pixelCodes[0];
-                main.depths[pixel] = !covered          ? clear
-                                     : centre == clear ? std::nextafter(clear, nearer)
-                                                       : centre;
-                main.coverage[pixel] = covered ? allSamples : 0;
-                mBackground[pixel] = covered ? 0 : uint8_t(samples);
-                mComplex[pixel] = 0;
+                const float centre = rowDepths[size_t(x) * kStride];
+                mainCodes[x] = pixelCodes[0];
+                mainDepths[x] = !covered          ? clear
+                                : centre == clear ? std::nextafter(clear, nearer)
+                                                  : centre;
+                mainCoverage[x] = covered ? allSamples : 0;
+                background[x] = covered ? 0 : uint8_t(kStride);
+                complex[x] = 0;
                 counts.coveredPixels += covered;
                 counts.fragments += covered;
                 continue;
@@ -143,11 +164,11 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
             uint32_t code[raster::kMaxSamples];
             uint8_t mask[raster::kMaxSamples];
             float depth[raster::kMaxSamples];
-            int count = 0, background = 0;
+            int count = 0, backgroundSamples = 0;
             for (size_t s = 0; s < kStride; ++s) {
                 const uint32_t c = pixelCodes[s];
                 if (c == VisibilityPass::kNoTriangle) {
-                    ++background;
+                    ++backgroundSamples;
                     continue;
                 }
                 int k = 0;
@@ -156,7 +177,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 if (k == count) {
                     code[k] = c;
                     mask[k] = 0;
-                    depth[k] = sampleDepths[pixel * kStride + s];
+                    depth[k] = rowDepths[size_t(x) * kStride + s];
                     if (depth[k] == clear)
                         depth[k] = std::nextafter(clear, nearer);
                     ++count;
@@ -168,9 +189,11 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
             for (int k = 1; k < count; ++k)
                 if (std::popcount(mask[k]) > std::popcount(mask[first]))
                     first = k;
-            moveToFront(code, first);
-            moveToFront(mask, first);
-            moveToFront(depth, first);
+            if (first != 0) {
+                moveToFront(code, first);
+                moveToFront(mask, first);
+                moveToFront(depth, first);
+            }
             if (mergeSmooth && count > 1) {
                 const Surface& firstSurface = mainSurfaces.at(code[0], x);
                 const float firstDepth = viewDepthAt(view, x, y, depth[0]);
@@ -195,25 +218,30 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 }
                 count = kept;
             }
-            main.codes[pixel] = count > 0 ? code[0] : VisibilityPass::kNoTriangle;
-            main.depths[pixel] = count > 0 ? depth[0] : clear;
-            main.coverage[pixel] = count > 0 ? mask[0] : 0;
+            mainCodes[x] = count > 0 ? code[0] : VisibilityPass::kNoTriangle;
+            mainDepths[x] = count > 0 ? depth[0] : clear;
+            mainCoverage[x] = count > 0 ? mask[0] : 0;
+            // The extra fragments straight into the layers above, in order.
+            for (int k = 1; k < count; ++k) {
+                if (k >= rowLayers)
+                    ensureLayer(k);
+                Layer& layer = mLayers[size_t(k)];
+                layer.codes[rowStart + size_t(x)] = code[k];
+                layer.depths[rowStart + size_t(x)] = depth[k];
+                layer.coverage[rowStart + size_t(x)] = mask[k];
+            }
             if (count > 1) {
                 upperColumns.push_back(uint32_t(x));
                 rowLayers = std::max(rowLayers, count);
-                mScratchCount[pixel] = uint8_t(count);
-                std::copy(code, code + count, &mScratchCode[pixel * kStride]);
-                std::copy(mask, mask + count, &mScratchMask[pixel * kStride]);
-                std::copy(depth, depth + count, &mScratchDepth[pixel * kStride]);
             }
-            mBackground[pixel] = uint8_t(background);
-            mComplex[pixel] = 0;
+            background[x] = uint8_t(backgroundSamples);
+            complex[x] = 0;
             if (count > 0) {
                 ++counts.coveredPixels;
                 counts.fragments += uint64_t(count);
-                counts.partialPixels += background > 0;
-                if (count > 1 || background > 0) {
-                    mComplex[pixel] = 1;
+                counts.partialPixels += backgroundSamples > 0;
+                if (count > 1 || backgroundSamples > 0) {
+                    complex[x] = 1;
                     ++counts.complexPixels;
                 }
             }
@@ -239,28 +267,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
         mCounts.mergedFragments += row.mergedFragments;
         mCounts.partialPixels += row.partialPixels;
     }
-
     mLayerCount = *std::max_element(mRowLayers.begin(), mRowLayers.end());
-    while (int(mLayers.size()) < mLayerCount) {
-        // A layer first needed now: "none" everywhere, then written where it has fragments.
-        Layer& layer = mLayers.emplace_back();
-        layer.codes.assign(pixels, VisibilityPass::kNoTriangle);
-        layer.depths.assign(pixels, clear);
-        layer.coverage.assign(pixels, 0);
-    }
-    // The extra fragments into the upper layers, at the pixels that have them only.
-    tbb::parallel_for(0, mHeight, [&](int y) {
-        for (const uint32_t x : mUpperColumns[size_t(y)]) {
-            const size_t pixel = size_t(y) * mWidth + x;
-            for (int k = 1; k < mScratchCount[pixel]; ++k) {
-                Layer& layer = mLayers[size_t(k)];
-                const size_t entry = pixel * stride + size_t(k);
-                layer.codes[pixel] = mScratchCode[entry];
-                layer.depths[pixel] = mScratchDepth[entry];
-                layer.coverage[pixel] = mScratchMask[entry];
-            }
-        }
-    });
 }
 
 double FragmentLayers::storedBytes(double bytesPerPixel) const {

@@ -35,7 +35,8 @@
 // Cost: layer 0 is written at every pixel; the layers above only at the pixels that have an extra
 // fragment (upperColumns) and at those the last build left, which are reset to "none": the planes
 // are kept between builds of one size, so an upper layer's cost follows the complex pixels, not
-// the screen.
+// the screen. One pass: a pixel's extra fragments go straight into their layers (a layer is made,
+// "none" everywhere, by the first row that needs it), with no per-pixel scratch copy.
 //
 // Deterministic: built per pixel from the visibility buffer; parallel over rows (TBB).
 #pragma once
@@ -134,18 +135,14 @@ private:
     int mSamples = 1;
     int mWidth = 0;
     int mHeight = 0;
-    std::vector<Layer> mLayers; // allocated; the first mLayerCount are this build's
+    std::vector<Layer> mLayers; // one per sample; made when first needed, the first mLayerCount
+                                // are this build's
     int mLayerCount = 0;
     float mClearDepth = 0.0f;                         // the view's, at the last build
     std::vector<std::vector<uint32_t>> mUpperColumns; // per row (upperColumns)
     std::vector<uint8_t> mBackground;                 // background samples per pixel
     std::vector<uint8_t> mComplex;
     Counts mCounts;
-    // Per pixel with an extra fragment, its fragments, during build() (kept: see build()).
-    std::vector<uint32_t> mScratchCode;
-    std::vector<uint8_t> mScratchMask;
-    std::vector<float> mScratchDepth;
-    std::vector<uint8_t> mScratchCount;
     std::vector<int> mRowLayers; // per row, the most fragments of a pixel
 };
 
