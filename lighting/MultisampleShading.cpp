@@ -1,6 +1,7 @@
 #include "lighting/MultisampleShading.h"
 
 #include <algorithm>
+#include <chrono>
 #include <string>
 
 #include <tbb/parallel_for.h>
@@ -32,11 +33,21 @@ void addTimings(std::vector<std::pair<std::string, double>>& total,
     }
 }
 
+// Runs `run` and appends its wall time in milliseconds to `runMs`.
+template <class Run> void timed(std::vector<double>& runMs, const Run& run) {
+    const auto start = std::chrono::steady_clock::now();
+    run();
+    runMs.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+}
+
 } // namespace
 
 void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepared,
                                StageResult& result) {
-    stage.shade(prepared.inputs, result);
+    mRunMs.clear();
+    timed(mRunMs, [&] { stage.shade(prepared.inputs, result); });
     if (!prepared.multisample)
         return;
     const gbuffer::FragmentLayers& layers = prepared.multisample->layers;
@@ -51,7 +62,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
     upper.resize(size_t(layers.layerCount() - 1));
     for (int k = 1; k < layers.layerCount(); ++k) {
         upper[size_t(k - 1)].traceLights = result.traceLights;
-        stage.shade(prepared.layerInputs(k), upper[size_t(k - 1)]);
+        timed(mRunMs, [&] { stage.shade(prepared.layerInputs(k), upper[size_t(k - 1)]); });
         addTimings(result.timingsMs, upper[size_t(k - 1)].timingsMs);
         KernelWork::addRecorded(upper[size_t(k - 1)], result);
     }
@@ -65,7 +76,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
         StageInputs frame = prepared.inputs;
         frame.gbuffer = mEmpty.get();
         frame.fragmentLayer = StageInputs::kBackgroundRun;
-        stage.shade(frame, background);
+        timed(mRunMs, [&] { stage.shade(frame, background); });
         addTimings(result.timingsMs, background.timingsMs);
         KernelWork::addRecorded(background, result);
     }

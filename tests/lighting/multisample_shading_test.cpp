@@ -206,6 +206,10 @@ TEST(MultisampleResolve, IsTheCoverageWeightedSumOfTheLayers) {
     }
     EXPECT_EQ(sum, layered);
     (void)partial;
+    // One timed run per layer (this scene has no blended material: no background run).
+    ASSERT_EQ(shading.runMs().size(), size_t(frame.layerCount()));
+    for (double ms : shading.runMs())
+        EXPECT_GT(ms, 0.0);
 }
 
 TEST(MultisampleResolve, SameImageForAnyThreadCount) {
