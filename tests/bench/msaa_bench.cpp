@@ -31,7 +31,7 @@ const char* const kStages[] = {"brute", "deferred",       "light-indexed", "clus
 struct Sampled {
     std::vector<double> frameMs, gbufferMs;
     std::vector<double> rasterMs, layersMs, resolveMs; // the G-buffer pass's phases
-    std::vector<double> shadeMainMs, shadeUpperMs;      // the stage on layer 0, on the others
+    std::vector<double> shadeMainMs, shadeUpperMs;     // the stage on layer 0, on the others
     void add(double frame, const gbuffer::GBufferPassTimings& t) {
         frameMs.push_back(frame);
         gbufferMs.push_back(t.transformMs + t.rasterMs + t.layersMs + t.resolveMs);
@@ -87,8 +87,7 @@ void msaaCost(benchmark::State& state) {
             measured[i].add(ms, frames[i]->gbufferTimings);
             const std::vector<double>& runs = shading[i].runMs();
             measured[i].shadeMainMs.push_back(runs.front());
-            measured[i].shadeUpperMs.push_back(
-                std::accumulate(runs.begin() + 1, runs.end(), 0.0));
+            measured[i].shadeUpperMs.push_back(std::accumulate(runs.begin() + 1, runs.end(), 0.0));
             if (i == 1)
                 iteration = ms;
         }
