@@ -1,7 +1,6 @@
 #include "lighting/MultisampleShading.h"
 
 #include <algorithm>
-#include <chrono>
 #include <string>
 
 #include <tbb/parallel_for.h>
@@ -33,13 +32,11 @@ void addTimings(std::vector<std::pair<std::string, double>>& total,
     }
 }
 
-// Runs `run` and appends its wall time in milliseconds to `runMs`.
+// Runs `run` and appends its wall time in milliseconds (the stages' Stopwatch) to `runMs`.
 template <class Run> void timed(std::vector<double>& runMs, const Run& run) {
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch clock;
     run();
-    runMs.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-            .count());
+    runMs.push_back(clock.milliseconds());
 }
 
 } // namespace
