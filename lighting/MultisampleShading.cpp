@@ -80,33 +80,48 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
 
     PassTimer resolve(result, pass::kResolve);
     const bool oracle = !result.lightsOracle.empty();
+    // Per pixel the same sum in the same order as the definition (layer 0, the layers above, the
+    // background run), but written only where it changes the pixel. A pixel whose main fragment
+    // covers every sample or none (weight exactly 1, so 1 x radiance is the radiance; no
+    // background samples beside a surface) and that has no fragment above keeps layer 0's
+    // values: one byte read. The layers above hold nothing (radiance, evaluations, oracle all
+    // zero) outside their fragments, which lie at upperColumns only, so the walk over them
+    // follows the complex pixels, not the screen.
+    const std::span<const uint8_t> mainCoverage = layers.coverage(0);
+    const uint8_t allSamples = uint8_t((1u << layers.samples()) - 1u);
     tbb::parallel_for(0, layers.height(), [&](int y) {
-        for (size_t pixel = size_t(y) * size_t(width); pixel < size_t(y + 1) * size_t(width);
-             ++pixel) {
+        const std::span<const uint32_t> columns = layers.upperColumns(y);
+        size_t nextColumn = 0;
+        const size_t rowStart = size_t(y) * size_t(width);
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = rowStart + size_t(x);
+            if (blended)
+                result.lightsEvaluated[pixel] += background.lightsEvaluated[pixel];
+            const bool upperHere =
+                nextColumn < columns.size() && columns[nextColumn] == uint32_t(x);
+            const uint8_t mask = mainCoverage[pixel];
+            if (!upperHere && (mask == allSamples || mask == 0))
+                continue;
+            nextColumn += upperHere ? 1 : 0;
             const float w0 = layers.weight(0, pixel);
+            const bool partial = blended && mask != 0 && layers.backgroundWeight(pixel) > 0.0f;
             float rgb[3];
             for (int c = 0; c < 3; ++c)
                 rgb[c] = w0 * result.radiance[c][pixel];
-            for (int k = 1; k < layers.layerCount(); ++k) {
+            for (int k = 1; upperHere && k < layers.layerCount(); ++k) {
                 const StageResult& layer = upper[size_t(k - 1)];
-                result.lightsEvaluated[pixel] += layer.lightsEvaluated[pixel];
                 if (layers.codes(k)[pixel] == gbuffer::VisibilityPass::kNoTriangle)
                     continue;
+                result.lightsEvaluated[pixel] += layer.lightsEvaluated[pixel];
                 const float w = layers.weight(k, pixel);
                 for (int c = 0; c < 3; ++c)
                     rgb[c] += w * layer.radiance[c][pixel];
                 if (oracle)
                     result.lightsOracle[pixel] += layer.lightsOracle[pixel];
             }
-            if (blended) {
-                result.lightsEvaluated[pixel] += background.lightsEvaluated[pixel];
-                const bool partial =
-                    layers.codes(0)[pixel] != gbuffer::VisibilityPass::kNoTriangle &&
-                    layers.backgroundWeight(pixel) > 0.0f;
-                if (partial)
-                    for (int c = 0; c < 3; ++c)
-                        rgb[c] += layers.backgroundWeight(pixel) * background.radiance[c][pixel];
-            }
+            if (partial)
+                for (int c = 0; c < 3; ++c)
+                    rgb[c] += layers.backgroundWeight(pixel) * background.radiance[c][pixel];
             for (int c = 0; c < 3; ++c)
                 result.radiance[c][pixel] = rgb[c];
         }
