@@ -22,14 +22,30 @@ TileGrid TileGrid::make(int widthPixels, int heightPixels, int tileSizePixels) {
 
 namespace {
 
+// Whether some sample of the pixels [x0, x1) of the row starting at pixel `rowStart` of a
+// pixel-major depth buffer (`samples` floats per pixel) differs from `clear`: one branch-free
+// pass over contiguous floats (vectorised).
+bool anyDepthOtherThan(std::span<const float> depth, size_t rowStart, int x0, int x1, int samples,
+                       float clear) {
+    const float* first = depth.data() + (rowStart + size_t(x0)) * size_t(samples);
+    const size_t count = size_t(x1 - x0) * size_t(samples);
+    bool any = false;
+    for (size_t i = 0; i < count; ++i)
+        any |= first[i] != clear;
+    return any;
+}
+
 // The bounds of every tile from its samples. sampleAt(x, y, depthMetres, normalView) returns
 // false for an uncovered pixel, else sets the sample's positive view depth and (read only when
 // options.normalCone) its normal. Templated so the per-pixel call is inlined, not virtual.
 // samplesPerPixel: sampleAt(x, y, s, ...) is called for s in [0, samplesPerPixel).
-template <typename SampleAt>
-std::vector<TileSurfaceBounds> boundsOfSamples(const TileGrid& grid,
-                                               const TileBoundsOptions& options,
-                                               const SampleAt& sampleAt, int samplesPerPixel = 1) {
+// anyCovered(y, x0, x1): whether some pixel of row y in [x0, x1) is covered, a cheap test that
+// skips a row of a tile before any sample is read: an upper MSAA fragment layer's tiles are mostly
+// empty, and its cost should follow its fragments, not the screen.
+template <typename SampleAt, typename AnyCovered>
+std::vector<TileSurfaceBounds>
+boundsOfSamples(const TileGrid& grid, const TileBoundsOptions& options, const SampleAt& sampleAt,
+                const AnyCovered& anyCovered, int samplesPerPixel = 1) {
     std::vector<TileSurfaceBounds> bounds(size_t(grid.tileCount()));
     const size_t maxSamples =
         size_t(grid.tileSizePixels) * grid.tileSizePixels * size_t(samplesPerPixel);
@@ -47,7 +63,9 @@ std::vector<TileSurfaceBounds> boundsOfSamples(const TileGrid& grid,
                 normals.clear();
                 float minDepth = INFINITY, maxDepth = -INFINITY;
                 glm::vec3 normalSum(0.0f);
-                for (int y = grid.y0(ty); y < grid.y1(ty); ++y)
+                for (int y = grid.y0(ty); y < grid.y1(ty); ++y) {
+                    if (!anyCovered(y, grid.x0(tx), grid.x1(tx)))
+                        continue;
                     for (int x = grid.x0(tx); x < grid.x1(tx); ++x)
                         for (int s = 0; s < samplesPerPixel; ++s) {
                             float depth = 0.0f;
@@ -69,6 +87,7 @@ std::vector<TileSurfaceBounds> boundsOfSamples(const TileGrid& grid,
                                 normalSum += n;
                             }
                         }
+                }
                 if (!(minDepth <= maxDepth))
                     continue; // no covered pixel
                 b.covered = true;
@@ -110,15 +129,23 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
     // surface (which a visibility buffer would fetch from its triangle). Bitwise the same range.
     if (!options.normalCone)
         return computeTileDepthBounds(gb.depthDecoder(), gb.depth(), grid, options.depthMask);
-    return boundsOfSamples(grid, options,
-                           [&gb](int x, int y, int, float& depthMetres, glm::vec3& normalView) {
-                               if (!gb.covered(size_t(y) * gb.width() + x))
-                                   return false;
-                               const gbuffer::Surface s = gb.decode(x, y);
-                               depthMetres = -s.positionView.z;
-                               normalView = s.normalView;
-                               return true;
-                           });
+    return boundsOfSamples(
+        grid, options,
+        [&gb](int x, int y, int, float& depthMetres, glm::vec3& normalView) {
+            if (!gb.covered(size_t(y) * gb.width() + x))
+                return false;
+            const gbuffer::Surface s = gb.decode(x, y);
+            depthMetres = -s.positionView.z;
+            normalView = s.normalView;
+            return true;
+        },
+        [&gb](int y, int x0, int x1) {
+            const size_t row = size_t(y) * gb.width();
+            bool any = false;
+            for (int x = x0; x < x1; ++x)
+                any |= gb.covered(row + size_t(x));
+            return any;
+        });
 }
 
 std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::DepthDecoder& decoder,
@@ -135,6 +162,10 @@ std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::DepthDecode
                 return false;
             depthMetres = decoder.viewDepthMetres(x, y, d);
             return true;
+        },
+        [&](int y, int x0, int x1) {
+            return anyDepthOtherThan(depth, size_t(y) * grid.widthPixels, x0, x1, samples,
+                                     clearDepth);
         },
         samples);
 }
