@@ -175,12 +175,14 @@ private:
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
         const ClusterGridOptions& options = mOptions.fixed;
+        if (inputs.fragmentLayer == 0)
+            mFrameGrid.valid = false; // a new frame
 
         // Nearest and farthest covered NDC depth (min/max: order-independent, so deterministic).
         const std::span<const float> depth = gb.depth();
         const float clear = gb.view().clearDepth();
         using MinMax = std::pair<float, float>;
-        const MinMax ndcRange = tbb::parallel_reduce(
+        MinMax ndcRange = tbb::parallel_reduce(
             tbb::blocked_range<int>(0, height), MinMax{INFINITY, -INFINITY},
             [&](const tbb::blocked_range<int>& rows, MinMax m) {
                 for (int y = rows.begin(); y < rows.end(); ++y)
@@ -192,6 +194,33 @@ private:
             [](MinMax a, MinMax b) {
                 return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
             });
+        // A multisampled frame's layer 0: the range takes in the other layers' fragments too
+        // (their rasterizer depths, at the columns that hold them), so that the frame's grid
+        // serves them (the reuse below). Where a layer's stored depth still falls outside (a
+        // lossy depth format), that layer builds its own grid: the check is on its G-buffer.
+        if (inputs.fragmentLayer == 0 && inputs.fragmentLayers &&
+            inputs.fragmentLayers->layerCount() > 1) {
+            const gbuffer::FragmentLayers& layers = *inputs.fragmentLayers;
+            const MinMax upper = tbb::parallel_reduce(
+                tbb::blocked_range<int>(0, height), MinMax{INFINITY, -INFINITY},
+                [&](const tbb::blocked_range<int>& rows, MinMax m) {
+                    for (int y = rows.begin(); y < rows.end(); ++y)
+                        for (const uint32_t x : layers.upperColumns(y))
+                            for (int k = 1; k < layers.layerCount(); ++k) {
+                                const size_t p = size_t(y) * width + x;
+                                if (layers.codes(k)[p] == gbuffer::VisibilityPass::kNoTriangle)
+                                    continue;
+                                const float d = layers.depths(k)[p];
+                                m = {std::min(m.first, d), std::max(m.second, d)};
+                            }
+                    return m;
+                },
+                [](MinMax a, MinMax b) {
+                    return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
+                });
+            ndcRange = {std::min(ndcRange.first, upper.first),
+                        std::max(ndcRange.second, upper.second)};
+        }
 
         std::string pairs = "0";
         if (ndcRange.first <= ndcRange.second) {
@@ -209,12 +238,30 @@ private:
                 nearDepth = std::min(nearDepth, gb.view().nearMetres);
                 farDepth = std::max(farDepth, gb.view().farMetres);
             }
-            if (!mGrid)
-                mGrid.emplace(options, gb.view(), nearDepth, farDepth);
-            else
-                mGrid->build(options, gb.view(), nearDepth, farDepth);
+            // A multisampled frame's layers above 0 (StageInputs::fragmentLayer >= 1) come after
+            // its layer 0, with the same view and lights (the stage contract): a cluster's list
+            // holds every light that may touch any point inside the cluster, so the frame's grid
+            // serves the other fragments too wherever their depths lie inside its range, as one
+            // grid per frame serves every sample on a GPU. It is built and assigned again only
+            // for a layer that reaches outside that range. Without this each sparse upper layer
+            // paid a whole grid's assignment (about 1 ms at 256 lights on atrium).
+            const bool reuse = inputs.fragmentLayer >= 1 && mFrameGrid.valid && mGrid &&
+                               nearDepth >= mFrameGrid.nearDepth &&
+                               farDepth <= mFrameGrid.farDepth &&
+                               mFrameGrid.lightCount == mSpheres.size();
+            if (!reuse) {
+                if (!mGrid)
+                    mGrid.emplace(options, gb.view(), nearDepth, farDepth);
+                else
+                    mGrid->build(options, gb.view(), nearDepth, farDepth);
+                mGrid->assign(mSpheres);
+                if (inputs.fragmentLayer == 0 && inputs.fragmentLayers != nullptr)
+                    mFrameGrid.valid = true;
+                mFrameGrid.nearDepth = nearDepth;
+                mFrameGrid.farDepth = farDepth;
+                mFrameGrid.lightCount = mSpheres.size();
+            }
             ClusterGrid& grid = *mGrid;
-            grid.assign(mSpheres);
             assign.stop();
             pairs = std::to_string(grid.pairCount());
 
@@ -257,8 +304,15 @@ private:
     ClusteredOptions mOptions;
     std::vector<LightSphere> mSpheres; // reused across frames (LightBounds.h)
     std::optional<ClusterGrid> mGrid;  // reused across frames for its storage
-    AdaptiveClusterGrid mAdaptive;     // likewise
-    BlendedPass mBlended;              // blended surfaces after the opaque pass (BlendedPass.h)
+    // What mGrid was last built for, when that was a multisampled frame's layer 0 or a layer
+    // above it: the frame's other layers may shade with it (shadeFixed).
+    struct FrameGrid {
+        bool valid = false;
+        float nearDepth = 0.0f, farDepth = 0.0f; // the grid's view depth range, metres
+        size_t lightCount = 0;
+    } mFrameGrid;
+    AdaptiveClusterGrid mAdaptive; // likewise
+    BlendedPass mBlended;          // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 std::vector<StageOption> clusteredOptionTable() {
