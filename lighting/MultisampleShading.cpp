@@ -55,9 +55,31 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
         return;
     }
     const int width = layers.width();
+    const bool blendedScene = hasBlendedMaterial(prepared.scene);
+    // The other fragments: in one packed run when the stage has one (PackedFragments.h; not with
+    // blended surfaces, which each layer's run composites over its own samples, nor for a stage
+    // that counts the oracle itself), else one run per layer.
+    bool packed = false;
+    auto* packedStage = dynamic_cast<PackedFragmentShading*>(&stage);
+    if (packedStage && layers.layerCount() > 1 && !blendedScene && result.lightsOracle.empty()) {
+        mFragments.build(layers);
+        PackedFragmentRun run;
+        run.frame = &prepared.inputs;
+        run.fragments = &mFragments;
+        for (int k = 0; k < layers.layerCount(); ++k)
+            run.layerGBuffers.push_back(prepared.layerInputs(k).gbuffer);
+        mPacked.traceLights = result.traceLights;
+        timed(mRunMs, [&] { packed = packedStage->shadeFragments(run, mPacked); });
+        if (packed) {
+            addTimings(result.timingsMs, mPacked.timingsMs);
+            KernelWork::addRecorded(mPacked, result);
+        } else {
+            mRunMs.pop_back(); // it did nothing
+        }
+    }
     std::vector<StageResult>& upper = mUpper;
-    upper.resize(size_t(layers.layerCount() - 1));
-    for (int k = 1; k < layers.layerCount(); ++k) {
+    upper.resize(packed ? 0 : size_t(layers.layerCount() - 1));
+    for (int k = 1; !packed && k < layers.layerCount(); ++k) {
         upper[size_t(k - 1)].traceLights = result.traceLights;
         timed(mRunMs, [&] { stage.shade(prepared.layerInputs(k), upper[size_t(k - 1)]); });
         addTimings(result.timingsMs, upper[size_t(k - 1)].timingsMs);
@@ -65,7 +87,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
     }
     // Blended surfaces over the background samples of partially covered pixels.
     StageResult& background = mBackground;
-    const bool blended = hasBlendedMaterial(prepared.scene) && layers.counts().partialPixels > 0;
+    const bool blended = blendedScene && layers.counts().partialPixels > 0;
     if (blended) {
         if (!mEmpty || mEmpty->width() != prepared.view.width ||
             mEmpty->height() != prepared.view.height)
@@ -92,6 +114,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
     tbb::parallel_for(0, layers.height(), [&](int y) {
         const std::span<const uint32_t> columns = layers.upperColumns(y);
         size_t nextColumn = 0;
+        size_t nextFragment = packed ? mFragments.rowFirst(y) : 0; // packed: the row's first
         const size_t rowStart = size_t(y) * size_t(width);
         for (int x = 0; x < width; ++x) {
             const size_t pixel = rowStart + size_t(x);
@@ -108,7 +131,17 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
             float rgb[3];
             for (int c = 0; c < 3; ++c)
                 rgb[c] = w0 * result.radiance[c][pixel];
-            for (int k = 1; upperHere && k < layers.layerCount(); ++k) {
+            // The pixel's other fragments in layer order: the packed run's (the list holds them
+            // in this order), or each layer's run.
+            for (; packed && upperHere && nextFragment < mFragments.size() &&
+                   mFragments.pixel(nextFragment) == pixel;
+                 ++nextFragment) {
+                result.lightsEvaluated[pixel] += mPacked.lightsEvaluated[nextFragment];
+                const float w = layers.weight(mFragments.layer(nextFragment), pixel);
+                for (int c = 0; c < 3; ++c)
+                    rgb[c] += w * mPacked.radiance[c][nextFragment];
+            }
+            for (int k = 1; !packed && upperHere && k < layers.layerCount(); ++k) {
                 const StageResult& layer = upper[size_t(k - 1)];
                 if (layers.codes(k)[pixel] == gbuffer::VisibilityPass::kNoTriangle)
                     continue;
@@ -129,7 +162,7 @@ void MultisampleShading::shade(ShadingStage& stage, const PreparedScene& prepare
     resolve.stop();
     const gbuffer::FragmentLayers::Counts& counts = layers.counts();
     result.parameters["msaa"] = std::to_string(layers.samples());
-    result.parameters["msaa_shading"] = "layers";
+    result.parameters["msaa_shading"] = packed ? "packed" : "layers";
     result.parameters["msaa_layers"] = std::to_string(layers.layerCount());
     result.parameters["msaa_complex_pixels"] = std::to_string(counts.complexPixels);
     result.parameters["msaa_shaded_fragments"] = std::to_string(counts.fragments);

@@ -1,16 +1,24 @@
 // MultisampleShading: how a stage shades a multisampled frame (PreparedScene with Multisampling)
 // and how its samples are resolved, for every stage that shades from the G-buffer.
 //
-// The stage runs once per fragment layer (gbuffer/msaa/FragmentLayers.h): on layer 0, the
-// full-screen G-buffer of every pixel's main fragment, then on each layer above, whose G-buffer is
-// covered only at complex pixels. Nothing in the stage changes: a tiled or clustered stage finds no
-// covered pixel in most tiles of an upper layer and skips them (the survey's per-tile MSAA choice,
-// made by the data), a light-volume stage tests its volumes against the layer's depth, and the
-// shading kernel runs full packets over the complex pixels' fragments. Scenes with blended
-// surfaces get one more run over an empty G-buffer: the blended surfaces over the background, for
-// the background samples of partially covered pixels. In each run the blended pass composites per
-// sample over the run's own samples and leaves their mean (passes/BlendedPass.h), so the resolve
-// below gives the per-sample composite averaged over the pixel.
+// The stage runs first on layer 0 (gbuffer/msaa/FragmentLayers.h), the full-screen G-buffer of
+// every pixel's main fragment. The other fragments (the layers above, covered only at complex
+// pixels) are then shaded one of two ways:
+// - packed (msaa_shading=packed): a stage with a packed run (PackedFragmentShading,
+//   passes/PackedFragments.h: tiled, tiled-backface, clustered with a fixed grid) shades all of
+//   them in ONE run, gathered into full SIMD packets by screen block, with its lists made once for
+//   them (Lauritzen 2010; the survey's per-tile MSAA choice: tiles without a complex pixel get no
+//   work). Not for scenes with blended surfaces, nor for a stage that counts its own oracle.
+// - per layer (msaa_shading=layers): the stage runs once on each layer above. Nothing in the
+//   stage changes: a tiled or clustered stage finds no covered pixel in most tiles of an upper
+//   layer and skips them, a light-volume stage tests its volumes against the layer's depth. It
+//   costs what the layer's 4x4 packets hold (mostly empty), plus the stage's whole-screen work
+//   per layer.
+// Scenes with blended surfaces get one more run over an empty G-buffer: the blended surfaces over
+// the background, for the background samples of partially covered pixels. In each run the blended
+// pass composites per sample over the run's own samples and leaves their mean
+// (passes/BlendedPass.h), so the resolve below gives the per-sample composite averaged over the
+// pixel.
 // Resolve ("resolve" pass): radiance = sum over layers of weight x the layer's radiance
 // (FragmentLayers::weight: the fraction of the pixel's samples the fragment covers), plus the
 // background run weighted by the background samples. lightsEvaluated adds every run's evaluations
@@ -33,7 +41,9 @@
 // Exactness: a layer's image is the stage's own on that layer's G-buffer, so the exactness of each
 // stage per layer (tested against brute per layer) carries over, and the resolve is the same
 // weighted sum for every stage: bitwise brute's resolve for a stage that is bitwise brute per
-// layer. Deterministic: per-pixel sums in layer order.
+// layer. A packed fragment's radiance is bitwise its layer run's (tested against brute on the
+// fragment's layer, with every contributing light evaluated), and the resolve adds a pixel's
+// fragments in the same layer order. Deterministic: per-pixel sums in layer order.
 #pragma once
 
 #include <cstdint>
@@ -42,6 +52,7 @@
 
 #include "lighting/PreparedScene.h"
 #include "lighting/ShadingStage.h"
+#include "lighting/passes/PackedFragments.h"
 
 namespace lighting {
 
@@ -54,15 +65,15 @@ public:
     void shade(ShadingStage& stage, const PreparedScene& prepared, StageResult& result);
 
     // The last shade()'s runs, wall milliseconds each: layer 0 (the whole frame when not
-    // multisampled or shaded natively), then each layer above, then the background run when there
-    // was one. Where a multisampled frame's shading goes: an upper layer's fragments lie at
-    // complex pixels only, so its 4x4 packets are mostly empty and it costs about what its
-    // packets hold, not what its fragments are (the benchmarks report it; not in StageResult,
-    // whose figures are the frame's).
+    // multisampled or shaded natively), then the packed run or each layer above, then the
+    // background run when there was one. Where a multisampled frame's shading goes (the
+    // benchmarks report it; not in StageResult, whose figures are the frame's).
     const std::vector<double>& runMs() const { return mRunMs; }
 
 private:
     std::vector<double> mRunMs;
+    PackedFragments mFragments; // the other fragments, for a stage with a packed run
+    StageResult mPacked;        // its result, per fragment
     std::vector<StageResult> mUpper;
     StageResult mBackground;
     std::unique_ptr<gbuffer::GBuffer> mEmpty;

@@ -148,6 +148,35 @@ std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& 
         });
 }
 
+std::vector<TileSurfaceBounds>
+computeTileSurfaceBounds(std::span<const gbuffer::GBuffer* const> layers, const TileGrid& grid,
+                         const TileBoundsOptions& options) {
+    return boundsOfSamples(
+        grid, options,
+        [&](int x, int y, int s, float& depthMetres, glm::vec3& normalView) {
+            const gbuffer::GBuffer& gb = *layers[size_t(s)];
+            const size_t pixel = size_t(y) * gb.width() + size_t(x);
+            if (!gb.covered(pixel))
+                return false;
+            if (!options.normalCone) {
+                depthMetres = gb.depthDecoder().viewDepthMetres(x, y, gb.depth()[pixel]);
+                return true;
+            }
+            const gbuffer::Surface surface = gb.decode(x, y);
+            depthMetres = -surface.positionView.z;
+            normalView = surface.normalView;
+            return true;
+        },
+        [&](int y, int x0, int x1) {
+            bool any = false;
+            for (const gbuffer::GBuffer* gb : layers)
+                any |= anyDepthOtherThan(gb->depth(), size_t(y) * gb->width(), x0, x1, 1,
+                                         gb->view().clearDepth());
+            return any;
+        },
+        int(layers.size()));
+}
+
 std::vector<TileSurfaceBounds> computeTileDepthBounds(const gbuffer::DepthDecoder& decoder,
                                                       std::span<const float> depth,
                                                       const TileGrid& grid, bool depthMask) {

@@ -66,6 +66,13 @@ struct TileBoundsOptions {
 std::vector<TileSurfaceBounds> computeTileSurfaceBounds(const gbuffer::GBuffer& gb,
                                                         const TileGrid& grid,
                                                         const TileBoundsOptions& options);
+// The bounds of the covered pixels of several G-buffers of one view (a multisampled frame's
+// fragment layers above 0, lighting/passes/PackedFragments.h): each covered pixel of each is a
+// sample of its tile, read as computeTileSurfaceBounds reads one G-buffer. A tile row none of
+// them covers costs one vectorised test per G-buffer.
+std::vector<TileSurfaceBounds>
+computeTileSurfaceBounds(std::span<const gbuffer::GBuffer* const> layers, const TileGrid& grid,
+                         const TileBoundsOptions& options);
 
 // Depth bounds (and optionally the depth mask; no normal cone) from a depth plane in the view's
 // convention, for stages without a G-buffer (tiled forward's depth pre-pass). A pixel is covered

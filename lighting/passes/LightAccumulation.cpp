@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -15,6 +16,7 @@
 #include "lighting/kernel/LightKernel.h"
 #include "lighting/kernel/PacketDecoder.h"
 #include "lighting/passes/KernelWork.h"
+#include "lighting/passes/PackedFragments.h"
 
 namespace lighting {
 
@@ -416,6 +418,100 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
         });
     work.record(isa, inputs.simtWarpLanes, result);
     path.record(result);
+}
+
+void accumulatePackedFragments(const PackedFragmentRun& run, const FragmentListSource& source,
+                               StageResult& result) {
+    const StageInputs& frame = *run.frame;
+    const PackedFragments& fragments = *run.fragments;
+    if (frame.simtWarpLanes != 32 && frame.simtWarpLanes != 64)
+        throw std::invalid_argument(
+            "accumulatePackedFragments: simtWarpLanes must be 32 or 64, not " +
+            std::to_string(frame.simtWarpLanes));
+    const PacketPath path(frame, false); // the kernel's lights and ISA; lanes are gathered
+    const kernel::KernelIsa isa = path.isa;
+    const bool emission = frame.gbuffer->hasEmission();
+    const size_t count = fragments.size();
+    const size_t warpLanes = size_t(frame.simtWarpLanes);
+    const size_t warps = (count + warpLanes - 1) / warpLanes;
+    std::vector<KernelWork> workPerWarp(warps);
+    tbb::enumerable_thread_specific<WarpUnion> unions(
+        [&] { return WarpUnion(frame.lights->lights.size()); });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, warps), [&](const auto& range) {
+        PacketScratch<kernel::PacketAccumulator> scratch;
+        kernel::ShadingPacket& packet = scratch.packet;
+        kernel::PacketAccumulator& accumulator = scratch.accumulator;
+        PacketLightLists& lists = scratch.lists;
+        WarpUnion& warpUnion = unions.local();
+        for (size_t warp = range.begin(); warp != range.end(); ++warp) {
+            KernelWork& work = workPerWarp[warp];
+            warpUnion.begin();
+            bool pays = false;
+            for (size_t first = warp * warpLanes; first < std::min(count, (warp + 1) * warpLanes);
+                 first += kPacketLanes) {
+                const int lanes = int(std::min<size_t>(kPacketLanes, count - first));
+                std::span<const uint32_t> laneLists[kPacketLanes];
+                size_t laneFragment[kPacketLanes];
+                packet.clear();
+                for (int lane = 0; lane < lanes; ++lane) {
+                    const size_t fragment = fragments.inShadingOrder(first + size_t(lane));
+                    laneFragment[lane] = fragment;
+                    const uint32_t pixel = fragments.pixel(fragment);
+                    const int x = int(pixel % uint32_t(fragments.width()));
+                    const int y = int(pixel / uint32_t(fragments.width()));
+                    const gbuffer::Surface s = run.gbufferOf(fragment).decode(x, y);
+                    setLaneSurface(packet, lane, s);
+                    laneLists[lane] = source.listOf(x, y, s.positionView);
+                }
+                // Lanes grouped by list (the same list is the same storage): one kernel call over
+                // the union of the packet's lists, each lane masked to its own.
+                lists.clear();
+                // (Storage and length: an empty list may start where another one does.)
+                using ListKey = std::pair<const uint32_t*, size_t>;
+                auto keyOf = [&](int lane) {
+                    return ListKey(laneLists[lane].data(), laneLists[lane].size());
+                };
+                lists.addByKeyMerged(packet, keyOf, [&](const ListKey& key) {
+                    int lane = 0;
+                    while (keyOf(lane) != key)
+                        ++lane;
+                    return laneLists[lane];
+                });
+                accumulator.clear();
+                work.groups += uint64_t(lists.size());
+                for (int g = 0; g < lists.size(); ++g) {
+                    const PacketLightLists::Group& group = lists[g];
+                    if (group.lightLaneMasks.empty())
+                        kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
+                                            accumulator, false);
+                    else
+                        kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
+                                            group.lightLaneMasks, accumulator, false);
+                }
+                work.addCounters(accumulator);
+                for (int lane = 0; lane < lanes; ++lane) {
+                    const size_t fragment = laneFragment[lane];
+                    for (int c = 0; c < 3; ++c)
+                        result.radiance[c][fragment] = accumulator.radiance[c][lane];
+                    if (emission) {
+                        const glm::vec3 emitted =
+                            run.gbufferOf(fragment).emission(fragments.pixel(fragment));
+                        for (int c = 0; c < 3; ++c)
+                            result.radiance[c][fragment] += emitted[c];
+                    }
+                    result.lightsEvaluated[fragment] = accumulator.lightsEvaluated[lane];
+                    result.traceLightList(fragment, laneLists[lane]);
+                }
+                pays |= payLists(lists, warpUnion);
+            }
+            if (pays)
+                work.laneSlots += uint64_t(warpLanes) * warpUnion.count();
+        }
+    });
+    KernelWork work;
+    for (const KernelWork& warp : workPerWarp)
+        work += warp;
+    work.record(isa, frame.simtWarpLanes, result);
 }
 
 } // namespace lighting

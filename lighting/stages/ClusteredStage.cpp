@@ -41,6 +41,7 @@
 #include "lighting/culling/ClusterGrid.h"
 #include "lighting/culling/LightBounds.h"
 #include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/PackedFragments.h"
 #include "lighting/passes/PassNames.h"
 
 #include "lighting/passes/BlendedPass.h"
@@ -116,7 +117,21 @@ struct ClusteredOptions {
     std::string cellsText; // the canonical text of the cells option, as recorded
 };
 
-class ClusteredStage final : public ShadingStage {
+// A packed fragment's list: its cluster's (PackedFragments.h), found as ClusterListSource finds a
+// lane's (tile from the pixel, slice from the decoded view depth).
+class ClusterFragmentLists final : public FragmentListSource {
+public:
+    explicit ClusterFragmentLists(const ClusterGrid& grid) : mGrid(grid) {}
+    std::span<const uint32_t> listOf(int x, int y, const glm::vec3& positionView) const override {
+        return mGrid.lightsOf(mGrid.clusterIndex(mGrid.tileXOfPixel(x), mGrid.tileYOfPixel(y),
+                                                 mGrid.sliceOfDepth(-positionView.z)));
+    }
+
+private:
+    const ClusterGrid& mGrid;
+};
+
+class ClusteredStage final : public ShadingStage, public PackedFragmentShading {
 public:
     explicit ClusteredStage(const ClusteredOptions& options) : mOptions(options) {}
     std::string name() const override { return "clustered"; }
@@ -131,6 +146,43 @@ public:
             shadeAdaptive(inputs, assign, result);
         else
             shadeFixed(inputs, assign, result);
+    }
+
+    // A multisampled frame's other fragments in one run (PackedFragments.h) with the frame's grid
+    // (built on layer 0 over every layer's depth range, shadeFixed), built and assigned again
+    // over the union only if a fragment's stored depth falls outside it. The adaptive grid has no
+    // packed run (false: the layers are run one by one).
+    bool shadeFragments(const PackedFragmentRun& run, StageResult& result) override {
+        if (mOptions.adaptive || !mFrameGrid.valid || !mGrid ||
+            mFrameGrid.lightCount != mSpheres.size())
+            return false;
+        const PackedFragments& fragments = *run.fragments;
+        const gbuffer::GBuffer& gb = *run.frame->gbuffer;
+        result.resize(int(fragments.size()), 1, false);
+        PassTimer assign(result, pass::kAssign);
+        const MinMax ndcRange = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, fragments.size()), MinMax{INFINITY, -INFINITY},
+            [&](const tbb::blocked_range<size_t>& range, MinMax m) {
+                for (size_t i = range.begin(); i != range.end(); ++i) {
+                    const float d = run.gbufferOf(i).depth()[fragments.pixel(i)];
+                    m = {std::min(m.first, d), std::max(m.second, d)};
+                }
+                return m;
+            },
+            [](MinMax a, MinMax b) {
+                return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
+            });
+        const MinMax viewRange = viewDepthRange(gb, ndcRange);
+        if (viewRange.first < mFrameGrid.nearDepth || viewRange.second > mFrameGrid.farDepth) {
+            mFrameGrid.nearDepth = std::min(viewRange.first, mFrameGrid.nearDepth);
+            mFrameGrid.farDepth = std::max(viewRange.second, mFrameGrid.farDepth);
+            mGrid->build(mOptions.fixed, gb.view(), mFrameGrid.nearDepth, mFrameGrid.farDepth);
+            mGrid->assign(mSpheres);
+        }
+        assign.stop();
+        PassTimer shading(result, pass::kShading);
+        accumulatePackedFragments(run, ClusterFragmentLists(*mGrid), result);
+        return true;
     }
 
 private:
@@ -171,6 +223,20 @@ private:
         result.parameters["cluster_light_pairs"] = std::to_string(built ? grid.pairCount() : 0);
     }
 
+    using MinMax = std::pair<float, float>;
+
+    // The view depths of the extremes of an NDC depth range (depth along -Z does not depend on
+    // the pixel for a pinhole), widened so that rounding in the per-pixel reconstruction stays
+    // inside: the grid's depth range.
+    static MinMax viewDepthRange(const gbuffer::GBuffer& gb, MinMax ndcRange) {
+        const gbuffer::DepthDecoder& decoder = gb.depthDecoder();
+        const int x = gb.width() / 2, y = gb.height() / 2;
+        const float depthA = decoder.viewDepthMetres(x, y, ndcRange.first);
+        const float depthB = decoder.viewDepthMetres(x, y, ndcRange.second);
+        const float nearDepth = std::max(std::min(depthA, depthB) * (1.0f - 1e-5f), 1e-6f);
+        return {nearDepth, std::max(std::max(depthA, depthB) * (1.0f + 1e-5f), nearDepth)};
+    }
+
     void shadeFixed(const StageInputs& inputs, PassTimer& assign, StageResult& result) {
         const gbuffer::GBuffer& gb = *inputs.gbuffer;
         const int width = gb.width(), height = gb.height();
@@ -181,7 +247,6 @@ private:
         // Nearest and farthest covered NDC depth (min/max: order-independent, so deterministic).
         const std::span<const float> depth = gb.depth();
         const float clear = gb.view().clearDepth();
-        using MinMax = std::pair<float, float>;
         MinMax ndcRange = tbb::parallel_reduce(
             tbb::blocked_range<int>(0, height), MinMax{INFINITY, -INFINITY},
             [&](const tbb::blocked_range<int>& rows, MinMax m) {
@@ -224,13 +289,8 @@ private:
 
         std::string pairs = "0";
         if (ndcRange.first <= ndcRange.second) {
-            // View depths of the extremes (depth along -Z does not depend on the pixel for a
-            // pinhole), widened so that rounding in the per-pixel reconstruction stays inside.
-            const gbuffer::DepthDecoder& decoder = gb.depthDecoder();
-            const float depthA = decoder.viewDepthMetres(width / 2, height / 2, ndcRange.first);
-            const float depthB = decoder.viewDepthMetres(width / 2, height / 2, ndcRange.second);
-            float nearDepth = std::max(std::min(depthA, depthB) * (1.0f - 1e-5f), 1e-6f);
-            float farDepth = std::max(std::max(depthA, depthB) * (1.0f + 1e-5f), nearDepth);
+            const MinMax viewRange = viewDepthRange(gb, ndcRange);
+            float nearDepth = viewRange.first, farDepth = viewRange.second;
             // Blended surfaces lie anywhere in front of the opaque depth, and over background:
             // the grid then spans the whole view depth range so that their clusters exist.
             const bool blended = mBlended.prepare(inputs);

@@ -42,6 +42,7 @@
 #include "lighting/culling/TileFrusta.h"
 #include "lighting/passes/BlendedPass.h"
 #include "lighting/passes/LightAccumulation.h"
+#include "lighting/passes/PackedFragments.h"
 #include "lighting/passes/PassNames.h"
 #include "lighting/stages/TiledStageOptions.h"
 
@@ -58,7 +59,52 @@ struct TiledOptions {
     bool hierarchical = false;
 };
 
-class TiledStage final : public ShadingStage {
+// A packed fragment's list: its tile's, layer 0's list where the tile kept it, else the one
+// culled for the fragments (TiledStage::shadeFragments).
+class TileFragmentLists final : public FragmentListSource {
+public:
+    TileFragmentLists(const TileGrid& grid, const std::vector<uint8_t>& kept,
+                      const LightIndexLists& frameLights, const LightIndexLists& fragmentLights)
+        : mGrid(grid), mKept(kept), mFrameLights(frameLights), mFragmentLights(fragmentLights) {}
+    std::span<const uint32_t> listOf(int x, int y, const glm::vec3&) const override {
+        const size_t tile =
+            size_t((y / mGrid.tileSizePixels) * mGrid.tileCountX + x / mGrid.tileSizePixels);
+        return mKept[tile] ? mFrameLights[tile] : mFragmentLights[tile];
+    }
+
+private:
+    const TileGrid& mGrid;
+    const std::vector<uint8_t>& mKept;
+    const LightIndexLists& mFrameLights;
+    const LightIndexLists& mFragmentLights;
+};
+
+// The depth bounds of a run's packed fragments per tile (no depth mask, no normal cone), straight
+// from the list: each fragment's view depth read as computeTileSurfaceBounds reads a covered
+// pixel's (its layer's DepthDecoder on its stored depth), so the same bounds as over the layers'
+// G-buffers, at a cost that follows the fragments. Tile rows in parallel (min and max: the same
+// for any order).
+std::vector<TileSurfaceBounds> fragmentDepthBounds(const PackedFragmentRun& run,
+                                                   const TileGrid& grid) {
+    const PackedFragments& fragments = *run.fragments;
+    std::vector<TileSurfaceBounds> bounds(size_t(grid.tileCount()));
+    tbb::parallel_for(0, grid.tileCountY, [&](int ty) {
+        for (size_t i = fragments.rowFirst(grid.y0(ty)); i < fragments.rowFirst(grid.y1(ty)); ++i) {
+            const uint32_t pixel = fragments.pixel(i);
+            const int x = int(pixel % uint32_t(fragments.width()));
+            const int y = int(pixel / uint32_t(fragments.width()));
+            const gbuffer::GBuffer& gb = run.gbufferOf(i);
+            const float depth = gb.depthDecoder().viewDepthMetres(x, y, gb.depth()[pixel]);
+            TileSurfaceBounds& b = bounds[size_t(ty * grid.tileCountX + x / grid.tileSizePixels)];
+            b.minDepthMetres = b.covered ? std::min(b.minDepthMetres, depth) : depth;
+            b.maxDepthMetres = b.covered ? std::max(b.maxDepthMetres, depth) : depth;
+            b.covered = true;
+        }
+    });
+    return bounds;
+}
+
+class TiledStage final : public ShadingStage, public PackedFragmentShading {
 public:
     explicit TiledStage(const TiledOptions& options) : mOptions(options) {}
 
@@ -73,13 +119,19 @@ public:
 
         const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
         const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
-        const std::vector<TileSurfaceBounds> bounds =
+        std::vector<TileSurfaceBounds> bounds =
             computeTileSurfaceBounds(gb, grid, {mOptions.depthMask, mOptions.backface});
         const TileLightListStats lists =
             buildTileLightLists(view, grid, bounds, spheres,
                                 {mOptions.viewFrustumCulling, mOptions.depthMask, mOptions.backface,
                                  mOptions.assign, mOptions.hierarchical},
                                 mTileLights, &mBvh);
+        // A multisampled frame's layer 0: its tiles' bounds, which its packed fragments are
+        // checked against (shadeFragments).
+        if (inputs.fragmentLayer == 0 && inputs.fragmentLayers)
+            mFrameBounds = std::move(bounds);
+        else
+            mFrameBounds.clear();
         cull.stop();
 
         PassTimer shading(result, pass::kShading);
@@ -102,11 +154,58 @@ public:
             result.parameters["backface_rejected"] = std::to_string(lists.backfaceRejected);
     }
 
+    // A multisampled frame's other fragments in one run (PackedFragments.h): the survey's per-tile
+    // MSAA choice made once for the frame. Per tile, the bounds of its fragments in every layer
+    // above 0. Where they lie inside the depth range of layer 0's bounds for the tile (the usual
+    // case: at an edge both surfaces are some pixel's main fragment in the tile), the tile's
+    // layer-0 list holds every light that may reach them: it is kept (not with the depth mask or
+    // the normal cone, whose bins and cones layer 0's samples alone made). The other tiles are
+    // culled as shade() culls, with the same options. Then the kernel over packets of fragments.
+    bool shadeFragments(const PackedFragmentRun& run, StageResult& result) override {
+        const StageInputs& inputs = *run.frame;
+        const gbuffer::GBuffer& gb = *inputs.gbuffer;
+        const TileGrid grid = TileGrid::make(gb.width(), gb.height(), mOptions.tileSizePixels);
+        if (mFrameBounds.size() != size_t(grid.tileCount()))
+            return false; // shade() did not run on this frame's layer 0
+        result.resize(int(run.fragments->size()), 1, false);
+        PassTimer cull(result, pass::kCull);
+        const std::vector<LightSphere> spheres = boundingSpheresView(*inputs.lights);
+        const std::span<const gbuffer::GBuffer* const> upper =
+            std::span(run.layerGBuffers).subspan(1);
+        const bool reusable = !mOptions.depthMask && !mOptions.backface;
+        std::vector<TileSurfaceBounds> bounds =
+            reusable
+                ? fragmentDepthBounds(run, grid)
+                : computeTileSurfaceBounds(upper, grid, {mOptions.depthMask, mOptions.backface});
+        mKeptTiles.assign(bounds.size(), 0);
+        for (size_t tile = 0; tile < bounds.size(); ++tile) {
+            const TileSurfaceBounds& frame = mFrameBounds[tile];
+            if (reusable && bounds[tile].covered && frame.covered &&
+                bounds[tile].minDepthMetres >= frame.minDepthMetres &&
+                bounds[tile].maxDepthMetres <= frame.maxDepthMetres) {
+                mKeptTiles[tile] = 1;
+                bounds[tile].covered = false; // no new list
+            }
+        }
+        buildTileLightLists(gb.view(), grid, bounds, spheres,
+                            {mOptions.viewFrustumCulling, mOptions.depthMask, mOptions.backface,
+                             mOptions.assign, mOptions.hierarchical},
+                            mFragmentTileLights, &mBvh);
+        cull.stop();
+        PassTimer shading(result, pass::kShading);
+        accumulatePackedFragments(
+            run, TileFragmentLists(grid, mKeptTiles, mTileLights, mFragmentTileLights), result);
+        return true;
+    }
+
 private:
     TiledOptions mOptions;
-    LightIndexLists mTileLights; // per tile, ascending; storage reused across frames
-    LightBvh mBvh;               // assign=bvh; storage reused across frames
-    BlendedPass mBlended;        // blended surfaces after the opaque pass (BlendedPass.h)
+    LightIndexLists mTileLights;         // per tile, ascending; storage reused across frames
+    LightIndexLists mFragmentTileLights; // the same for a frame's packed fragments
+    std::vector<TileSurfaceBounds> mFrameBounds; // a multisampled frame's layer-0 tile bounds
+    std::vector<uint8_t> mKeptTiles;             // per tile: its packed fragments use mTileLights
+    LightBvh mBvh;                               // assign=bvh; storage reused across frames
+    BlendedPass mBlended; // blended surfaces after the opaque pass (BlendedPass.h)
 };
 
 // The options of both stages.

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -26,6 +27,7 @@
 #include "lighting/StageRegistry.h"
 #include "lighting/lists/ContributingLights.h"
 #include "lighting/passes/MaterialPass.h"
+#include "lighting/passes/PackedFragments.h"
 #include "scenes/SceneLoader.h"
 #include "scenes/procedural/ProceduralScenes.h"
 #include "tests/lighting/LightIdentity.h"
@@ -441,6 +443,148 @@ TEST(MultisampleStages, EveryStageSaysWhetherItTakesMultisampledFrames) {
         EXPECT_EQ(!info.msaaRefusal.empty(), refused) << info.name;
         EXPECT_EQ(info.msaaNative, native) << info.name;
         EXPECT_EQ(lighting::makeStage(info.name)->multisamplesNatively(), native) << info.name;
+    }
+}
+
+// The packed run (lighting/passes/PackedFragments.h): every fragment above layer 0 once, in row
+// order for the resolve and in screen-block order for the packets.
+TEST(PackedFragments, ListEveryUpperFragmentOnceInRowOrderAndShadeByBlocks) {
+    const lighting::PreparedScene& frame = cachedFrame(0);
+    const gbuffer::FragmentLayers& layers = frame.multisample->layers;
+    lighting::PackedFragments fragments;
+    fragments.build(layers);
+    ASSERT_EQ(fragments.size(), layers.counts().fragments - layers.counts().coveredPixels);
+    ASSERT_GT(fragments.size(), 100u);
+    size_t expected = 0;
+    for (int y = 0; y < layers.height(); ++y) {
+        ASSERT_EQ(fragments.rowFirst(y), expected) << "row " << y;
+        for (int x = 0; x < layers.width(); ++x) {
+            const size_t pixel = size_t(y) * size_t(layers.width()) + size_t(x);
+            for (int k = 1; k < layers.layerCount(); ++k) {
+                if (layers.codes(k)[pixel] == gbuffer::VisibilityPass::kNoTriangle)
+                    continue;
+                ASSERT_EQ(fragments.pixel(expected), pixel);
+                ASSERT_EQ(fragments.layer(expected), k);
+                ++expected;
+            }
+        }
+    }
+    ASSERT_EQ(expected, fragments.size());
+    // The shading order: a permutation, block by block (block rows, then block columns), list
+    // order inside a block.
+    const int block = lighting::PackedFragments::kBlockPixels;
+    auto blockOf = [&](uint32_t i) {
+        const uint32_t pixel = fragments.pixel(i);
+        const int x = int(pixel % uint32_t(layers.width())),
+                  y = int(pixel / uint32_t(layers.width()));
+        return std::pair(y / block, x / block);
+    };
+    std::vector<bool> seen(fragments.size(), false);
+    for (size_t j = 0; j < fragments.size(); ++j) {
+        const uint32_t i = fragments.inShadingOrder(j);
+        ASSERT_LT(i, fragments.size());
+        ASSERT_FALSE(seen[i]) << "fragment " << i << " twice";
+        seen[i] = true;
+        if (j > 0) {
+            const uint32_t previous = fragments.inShadingOrder(j - 1);
+            ASSERT_TRUE(blockOf(previous) < blockOf(i) ||
+                        (blockOf(previous) == blockOf(i) && previous < i))
+                << "shading order at " << j;
+        }
+    }
+}
+
+class PackedFragmentStage : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+
+// Each packed fragment is shaded as its own layer's run shades its pixel: brute's radiance there,
+// bitwise (ascending lists), every contributing light evaluated (the trace), its evaluations the
+// trace's length. The stages' lists differ from their per-layer runs' (tiles bounded over every
+// layer, layer 0's cluster grid), never the image.
+TEST_P(PackedFragmentStage, EveryFragmentIsBruteOnItsLayerWithEveryContributingLight) {
+    const auto& [stageName, sceneIndex] = GetParam();
+    const lighting::PreparedScene& frame = cachedFrame(sceneIndex);
+    const gbuffer::FragmentLayers& layers = frame.multisample->layers;
+    ASSERT_GE(frame.layerCount(), 2);
+    const auto stage = lighting::makeStage(stageName);
+    auto* packed = dynamic_cast<lighting::PackedFragmentShading*>(stage.get());
+    ASSERT_NE(packed, nullptr) << stageName;
+    lighting::StageResult main;
+    stage->shade(frame.inputs, main); // layer 0 first, as in a frame
+    lighting::PackedFragments fragments;
+    fragments.build(layers);
+    lighting::PackedFragmentRun run;
+    run.frame = &frame.inputs;
+    run.fragments = &fragments;
+    for (int k = 0; k < frame.layerCount(); ++k)
+        run.layerGBuffers.push_back(frame.layerInputs(k).gbuffer);
+    lighting::StageResult result;
+    result.traceLights = true;
+    ASSERT_TRUE(packed->shadeFragments(run, result)) << stageName;
+    ASSERT_EQ(result.width, int(fragments.size()));
+    ASSERT_EQ(result.timingsMs.size(), 2u);
+    EXPECT_EQ(result.timingsMs[1].first, "shading");
+
+    const auto brute = lighting::makeStage("brute");
+    std::vector<lighting::StageResult> bruteLayers(size_t(frame.layerCount()));
+    std::vector<lighting::ContributingLights> contributing(size_t(frame.layerCount()));
+    for (int k = 1; k < frame.layerCount(); ++k) {
+        const lighting::StageInputs inputs = frame.layerInputs(k);
+        brute->shade(inputs, bruteLayers[size_t(k)]);
+        contributing[size_t(k)].build(*inputs.gbuffer, inputs.lights->lights);
+    }
+    size_t lit = 0;
+    for (size_t i = 0; i < fragments.size(); ++i) {
+        const size_t k = size_t(fragments.layer(i));
+        const size_t pixel = fragments.pixel(i);
+        for (int c = 0; c < 3; ++c)
+            ASSERT_EQ(std::bit_cast<uint32_t>(result.radiance[c][i]),
+                      std::bit_cast<uint32_t>(bruteLayers[k].radiance[c][pixel]))
+                << stageName << ": fragment " << i << " (layer " << k << ", pixel " << pixel
+                << ") channel " << c << ": " << result.radiance[c][i] << " vs brute "
+                << bruteLayers[k].radiance[c][pixel];
+        const std::vector<uint32_t>& trace = result.lightTrace[i];
+        const std::span<const uint32_t> needed = contributing[k].lightsOf(pixel);
+        ASSERT_TRUE(std::includes(trace.begin(), trace.end(), needed.begin(), needed.end()))
+            << stageName << ": fragment " << i << " misses a contributing light";
+        ASSERT_EQ(result.lightsEvaluated[i], trace.size());
+        lit += needed.empty() ? 0 : 1;
+    }
+    EXPECT_GT(lit, fragments.size() / 4) << "too few lit fragments to mean anything";
+
+    // Through MultisampleShading the frame takes the packed run (one run after layer 0).
+    lighting::MultisampleShading shading;
+    lighting::StageResult resolved;
+    shading.shade(*stage, frame, resolved);
+    EXPECT_EQ(resolved.parameters.at("msaa_shading"), "packed");
+    EXPECT_EQ(shading.runMs().size(), 2u);
+}
+
+INSTANTIATE_TEST_SUITE_P(TiledAndClustered, PackedFragmentStage,
+                         ::testing::Combine(::testing::Values("tiled", "tiled-backface",
+                                                              "tiled:mask=1", "tiled:hier=1",
+                                                              "clustered", "clustered:assign=bvh"),
+                                            ::testing::Values(0, 2)), // atrium, helmet
+                         [](const auto& info) {
+                             std::string name = std::get<0>(info.param) + "_" +
+                                                kScenes[std::get<1>(info.param)].name;
+                             for (char& ch : name)
+                                 if (!std::isalnum(static_cast<unsigned char>(ch)))
+                                     ch = '_';
+                             return name;
+                         });
+
+// Where the packed run does not apply, the layers are run one by one: blended surfaces (each
+// layer's run composites them over its own samples) and the adaptive cluster grid.
+TEST(PackedFragments, BlendedScenesAndTheAdaptiveGridRunTheLayers) {
+    for (const auto& [stageName, sceneIndex] : {std::pair<std::string, int>{"tiled", 1},
+                                                {"clustered", 1},
+                                                {"clustered:grid=adaptive", 0}}) {
+        const lighting::PreparedScene& frame = cachedFrame(sceneIndex);
+        const auto stage = lighting::makeStage(stageName);
+        lighting::MultisampleShading shading;
+        lighting::StageResult resolved;
+        shading.shade(*stage, frame, resolved);
+        EXPECT_EQ(resolved.parameters.at("msaa_shading"), "layers") << stageName;
     }
 }
 
