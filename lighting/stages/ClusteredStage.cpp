@@ -420,7 +420,10 @@ const StageRegistrar kRegistrar(
                     "the light density), lights assigned per cluster AABB",
      .kind = StageKind::Exact,
      .options = clusteredOptionTable(),
-     .listOrder = 50},
+     .listOrder = 50,
+     .msaaNote = "one grid per frame, over every fragment's depth; the complex pixels' other "
+                 "fragments in one packed run, full packets by screen block (grid=adaptive: "
+                 "one run per fragment layer, as with blended surfaces)"},
     [](const StageOptions& table) {
         ClusteredOptions options;
         options.adaptive = table.text("grid") == "adaptive";

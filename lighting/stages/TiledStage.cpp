@@ -231,12 +231,20 @@ StageFactory tiledFactory(bool backface) {
     };
 }
 
+// What `testbed list` says of both stages with --msaa (MultisampleShading.h).
+constexpr const char* kTiledMsaaNote =
+    "layer 0 tiled as at 1x; the complex pixels' other fragments in one packed run, full "
+    "packets by screen block, a tile's layer-0 list kept where they lie inside its depth "
+    "bounds (not with the depth mask or the normal cone), else culled for them; tiles without "
+    "a complex pixel pay nothing (per-layer runs with blended surfaces)";
+
 const StageRegistrar
     kTiledRegistrar({.name = "tiled",
                      .description = "tiled deferred: per-tile depth-bounded frusta",
                      .kind = StageKind::Exact,
                      .options = tiledOptionTable(),
-                     .listOrder = 60},
+                     .listOrder = 60,
+                     .msaaNote = kTiledMsaaNote},
                     tiledFactory(false));
 
 const StageRegistrar kTiledBackfaceRegistrar(
@@ -244,7 +252,8 @@ const StageRegistrar kTiledBackfaceRegistrar(
      .description = "tiled deferred plus per-tile normal-cone back-face culling of lights",
      .kind = StageKind::Exact,
      .options = tiledOptionTable(),
-     .listOrder = 70},
+     .listOrder = 70,
+     .msaaNote = kTiledMsaaNote},
     tiledFactory(true));
 
 } // namespace
