@@ -1,6 +1,7 @@
 #include "lighting/passes/LightAccumulation.h"
 
 #include <algorithm>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -420,6 +421,36 @@ void accumulateSplitLights(const StageInputs& inputs, const SplitLightingOptions
     path.record(result);
 }
 
+namespace {
+
+// A 4x4 block of one layer as the vector decoder gave it (accumulatePackedFragments).
+struct DecodedBlock {
+    int x = -1, y = -1; // in blocks; -1: none yet
+    kernel::ShadingPacket packet;
+};
+
+// Lane `from` of `source` into lane `to` of `packet` (the surface, its material model), as if
+// `packet` had decoded it.
+void copyLane(const kernel::ShadingPacket& source, int from, kernel::ShadingPacket& packet,
+              int to) {
+    for (int c = 0; c < 3; ++c) {
+        packet.positionView[c][to] = source.positionView[c][from];
+        packet.normalView[c][to] = source.normalView[c][from];
+        packet.albedo[c][to] = source.albedo[c][from];
+    }
+    packet.specularIntensity[to] = source.specularIntensity[from];
+    packet.specularPower[to] = source.specularPower[from];
+    packet.roughness[to] = source.roughness[from];
+    packet.metallic[to] = source.metallic[from];
+    packet.occlusion[to] = source.occlusion[from];
+    const uint32_t bit = 1u << to;
+    packet.metallicRoughnessMask =
+        (packet.metallicRoughnessMask & ~bit) | ((source.metallicRoughnessMask >> from & 1u) << to);
+    packet.laneMask |= bit;
+}
+
+} // namespace
+
 void accumulatePackedFragments(const PackedFragmentRun& run, const FragmentListSource& source,
                                StageResult& result) {
     const StageInputs& frame = *run.frame;
@@ -430,6 +461,18 @@ void accumulatePackedFragments(const PackedFragmentRun& run, const FragmentListS
             std::to_string(frame.simtWarpLanes));
     const PacketPath path(frame, false); // the kernel's lights and ISA; lanes are gathered
     const kernel::KernelIsa isa = path.isa;
+    // A lane's surface: from its layer's 4x4 block decoded by the vector decoder (the per-layer
+    // runs' decode, bitwise GBuffer::decode), kept while the packets' lanes come from it, at a
+    // block's cost instead of a scalar decode per lane (perf on atrium at 4x: GBuffer::decode and
+    // its inverse projection were 10% of the frame's CPU time). GBuffer::decode per lane for a
+    // layout the decoder does not read.
+    std::vector<std::unique_ptr<kernel::PacketDecoder>> decoders(run.layerGBuffers.size());
+    if (packetPathFits(frame))
+        for (size_t k = 0; k < decoders.size(); ++k)
+            decoders[k] = std::make_unique<kernel::PacketDecoder>(run.layerGBuffers[k]->layout(),
+                                                                  run.layerGBuffers[k]->view(),
+                                                                  planesOf(*run.layerGBuffers[k]));
+    const int layerCount = int(run.layerGBuffers.size());
     const bool emission = frame.gbuffer->hasEmission();
     const size_t count = fragments.size();
     const size_t warpLanes = size_t(frame.simtWarpLanes);
@@ -443,6 +486,11 @@ void accumulatePackedFragments(const PackedFragmentRun& run, const FragmentListS
         kernel::PacketAccumulator& accumulator = scratch.accumulator;
         PacketLightLists& lists = scratch.lists;
         WarpUnion& warpUnion = unions.local();
+        // Decoded blocks, per layer the four block columns of a 16-pixel screen block (the
+        // shading order's unit, PackedFragments::kBlockPixels): a block is decoded once for all
+        // the rows of fragments it holds.
+        constexpr int kColumns = PackedFragments::kBlockPixels / kPacketWidth;
+        std::vector<DecodedBlock> blocks(decoders[0] ? size_t(layerCount * kColumns) : 0);
         for (size_t warp = range.begin(); warp != range.end(); ++warp) {
             KernelWork& work = workPerWarp[warp];
             warpUnion.begin();
@@ -459,6 +507,25 @@ void accumulatePackedFragments(const PackedFragmentRun& run, const FragmentListS
                     const uint32_t pixel = fragments.pixel(fragment);
                     const int x = int(pixel % uint32_t(fragments.width()));
                     const int y = int(pixel / uint32_t(fragments.width()));
+                    const int layer = fragments.layer(fragment);
+                    if (!blocks.empty()) {
+                        const int bx = x / kPacketWidth, by = y / kPacketHeight;
+                        DecodedBlock& block = blocks[size_t(layer * kColumns + bx % kColumns)];
+                        if (block.x != bx || block.y != by) {
+                            decoders[size_t(layer)]->decode(isa, bx * kPacketWidth,
+                                                            by * kPacketHeight, block.packet);
+                            block.x = bx;
+                            block.y = by;
+                        }
+                        copyLane(block.packet,
+                                 (y % kPacketHeight) * kPacketWidth + x % kPacketWidth, packet,
+                                 lane);
+                        laneLists[lane] = source.listOf(x, y,
+                                                        glm::vec3(packet.positionView[0][lane],
+                                                                  packet.positionView[1][lane],
+                                                                  packet.positionView[2][lane]));
+                        continue;
+                    }
                     const gbuffer::Surface s = run.gbufferOf(fragment).decode(x, y);
                     setLaneSurface(packet, lane, s);
                     laneLists[lane] = source.listOf(x, y, s.positionView);
