@@ -13,6 +13,7 @@
 #include <bit>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -22,6 +23,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "gbuffer/LayoutDerivation.h"
 #include "lighting/MultisampleShading.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
@@ -494,15 +496,35 @@ TEST(PackedFragments, ListEveryUpperFragmentOnceInRowOrderAndShadeByBlocks) {
     }
 }
 
-class PackedFragmentStage : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+// A frame of scene kScenes[sceneIndex] at 4x (primitive detection) in layout preset `layout`, or
+// the lossless layout for "lossless" (cachedFrame): the packed run gathers its lanes from the
+// vector decoder's 4x4 blocks where the layout fits the decoder, else with GBuffer::decode.
+const lighting::PreparedScene& cachedLayoutFrame(int sceneIndex, const std::string& layout) {
+    if (layout == "lossless")
+        return cachedFrame(sceneIndex);
+    static std::map<std::pair<int, std::string>, std::unique_ptr<lighting::PreparedScene>> frames;
+    auto& frame = frames[{sceneIndex, layout}];
+    if (!frame) {
+        scenes::Scene scene = loadCase(kScenes[sceneIndex]);
+        const gbuffer::GBufferLayout chosen = gbuffer::presetLayout(layout, scene);
+        lighting::Multisampling multisampling;
+        multisampling.samples = 4;
+        frame = std::make_unique<lighting::PreparedScene>(std::move(scene), kWidth, kHeight, false,
+                                                          chosen, multisampling);
+    }
+    return *frame;
+}
+
+class PackedFragmentStage
+    : public ::testing::TestWithParam<std::tuple<std::string, int, std::string>> {};
 
 // Each packed fragment is shaded as its own layer's run shades its pixel: brute's radiance there,
 // bitwise (ascending lists), every contributing light evaluated (the trace), its evaluations the
 // trace's length. The stages' lists differ from their per-layer runs' (tiles bounded over every
 // layer, layer 0's cluster grid), never the image.
 TEST_P(PackedFragmentStage, EveryFragmentIsBruteOnItsLayerWithEveryContributingLight) {
-    const auto& [stageName, sceneIndex] = GetParam();
-    const lighting::PreparedScene& frame = cachedFrame(sceneIndex);
+    const auto& [stageName, sceneIndex, layout] = GetParam();
+    const lighting::PreparedScene& frame = cachedLayoutFrame(sceneIndex, layout);
     const gbuffer::FragmentLayers& layers = frame.multisample->layers;
     ASSERT_GE(frame.layerCount(), 2);
     const auto stage = lighting::makeStage(stageName);
@@ -559,19 +581,30 @@ TEST_P(PackedFragmentStage, EveryFragmentIsBruteOnItsLayerWithEveryContributingL
     EXPECT_EQ(shading.runMs().size(), 2u);
 }
 
+std::string
+packedCaseName(const ::testing::TestParamInfo<std::tuple<std::string, int, std::string>>& info) {
+    std::string name = std::get<0>(info.param) + "_" + kScenes[std::get<1>(info.param)].name + "_" +
+                       std::get<2>(info.param);
+    for (char& ch : name)
+        if (!std::isalnum(static_cast<unsigned char>(ch)))
+            ch = '_';
+    return name;
+}
+
 INSTANTIATE_TEST_SUITE_P(TiledAndClustered, PackedFragmentStage,
                          ::testing::Combine(::testing::Values("tiled", "tiled-backface",
                                                               "tiled:mask=1", "tiled:hier=1",
                                                               "clustered", "clustered:assign=bvh"),
-                                            ::testing::Values(0, 2)), // atrium, helmet
-                         [](const auto& info) {
-                             std::string name = std::get<0>(info.param) + "_" +
-                                                kScenes[std::get<1>(info.param)].name;
-                             for (char& ch : name)
-                                 if (!std::isalnum(static_cast<unsigned char>(ch)))
-                                     ch = '_';
-                             return name;
-                         });
+                                            ::testing::Values(0, 2), // atrium, helmet
+                                            ::testing::Values("lossless")),
+                         packedCaseName);
+// Layouts the vector decoder does not read (normal codes, the visibility buffer): lanes decoded
+// one by one.
+INSTANTIATE_TEST_SUITE_P(OtherLayouts, PackedFragmentStage,
+                         ::testing::Combine(::testing::Values("tiled", "clustered"),
+                                            ::testing::Values(0, 2),
+                                            ::testing::Values("compact", "visibility")),
+                         packedCaseName);
 
 // Where the packed run does not apply, the layers are run one by one: blended surfaces (each
 // layer's run composites them over its own samples) and the adaptive cluster grid.
