@@ -155,6 +155,23 @@ private:
     uint64_t mCount = 0;
 };
 
+// Shades each lane group of `lists` on the kernel into `accumulator` (cleared first): one call per
+// group, with its per-light lane masks when it has them.
+void shadeGroups(const kernel::KernelIsa& isa, const kernel::ShadingPacket& packet,
+                 const PacketLightLists& lists, const kernel::KernelLights& lights,
+                 bool countOracle, kernel::PacketAccumulator& accumulator) {
+    accumulator.clear();
+    for (int g = 0; g < lists.size(); ++g) {
+        const PacketLightLists::Group& group = lists[g];
+        if (group.lightLaneMasks.empty())
+            kernel::shadePacket(isa, packet, group.laneMask, lights, group.lights, accumulator,
+                                countOracle);
+        else
+            kernel::shadePacket(isa, packet, group.laneMask, lights, group.lights,
+                                group.lightLaneMasks, accumulator, countOracle);
+    }
+}
+
 // What one warp-row task of walkWarps keeps between packets.
 template <class Accumulator> struct PacketScratch {
     kernel::ShadingPacket packet;
@@ -245,17 +262,8 @@ void accumulateLights(const StageInputs& inputs, const PacketListSource& source,
                 return false;
             lists.clear();
             source.listsOf(packet, lists);
-            accumulator.clear();
+            shadeGroups(isa, packet, lists, path.lights, options.countOracle, accumulator);
             rowWork.groups += uint64_t(lists.size());
-            for (int g = 0; g < lists.size(); ++g) {
-                const PacketLightLists::Group& group = lists[g];
-                if (group.lightLaneMasks.empty())
-                    kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
-                                        accumulator, options.countOracle);
-                else
-                    kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
-                                        group.lightLaneMasks, accumulator, options.countOracle);
-            }
             rowWork.addCounters(accumulator);
             // The test-only light trace (StageResult::traceLights): each lane summed exactly its
             // group's list (with per-light masks, its lights of it).
@@ -544,17 +552,8 @@ void accumulatePackedFragments(const PackedFragmentRun& run, const FragmentListS
                         ++lane;
                     return laneLists[lane];
                 });
-                accumulator.clear();
+                shadeGroups(isa, packet, lists, path.lights, false, accumulator);
                 work.groups += uint64_t(lists.size());
-                for (int g = 0; g < lists.size(); ++g) {
-                    const PacketLightLists::Group& group = lists[g];
-                    if (group.lightLaneMasks.empty())
-                        kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
-                                            accumulator, false);
-                    else
-                        kernel::shadePacket(isa, packet, group.laneMask, path.lights, group.lights,
-                                            group.lightLaneMasks, accumulator, false);
-                }
                 work.addCounters(accumulator);
                 for (int lane = 0; lane < lanes; ++lane) {
                     const size_t fragment = laneFragment[lane];

@@ -169,9 +169,7 @@ public:
                 }
                 return m;
             },
-            [](MinMax a, MinMax b) {
-                return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
-            });
+            joinRanges);
         const MinMax viewRange = viewDepthRange(gb, ndcRange);
         if (viewRange.first < mFrameGrid.nearDepth || viewRange.second > mFrameGrid.farDepth) {
             mFrameGrid.nearDepth = std::min(viewRange.first, mFrameGrid.nearDepth);
@@ -225,6 +223,11 @@ private:
 
     using MinMax = std::pair<float, float>;
 
+    // The range spanning both (min and max: the same for any order, so deterministic).
+    static MinMax joinRanges(MinMax a, MinMax b) {
+        return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
+    }
+
     // The view depths of the extremes of an NDC depth range (depth along -Z does not depend on
     // the pixel for a pinhole), widened so that rounding in the per-pixel reconstruction stays
     // inside: the grid's depth range.
@@ -256,9 +259,7 @@ private:
                             m = {std::min(m.first, depth[p]), std::max(m.second, depth[p])};
                 return m;
             },
-            [](MinMax a, MinMax b) {
-                return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
-            });
+            joinRanges);
         // A multisampled frame's layer 0: the range takes in the other layers' fragments too
         // (their rasterizer depths, at the columns that hold them), so that the frame's grid
         // serves them (the reuse below). Where a layer's stored depth still falls outside (a
@@ -280,11 +281,8 @@ private:
                             }
                     return m;
                 },
-                [](MinMax a, MinMax b) {
-                    return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
-                });
-            ndcRange = {std::min(ndcRange.first, upper.first),
-                        std::max(ndcRange.second, upper.second)};
+                joinRanges);
+            ndcRange = joinRanges(ndcRange, upper);
         }
 
         std::string pairs = "0";
