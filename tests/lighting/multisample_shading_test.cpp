@@ -217,18 +217,28 @@ TEST(MultisampleResolve, IsTheCoverageWeightedSumOfTheLayers) {
 }
 
 TEST(MultisampleResolve, SameImageForAnyThreadCount) {
-    for (const char* stageName : {"tiled", "clustered", "clustered:grid=adaptive", "deferred",
-                                  "light-prepass", "inferred", "inferred:scale=1"}) {
+    // glass (blended: every stage runs the layers one by one) and atrium (`tiled` and
+    // `clustered` take the packed run, PackedFragments.h).
+    const std::pair<const char*, int> cases[] = {
+        {"tiled", 1},          {"clustered", 1}, {"clustered:grid=adaptive", 1}, {"deferred", 1},
+        {"light-prepass", 1},  {"inferred", 1},  {"inferred:scale=1", 1},        {"tiled", 0},
+        {"tiled-backface", 0}, {"clustered", 0}};
+    for (const auto& [stageName, sceneIndex] : cases) {
         lighting::StageResult images[2];
         for (int t = 0; t < 2; ++t)
             tbb::task_arena(t + 1).execute([&] {
-                auto frame =
-                    prepareMultisampled(kScenes[1], 8, gbuffer::ComplexDetection::Primitive);
+                auto frame = prepareMultisampled(kScenes[sceneIndex], 8,
+                                                 gbuffer::ComplexDetection::Primitive);
                 lighting::MultisampleShading shading;
                 shading.shade(*lighting::makeStage(stageName), *frame, images[t]);
             });
         EXPECT_TRUE(stagecheck::bitwiseEqualImages(images[0], images[1])) << stageName;
         EXPECT_EQ(images[0].lightsEvaluated, images[1].lightsEvaluated) << stageName;
+        EXPECT_EQ(images[0].parameters.at("simt_lane_slots"),
+                  images[1].parameters.at("simt_lane_slots"))
+            << stageName;
+        EXPECT_EQ(images[0].parameters.at("msaa_shading"), sceneIndex == 0 ? "packed" : "layers")
+            << stageName;
     }
 }
 
