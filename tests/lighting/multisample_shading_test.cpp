@@ -27,6 +27,7 @@
 #include "lighting/MultisampleShading.h"
 #include "lighting/PreparedScene.h"
 #include "lighting/StageRegistry.h"
+#include "lighting/culling/TileFrusta.h"
 #include "lighting/lists/ContributingLights.h"
 #include "lighting/passes/MaterialPass.h"
 #include "lighting/passes/PackedFragments.h"
@@ -628,6 +629,74 @@ TEST(PackedFragments, BlendedScenesAndTheAdaptiveGridRunTheLayers) {
         lighting::StageResult resolved;
         shading.shade(*stage, frame, resolved);
         EXPECT_EQ(resolved.parameters.at("msaa_shading"), "layers") << stageName;
+    }
+}
+
+// `tiled`'s packed run keeps a tile's layer-0 list only for fragments inside layer 0's depth
+// bounds for the tile. The frame's other fragments that lie outside them (behind a foreground
+// surface that holds every main fragment of the tile) each get a light of their own, too small
+// to reach the tile's main surfaces: every one must be evaluated where it contributes, so a list
+// kept regardless of the bounds fails here.
+TEST(PackedFragments, TiledCullsTheTilesWhoseFragmentsLeaveLayerZerosBounds) {
+    for (const int sceneIndex : {0, 2}) { // atrium, helmet
+        const lighting::PreparedScene& frame = cachedFrame(sceneIndex);
+        const gbuffer::FragmentLayers& layers = frame.multisample->layers;
+        lighting::PackedFragments fragments;
+        fragments.build(layers);
+        const lighting::TileGrid grid = lighting::TileGrid::make(kWidth, kHeight, 16);
+        const std::vector<lighting::TileSurfaceBounds> frameBounds =
+            lighting::computeTileSurfaceBounds(*frame.gbuffer, grid, {});
+        lighting::LightList lights = frame.lights;
+        size_t outside = 0;
+        for (size_t i = 0; i < fragments.size(); ++i) {
+            const uint32_t pixel = fragments.pixel(i);
+            const int x = int(pixel % uint32_t(kWidth)), y = int(pixel / uint32_t(kWidth));
+            const gbuffer::Surface s = frame.layerInputs(fragments.layer(i)).gbuffer->decode(x, y);
+            const float depth = -s.positionView.z;
+            const lighting::TileSurfaceBounds& b =
+                frameBounds[size_t((y / 16) * grid.tileCountX + x / 16)];
+            if (depth >= b.minDepthMetres && depth <= b.maxDepthMetres)
+                continue;
+            ++outside;
+            // A light just off the surface, along its normal, reaching a few centimetres.
+            lighting::LightInView<float> light;
+            light.type = scenes::LightType::Point;
+            light.positionView = s.positionView + 0.01f * s.normalView;
+            light.radiance = glm::vec3(1.0f);
+            light.rangeMetres = 0.03f;
+            lights.lights.push_back(light);
+            if (outside == 64)
+                break;
+        }
+        ASSERT_GT(outside, 0u) << kScenes[sceneIndex].name
+                               << ": no fragment outside its tile's layer-0 bounds to test";
+        lighting::StageInputs frameInputs = frame.inputs;
+        frameInputs.lights = &lights;
+        const auto stage = lighting::makeStage("tiled");
+        lighting::StageResult main;
+        stage->shade(frameInputs, main);
+        lighting::PackedFragmentRun run;
+        run.frame = &frameInputs;
+        run.fragments = &fragments;
+        for (int k = 0; k < frame.layerCount(); ++k)
+            run.layerGBuffers.push_back(frame.layerInputs(k).gbuffer);
+        lighting::StageResult result;
+        result.traceLights = true;
+        ASSERT_TRUE(
+            dynamic_cast<lighting::PackedFragmentShading&>(*stage).shadeFragments(run, result));
+        std::vector<lighting::ContributingLights> contributing(size_t(frame.layerCount()));
+        for (int k = 1; k < frame.layerCount(); ++k)
+            contributing[size_t(k)].build(*frame.layerInputs(k).gbuffer, lights.lights);
+        size_t reachedByOwnLight = 0;
+        for (size_t i = 0; i < fragments.size(); ++i) {
+            const std::span<const uint32_t> needed =
+                contributing[size_t(fragments.layer(i))].lightsOf(fragments.pixel(i));
+            const std::vector<uint32_t>& trace = result.lightTrace[i];
+            ASSERT_TRUE(std::includes(trace.begin(), trace.end(), needed.begin(), needed.end()))
+                << kScenes[sceneIndex].name << ": fragment " << i << " misses a light";
+            reachedByOwnLight += !needed.empty() && needed.back() >= frame.lights.size();
+        }
+        EXPECT_GT(reachedByOwnLight, 0u) << kScenes[sceneIndex].name;
     }
 }
 
