@@ -4,7 +4,8 @@
 // their ratios (frame, G-buffer pass, G-buffer bytes as the fragment layers store them), the
 // complex fraction and the surfaces shaded per covered pixel, with minimum and median times, and
 // the G-buffer pass's phases (rasterization, fragment layers, resolve; minimum, 1x beside) and the
-// stage's runs (layer 0, the layers above; MultisampleShading::runMs).
+// stage's runs (layer 0, then the other fragments: the packed run or the layers above;
+// MultisampleShading::runMs).
 // Targets at 4x: frame <= 2.0x (tiled, clustered), G-buffer pass <= 2.5x, bytes <= 2.5x.
 //   build/bin/testbed_bench --benchmark_filter=msaaCost --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
@@ -112,8 +113,8 @@ void msaaCost(benchmark::State& state) {
     state.counters["raster_ms_min"] = Sampled::min(measured[1].rasterMs);
     state.counters["layers_ms_min"] = Sampled::min(measured[1].layersMs);
     state.counters["resolve_ms_min"] = Sampled::min(measured[1].resolveMs);
-    // The stage's runs (minimum): on layer 0 (1x: the whole shading) and on the layers above
-    // (with the background run), whose mostly empty packets are what keeps the frame ratio up.
+    // The stage's runs (minimum): on layer 0 (1x: the whole shading) and on the other fragments
+    // (the packed run of tiled and clustered, else the layers above; with the background run).
     state.counters["shade_1x_ms_min"] = Sampled::min(measured[0].shadeMainMs);
     state.counters["shade_main_ms_min"] = Sampled::min(measured[1].shadeMainMs);
     state.counters["shade_upper_ms_min"] = Sampled::min(measured[1].shadeUpperMs);
