@@ -224,7 +224,9 @@ TEST(MultisampleResolve, SameImageForAnyThreadCount) {
         {"tiled", 1},          {"clustered", 1}, {"clustered:grid=adaptive", 1}, {"deferred", 1},
         {"light-prepass", 1},  {"inferred", 1},  {"inferred:scale=1", 1},        {"tiled", 0},
         {"tiled-backface", 0}, {"clustered", 0}};
-    for (const auto& [stageName, sceneIndex] : cases) {
+    for (const auto& testCase : cases) {
+        const char* const stageName = testCase.first; // named, not bound: lambdas capture it
+        const int sceneIndex = testCase.second;
         lighting::StageResult images[2];
         for (int t = 0; t < 2; ++t)
             tbb::task_arena(t + 1).execute([&] {
