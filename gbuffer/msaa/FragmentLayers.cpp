@@ -12,6 +12,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "gbuffer/msaa/UniformPixels.h"
+
 namespace gbuffer {
 
 const char* complexDetectionName(ComplexDetection detection) {
@@ -108,9 +110,8 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     const bool mergeSmooth = options.detection == ComplexDetection::Discontinuity;
     const int lastLayerCount = mLayerCount;
 
-    const uint8_t allSamples = uint8_t((1u << samples) - 1u);
-    // One row; `kSamples` is the sample count as a constant, so that the per-pixel loops over a
-    // pixel's samples (the uniformity test first) are unrolled.
+    // One row; `kSamples` is the sample count as a constant, so that the loops over a mixed
+    // pixel's samples are unrolled.
     auto buildRow = [&](int y, auto kSamples) {
         constexpr size_t kStride = decltype(kSamples)::value;
         // The planes as local pointers: the byte planes' stores could otherwise alias the
@@ -140,27 +141,31 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
         // an edge both keep showing the same two triangles, so each reuses its corners (bitwise
         // surfaceAt()).
         VisibilityPass::RowSurfaces mainSurfaces(visibility, y), otherSurfaces(visibility, y);
-        for (int x = 0; x < mWidth; ++x) {
-            // Most pixels: every sample shows one triangle (or none), what the search below
-            // finds for them, written straight into layer 0 (no fragment arrays).
+        // Most pixels: every sample shows one triangle (or none), what the search below finds
+        // for them, written into layer 0 at every pixel on SIMD lanes (UniformPixels.h); the
+        // others are listed and rewritten here one by one.
+        thread_local std::vector<uint32_t> mixed;
+        mixed.resize(size_t(mWidth) + kMixedPixelSlack);
+        UniformRowArgs rowArgs;
+        rowArgs.codes = rowCodes;
+        rowArgs.centreDepths = rowDepths;
+        rowArgs.pixels = mWidth;
+        rowArgs.samples = int(kStride);
+        rowArgs.noTriangle = VisibilityPass::kNoTriangle;
+        rowArgs.clear = clear;
+        rowArgs.nearerClear = std::nextafter(clear, nearer);
+        rowArgs.mainCodes = mainCodes;
+        rowArgs.mainDepths = mainDepths;
+        rowArgs.mainCoverage = mainCoverage;
+        rowArgs.background = background;
+        rowArgs.complex = complex;
+        rowArgs.mixed = mixed.data();
+        const UniformRowResult uniform = writeUniformRow(rowArgs);
+        counts.coveredPixels += uniform.coveredUniformPixels;
+        counts.fragments += uniform.coveredUniformPixels;
+        for (int i = 0; i < uniform.mixedCount; ++i) {
+            const int x = int(mixed[size_t(i)]);
             const uint32_t* pixelCodes = rowCodes + size_t(x) * kStride;
-            bool uniform = true;
-            for (size_t s = 1; s < kStride; ++s)
-                uniform &= pixelCodes[s] == pixelCodes[0];
-            if (uniform) {
-                const bool covered = pixelCodes[0] != VisibilityPass::kNoTriangle;
-                const float centre = rowDepths[size_t(x) * kStride];
-                mainCodes[x] = pixelCodes[0];
-                mainDepths[x] = !covered          ? clear
-                                : centre == clear ? std::nextafter(clear, nearer)
-                                                  : centre;
-                mainCoverage[x] = covered ? allSamples : 0;
-                background[x] = covered ? 0 : uint8_t(kStride);
-                complex[x] = 0;
-                counts.coveredPixels += covered;
-                counts.fragments += covered;
-                continue;
-            }
             uint32_t code[raster::kMaxSamples];
             uint8_t mask[raster::kMaxSamples];
             float depth[raster::kMaxSamples];
