@@ -32,13 +32,6 @@ bool parseComplexDetection(const std::string& text, ComplexDetection& detection)
 
 namespace {
 
-// Positive view depth of NDC depth `depth` at pixel (x, y)'s centre.
-float viewDepthAt(const CameraView& view, int x, int y, float depth) {
-    const glm::vec2 ndc = view.ndcOfPixel(x, y);
-    const glm::vec4 p = view.viewFromClip * glm::vec4(ndc.x, ndc.y, depth, 1.0f);
-    return -p.z / p.w;
-}
-
 // Moves values[first] to the front, the ones before it one place up (std::rotate's effect; its
 // inlined form on these 8-entry arrays draws a false -Wstringop-overflow from GCC 12).
 template <class T> void moveToFront(T* values, int first) {
@@ -109,6 +102,12 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     const float nearer = view.reversedZ() ? 1.0f : 0.0f;
     const bool mergeSmooth = options.detection == ComplexDetection::Discontinuity;
     const int lastLayerCount = mLayerCount;
+    // The merge test's view depths: the pixel centres' NDC per column and row, computed once
+    // (view.ndcOfPixel's two divisions per fragment were a fifth of the test's cost).
+    std::vector<float> ndcXOfColumn;
+    if (mergeSmooth)
+        for (int x = 0; x < mWidth; ++x)
+            ndcXOfColumn.push_back(view.ndcOfPixel(x, 0).x);
 
     // One row; `kSamples` is the sample count as a constant, so that the loops over a mixed
     // pixel's samples are unrolled.
@@ -141,6 +140,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
         // an edge both keep showing the same two triangles, so each reuses its corners (bitwise
         // surfaceAt()).
         VisibilityPass::RowSurfaces mainSurfaces(visibility, y), otherSurfaces(visibility, y);
+        const float ndcY = view.ndcOfPixel(0, y).y;
         // Most pixels: every sample shows one triangle (or none), what the search below finds
         // for them, written into layer 0 at every pixel on SIMD lanes (UniformPixels.h); the
         // others are listed and rewritten here one by one.
@@ -201,11 +201,12 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
             }
             if (mergeSmooth && count > 1) {
                 const Surface& firstSurface = mainSurfaces.at(code[0], x);
-                const float firstDepth = viewDepthAt(view, x, y, depth[0]);
+                const float ndcX = ndcXOfColumn[size_t(x)];
+                const float firstDepth = view.viewDepthOfNdc(ndcX, ndcY, depth[0]);
                 int kept = 1;
                 for (int k = 1; k < count; ++k) {
                     const Surface& other = otherSurfaces.at(code[k], x);
-                    const float otherDepth = viewDepthAt(view, x, y, depth[k]);
+                    const float otherDepth = view.viewDepthOfNdc(ndcX, ndcY, depth[k]);
                     const bool smooth =
                         std::abs(otherDepth - firstDepth) <= options.depthTolerance * firstDepth &&
                         glm::dot(other.normalView, firstSurface.normalView) >=

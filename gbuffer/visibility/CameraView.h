@@ -55,6 +55,16 @@ struct CameraView {
         return {(float(x) + 0.5f) / float(width) * 2.0f - 1.0f,
                 1.0f - (float(y) + 0.5f) / float(height) * 2.0f};
     }
+    // Positive view depth at NDC (ndcX, ndcY, depth): -p.z / p.w for
+    // p = viewFromClip * vec4(ndcX, ndcY, depth, 1), bitwise that product (glm sums the columns
+    // as (c0 x + c1 y) + (c2 z + c3 w); -ffp-contract=off keeps both unfused) with only the two
+    // rows it needs. For loops that know the pixel's NDC already (a table per column and row).
+    float viewDepthOfNdc(float ndcX, float ndcY, float depth) const {
+        const glm::mat4& m = viewFromClip;
+        const float z = (m[0].z * ndcX + m[1].z * ndcY) + (m[2].z * depth + m[3].z * 1.0f);
+        const float w = (m[0].w * ndcX + m[1].w * ndcY) + (m[2].w * depth + m[3].w * 1.0f);
+        return -z / w;
+    }
 };
 
 } // namespace gbuffer

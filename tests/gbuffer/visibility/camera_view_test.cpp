@@ -2,10 +2,13 @@
 // offset leaves every matrix bitwise as it was; with an offset the point that was (dx, dy) pixels
 // from a pixel's centre lands on it; and every reader of the jittered view agrees on that sample
 // point: the rasterized depth decoded by the DepthDecoder (inverse projection and view ray) and
-// the exact surface both lie on the geometry, on the ray through the jittered sample.
+// the exact surface both lie on the geometry, on the ray through the jittered sample. And
+// viewDepthOfNdc is bitwise glm's whole product.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cstring>
+#include <random>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -140,6 +143,41 @@ TEST(CameraViewJitter, DecodedAndExactPositionsLieOnTheGeometryAtTheJitteredSamp
             }
         EXPECT_GT(covered, kWidth * kHeight / 4);
     }
+}
+
+TEST(CameraView, ViewDepthOfNdcIsBitwiseTheWholeProduct) {
+    // Both conventions, finite and infinite far planes, jittered and not; depths across [0, 1]
+    // with the ends, at every pixel centre of a small view.
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    int compared = 0;
+    for (const auto convention :
+         {gbuffer::DepthConvention::Reversed, gbuffer::DepthConvention::Standard})
+        for (const bool infiniteFar : {false, true})
+            for (const glm::dvec2 offset : {glm::dvec2(0.0), kOffset}) {
+                gbuffer::CameraView view = gbuffer::CameraView::fromCamera(
+                    camera(), kWidth, kHeight, convention, infiniteFar, offset);
+                // A projection's inverse has zeros where the sums' order would show; a dense
+                // matrix (the last case) has none.
+                if (infiniteFar && offset != glm::dvec2(0.0) &&
+                    convention == gbuffer::DepthConvention::Standard)
+                    for (int c = 0; c < 4; ++c)
+                        for (int r = 0; r < 4; ++r)
+                            view.viewFromClip[c][r] = unit(random) * 2.0f - 0.5f;
+                for (int y = 0; y < kHeight; ++y)
+                    for (int x = 0; x < kWidth; ++x) {
+                        const float depth = x == 0 ? 0.0f : x == 1 ? 1.0f : unit(random);
+                        const glm::vec2 ndc = view.ndcOfPixel(x, y);
+                        const glm::vec4 p =
+                            view.viewFromClip * glm::vec4(ndc.x, ndc.y, depth, 1.0f);
+                        const float expected = -p.z / p.w;
+                        const float got = view.viewDepthOfNdc(ndc.x, ndc.y, depth);
+                        ASSERT_EQ(std::bit_cast<uint32_t>(got), std::bit_cast<uint32_t>(expected))
+                            << x << ", " << y << ", depth " << depth;
+                        ++compared;
+                    }
+            }
+    EXPECT_EQ(compared, 8 * kWidth * kHeight);
 }
 
 } // namespace
