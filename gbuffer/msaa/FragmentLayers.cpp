@@ -104,6 +104,7 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     const int lastLayerCount = mLayerCount;
     // The merge test's view depths: the pixel centres' NDC per column and row, computed once
     // (view.ndcOfPixel's two divisions per fragment were a fifth of the test's cost).
+    const uint32_t* triangleMaterial = visibility.geometry().triangleMaterial.data();
     std::vector<float> ndcXOfColumn;
     if (mergeSmooth)
         for (int x = 0; x < mWidth; ++x)
@@ -200,18 +201,26 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
                 moveToFront(depth, first);
             }
             if (mergeSmooth && count > 1) {
-                const Surface& firstSurface = mainSurfaces.at(code[0], x);
+                // The test's cheap parts first (view depth, material), the surfaces' normals only
+                // for a fragment that passes both: the same outcome, without the surfaces at a
+                // silhouette.
                 const float ndcX = ndcXOfColumn[size_t(x)];
                 const float firstDepth = view.viewDepthOfNdc(ndcX, ndcY, depth[0]);
+                const uint32_t firstMaterial =
+                    triangleMaterial[VisibilityPass::triangleOf(code[0])];
+                const Surface* firstSurface = nullptr;
                 int kept = 1;
                 for (int k = 1; k < count; ++k) {
-                    const Surface& other = otherSurfaces.at(code[k], x);
                     const float otherDepth = view.viewDepthOfNdc(ndcX, ndcY, depth[k]);
-                    const bool smooth =
+                    bool smooth =
                         std::abs(otherDepth - firstDepth) <= options.depthTolerance * firstDepth &&
-                        glm::dot(other.normalView, firstSurface.normalView) >=
-                            options.normalCosine &&
-                        other.material == firstSurface.material;
+                        triangleMaterial[VisibilityPass::triangleOf(code[k])] == firstMaterial;
+                    if (smooth) {
+                        if (!firstSurface)
+                            firstSurface = &mainSurfaces.at(code[0], x);
+                        smooth = glm::dot(otherSurfaces.at(code[k], x).normalView,
+                                          firstSurface->normalView) >= options.normalCosine;
+                    }
                     if (smooth) {
                         mask[0] = uint8_t(mask[0] | mask[k]);
                         ++counts.mergedFragments;
