@@ -73,20 +73,27 @@ void GBufferPass::resolveUpperRow(const UpperLayers& upper, int y) const {
     const FragmentLayers& layers = upper.layers;
     const size_t rowStart = size_t(y) * size_t(layers.width());
     const float clear = upper.targets[0]->view().clearDepth(); // targets is not empty
-    for (size_t i = 0; i < upper.targets.size(); ++i) {
-        const std::span<float> depth = upper.targets[i]->depthPlane();
-        for (const uint32_t x : upper.lastColumns[size_t(y)]) {
-            upper.writers[i].writeBackground(rowStart + x);
-            depth[rowStart + x] = clear;
-        }
+    // Layer k (1 .. targets.size()) exists in this frame's layers and G-buffers; a layer the last
+    // frame had beyond those was dropped with its G-buffer (resolveLayers), so nothing to reset.
+    const int layerCount = int(upper.targets.size()) + 1;
+    std::vector<MultisampleTarget::WrittenColumn>& written = upper.written[size_t(y)];
+    for (const MultisampleTarget::WrittenColumn& column : written) {
+        const size_t pixel = rowStart + column.x;
+        for (int k = 1; k <= int(column.layers) && k < layerCount; ++k)
+            if (layers.codes(k)[pixel] == VisibilityPass::kNoTriangle) {
+                upper.writers[size_t(k - 1)].writeBackground(pixel);
+                upper.targets[size_t(k - 1)]->depthPlane()[pixel] = clear;
+            }
     }
+    written.clear();
     const DepthDecoder& decoder = upper.targets[0]->depthDecoder(); // every layer's layout
     const bool lossless = decoder.lossless();
     VisibilityPass::RowSurfaces surfaces(mVisibility, y);
     for (const uint32_t x : layers.upperColumns(y)) {
         const size_t pixel = rowStart + x;
         // A pixel's fragments fill layers 1, 2, ... in order: the first without one ends them.
-        for (int k = 1; k < layers.layerCount(); ++k) {
+        int k = 1;
+        for (; k < layers.layerCount(); ++k) {
             const uint32_t code = layers.codes(k)[pixel];
             if (code == VisibilityPass::kNoTriangle)
                 break;
@@ -96,6 +103,7 @@ void GBufferPass::resolveUpperRow(const UpperLayers& upper, int y) const {
                 lossless ? z : decoder.storedDepthNdc(z);
             upper.writers[size_t(k - 1)].write(pixel, surfaces.at(code, int(x)));
         }
+        written.push_back({x, uint32_t(k - 1)});
     }
 }
 
@@ -112,10 +120,11 @@ void GBufferPass::resolveLayers(std::span<const uint32_t> codes, GBuffer& target
                                 ExactSurface* exact, MultisampleTarget& multisample) const {
     const FragmentLayers& layers = multisample.layers;
     const CameraView& view = target.view();
-    std::vector<std::vector<uint32_t>>& lastColumns = multisample.upperWrittenColumns;
-    if (lastColumns.size() != size_t(view.height)) {
+    std::vector<std::vector<MultisampleTarget::WrittenColumn>>& written =
+        multisample.upperWrittenColumns;
+    if (written.size() != size_t(view.height)) {
         multisample.upperLayers.clear(); // another size: every layer is new
-        lastColumns.assign(size_t(view.height), {});
+        written.assign(size_t(view.height), {});
     }
     multisample.upperLayers.resize(size_t(layers.layerCount() - 1));
     std::vector<GBuffer*> targets;
@@ -138,6 +147,11 @@ void GBufferPass::resolveLayers(std::span<const uint32_t> codes, GBuffer& target
         targets.push_back(layer.get());
         writers.push_back(layer->writer());
     }
+    if (targets.empty() || target.layout().visibilityBuffer) {
+        // No upper G-buffer is kept, or each is copied whole: nothing to reset next frame.
+        for (std::vector<MultisampleTarget::WrittenColumn>& row : written)
+            row.clear();
+    }
     if (targets.empty()) {
         resolve(codes, target, exact);
     } else if (target.layout().visibilityBuffer) {
@@ -151,12 +165,8 @@ void GBufferPass::resolveLayers(std::span<const uint32_t> codes, GBuffer& target
             storeCodes(layers.codes(k), layer);
         }
     } else {
-        const UpperLayers upper{layers, targets, writers, lastColumns};
+        const UpperLayers upper{layers, targets, writers, written};
         resolve(codes, target, exact, &upper);
-    }
-    for (int y = 0; y < view.height; ++y) {
-        const std::span<const uint32_t> columns = layers.upperColumns(y);
-        lastColumns[size_t(y)].assign(columns.begin(), columns.end());
     }
 }
 

@@ -45,11 +45,15 @@ struct MultisampleTarget {
     FragmentLayerOptions options;
     FragmentLayers layers;
     std::vector<std::unique_ptr<GBuffer>> upperLayers; // layers 1 .. layerCount - 1
-    // Per row, the columns where the last frame's upper layers may hold a surface
-    // (FragmentLayers::upperColumns then): the upper layers' resolve writes only this frame's
-    // fragments and resets only what the last frame left, so its cost follows the complex
-    // pixels, not the screen.
-    std::vector<std::vector<uint32_t>> upperWrittenColumns;
+    // Per row, the columns where the last frame's upper layers hold a surface, and in how many
+    // layers (1 .. layers): the upper layers' resolve writes only this frame's fragments and
+    // resets only the layers the last frame wrote and this one does not, so its cost follows the
+    // complex pixels and their fragment counts, not the screen or the deepest pixel.
+    struct WrittenColumn {
+        uint32_t x;
+        uint32_t layers;
+    };
+    std::vector<std::vector<WrittenColumn>> upperWrittenColumns;
     std::vector<float> sampleDepth; // the per-sample depth buffer
     // The G-buffer of layer k: `target` for 0.
     const GBuffer& layer(const GBuffer& target, int k) const {
@@ -78,9 +82,10 @@ private:
         const FragmentLayers& layers;
         std::span<GBuffer* const> targets;        // layer k's G-buffer at k - 1
         std::span<const GBuffer::Writer> writers; // the same order
-        // Per row, the columns where the last frame's upper layers may hold a surface: reset to
-        // the background value and clear depth before this frame's are written.
-        const std::vector<std::vector<uint32_t>>& lastColumns;
+        // Per row, where the last frame's upper layers hold a surface (reset to the background
+        // value and clear depth where this frame has no fragment), replaced by this frame's as
+        // each row is resolved.
+        std::vector<std::vector<MultisampleTarget::WrittenColumn>>& written;
     };
     // Encodes the surfaces of `codes` (one per pixel) into `target`, whose depth plane holds
     // their depths already; with `upper`, each row's upper-layer fragments right after the row
