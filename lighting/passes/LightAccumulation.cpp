@@ -512,9 +512,7 @@ void accumulatePackedFragments(const PackedFragmentRun& run, const FragmentListS
                 for (int lane = 0; lane < lanes; ++lane) {
                     const size_t fragment = fragments.inShadingOrder(first + size_t(lane));
                     laneFragment[lane] = fragment;
-                    const uint32_t pixel = fragments.pixel(fragment);
-                    const int x = int(pixel % uint32_t(fragments.width()));
-                    const int y = int(pixel / uint32_t(fragments.width()));
+                    const int x = fragments.x(fragment), y = fragments.y(fragment);
                     const int layer = fragments.layer(fragment);
                     if (!blocks.empty()) {
                         const int bx = x / kPacketWidth, by = y / kPacketHeight;

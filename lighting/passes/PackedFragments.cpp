@@ -49,11 +49,11 @@ void PackedFragments::build(const gbuffer::FragmentLayers& layers) {
         const size_t end = mRowFirst[size_t(std::min((band + 1) * kBlockPixels, height))];
         std::vector<size_t> next(size_t(blocksX) + 1, begin);
         for (size_t i = begin; i < end; ++i)
-            ++next[size_t(mPixels[i] % uint32_t(mWidth)) / kBlockPixels + 1];
+            ++next[size_t(x(i)) / kBlockPixels + 1];
         for (size_t b = 1; b < next.size(); ++b)
             next[b] += next[b - 1] - begin;
         for (size_t i = begin; i < end; ++i)
-            mOrder[next[size_t(mPixels[i] % uint32_t(mWidth)) / kBlockPixels]++] = uint32_t(i);
+            mOrder[next[size_t(x(i)) / kBlockPixels]++] = uint32_t(i);
     });
 }
 

@@ -48,6 +48,9 @@ public:
     size_t size() const { return mPixels.size(); }
     // Fragment i: its pixel (y width + x) and layer (>= 1).
     uint32_t pixel(size_t i) const { return mPixels[i]; }
+    // Its column and row.
+    int x(size_t i) const { return int(mPixels[i] % uint32_t(mWidth)); }
+    int y(size_t i) const { return int(mPixels[i] / uint32_t(mWidth)); }
     int layer(size_t i) const { return mLayers[i]; }
     // The fragments of row y are [rowFirst(y), rowFirst(y + 1)).
     size_t rowFirst(int y) const { return mRowFirst[size_t(y)]; }

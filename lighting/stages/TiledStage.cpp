@@ -91,8 +91,7 @@ std::vector<TileSurfaceBounds> fragmentDepthBounds(const PackedFragmentRun& run,
     tbb::parallel_for(0, grid.tileCountY, [&](int ty) {
         for (size_t i = fragments.rowFirst(grid.y0(ty)); i < fragments.rowFirst(grid.y1(ty)); ++i) {
             const uint32_t pixel = fragments.pixel(i);
-            const int x = int(pixel % uint32_t(fragments.width()));
-            const int y = int(pixel / uint32_t(fragments.width()));
+            const int x = fragments.x(i), y = fragments.y(i);
             const gbuffer::GBuffer& gb = run.gbufferOf(i);
             const float depth = gb.depthDecoder().viewDepthMetres(x, y, gb.depth()[pixel]);
             TileSurfaceBounds& b = bounds[size_t(ty * grid.tileCountX + x / grid.tileSizePixels)];
