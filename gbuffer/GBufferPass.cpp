@@ -122,9 +122,10 @@ void GBufferPass::resolveLayers(std::span<const uint32_t> codes, GBuffer& target
     const CameraView& view = target.view();
     std::vector<std::vector<MultisampleTarget::WrittenColumn>>& written =
         multisample.upperWrittenColumns;
-    if (written.size() != size_t(view.height)) {
+    if (written.size() != size_t(view.height) || multisample.upperWrittenWidth != view.width) {
         multisample.upperLayers.clear(); // another size: every layer is new
         written.assign(size_t(view.height), {});
+        multisample.upperWrittenWidth = view.width;
     }
     multisample.upperLayers.resize(size_t(layers.layerCount() - 1));
     std::vector<GBuffer*> targets;

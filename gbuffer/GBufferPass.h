@@ -54,6 +54,7 @@ struct MultisampleTarget {
         uint32_t layers;
     };
     std::vector<std::vector<WrittenColumn>> upperWrittenColumns;
+    int upperWrittenWidth = 0;      // the frame width those columns are of
     std::vector<float> sampleDepth; // the per-sample depth buffer
     // The G-buffer of layer k: `target` for 0.
     const GBuffer& layer(const GBuffer& target, int k) const {
