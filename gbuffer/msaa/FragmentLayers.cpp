@@ -102,8 +102,8 @@ void FragmentLayers::build(const VisibilityPass& visibility, const FragmentLayer
     const float nearer = view.reversedZ() ? 1.0f : 0.0f;
     const bool mergeSmooth = options.detection == ComplexDetection::Discontinuity;
     const int lastLayerCount = mLayerCount;
-    // The merge test's view depths: the pixel centres' NDC per column and row, computed once
-    // (view.ndcOfPixel's two divisions per fragment were a fifth of the test's cost).
+    // The merge test's inputs: each triangle's material, and the pixel centres' NDC per column
+    // and row computed once (ndcOfPixel's divisions per fragment were a fifth of the test's cost).
     const uint32_t* triangleMaterial = visibility.geometry().triangleMaterial.data();
     std::vector<float> ndcXOfColumn;
     if (mergeSmooth)
